@@ -1,0 +1,1 @@
+//! CORRELI-GD digital image correlation on a parallel mesh of zones of interest, and strains.

@@ -1,0 +1,1 @@
+//! Hyperelastic identification of rubber-like materials (not implemented yet).

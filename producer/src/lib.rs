@@ -1,0 +1,1 @@
+//! Frame producer: simulated speckle camera and image-folder replay.

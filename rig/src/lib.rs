@@ -1,0 +1,1 @@
+//! Simulated ASTREE multiaxial servo-hydraulic test machine (not implemented yet).

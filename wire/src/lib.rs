@@ -1,0 +1,1 @@
+//! Shared-memory layouts, service names and node construction for dicstream.
