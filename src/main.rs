@@ -1,1 +1,32 @@
-fn main() {}
+//! `dicstream`: one binary, one subcommand per process and per tool a user runs by hand.
+//! Each subcommand lives in its own file under `src/cmd/`; this file only dispatches.
+
+mod cmd;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "dicstream", version, about = "Live digital image correlation bench", long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    // One variant per subcommand; keep one line each so parallel edits stay simple.
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    let result: anyhow::Result<()> = match cli.command {
+        // One arm per subcommand.
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("dicstream: error: {error:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! The subcommands of `dicstream`, one module each.
