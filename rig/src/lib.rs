@@ -1,1 +1,21 @@
-//! Simulated ASTREE multiaxial servo-hydraulic test machine (not implemented yet).
+//! Simulated ASTREE multiaxial servo-hydraulic machine (paper section 2): six actuators on a
+//! shared power station, PIDF control with centroid mode, programs, limits and a hyperelastic
+//! specimen. A deterministic library stepped in simulated time; the process shell is separate.
+
+pub mod actuator;
+pub mod config;
+pub mod control;
+pub mod hydraulics;
+pub mod ids;
+pub mod params;
+pub mod pidf;
+pub mod refusal;
+pub mod rig;
+pub mod snapshot;
+
+pub use config::RigConfig;
+pub use control::{AxisControl, ControlGains, ControlMode};
+pub use ids::{ActuatorId, Axis, Channel};
+pub use refusal::Refusal;
+pub use rig::{Rig, RigCommand};
+pub use snapshot::RigSnapshot;

@@ -1,0 +1,72 @@
+//! Configuration of a rig run: sampling, plant parameters, gains.
+
+use crate::control::ControlGains;
+use crate::hydraulics::ACTUATOR_COUNT;
+use crate::params::ActuatorParams;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigConfig {
+    /// Control rate of the digital controller (Schenck-class: 5 kHz).
+    pub control_hz: f64,
+    /// Plant sub-steps per control period (4 ⇒ 20 kHz plant, ω·h ≤ 0.06 at 144 Hz).
+    pub plant_substeps: u32,
+    pub actuators: [ActuatorParams; ACTUATOR_COUNT],
+    pub gains: ControlGains,
+    /// Standard deviation of the spool null bias drawn per actuator from the seed (fraction of
+    /// full opening). Real valves are nulled to a fraction of a percent.
+    pub spool_bias_std: f64,
+    /// Load-cell noise, standard deviation (kN).
+    pub load_cell_noise_kn: f64,
+}
+
+impl Default for RigConfig {
+    fn default() -> Self {
+        let h = ActuatorParams::horizontal();
+        let v = ActuatorParams::vertical();
+        RigConfig {
+            control_hz: 5000.0,
+            plant_substeps: 4,
+            actuators: [h, h, h, h, v, v],
+            gains: ControlGains::default_for_machine(),
+            spool_bias_std: 0.002,
+            load_cell_noise_kn: 0.002,
+        }
+    }
+}
+
+impl RigConfig {
+    pub fn dt_s(&self) -> f64 {
+        1.0 / self.control_hz
+    }
+
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.control_hz.is_finite() && (100.0..=100_000.0).contains(&self.control_hz)) {
+            return Err(format!(
+                "control_hz {} not in [100, 100000]",
+                self.control_hz
+            ));
+        }
+        if !(1..=64).contains(&self.plant_substeps) {
+            return Err(format!(
+                "plant_substeps {} not in [1, 64]",
+                self.plant_substeps
+            ));
+        }
+        if !self.gains.is_valid() {
+            return Err("control gains are not finite or not ordered".into());
+        }
+        if !(self.spool_bias_std.is_finite() && (0.0..0.02).contains(&self.spool_bias_std)) {
+            return Err(format!(
+                "spool_bias_std {} not in [0, 0.02)",
+                self.spool_bias_std
+            ));
+        }
+        if !(self.load_cell_noise_kn.is_finite() && self.load_cell_noise_kn >= 0.0) {
+            return Err(format!(
+                "load_cell_noise_kn {} is not ≥ 0",
+                self.load_cell_noise_kn
+            ));
+        }
+        Ok(())
+    }
+}
