@@ -1,0 +1,84 @@
+//! The one error type of the producer crate: every variant names the input and what was expected.
+
+use std::path::PathBuf;
+
+/// Errors of the simulated camera and of replay.
+#[derive(Debug, thiserror::Error)]
+pub enum ProducerError {
+    /// A file could not be opened or read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A file is not a decodable image (not an image, truncated, unsupported format).
+    #[error("cannot decode image {path}: {reason}")]
+    Decode {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong, from the decoder.
+        reason: String,
+    },
+    /// An image has a pixel type replay does not support.
+    #[error("unsupported pixel type in {path}: {found}; expected 8- or 16-bit grayscale (or colour, converted to luma)")]
+    PixelType {
+        /// The file.
+        path: PathBuf,
+        /// The pixel type found.
+        found: String,
+    },
+    /// A replay frame differs from the first frame in size or bit depth.
+    #[error("{path} is {found_width}x{found_height} at {found_bit_depth} bit, expected {expected_width}x{expected_height} at {expected_bit_depth} bit like the first frame {first}")]
+    FrameMismatch {
+        /// The offending file.
+        path: PathBuf,
+        /// The first frame of the sequence, the reference for size and depth.
+        first: PathBuf,
+        /// Width found, px.
+        found_width: u32,
+        /// Height found, px.
+        found_height: u32,
+        /// Bit depth found.
+        found_bit_depth: u8,
+        /// Width expected, px.
+        expected_width: u32,
+        /// Height expected, px.
+        expected_height: u32,
+        /// Bit depth expected.
+        expected_bit_depth: u8,
+    },
+    /// A replay source matched no image file.
+    #[error("no image found in {path}: expected files ending in .png, .tif, .tiff or .bmp")]
+    NoImages {
+        /// The folder or glob given.
+        path: PathBuf,
+    },
+    /// The caller's output buffer has the wrong length.
+    #[error("frame buffer holds {found_px} pixels, expected {expected_px} (width x height)")]
+    BufferSize {
+        /// Length given, pixels.
+        found_px: usize,
+        /// Length expected, pixels.
+        expected_px: usize,
+    },
+    /// A scenario name that is not known.
+    #[error("unknown scenario '{name}'; known scenarios: {known}")]
+    UnknownScenario {
+        /// The name given.
+        name: String,
+        /// The known names, comma separated.
+        known: String,
+    },
+    /// A parameter out of its valid range or malformed.
+    #[error("invalid parameter {name} = {value}: expected {expected}")]
+    InvalidParameter {
+        /// Parameter name.
+        name: String,
+        /// Value given.
+        value: String,
+        /// What was expected.
+        expected: String,
+    },
+}
