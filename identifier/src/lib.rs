@@ -1,5 +1,17 @@
-//! Hyperelastic identification of rubber-like materials (paper section 4).
+//! Hyperelastic identification of rubber-like materials (paper section 4). Pure library: no IPC.
 //!
 //! - [`law`]: the invariant-based law W(I1, I2) with f(I1), g(I2) (eqs 18-25), Smactane™ default.
+//! - [`data`]: load cases, kinematics, stresses from forces, the CSV reader.
+//! - [`models`]: the catalogue of potentials (Table 2 and the usual others).
+//! - [`lsq`]: linear least squares and a bounded Levenberg-Marquardt (nalgebra).
+//! - [`fit`]: fitting a model to any combination of load cases, statistics, ranking by AIC.
+//! - [`stability`]: Drucker stability along the load paths.
+//! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
 
+pub mod data;
+pub mod fit;
 pub mod law;
+pub mod lsq;
+pub mod models;
+pub mod route;
+pub mod stability;

@@ -1,0 +1,272 @@
+//! Least squares: linear (SVD with a rank check) and a small bounded Levenberg-Marquardt.
+//!
+//! Written with nalgebra rather than a crate (`levenberg-marquardt` is the candidate) so that
+//! steps giving non-finite residuals (Gent's and Arruda-Boyce's limiting chains) are simply
+//! rejected, the iteration count is bounded, and nothing panics on a singular JᵀJ.
+
+use nalgebra::{DMatrix, DVector};
+
+/// Relative singular value below which a design matrix is declared rank deficient.
+pub const RANK_TOLERANCE: f64 = 1e-10;
+/// Maximum Levenberg-Marquardt iterations.
+pub const LM_MAX_ITERATIONS: usize = 300;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum LsqError {
+    /// Fewer residuals than parameters (+1 for the residual variance).
+    TooFewPoints { points: usize, params: usize },
+    /// Parameters not identifiable from the data (rank of the design < number of parameters).
+    RankDeficient { rank: usize, params: usize },
+    /// Non-finite residuals at the starting point.
+    NonFiniteStart,
+}
+
+impl std::fmt::Display for LsqError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LsqError::TooFewPoints { points, params } => write!(
+                f,
+                "too few points: {points} data points for {params} parameters, need at least {}",
+                params + 1
+            ),
+            LsqError::RankDeficient { rank, params } => write!(
+                f,
+                "parameters not identifiable from these load cases: design rank {rank} < {params} parameters"
+            ),
+            LsqError::NonFiniteStart => write!(f, "model not defined at the starting parameters"),
+        }
+    }
+}
+
+impl std::error::Error for LsqError {}
+
+/// Solves min ||A x − b|| by SVD; errors when A is rank deficient.
+pub fn linear_least_squares(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>, LsqError> {
+    let (m, n) = a.shape();
+    assert_eq!(m, b.len(), "design rows and right-hand side must match");
+    if m < n {
+        return Err(LsqError::TooFewPoints {
+            points: m,
+            params: n,
+        });
+    }
+    if n == 0 {
+        return Ok(DVector::zeros(0));
+    }
+    // Column scaling so that the rank test is not fooled by units.
+    let scales: Vec<f64> = (0..n).map(|j| a.column(j).norm()).collect();
+    if scales.iter().any(|s| !s.is_finite()) {
+        return Err(LsqError::NonFiniteStart);
+    }
+    let mut scaled = a.clone();
+    for (j, &s) in scales.iter().enumerate() {
+        if s > 0.0 {
+            scaled.column_mut(j).scale_mut(1.0 / s);
+        }
+    }
+    let svd = scaled.svd(true, true);
+    let s_max = svd.singular_values.max();
+    let rank = svd
+        .singular_values
+        .iter()
+        .filter(|&&s| s > RANK_TOLERANCE * s_max.max(f64::MIN_POSITIVE))
+        .count();
+    if rank < n || scales.contains(&0.0) {
+        return Err(LsqError::RankDeficient { rank, params: n });
+    }
+    let y = svd
+        .solve(b, RANK_TOLERANCE * s_max)
+        .map_err(|_| LsqError::RankDeficient { rank, params: n })?;
+    Ok(DVector::from_iterator(
+        n,
+        y.iter().zip(&scales).map(|(v, s)| v / s),
+    ))
+}
+
+/// Covariance (JᵀJ)⁻¹ by SVD; `None` when JᵀJ is numerically singular.
+pub fn inverse_normal_matrix(jacobian: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+    let n = jacobian.ncols();
+    let scales: Vec<f64> = (0..n).map(|j| jacobian.column(j).norm()).collect();
+    if scales.iter().any(|&s| s == 0.0 || !s.is_finite()) {
+        return None;
+    }
+    let mut scaled = jacobian.clone();
+    for (j, &s) in scales.iter().enumerate() {
+        scaled.column_mut(j).scale_mut(1.0 / s);
+    }
+    let svd = scaled.svd(false, true);
+    let s_max = svd.singular_values.max();
+    if svd.singular_values.iter().any(|&s| s <= 1e-12 * s_max) {
+        return None;
+    }
+    let v_t = svd.v_t?;
+    let mut inv = DMatrix::zeros(n, n);
+    for k in 0..n {
+        let s2 = svd.singular_values[k] * svd.singular_values[k];
+        let v = v_t.row(k).transpose();
+        inv += &v * v.transpose() / s2;
+    }
+    for i in 0..n {
+        for j in 0..n {
+            inv[(i, j)] /= scales[i] * scales[j];
+        }
+    }
+    Some(inv)
+}
+
+/// Central finite-difference Jacobian of `residuals` at `p`.
+pub fn numeric_jacobian<F>(residuals: &F, p: &[f64], m: usize) -> DMatrix<f64>
+where
+    F: Fn(&[f64]) -> Option<DVector<f64>>,
+{
+    let n = p.len();
+    let mut jac = DMatrix::zeros(m, n);
+    let mut q = p.to_vec();
+    for j in 0..n {
+        let h = 1e-6 * p[j].abs().max(1e-6);
+        q[j] = p[j] + h;
+        let plus = residuals(&q);
+        q[j] = p[j] - h;
+        let minus = residuals(&q);
+        q[j] = p[j];
+        let column = match (plus, minus) {
+            (Some(a), Some(b)) => (a - b) / (2.0 * h),
+            (Some(a), None) => (a - residuals(p).expect("residuals finite at p")) / h,
+            (None, Some(b)) => (residuals(p).expect("residuals finite at p") - b) / h,
+            (None, None) => DVector::zeros(m),
+        };
+        jac.set_column(j, &column);
+    }
+    jac
+}
+
+/// Outcome of a Levenberg-Marquardt run.
+#[derive(Clone, Debug)]
+pub struct LmResult {
+    pub params: Vec<f64>,
+    pub cost: f64,
+    pub iterations: usize,
+    pub converged: bool,
+}
+
+/// Minimises ||r(p)||² from `start`. `residuals` returns `None` where the model is undefined.
+pub fn levenberg_marquardt<F>(residuals: &F, start: &[f64], m: usize) -> Result<LmResult, LsqError>
+where
+    F: Fn(&[f64]) -> Option<DVector<f64>>,
+{
+    let n = start.len();
+    if m < n {
+        return Err(LsqError::TooFewPoints {
+            points: m,
+            params: n,
+        });
+    }
+    let mut p = start.to_vec();
+    let mut r = residuals(&p)
+        .filter(|r| r.iter().all(|v| v.is_finite()))
+        .ok_or(LsqError::NonFiniteStart)?;
+    assert_eq!(
+        r.len(),
+        m,
+        "residual length must match the declared point count"
+    );
+    let mut cost = r.norm_squared();
+    let mut damping = 1e-3;
+    let mut converged = false;
+    let mut iterations = 0;
+    while iterations < LM_MAX_ITERATIONS && !converged {
+        iterations += 1;
+        let jac = numeric_jacobian(residuals, &p, m);
+        let jtj = jac.transpose() * &jac;
+        let jtr = jac.transpose() * &r;
+        if jtr.amax() <= 1e-15 * (1.0 + cost) {
+            converged = true;
+            break;
+        }
+        let mut accepted = false;
+        for _ in 0..40 {
+            let mut lhs = jtj.clone();
+            for k in 0..n {
+                lhs[(k, k)] += damping * jtj[(k, k)].max(1e-12);
+            }
+            let step = match lhs.clone().cholesky() {
+                Some(ch) => ch.solve(&(-&jtr)),
+                None => {
+                    damping *= 10.0;
+                    continue;
+                }
+            };
+            let trial: Vec<f64> = p.iter().zip(step.iter()).map(|(a, d)| a + d).collect();
+            match residuals(&trial).filter(|r| r.iter().all(|v| v.is_finite())) {
+                Some(r_trial) if r_trial.norm_squared() < cost => {
+                    let new_cost = r_trial.norm_squared();
+                    let relative_decrease = (cost - new_cost) / cost.max(f64::MIN_POSITIVE);
+                    let step_small = step
+                        .iter()
+                        .zip(&p)
+                        .all(|(d, a)| d.abs() <= 1e-12 * (a.abs() + 1e-12));
+                    p = trial;
+                    r = r_trial;
+                    cost = new_cost;
+                    damping = (damping / 3.0).max(1e-12);
+                    accepted = true;
+                    if relative_decrease < 1e-14 || step_small {
+                        converged = true;
+                    }
+                    break;
+                }
+                _ => damping *= 4.0,
+            }
+            if damping > 1e16 {
+                break;
+            }
+        }
+        if !accepted {
+            // No descent possible: a (local) minimum to the precision of the Jacobian.
+            converged = true;
+        }
+    }
+    Ok(LmResult {
+        params: p,
+        cost,
+        iterations,
+        converged,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rank_deficient_design_is_an_error_not_a_panic() {
+        let a = DMatrix::from_row_slice(3, 2, &[1.0, 2.0, 2.0, 4.0, 3.0, 6.0]);
+        let b = DVector::from_vec(vec![1.0, 2.0, 3.0]);
+        assert!(matches!(
+            linear_least_squares(&a, &b),
+            Err(LsqError::RankDeficient { .. })
+        ));
+        let a = DMatrix::from_row_slice(1, 2, &[1.0, 2.0]);
+        assert!(matches!(
+            linear_least_squares(&a, &b.rows(0, 1).into()),
+            Err(LsqError::TooFewPoints { .. })
+        ));
+    }
+
+    #[test]
+    fn lm_fits_an_exponential() {
+        let xs: Vec<f64> = (0..20).map(|i| i as f64 * 0.1).collect();
+        let ys: Vec<f64> = xs.iter().map(|x| 2.0 * (-1.3 * x).exp()).collect();
+        let res = |p: &[f64]| {
+            Some(DVector::from_iterator(
+                20,
+                xs.iter().zip(&ys).map(|(x, y)| p[0] * (p[1] * x).exp() - y),
+            ))
+        };
+        let out = levenberg_marquardt(&res, &[1.0, 0.0], 20).unwrap();
+        assert!(
+            (out.params[0] - 2.0).abs() < 1e-6 && (out.params[1] + 1.3).abs() < 1e-6,
+            "{out:?}"
+        );
+    }
+}
