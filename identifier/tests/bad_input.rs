@@ -51,7 +51,12 @@ fn too_few_points() {
     let e = parse("stretch,nominal_stress_mpa\n1.0,0.0\n1.1,0.1\n").unwrap_err();
     assert!(e.contains("too few points"), "{e}");
     let c = Curve::new(LoadCase::Uniaxial, vec![1.1, 1.2, 1.3], vec![0.1, 0.2, 0.3]).unwrap();
-    let e = fit_model(&Model::Ogden(3), &[c.clone()], &FitOptions::default()).unwrap_err();
+    let e = fit_model(
+        &Model::Ogden(3),
+        std::slice::from_ref(&c),
+        &FitOptions::default(),
+    )
+    .unwrap_err();
     assert!(
         matches!(
             e,

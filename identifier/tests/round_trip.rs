@@ -138,9 +138,9 @@ fn standard_deviations_cover_the_truth() {
         let worst = worst_relative_deviation(&model, &fit.params);
         worst_of_all = worst_of_all.max(worst);
         within_one_percent += usize::from(worst < 0.01);
-        for k in 0..TRUTH.len() {
+        for ((param, std), truth) in fit.params.iter().zip(&fit.stderr).zip(TRUTH) {
             total += 1;
-            if (fit.params[k] - TRUTH[k]).abs() < 2.0 * fit.stderr[k].unwrap() {
+            if (param - truth).abs() < 2.0 * std.unwrap() {
                 inside += 1;
             }
         }
