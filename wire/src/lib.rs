@@ -1,1 +1,34 @@
-//! Shared-memory layouts, service names and node construction for dicstream.
+//! The shared contract between dicstream processes: shared-memory layouts (`#[repr(C)]`,
+//! `ZeroCopySend`, an explicit `#[type_name]` carrying the layout version), service names and
+//! sizes, node creation under an instance prefix, the `/dev/shm` space check, and the thin
+//! publish/subscribe wrappers every process uses. One place per concept: no other crate defines
+//! a type that crosses a process boundary.
+//!
+//! Units are in every field name. Coordinates follow DESIGN.md: x = pixel column, y = pixel row,
+//! origin at the centre of the top-left pixel; u, v are Lagrangian displacements in pixels.
+
+pub mod clock;
+pub mod field;
+pub mod frame;
+pub mod identification;
+pub mod instance;
+pub mod pubsub;
+pub mod rig;
+pub mod services;
+pub mod shm;
+pub mod text;
+
+pub use clock::monotonic_ns;
+pub use field::{FieldHeader, FieldNode, GaugeStrain, NodeStatus, StrainMeasure};
+pub use frame::{FrameHeader, GroundTruth};
+pub use identification::IdentificationReport;
+pub use instance::{Instance, InstanceError};
+pub use rig::{ActuatorState, RigCommand, RigCommandKind, RigReply, RigState};
+
+/// Version of every layout in this crate. Bump it (and the `#[type_name]` suffixes, which
+/// embed it) whenever a field changes: processes of different versions then refuse to connect
+/// instead of misreading each other.
+pub const LAYOUT_VERSION: u32 = 1;
+
+/// Marks an absent rig sample id (a frame not taken under a rig, e.g. a replayed image).
+pub const NO_RIG_SAMPLE: u64 = u64::MAX;

@@ -1,0 +1,191 @@
+//! `fields`: one measured displacement/strain field as a `[FieldNode]` slice (row-major over
+//! the ZOI mesh, `mesh_cols * mesh_rows` nodes) behind a [`FieldHeader`].
+
+use iceoryx2::prelude::ZeroCopySend;
+
+/// Strain measures of the paper's eq. (13), plus the infinitesimal strain.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StrainMeasure {
+    /// ε = sym(∇u).
+    Small = 0,
+    /// m = 1: E = (C − 1)/2.
+    Green = 1,
+    /// m = 1/2: E = C^(1/2) − 1 (ΔL/L0 in uniaxial elongation).
+    Nominal = 2,
+    /// m = 0: E = ln(C)/2, the default.
+    Log = 3,
+}
+
+impl StrainMeasure {
+    pub const ALL: [StrainMeasure; 4] = [
+        StrainMeasure::Small,
+        StrainMeasure::Green,
+        StrainMeasure::Nominal,
+        StrainMeasure::Log,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            StrainMeasure::Small => "small",
+            StrainMeasure::Green => "green",
+            StrainMeasure::Nominal => "nominal",
+            StrainMeasure::Log => "log",
+        }
+    }
+
+    pub fn from_code(code: u32) -> Option<StrainMeasure> {
+        StrainMeasure::ALL.into_iter().find(|m| *m as u32 == code)
+    }
+}
+
+/// Outcome of one ZOI, carried in [`FieldNode::status`].
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NodeStatus {
+    Ok = 0,
+    NotConverged = 1,
+    LowContrast = 2,
+    OutsideImage = 3,
+}
+
+impl NodeStatus {
+    pub fn name(self) -> &'static str {
+        match self {
+            NodeStatus::Ok => "ok",
+            NodeStatus::NotConverged => "not_converged",
+            NodeStatus::LowContrast => "low_contrast",
+            NodeStatus::OutsideImage => "outside_image",
+        }
+    }
+
+    pub fn from_code(code: u32) -> Option<NodeStatus> {
+        [
+            NodeStatus::Ok,
+            NodeStatus::NotConverged,
+            NodeStatus::LowContrast,
+            NodeStatus::OutsideImage,
+        ]
+        .into_iter()
+        .find(|s| *s as u32 == code)
+    }
+}
+
+/// One ZOI of the mesh. Strains are of the measure named in the header.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("dicstream.FieldNode.v1")]
+pub struct FieldNode {
+    /// ZOI centre in the reference image (px).
+    pub x_px: f32,
+    pub y_px: f32,
+    /// Displacement (px).
+    pub u_px: f32,
+    pub v_px: f32,
+    pub exx: f32,
+    pub eyy: f32,
+    pub exy: f32,
+    /// Normalised correlation score in [-1, 1].
+    pub score: f32,
+    pub iterations: u32,
+    /// A [`NodeStatus`] code.
+    pub status: u32,
+}
+
+/// In-plane strain components (dimensionless).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("dicstream.GaugeStrain.v1")]
+pub struct GaugeStrain {
+    pub exx: f64,
+    pub eyy: f64,
+    pub exy: f64,
+}
+
+/// Header of one field on the `fields` service.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[type_name("dicstream.FieldHeader.v1")]
+pub struct FieldHeader {
+    pub layout_version: u32,
+    /// The [`StrainMeasure`] code of the node strains.
+    pub strain_measure: u32,
+    /// The frame this field was measured on, and its reference frame.
+    pub frame_id: u64,
+    pub reference_frame_id: u64,
+    /// Copied from the frame: capture time and rig sample (monotonic ns).
+    pub t_capture_ns: u64,
+    pub rig_sample_id: u64,
+    /// When the correlator received the frame and published this field (monotonic ns).
+    pub t_received_ns: u64,
+    pub t_published_ns: u64,
+    /// Time spent correlating this frame (ns).
+    pub correlate_ns: u64,
+    /// Frames the correlator skipped so far (gaps in frame ids it saw).
+    pub frames_dropped: u64,
+    pub mesh_cols: u32,
+    pub mesh_rows: u32,
+    pub zoi_px: u32,
+    pub step_px: u32,
+    pub valid_nodes: u32,
+    /// 1 when `truth` holds the frame's exact imposed motion.
+    pub has_truth: u32,
+    pub truth: crate::frame::GroundTruth,
+    pub u_mean_px: f64,
+    pub v_mean_px: f64,
+    /// Gauge (ROI average) strains in the order of [`StrainMeasure::ALL`].
+    pub gauge: [GaugeStrain; 4],
+}
+
+impl FieldHeader {
+    pub fn node_count(&self) -> usize {
+        self.mesh_cols as usize * self.mesh_rows as usize
+    }
+
+    pub fn gauge_of(&self, measure: StrainMeasure) -> GaugeStrain {
+        self.gauge[measure as usize]
+    }
+}
+
+impl Default for FieldHeader {
+    fn default() -> Self {
+        FieldHeader {
+            layout_version: crate::LAYOUT_VERSION,
+            strain_measure: StrainMeasure::Log as u32,
+            frame_id: 0,
+            reference_frame_id: 0,
+            t_capture_ns: 0,
+            rig_sample_id: crate::NO_RIG_SAMPLE,
+            t_received_ns: 0,
+            t_published_ns: 0,
+            correlate_ns: 0,
+            frames_dropped: 0,
+            mesh_cols: 0,
+            mesh_rows: 0,
+            zoi_px: 0,
+            step_px: 0,
+            valid_nodes: 0,
+            has_truth: 0,
+            truth: crate::frame::GroundTruth::IDENTITY,
+            u_mean_px: 0.0,
+            v_mean_px: 0.0,
+            gauge: [GaugeStrain::default(); 4],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_round_trip() {
+        for m in StrainMeasure::ALL {
+            assert_eq!(StrainMeasure::from_code(m as u32), Some(m));
+        }
+        assert_eq!(StrainMeasure::from_code(9), None);
+        assert_eq!(NodeStatus::from_code(2), Some(NodeStatus::LowContrast));
+        assert_eq!(NodeStatus::from_code(4), None);
+        assert_eq!(StrainMeasure::Log.name(), "log");
+    }
+}

@@ -1,0 +1,219 @@
+//! An instance is one run of the bench: every process of the run shares its name, which becomes
+//! the iceoryx2 file prefix, so two runs (or two tests) on one machine never meet.
+
+use iceoryx2::prelude::*;
+use std::path::PathBuf;
+
+/// Longest instance name accepted (the prefix lands in file names of `/dev/shm`).
+pub const MAX_NAME_LEN: usize = 48;
+
+#[derive(Debug)]
+pub enum InstanceError {
+    BadName {
+        name: String,
+        reason: String,
+    },
+    Node {
+        role: String,
+        detail: String,
+    },
+    Service {
+        service: String,
+        detail: String,
+    },
+    ShmSpace {
+        needed_bytes: u64,
+        free_bytes: u64,
+        path: String,
+    },
+    Io(String),
+}
+
+impl std::fmt::Display for InstanceError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            InstanceError::BadName { name, reason } => {
+                write!(f, "instance name {name:?}: {reason}")
+            }
+            InstanceError::Node { role, detail } => {
+                write!(f, "cannot create the {role} node: {detail}")
+            }
+            InstanceError::Service { service, detail } => {
+                write!(f, "cannot open service {service:?}: {detail}")
+            }
+            InstanceError::ShmSpace {
+                needed_bytes,
+                free_bytes,
+                path,
+            } => write!(
+                f,
+                "{path} has {:.1} MiB free but the services need about {:.1} MiB: free some space \
+                 (old runs: `ls {path}`), use a smaller frame, or enlarge {path} \
+                 (mount -o remount,size=... {path})",
+                *free_bytes as f64 / 1048576.0,
+                *needed_bytes as f64 / 1048576.0
+            ),
+            InstanceError::Io(detail) => write!(f, "{detail}"),
+        }
+    }
+}
+
+impl std::error::Error for InstanceError {}
+
+/// One run's name and the iceoryx2 configuration that isolates it.
+#[derive(Debug)]
+pub struct Instance {
+    name: String,
+    config: Config,
+}
+
+impl Instance {
+    /// The default instance name: `dicstream_<user>`, so one user's runs share it by default.
+    pub fn default_name() -> String {
+        let user = std::env::var("USER")
+            .or_else(|_| std::env::var("LOGNAME"))
+            .unwrap_or_else(|_| "user".to_string());
+        let user: String = user
+            .chars()
+            .filter(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == '-')
+            .take(24)
+            .collect();
+        format!("dicstream_{}", if user.is_empty() { "user" } else { &user })
+    }
+
+    /// Validates `name` (ASCII letters, digits, `_`, `-`; at most [`MAX_NAME_LEN`]).
+    pub fn new(name: &str) -> Result<Instance, InstanceError> {
+        let bad = |reason: &str| InstanceError::BadName {
+            name: name.to_string(),
+            reason: reason.to_string(),
+        };
+        if name.is_empty() {
+            return Err(bad("must not be empty"));
+        }
+        if name.len() > MAX_NAME_LEN {
+            return Err(bad(&format!("longer than {MAX_NAME_LEN} characters")));
+        }
+        if !name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+        {
+            return Err(bad("use only ASCII letters, digits, '_' and '-'"));
+        }
+        let mut config = Config::default();
+        let prefix = Self::prefix_of(name);
+        config.global.prefix =
+            FileName::new(prefix.as_bytes()).map_err(|e| bad(&format!("{e:?}")))?;
+        Ok(Instance {
+            name: name.to_string(),
+            config,
+        })
+    }
+
+    fn prefix_of(name: &str) -> String {
+        format!("{name}_")
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The file prefix of this instance's shared-memory and bookkeeping files.
+    pub fn prefix(&self) -> String {
+        Self::prefix_of(&self.name)
+    }
+
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// Creates the node of one process role (`producer`, `tap`, ...). Dead nodes of this
+    /// instance are cleaned first (iceoryx2 also does it on creation; doing it here lets the
+    /// caller know how many it found).
+    pub fn create_node(&self, role: &str) -> Result<(Node<ipc::Service>, usize), InstanceError> {
+        let removed = self.cleanup_dead_nodes();
+        let node_error = |detail: String| InstanceError::Node {
+            role: role.to_string(),
+            detail,
+        };
+        let node_name = NodeName::new(role).map_err(|e| node_error(format!("{e:?}")))?;
+        let node = NodeBuilder::new()
+            .name(&node_name)
+            .config(&self.config)
+            // The processes handle SIGINT/SIGTERM themselves through WaitSet and `node.wait`.
+            .signal_handling_mode(SignalHandlingMode::HandleTerminationRequests)
+            .create::<ipc::Service>()
+            .map_err(|e| node_error(format!("{e:?}")))?;
+        Ok((node, removed))
+    }
+
+    /// Removes the stale resources of this instance's nodes whose process died (e.g. SIGKILL).
+    /// Returns how many dead nodes were cleaned.
+    pub fn cleanup_dead_nodes(&self) -> usize {
+        let mut removed = 0;
+        let _ = Node::<ipc::Service>::list(&self.config, |state| {
+            if let NodeState::<ipc::Service>::Dead(view) = state {
+                if view.try_remove_stale_resources().is_ok() {
+                    removed += 1;
+                }
+            }
+            CallbackProgression::Continue
+        });
+        removed
+    }
+
+    /// Files of this instance left in `/dev/shm` and in iceoryx2's bookkeeping folder.
+    pub fn leftover_files(&self) -> Vec<PathBuf> {
+        let prefix = self.prefix();
+        let mut found = Vec::new();
+        let mut roots = vec![PathBuf::from("/dev/shm")];
+        roots.push(PathBuf::from(self.config.global.root_path().to_string()));
+        for root in roots {
+            collect_with_prefix(&root, &prefix, 3, &mut found);
+        }
+        found.sort();
+        found
+    }
+
+    /// Deletes [`Instance::leftover_files`]. Only for tests and for `dicstream run` after every
+    /// child has stopped: removing files under a live process breaks it.
+    pub fn remove_leftover_files(&self) -> usize {
+        let files = self.leftover_files();
+        files
+            .iter()
+            .filter(|path| std::fs::remove_file(path).is_ok())
+            .count()
+    }
+}
+
+fn collect_with_prefix(dir: &std::path::Path, prefix: &str, depth: u32, found: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        let is_dir = entry.file_type().map(|t| t.is_dir()).unwrap_or(false);
+        if is_dir && depth > 0 {
+            collect_with_prefix(&path, prefix, depth - 1, found);
+        } else if !is_dir && entry.file_name().to_string_lossy().starts_with(prefix) {
+            found.push(path);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_validated() {
+        assert!(Instance::new("bench_1-a").is_ok());
+        assert!(Instance::new("").is_err());
+        assert!(Instance::new("has space")
+            .unwrap_err()
+            .to_string()
+            .contains("letters"));
+        assert!(Instance::new(&"x".repeat(MAX_NAME_LEN + 1)).is_err());
+        assert!(Instance::default_name().starts_with("dicstream_"));
+        assert!(Instance::new(&Instance::default_name()).is_ok());
+    }
+}

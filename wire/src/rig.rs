@@ -1,0 +1,178 @@
+//! `rig/state` (a fixed [`RigState`] sample, decimated from the rig's control rate) and
+//! `rig/command` (request [`RigCommand`], response [`RigReply`]).
+
+use iceoryx2::prelude::ZeroCopySend;
+
+/// Actuators in this order everywhere: X+, X−, Y+, Y−, Z+, Z−.
+pub const ACTUATOR_NAMES: [&str; 6] = ["X+", "X-", "Y+", "Y-", "Z+", "Z-"];
+/// Axes in this order everywhere: X, Y, Z.
+pub const AXIS_NAMES: [&str; 3] = ["X", "Y", "Z"];
+
+/// One servo-hydraulic actuator at one instant.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("dicstream.ActuatorState.v1")]
+pub struct ActuatorState {
+    pub position_mm: f64,
+    pub command_mm: f64,
+    pub following_error_mm: f64,
+    pub force_kn: f64,
+    /// Control mode code of this channel (rig crate: displacement, force, centroid).
+    pub mode: u32,
+    /// Bit set of tripped limits of this channel (rig crate defines the bits).
+    pub limit_flags: u32,
+}
+
+/// One decimated sample of the rig.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("dicstream.RigState.v1")]
+pub struct RigState {
+    pub layout_version: u32,
+    /// Program state code (rig crate: idle, running, holding, stopped, tripped).
+    pub program_state: u32,
+    /// Consecutive from 0; frames name the sample they were taken at.
+    pub sample_id: u64,
+    /// Simulated time since the rig started (s), and when this sample was published (monotonic ns).
+    pub t_sim_s: f64,
+    pub t_published_ns: u64,
+    pub actuators: [ActuatorState; 6],
+    /// Per axis X, Y, Z: centre position ((p+ − p−)/2) and elongation (p+ + p−), mm.
+    pub axis_centre_mm: [f64; 3],
+    pub axis_elongation_mm: [f64; 3],
+    /// Specimen kinematics for the camera: in-plane stretches, rotation, centre offset.
+    pub specimen_stretch_x: f64,
+    pub specimen_stretch_y: f64,
+    pub specimen_rotation_rad: f64,
+    pub specimen_centre_offset_mm: [f64; 2],
+    /// Current specimen cross-sections normal to X and Y (mm²), for Cauchy stress = force / area.
+    pub specimen_section_x_mm2: f64,
+    pub specimen_section_y_mm2: f64,
+    /// Load case code of the running test (rig crate: none, uniaxial, equibiaxial).
+    pub load_case: u32,
+    /// 1 when the hydraulics are on.
+    pub hydraulics_on: u32,
+}
+
+/// What a [`RigCommand`] asks for.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RigCommandKind {
+    /// Start the program file named in `text`, or the built-in test `value` names (rig crate).
+    StartProgram = 0,
+    Hold = 1,
+    Resume = 2,
+    /// Stop the program; `value` 0 stays at level, 1 ramps to zero.
+    Stop = 3,
+    /// Switch `channel` to mode `value` (rig crate codes), bumplessly.
+    SetMode = 4,
+    /// Set limit `limit` of `channel` to `value` (units of that limit).
+    SetLimit = 5,
+    EmergencyStop = 6,
+    /// Set the command of `channel` directly (mm or kN by its mode).
+    SetPoint = 7,
+}
+
+impl RigCommandKind {
+    pub fn from_code(code: u32) -> Option<RigCommandKind> {
+        use RigCommandKind::*;
+        [
+            StartProgram,
+            Hold,
+            Resume,
+            Stop,
+            SetMode,
+            SetLimit,
+            EmergencyStop,
+            SetPoint,
+        ]
+        .into_iter()
+        .find(|k| *k as u32 == code)
+    }
+}
+
+/// A request on `rig/command`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[type_name("dicstream.RigCommand.v1")]
+pub struct RigCommand {
+    pub layout_version: u32,
+    /// A [`RigCommandKind`] code.
+    pub kind: u32,
+    /// Actuator index (see [`ACTUATOR_NAMES`]) or axis index, as the kind says.
+    pub channel: u32,
+    /// Limit code for `SetLimit` (rig crate).
+    pub limit: u32,
+    pub value: f64,
+    /// NUL-padded UTF-8 (a program path), see [`crate::text`].
+    pub text: [u8; 240],
+}
+
+impl RigCommand {
+    pub fn new(kind: RigCommandKind) -> RigCommand {
+        RigCommand {
+            layout_version: crate::LAYOUT_VERSION,
+            kind: kind as u32,
+            channel: 0,
+            limit: 0,
+            value: 0.0,
+            text: [0; 240],
+        }
+    }
+}
+
+/// The answer to a [`RigCommand`]: accepted, or refused with the reason.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[type_name("dicstream.RigReply.v1")]
+pub struct RigReply {
+    pub layout_version: u32,
+    pub accepted: u32,
+    /// NUL-padded UTF-8 reason when refused, see [`crate::text`].
+    pub reason: [u8; 248],
+}
+
+impl RigReply {
+    pub fn accepted() -> RigReply {
+        RigReply {
+            layout_version: crate::LAYOUT_VERSION,
+            accepted: 1,
+            reason: [0; 248],
+        }
+    }
+
+    pub fn refused(reason: &str) -> RigReply {
+        let mut reply = RigReply {
+            layout_version: crate::LAYOUT_VERSION,
+            accepted: 0,
+            reason: [0; 248],
+        };
+        crate::text::write_fixed(&mut reply.reason, reason);
+        reply
+    }
+
+    pub fn reason(&self) -> String {
+        crate::text::read_fixed(&self.reason)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refusal_carries_its_reason() {
+        let reply = RigReply::refused("stroke 300 mm beyond the 250 mm limit of X+");
+        assert_eq!(reply.accepted, 0);
+        assert_eq!(
+            reply.reason(),
+            "stroke 300 mm beyond the 250 mm limit of X+"
+        );
+        assert_eq!(RigReply::accepted().accepted, 1);
+        assert_eq!(
+            RigCommandKind::from_code(6),
+            Some(RigCommandKind::EmergencyStop)
+        );
+        assert_eq!(RigCommandKind::from_code(99), None);
+    }
+}
