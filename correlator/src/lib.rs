@@ -1,1 +1,40 @@
 //! CORRELI-GD digital image correlation on a parallel mesh of zones of interest, and strains.
+//!
+//! Chevalier, Calloch, Hild, Marco, section 3.b: a centred 2^p ROI (or the user's), one global
+//! FFT correlation for the mean integer displacement (U0, V0), then per ZOI of 2^s px every
+//! δx px: integer FFT correlation and move, modified Hanning window (eq. 9), 3x3 quadratic
+//! sub-pixel peak, Fourier-shift iterations (eqs. 5-7) while the interpolated maximum increases.
+//! Each ZOI is zero-mean and unit-norm (insensitive to brightness and contrast changes).
+//!
+//! ```no_run
+//! use correlator::{Correlator, CorrelatorSettings};
+//! let (w, h) = (512, 512);
+//! let reference = vec![0u16; w * h];
+//! let deformed = vec![0u16; w * h];
+//! let mut c = Correlator::new(CorrelatorSettings::default(), w, h).unwrap();
+//! c.set_reference(&reference).unwrap();
+//! let field = c.correlate(&deformed).unwrap();
+//! println!("{} of {} nodes valid, log gauge exx {}", field.valid, field.nodes.len(), field.gauge.log.exx);
+//! ```
+//!
+//! No allocation per ZOI or per frame after `Correlator::new` (the first `set_reference` fills
+//! preallocated caches); worker threads are spawned once and own their FFT plans and buffers.
+
+mod correlator;
+mod fft2d;
+pub mod field;
+mod global;
+mod mesh;
+mod peak;
+mod pool;
+pub mod settings;
+pub mod strain;
+mod window;
+mod zoi;
+
+pub use correlator::Correlator;
+pub use field::{Field, GaugeStrains, Node, NodeStatus, Strain2};
+pub use settings::{
+    CorrelatorSettings, GuessMode, ReferenceMode, Roi, SettingsError, StrainMeasure,
+};
+pub use zoi::TimeSplit;

@@ -1,0 +1,478 @@
+//! The correlator: mesh, reference cache, worker pool, guesses, reference modes, strains.
+
+use crate::field::{Field, Node, NodeStatus};
+use crate::global::GlobalCorrelator;
+use crate::mesh::Mesh;
+use crate::pool::{Pool, SharedSlice};
+use crate::settings::{CorrelatorSettings, GuessMode, ReferenceMode, Roi, SettingsError};
+use crate::strain::{gauge, node_strains, AffineSums};
+use crate::zoi::{Image, ReferenceSpectra, TimeSplit, ZoiResult};
+use rustfft::num_complex::Complex32;
+
+/// Per-node state of the current reference image.
+#[derive(Clone, Copy, Debug, Default)]
+struct RefNode {
+    /// ZOI top-left in the current reference image (px).
+    top_left: (usize, usize),
+    /// Followed position minus ZOI centre (px), |r| <= 0.5: the ZOI is on the pixel grid.
+    offset_px: (f64, f64),
+    /// Total displacement of the node when the current reference was taken (px).
+    base_px: (f64, f64),
+    /// Ok, or why this node cannot be correlated against this reference.
+    status: NodeStatus,
+}
+
+/// CORRELI-GD correlator for images of one size. See the crate documentation.
+pub struct Correlator {
+    settings: CorrelatorSettings,
+    width_px: usize,
+    height_px: usize,
+    roi: Roi,
+    mesh: Mesh,
+    pool: Pool,
+    global: GlobalCorrelator,
+    reference_pixels: Vec<u16>,
+    has_reference: bool,
+    ref_nodes: Vec<RefNode>,
+    plain_spectra: Vec<Complex32>,
+    windowed_spectra: Vec<Complex32>,
+    /// Initial guess per node against the current reference (px).
+    guesses: Vec<(f64, f64)>,
+    results: Vec<ZoiResult>,
+    /// Total displacement of the previous frame, for the predictor (None = no usable value).
+    previous: Vec<Option<(f64, f64)>>,
+    has_previous: bool,
+    field: Field,
+    scratch_pairs: Vec<(f64, f64)>,
+    frames_since_reference: u64,
+}
+
+impl Correlator {
+    /// Validates the settings against the image size and makes every buffer, plan and thread.
+    pub fn new(
+        settings: CorrelatorSettings,
+        width_px: usize,
+        height_px: usize,
+    ) -> Result<Self, SettingsError> {
+        settings.validate()?;
+        let roi = settings.resolve_roi(width_px, height_px)?;
+        let mesh = Mesh::new(roi, settings.zoi_px, settings.step_px);
+        let nodes = mesh.len();
+        let n2 = settings.zoi_px * settings.zoi_px;
+        let zero = Complex32::new(0.0, 0.0);
+        let mut field = Field {
+            nx: mesh.nx,
+            ny: mesh.ny,
+            nodes: vec![Node::default(); nodes],
+            ..Field::default()
+        };
+        for (k, node) in field.nodes.iter_mut().enumerate() {
+            let (x, y) = mesh.centre_px(k, settings.zoi_px);
+            node.x_px = x;
+            node.y_px = y;
+        }
+        let ref_nodes = (0..nodes)
+            .map(|k| RefNode {
+                top_left: mesh.top_left[k],
+                ..RefNode::default()
+            })
+            .collect();
+        Ok(Self {
+            pool: Pool::new(settings.threads, settings.zoi_px),
+            global: GlobalCorrelator::new(roi),
+            reference_pixels: vec![0; width_px * height_px],
+            has_reference: false,
+            ref_nodes,
+            plain_spectra: vec![zero; nodes * n2],
+            windowed_spectra: vec![zero; nodes * n2],
+            guesses: vec![(0.0, 0.0); nodes],
+            results: vec![ZoiResult::default(); nodes],
+            previous: vec![None; nodes],
+            has_previous: false,
+            field,
+            scratch_pairs: vec![(0.0, 0.0); nodes],
+            frames_since_reference: 0,
+            settings,
+            width_px,
+            height_px,
+            roi,
+            mesh,
+        })
+    }
+
+    pub fn settings(&self) -> &CorrelatorSettings {
+        &self.settings
+    }
+
+    pub fn roi(&self) -> Roi {
+        self.roi
+    }
+
+    /// Mesh size (nx, ny).
+    pub fn mesh_size(&self) -> (usize, usize) {
+        (self.mesh.nx, self.mesh.ny)
+    }
+
+    /// The last field computed.
+    pub fn field(&self) -> &Field {
+        &self.field
+    }
+
+    fn check_size(&self, what: &'static str, pixels: &[u16]) -> Result<(), SettingsError> {
+        let expected = self.width_px * self.height_px;
+        if pixels.len() != expected {
+            return Err(SettingsError::ImageSize {
+                what,
+                got: pixels.len(),
+                expected,
+                width_px: self.width_px,
+                height_px: self.height_px,
+            });
+        }
+        Ok(())
+    }
+
+    /// Sets the reference image (row-major u16, the size given to `new`); the mesh restarts at
+    /// the nodes' initial positions and previous fields are forgotten.
+    pub fn set_reference(&mut self, pixels: &[u16]) -> Result<(), SettingsError> {
+        self.check_size("reference", pixels)?;
+        for (k, r) in self.ref_nodes.iter_mut().enumerate() {
+            *r = RefNode {
+                top_left: self.mesh.top_left[k],
+                ..RefNode::default()
+            };
+        }
+        self.previous.fill(None);
+        self.has_previous = false;
+        self.take_reference(pixels);
+        Ok(())
+    }
+
+    /// Copies the pixels as the current reference and prepares the spectra of every node at its
+    /// followed position (`ref_nodes[k].base_px` must be set).
+    fn take_reference(&mut self, pixels: &[u16]) {
+        self.reference_pixels.copy_from_slice(pixels);
+        let n = self.settings.zoi_px;
+        let half = (n as f64 - 1.0) / 2.0;
+        let image = Image {
+            pixels: &self.reference_pixels,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        };
+        for (k, r) in self.ref_nodes.iter_mut().enumerate() {
+            let (x, y) = (
+                self.field.nodes[k].x_px + r.base_px.0,
+                self.field.nodes[k].y_px + r.base_px.1,
+            );
+            let (tx, ty) = ((x - half).round(), (y - half).round());
+            r.offset_px = (x - (tx + half), y - (ty + half));
+            if image.contains_block(tx as i64, ty as i64, n) {
+                r.top_left = (tx as usize, ty as usize);
+                r.status = NodeStatus::Ok;
+            } else {
+                r.status = NodeStatus::OutsideImage;
+            }
+        }
+        self.global.set_reference(image);
+        let n2 = n * n;
+        let plain = SharedSlice::new(&mut self.plain_spectra);
+        let windowed = SharedSlice::new(&mut self.windowed_spectra);
+        let ref_nodes = SharedSlice::new(&mut self.ref_nodes);
+        self.pool.run(self.mesh.len(), &|engine, k| {
+            // SAFETY: item k touches only node k's slots.
+            let mut r = unsafe { ref_nodes.read(k) };
+            if r.status != NodeStatus::Ok {
+                return;
+            }
+            let (p, w) = unsafe { (plain.slice_mut(k * n2, n2), windowed.slice_mut(k * n2, n2)) };
+            if !engine.prepare_reference(image, r.top_left.0, r.top_left.1, p, w) {
+                r.status = NodeStatus::LowContrast;
+                unsafe { ref_nodes.write(k, r) };
+            }
+        });
+        self.has_reference = true;
+        self.frames_since_reference = 0;
+    }
+
+    /// Correlates one deformed image against the current reference and returns the field.
+    pub fn correlate(&mut self, pixels: &[u16]) -> Result<&Field, SettingsError> {
+        self.check_size("deformed", pixels)?;
+        if !self.has_reference {
+            return Err(SettingsError::NoReference);
+        }
+        let image = Image {
+            pixels,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        };
+        self.run_zois(image);
+        self.assemble();
+        self.update_reference(pixels);
+        Ok(&self.field)
+    }
+
+    fn run_zois(&mut self, image: Image) {
+        let n = self.settings.zoi_px;
+        let n2 = n * n;
+        let max_iterations = self.settings.max_iterations;
+        let use_previous = self.settings.guess == GuessMode::Predict && self.has_previous;
+        let needs_global = !use_previous || self.previous.iter().any(|p| p.is_none());
+        let global = if needs_global {
+            self.global.displacement(image)
+        } else {
+            (0, 0)
+        };
+        self.field.global_px = global;
+        let global_guess = (global.0 as f64, global.1 as f64);
+        for (k, guess) in self.guesses.iter_mut().enumerate() {
+            let base = self.ref_nodes[k].base_px;
+            *guess = match (use_previous, self.previous[k]) {
+                (true, Some(p)) => (p.0 - base.0, p.1 - base.1),
+                _ => global_guess,
+            };
+        }
+        let plain = &self.plain_spectra;
+        let windowed = &self.windowed_spectra;
+        let ref_nodes = &self.ref_nodes;
+        let guesses = &self.guesses;
+        let results = SharedSlice::new(&mut self.results);
+        let correlate_node = |engine: &mut crate::zoi::ZoiEngine, k: usize, guess: (f64, f64)| {
+            let r = ref_nodes[k];
+            let result = if r.status != NodeStatus::Ok {
+                ZoiResult {
+                    status: r.status,
+                    ..ZoiResult::default()
+                }
+            } else {
+                let spectra = ReferenceSpectra {
+                    plain: &plain[k * n2..(k + 1) * n2],
+                    windowed: &windowed[k * n2..(k + 1) * n2],
+                };
+                engine.correlate(
+                    &spectra,
+                    image,
+                    r.top_left.0,
+                    r.top_left.1,
+                    guess,
+                    max_iterations,
+                )
+            };
+            // SAFETY: each node is written by exactly one item of the job.
+            unsafe { results.write(k, result) };
+        };
+        if self.settings.guess == GuessMode::Correli || use_previous {
+            self.pool.run(self.mesh.len(), &|engine, k| {
+                correlate_node(engine, k, guesses[k])
+            });
+            return;
+        }
+        // Predict without a previous field: grow from the centre node, ring by ring; each node
+        // starts from the mean of its converged neighbours of inner rings.
+        let mesh = &self.mesh;
+        for ring in 0..mesh.rings() {
+            let members = &mesh.ring_order[mesh.ring_starts[ring]..mesh.ring_starts[ring + 1]];
+            self.pool.run(members.len(), &|engine, item| {
+                let k = members[item];
+                let (i, j) = ((k % mesh.nx) as i64, (k / mesh.nx) as i64);
+                let (mut su, mut sv, mut count) = (0.0, 0.0, 0.0);
+                for dj in -1..=1i64 {
+                    for di in -1..=1i64 {
+                        let (ii, jj) = (i + di, j + dj);
+                        if ii < 0 || jj < 0 || ii >= mesh.nx as i64 || jj >= mesh.ny as i64 {
+                            continue;
+                        }
+                        let nb = jj as usize * mesh.nx + ii as usize;
+                        if mesh.ring_of[nb] >= ring {
+                            continue;
+                        }
+                        // SAFETY: inner rings were finished by earlier jobs; this job writes only this ring.
+                        let result = unsafe { results.read(nb) };
+                        if result.status == NodeStatus::Ok {
+                            su += result.u_px;
+                            sv += result.v_px;
+                            count += 1.0;
+                        }
+                    }
+                }
+                let guess = if count > 0.0 {
+                    (su / count, sv / count)
+                } else {
+                    guesses[k]
+                };
+                correlate_node(engine, k, guess);
+            });
+        }
+    }
+
+    /// Results (against the current reference, at the ZOI centres) to total displacements at
+    /// the followed nodes, then strains and gauge.
+    fn assemble(&mut self) {
+        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
+        // First-order correction from the ZOI centre to the followed point: u(x + r) ≈ u(x) + ∇u r.
+        for k in 0..nx * ny {
+            let r = self.ref_nodes[k];
+            let result = self.results[k];
+            let mut u = (result.u_px, result.v_px);
+            if result.status == NodeStatus::Ok && (r.offset_px.0 != 0.0 || r.offset_px.1 != 0.0) {
+                if let Some(g) = self.result_gradient(k) {
+                    u.0 += g[(0, 0)] * r.offset_px.0 + g[(0, 1)] * r.offset_px.1;
+                    u.1 += g[(1, 0)] * r.offset_px.0 + g[(1, 1)] * r.offset_px.1;
+                }
+            }
+            self.scratch_pairs[k] = u;
+        }
+        let mut valid = 0usize;
+        let (mut su, mut sv) = (0.0, 0.0);
+        for k in 0..nx * ny {
+            let r = self.ref_nodes[k];
+            let result = self.results[k];
+            let node = &mut self.field.nodes[k];
+            let ok = result.status == NodeStatus::Ok;
+            node.u_px = if ok {
+                r.base_px.0 + self.scratch_pairs[k].0
+            } else {
+                0.0
+            };
+            node.v_px = if ok {
+                r.base_px.1 + self.scratch_pairs[k].1
+            } else {
+                0.0
+            };
+            node.score = if result.score.is_finite() {
+                result.score
+            } else {
+                0.0
+            };
+            node.iterations = result.iterations;
+            node.status = result.status;
+            if ok {
+                valid += 1;
+                su += node.u_px;
+                sv += node.v_px;
+            }
+        }
+        self.field.valid = valid;
+        self.field.u_mean_px = if valid > 0 { su / valid as f64 } else { 0.0 };
+        self.field.v_mean_px = if valid > 0 { sv / valid as f64 } else { 0.0 };
+        node_strains(
+            &mut self.field.nodes,
+            nx,
+            ny,
+            self.settings.strain_window_nodes,
+            self.settings.strain,
+        );
+        self.field.gauge = gauge(&self.field.nodes);
+        for (p, node) in self.previous.iter_mut().zip(&self.field.nodes) {
+            *p = (node.status == NodeStatus::Ok).then_some((node.u_px, node.v_px));
+        }
+        self.has_previous = true;
+    }
+
+    /// Least-squares gradient of the current results over the 3x3 nodes around k (ZOI centres).
+    fn result_gradient(&self, k: usize) -> Option<nalgebra::Matrix2<f64>> {
+        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
+        let (i, j) = (k % nx, k / nx);
+        let n = self.settings.zoi_px;
+        let mut sums = AffineSums::default();
+        for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
+            for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
+                let m = jj * nx + ii;
+                if self.results[m].status != NodeStatus::Ok {
+                    continue;
+                }
+                let (a, b) = (self.ref_nodes[m].top_left, self.ref_nodes[k].top_left);
+                let _ = n;
+                sums.add(
+                    a.0 as f64 - b.0 as f64,
+                    a.1 as f64 - b.1 as f64,
+                    self.results[m].u_px,
+                    self.results[m].v_px,
+                );
+            }
+        }
+        sums.gradient()
+    }
+
+    fn update_reference(&mut self, pixels: &[u16]) {
+        self.frames_since_reference += 1;
+        self.field.reference_updated = false;
+        let replace = match self.settings.reference {
+            ReferenceMode::Fixed => false,
+            ReferenceMode::Incremental => true,
+            ReferenceMode::Auto {
+                max_displacement_zoi_fraction,
+                min_mean_score,
+            } => {
+                let limit = max_displacement_zoi_fraction * self.settings.zoi_px as f64;
+                let (mut largest, mut score_sum, mut count) = (0.0f64, 0.0, 0.0);
+                for (k, result) in self.results.iter().enumerate() {
+                    if result.status == NodeStatus::Ok {
+                        let _ = k;
+                        largest = largest.max(result.u_px.abs()).max(result.v_px.abs());
+                        score_sum += result.score;
+                        count += 1.0;
+                    }
+                }
+                count > 0.0 && (largest > limit || score_sum / count < min_mean_score)
+            }
+        };
+        if !replace || self.field.valid == 0 {
+            return;
+        }
+        // New base = total displacement; nodes that failed take the mean of valid neighbours.
+        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
+        let mean = (self.field.u_mean_px, self.field.v_mean_px);
+        for k in 0..nx * ny {
+            let node = self.field.nodes[k];
+            self.scratch_pairs[k] = if node.status == NodeStatus::Ok {
+                (node.u_px, node.v_px)
+            } else {
+                let (i, j) = (k % nx, k / nx);
+                let (mut su, mut sv, mut c) = (0.0, 0.0, 0.0);
+                for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
+                    for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
+                        let nb = self.field.nodes[jj * nx + ii];
+                        if nb.status == NodeStatus::Ok {
+                            su += nb.u_px;
+                            sv += nb.v_px;
+                            c += 1.0;
+                        }
+                    }
+                }
+                if c > 0.0 {
+                    (su / c, sv / c)
+                } else {
+                    mean
+                }
+            };
+        }
+        for (r, &base) in self.ref_nodes.iter_mut().zip(&self.scratch_pairs) {
+            r.base_px = base;
+        }
+        self.take_reference(pixels);
+        self.field.reference_updated = true;
+    }
+
+    /// Sum of the engines' time splits (profiling must be switched on with `set_profiling`).
+    pub fn time_split(&self) -> TimeSplit {
+        let mut total = TimeSplit::default();
+        for i in 0..self.pool.threads() {
+            let s = self.pool.engine(i).split;
+            total.fft_ns += s.fft_ns;
+            total.window_ns += s.window_ns;
+            total.peak_ns += s.peak_ns;
+            total.shift_ns += s.shift_ns;
+            total.other_ns += s.other_ns;
+        }
+        total
+    }
+
+    /// Switches the per-engine time split on or off and resets it (benchmark only: reads the clock in the hot loop).
+    pub fn set_profiling(&mut self, on: bool) {
+        for i in 0..self.pool.threads() {
+            let mut engine = self.pool.engine(i);
+            engine.profile = on;
+            engine.split = TimeSplit::default();
+        }
+    }
+}

@@ -1,0 +1,81 @@
+//! Square 2-D complex FFT built from rustfft 1-D plans, planned once, with owned scratch.
+//!
+//! Forward output is stored transposed (`spectrum[kx * n + ky]`), which saves two transposes
+//! per forward/inverse pair; the inverse takes that layout and returns row-major `[y * n + x]`.
+//! Products of spectra are element-wise, so the layout never matters to callers that only
+//! multiply spectra of the same `Fft2d` and use `frequency_index` for phase ramps.
+
+use rustfft::num_complex::Complex32;
+use rustfft::{Fft, FftPlanner};
+use std::sync::Arc;
+
+pub struct Fft2d {
+    n: usize,
+    forward: Arc<dyn Fft<f32>>,
+    inverse: Arc<dyn Fft<f32>>,
+    scratch: Vec<Complex32>,
+    transposed: Vec<Complex32>,
+}
+
+impl Fft2d {
+    pub fn new(n: usize) -> Self {
+        assert!(n.is_power_of_two() && n >= 2);
+        let mut planner = FftPlanner::<f32>::new();
+        let forward = planner.plan_fft_forward(n);
+        let inverse = planner.plan_fft_inverse(n);
+        let scratch_len = forward
+            .get_inplace_scratch_len()
+            .max(inverse.get_inplace_scratch_len())
+            .max(1);
+        Self {
+            n,
+            forward,
+            inverse,
+            scratch: vec![Complex32::new(0.0, 0.0); scratch_len],
+            transposed: vec![Complex32::new(0.0, 0.0); n * n],
+        }
+    }
+
+    /// Row-major image in, transposed spectrum out (in place).
+    pub fn forward(&mut self, data: &mut [Complex32]) {
+        assert_eq!(data.len(), self.n * self.n);
+        self.forward.process_with_scratch(data, &mut self.scratch);
+        transpose(data, &mut self.transposed, self.n);
+        self.forward
+            .process_with_scratch(&mut self.transposed, &mut self.scratch);
+        data.copy_from_slice(&self.transposed);
+    }
+
+    /// Transposed spectrum in, row-major image out (in place), unnormalised (times n²).
+    pub fn inverse(&mut self, data: &mut [Complex32]) {
+        assert_eq!(data.len(), self.n * self.n);
+        self.inverse.process_with_scratch(data, &mut self.scratch);
+        transpose(data, &mut self.transposed, self.n);
+        self.inverse
+            .process_with_scratch(&mut self.transposed, &mut self.scratch);
+        data.copy_from_slice(&self.transposed);
+    }
+}
+
+/// Signed frequency of DFT bin k (Nyquist bin counted as +n/2).
+#[inline]
+pub fn signed_frequency(k: usize, n: usize) -> f32 {
+    if k <= n / 2 {
+        k as f32
+    } else {
+        k as f32 - n as f32
+    }
+}
+
+fn transpose(src: &[Complex32], dst: &mut [Complex32], n: usize) {
+    const BLOCK: usize = 8;
+    for by in (0..n).step_by(BLOCK) {
+        for bx in (0..n).step_by(BLOCK) {
+            for y in by..(by + BLOCK).min(n) {
+                for x in bx..(bx + BLOCK).min(n) {
+                    dst[x * n + y] = src[y * n + x];
+                }
+            }
+        }
+    }
+}

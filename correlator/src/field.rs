@@ -1,0 +1,99 @@
+//! The result of one correlation: nodes of the mesh and gauge strains.
+
+use crate::settings::StrainMeasure;
+
+/// What happened at one node. Never NaN: a node that could not be measured says why.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum NodeStatus {
+    /// Converged: displacement and score are meaningful.
+    Ok,
+    /// The integer search did not settle or the sub-pixel iterations hit the cap.
+    NotConverged,
+    /// The reference or deformed ZOI has (almost) no grey-level variation.
+    LowContrast,
+    /// The deformed ZOI left the image.
+    #[default]
+    OutsideImage,
+}
+
+impl NodeStatus {
+    pub fn word(self) -> &'static str {
+        match self {
+            Self::Ok => "ok",
+            Self::NotConverged => "not_converged",
+            Self::LowContrast => "low_contrast",
+            Self::OutsideImage => "outside_image",
+        }
+    }
+}
+
+/// In-plane strain components (engineering strain, dimensionless; exy is the tensor component).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Strain2 {
+    pub exx: f64,
+    pub eyy: f64,
+    pub exy: f64,
+}
+
+/// Average strain over the ROI in the four measures (CORRELI-GAUGE, see `strain::gauge`).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct GaugeStrains {
+    pub small: Strain2,
+    pub green: Strain2,
+    pub nominal: Strain2,
+    pub log: Strain2,
+}
+
+impl GaugeStrains {
+    pub fn get(&self, measure: StrainMeasure) -> Strain2 {
+        match measure {
+            StrainMeasure::Small => self.small,
+            StrainMeasure::Green => self.green,
+            StrainMeasure::Nominal => self.nominal,
+            StrainMeasure::Log => self.log,
+        }
+    }
+}
+
+/// One node of the mesh: ZOI centre in the reference image given to `set_reference`
+/// (px, x = column, y = row, origin at the centre of the top-left pixel) and its displacement.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Node {
+    pub x_px: f64,
+    pub y_px: f64,
+    pub u_px: f64,
+    pub v_px: f64,
+    /// Strain of the chosen measure (zero where the node or its window is invalid).
+    pub exx: f64,
+    pub eyy: f64,
+    pub exy: f64,
+    /// Zero-normalised cross-correlation of the windowed ZOIs at the final position, -1..=1.
+    pub score: f64,
+    /// Sub-pixel Fourier-shift iterations done.
+    pub iterations: u32,
+    pub status: NodeStatus,
+}
+
+/// A displacement and strain field on a regular mesh of `nx` x `ny` nodes (row-major, x fastest).
+#[derive(Clone, Debug, Default)]
+pub struct Field {
+    pub nx: usize,
+    pub ny: usize,
+    pub nodes: Vec<Node>,
+    pub gauge: GaugeStrains,
+    /// Nodes with status Ok.
+    pub valid: usize,
+    /// Mean u, v over valid nodes (px; 0 when none).
+    pub u_mean_px: f64,
+    pub v_mean_px: f64,
+    /// Global integer ROI displacement (U0, V0) of this frame against its reference (px).
+    pub global_px: (i64, i64),
+    /// True when the reference was replaced after this frame (auto and incremental modes).
+    pub reference_updated: bool,
+}
+
+impl Field {
+    pub fn node(&self, i: usize, j: usize) -> &Node {
+        &self.nodes[j * self.nx + i]
+    }
+}

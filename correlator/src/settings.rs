@@ -1,0 +1,298 @@
+//! User settings of the correlator and their validation.
+
+use thiserror::Error;
+
+/// Region of interest in the reference image, in pixels (x = column, y = row of the top-left pixel).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Roi {
+    pub x_px: usize,
+    pub y_px: usize,
+    pub width_px: usize,
+    pub height_px: usize,
+}
+
+/// Strain measure of the per-node strains (the gauge gives all four).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum StrainMeasure {
+    /// Infinitesimal strain, sym(grad u).
+    Small,
+    /// Green-Lagrange, eq. (13) with m = 1.
+    Green,
+    /// Nominal (Biot), eq. (13) with m = 1/2.
+    Nominal,
+    /// Logarithmic (Hencky), eq. (13) with m = 0: the paper's default.
+    #[default]
+    Log,
+}
+
+impl StrainMeasure {
+    pub const ALL: [StrainMeasure; 4] = [Self::Small, Self::Green, Self::Nominal, Self::Log];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Small => "small",
+            Self::Green => "green",
+            Self::Nominal => "nominal",
+            Self::Log => "log",
+        }
+    }
+}
+
+/// Which image the deformed images are compared with.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum ReferenceMode {
+    /// The reference given to `set_reference` stays for every frame.
+    #[default]
+    Fixed,
+    /// Each frame is correlated with the previous one; displacements accumulate on the followed mesh.
+    Incremental,
+    /// The reference is replaced by the current frame (mesh followed) when the displacement since
+    /// the reference exceeds `max_displacement_zoi_fraction` of the ZOI size or the mean score drops
+    /// below `min_mean_score`.
+    Auto {
+        max_displacement_zoi_fraction: f64,
+        min_mean_score: f64,
+    },
+}
+
+impl ReferenceMode {
+    /// Auto update with the defaults: a quarter of the ZOI, mean score 0.5.
+    pub const AUTO_DEFAULT: ReferenceMode = ReferenceMode::Auto {
+        max_displacement_zoi_fraction: 0.25,
+        min_mean_score: 0.5,
+    };
+}
+
+/// Initial guess of each ZOI before its integer FFT correlation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum GuessMode {
+    /// The paper: every ZOI starts from the global ROI displacement (U0, V0).
+    Correli,
+    /// Beyond the paper: the previous frame's field when there is one, otherwise grow from the
+    /// centre node outwards, each ring starting from its converged inner neighbours.
+    #[default]
+    Predict,
+}
+
+/// Everything the correlator needs to know before the first frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CorrelatorSettings {
+    /// ZOI side 2^s in pixels (a power of two, 8 to 256).
+    pub zoi_px: usize,
+    /// Distance between neighbouring ZOI centres, delta x = delta y, 1 ..= zoi_px.
+    pub step_px: usize,
+    /// Region of interest; `None` = the largest centred 2^p square (the paper).
+    pub roi: Option<Roi>,
+    /// Measure of the per-node strains.
+    pub strain: StrainMeasure,
+    pub reference: ReferenceMode,
+    pub guess: GuessMode,
+    /// Worker threads including the calling thread (1 ..= 64).
+    pub threads: usize,
+    /// Cap of the sub-pixel Fourier-shift iterations per ZOI (1 ..= 100).
+    pub max_iterations: u32,
+    /// Half-width, in nodes, of the least-squares window of the displacement gradient
+    /// (1 = 3x3 nodes).
+    pub strain_window_nodes: usize,
+}
+
+impl Default for CorrelatorSettings {
+    fn default() -> Self {
+        Self {
+            zoi_px: 32,
+            step_px: 16,
+            roi: None,
+            strain: StrainMeasure::Log,
+            reference: ReferenceMode::Fixed,
+            guess: GuessMode::Predict,
+            threads: 2,
+            max_iterations: 10,
+            strain_window_nodes: 1,
+        }
+    }
+}
+
+/// Why settings or an image were refused.
+#[derive(Debug, Error, PartialEq)]
+pub enum SettingsError {
+    #[error("ZOI size {zoi_px} px is not a power of two: use {nearest} px (CORRELI-GD needs 2^s)")]
+    ZoiNotPowerOfTwo { zoi_px: usize, nearest: usize },
+    #[error("ZOI size {zoi_px} px is out of range: expected a power of two from 8 to 256 px")]
+    ZoiOutOfRange { zoi_px: usize },
+    #[error("step {step_px} px is invalid: expected 1 ..= ZOI size ({zoi_px} px)")]
+    Step { step_px: usize, zoi_px: usize },
+    #[error("threads {threads} is invalid: expected 1 ..= 64")]
+    Threads { threads: usize },
+    #[error("max_iterations {max_iterations} is invalid: expected 1 ..= 100")]
+    MaxIterations { max_iterations: u32 },
+    #[error("strain window half-width {nodes} is invalid: expected 1 ..= 8 nodes")]
+    StrainWindow { nodes: usize },
+    #[error("image {width_px}x{height_px} px is too small: expected at least 16x16 px")]
+    ImageTooSmall { width_px: usize, height_px: usize },
+    #[error("ROI {roi:?} does not fit in the {width_px}x{height_px} px image")]
+    RoiOutside {
+        roi: Roi,
+        width_px: usize,
+        height_px: usize,
+    },
+    #[error("ZOI {zoi_px} px is larger than the ROI ({roi_width_px}x{roi_height_px} px): choose a smaller --zoi or a larger ROI")]
+    ZoiLargerThanRoi {
+        zoi_px: usize,
+        roi_width_px: usize,
+        roi_height_px: usize,
+    },
+    #[error("{what} image has {got} pixels, expected {expected} ({width_px}x{height_px} px, the size given to Correlator::new): images must all have the same size")]
+    ImageSize {
+        what: &'static str,
+        got: usize,
+        expected: usize,
+        width_px: usize,
+        height_px: usize,
+    },
+    #[error("correlate called before set_reference")]
+    NoReference,
+    #[error("auto reference thresholds invalid: expected 0 < displacement fraction <= 0.5 and 0 <= score < 1")]
+    AutoThresholds,
+}
+
+/// Nearest power of two (ties go up), for the error message.
+pub fn nearest_power_of_two(n: usize) -> usize {
+    let n = n.max(1);
+    let up = n.next_power_of_two();
+    let down = up / 2;
+    if down >= 1 && n - down < up - n {
+        down
+    } else {
+        up
+    }
+}
+
+impl CorrelatorSettings {
+    /// Checks the settings alone (no image size yet).
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        if !self.zoi_px.is_power_of_two() {
+            return Err(SettingsError::ZoiNotPowerOfTwo {
+                zoi_px: self.zoi_px,
+                nearest: nearest_power_of_two(self.zoi_px).clamp(8, 256),
+            });
+        }
+        if !(8..=256).contains(&self.zoi_px) {
+            return Err(SettingsError::ZoiOutOfRange {
+                zoi_px: self.zoi_px,
+            });
+        }
+        if self.step_px == 0 || self.step_px > self.zoi_px {
+            return Err(SettingsError::Step {
+                step_px: self.step_px,
+                zoi_px: self.zoi_px,
+            });
+        }
+        if !(1..=64).contains(&self.threads) {
+            return Err(SettingsError::Threads {
+                threads: self.threads,
+            });
+        }
+        if !(1..=100).contains(&self.max_iterations) {
+            return Err(SettingsError::MaxIterations {
+                max_iterations: self.max_iterations,
+            });
+        }
+        if !(1..=8).contains(&self.strain_window_nodes) {
+            return Err(SettingsError::StrainWindow {
+                nodes: self.strain_window_nodes,
+            });
+        }
+        if let ReferenceMode::Auto {
+            max_displacement_zoi_fraction,
+            min_mean_score,
+        } = self.reference
+        {
+            let fraction_ok =
+                max_displacement_zoi_fraction > 0.0 && max_displacement_zoi_fraction <= 0.5;
+            let score_ok = (0.0..1.0).contains(&min_mean_score);
+            if !fraction_ok || !score_ok {
+                return Err(SettingsError::AutoThresholds);
+            }
+        }
+        Ok(())
+    }
+
+    /// The ROI used for an image of this size: the user's, or the largest centred 2^p square.
+    pub fn resolve_roi(&self, width_px: usize, height_px: usize) -> Result<Roi, SettingsError> {
+        if width_px < 16 || height_px < 16 {
+            return Err(SettingsError::ImageTooSmall {
+                width_px,
+                height_px,
+            });
+        }
+        let roi = match self.roi {
+            Some(roi) => {
+                let fits = roi.width_px > 0
+                    && roi.height_px > 0
+                    && roi.x_px + roi.width_px <= width_px
+                    && roi.y_px + roi.height_px <= height_px;
+                if !fits {
+                    return Err(SettingsError::RoiOutside {
+                        roi,
+                        width_px,
+                        height_px,
+                    });
+                }
+                roi
+            }
+            None => centred_power_of_two_square(width_px, height_px),
+        };
+        if self.zoi_px > roi.width_px || self.zoi_px > roi.height_px {
+            return Err(SettingsError::ZoiLargerThanRoi {
+                zoi_px: self.zoi_px,
+                roi_width_px: roi.width_px,
+                roi_height_px: roi.height_px,
+            });
+        }
+        Ok(roi)
+    }
+}
+
+/// The largest 2^p x 2^p square centred in a width x height image.
+pub fn centred_power_of_two_square(width_px: usize, height_px: usize) -> Roi {
+    let side = width_px.min(height_px);
+    assert!(side >= 1);
+    let p2 = if side.is_power_of_two() {
+        side
+    } else {
+        side.next_power_of_two() / 2
+    };
+    Roi {
+        x_px: (width_px - p2) / 2,
+        y_px: (height_px - p2) / 2,
+        width_px: p2,
+        height_px: p2,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nearest_power() {
+        assert_eq!(nearest_power_of_two(30), 32);
+        assert_eq!(nearest_power_of_two(40), 32);
+        assert_eq!(nearest_power_of_two(48), 64);
+        assert_eq!(nearest_power_of_two(1), 1);
+    }
+
+    #[test]
+    fn centred_square() {
+        let roi = centred_power_of_two_square(2048, 589);
+        assert_eq!(
+            roi,
+            Roi {
+                x_px: 768,
+                y_px: 38,
+                width_px: 512,
+                height_px: 512
+            }
+        );
+    }
+}
