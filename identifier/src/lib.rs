@@ -7,11 +7,13 @@
 //! - [`fit`]: fitting a model to any combination of load cases, statistics, ranking by AIC.
 //! - [`stability`]: Drucker stability along the load paths.
 //! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
+//! - [`plot`]: PNG plots of the data, fits, f(I1) and g(I2) (plotters, bitmap backend).
 
 pub mod data;
 pub mod fit;
 pub mod law;
 pub mod lsq;
 pub mod models;
+pub mod plot;
 pub mod route;
 pub mod stability;

@@ -1,0 +1,312 @@
+//! PNG plots: data and fitted curves per load case, and the paper's f(I1) (Fig. 8) and
+//! g(I2) (Fig. 14) plots. Text uses a TrueType font read at run time from the usual system
+//! locations (DejaVu, Liberation); without one, the plots are drawn without text.
+
+use crate::data::{Curve, LoadCase};
+use crate::fit::Fit;
+use crate::law::InvariantFn;
+use crate::route::RouteResult;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// Fits drawn per plot (best AIC first).
+pub const MAX_FITS_PLOTTED: usize = 6;
+const SIZE_PX: (u32, u32) = (1000, 700);
+const CURVE_SAMPLES: usize = 200;
+const FONT_CANDIDATES: [&str; 4] = [
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+];
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+];
+
+/// A plotting error naming the file.
+#[derive(Debug)]
+pub struct PlotError(pub String);
+
+impl std::fmt::Display for PlotError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for PlotError {}
+
+/// Registers a system font once; true if text can be drawn.
+pub fn text_available() -> bool {
+    static AVAILABLE: OnceLock<bool> = OnceLock::new();
+    *AVAILABLE.get_or_init(|| {
+        for path in FONT_CANDIDATES {
+            if let Ok(bytes) = std::fs::read(path) {
+                let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+                if plotters::style::register_font("sans-serif", FontStyle::Normal, bytes).is_ok() {
+                    return true;
+                }
+            }
+        }
+        false
+    })
+}
+
+/// A fitted invariant function with its legend label.
+type LabelledFn = (String, InvariantFn);
+
+struct Series {
+    label: String,
+    points: Vec<(f64, f64)>,
+    /// Markers (data) rather than a line (model).
+    markers: bool,
+}
+
+fn chart(
+    path: &Path,
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[Series],
+) -> Result<(), PlotError> {
+    let err = |e: &dyn std::fmt::Display| PlotError(format!("{}: {e}", path.display()));
+    let finite = series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| p.0.is_finite() && p.1.is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in finite {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 >= x1 || y0 > y1 {
+        return Err(PlotError(format!("{}: nothing to plot", path.display())));
+    }
+    let pad = 0.05 * (y1 - y0).max(1e-9);
+    let text = text_available();
+    let root = BitMapBackend::new(path, SIZE_PX).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut builder = ChartBuilder::on(&root);
+    builder.margin(20);
+    if text {
+        builder
+            .caption(title, ("sans-serif", 24))
+            .x_label_area_size(45)
+            .y_label_area_size(70);
+    }
+    let mut chart = builder
+        .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
+        .map_err(|e| err(&e))?;
+    if text {
+        chart
+            .configure_mesh()
+            .x_desc(x_desc)
+            .y_desc(y_desc)
+            .draw()
+            .map_err(|e| err(&e))?;
+    } else {
+        let area = chart.plotting_area();
+        area.draw(&Rectangle::new(
+            [(x0, y0 - pad), (x1, y1 + pad)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(|e| err(&e))?;
+    }
+    for (k, s) in series.iter().enumerate() {
+        let color = if s.markers {
+            BLACK
+        } else {
+            PALETTE[k % PALETTE.len()]
+        };
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect();
+        let drawn = if s.markers {
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                .map_err(|e| err(&e))?
+        } else {
+            chart
+                .draw_series(LineSeries::new(pts, color.stroke_width(2)))
+                .map_err(|e| err(&e))?
+        };
+        if text {
+            drawn.label(s.label.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+            });
+        }
+    }
+    if text {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 16))
+            .draw()
+            .map_err(|e| err(&e))?;
+    }
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+fn sample(from: f64, to: f64) -> impl Iterator<Item = f64> {
+    (0..=CURVE_SAMPLES).map(move |k| from + (to - from) * k as f64 / CURVE_SAMPLES as f64)
+}
+
+/// Writes `stress_<case>.png` per load case, `f_I1.png` and `g_I2.png` into `dir`; returns the paths.
+pub fn write_plots(
+    dir: &Path,
+    curves: &[Curve],
+    fits: &[Fit],
+    route: Option<&RouteResult>,
+) -> Result<Vec<PathBuf>, PlotError> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| PlotError(format!("{}: cannot create the folder: {e}", dir.display())))?;
+    let mut written = Vec::new();
+    let shown = &fits[..fits.len().min(MAX_FITS_PLOTTED)];
+    for curve in curves {
+        let max_stretch = curve.stretch.last().copied().unwrap_or(1.0);
+        let mut series = vec![Series {
+            label: format!("{} data", curve.case),
+            points: curve
+                .stretch
+                .iter()
+                .copied()
+                .zip(curve.nominal_stress_mpa.iter().copied())
+                .collect(),
+            markers: true,
+        }];
+        for fit in shown {
+            let points = sample(1.0, max_stretch)
+                .filter_map(|l| {
+                    fit.model
+                        .nominal_stress_mpa(&fit.params, curve.case, l)
+                        .map(|p| (l, p))
+                })
+                .collect();
+            series.push(Series {
+                label: fit.model.name(),
+                points,
+                markers: false,
+            });
+        }
+        let path = dir.join(format!("stress_{}.png", curve.case));
+        chart(
+            &path,
+            &format!("{} tension", curve.case),
+            "stretch",
+            "nominal stress (MPa)",
+            &series,
+        )?;
+        written.push(path);
+    }
+    // f(I1) along the uniaxial path and g(I2) along the equibiaxial path (Figs 8 and 14).
+    let invariant_fits: Vec<&Fit> = shown
+        .iter()
+        .filter(|f| {
+            f.model
+                .invariant_derivatives_mpa(&f.params, 3.0, 3.0)
+                .is_some()
+        })
+        .collect();
+    for (case, which, name) in [
+        (LoadCase::Uniaxial, 0, "f_I1"),
+        (LoadCase::Equibiaxial, 1, "g_I2"),
+    ] {
+        let Some(curve) = curves.iter().find(|c| c.case == case) else {
+            continue;
+        };
+        let max_stretch = curve.stretch.last().copied().unwrap_or(1.0);
+        let mut series = Vec::new();
+        if let Some(r) = route {
+            let (points, label, fitted): (&Vec<(f64, f64)>, &str, Vec<LabelledFn>) = if which == 0 {
+                (
+                    &r.f_points,
+                    "f from eq. 19 (g-corrected)",
+                    vec![(
+                        "ln f = Σ a_i (I1-3)^i".into(),
+                        InvariantFn::ExpPoly(r.a.clone()),
+                    )],
+                )
+            } else {
+                (
+                    &r.g_points,
+                    "g from eq. 23",
+                    vec![
+                        (
+                            "g = exp Σ b_i (I2-3)^i".into(),
+                            InvariantFn::ExpPoly(r.b.clone()),
+                        ),
+                        (
+                            "g = Σ c_i / I2^i".into(),
+                            InvariantFn::InversePower(r.c.clone()),
+                        ),
+                    ],
+                )
+            };
+            series.push(Series {
+                label: label.into(),
+                points: points.clone(),
+                markers: true,
+            });
+            if which == 0 {
+                series.push(Series {
+                    label: "f from eq. 20 (no g)".into(),
+                    points: r.f_points_uncorrected.clone(),
+                    markers: true,
+                });
+            }
+            for (label, func) in fitted {
+                let points = sample(1.0 + 1e-3, max_stretch)
+                    .map(|l| {
+                        let (i1, i2) = case.invariants(l);
+                        let inv = if which == 0 { i1 } else { i2 };
+                        (inv, func.value_mpa(inv))
+                    })
+                    .collect();
+                series.push(Series {
+                    label,
+                    points,
+                    markers: false,
+                });
+            }
+        }
+        for fit in &invariant_fits {
+            let points = sample(1.0 + 1e-3, max_stretch)
+                .filter_map(|l| {
+                    let (i1, i2) = case.invariants(l);
+                    let (w1, w2) = fit.model.invariant_derivatives_mpa(&fit.params, i1, i2)?;
+                    Some(if which == 0 { (i1, w1) } else { (i2, w2) })
+                })
+                .collect();
+            series.push(Series {
+                label: fit.model.name(),
+                points,
+                markers: false,
+            });
+        }
+        if series.is_empty() {
+            continue;
+        }
+        let path = dir.join(format!("{name}.png"));
+        let (title, x, y) = if which == 0 {
+            ("f(I1) = dW/dI1 along the uniaxial path", "I1", "f (MPa)")
+        } else {
+            ("g(I2) = dW/dI2 along the equibiaxial path", "I2", "g (MPa)")
+        };
+        chart(&path, title, x, y, &series)?;
+        written.push(path);
+    }
+    Ok(written)
+}
