@@ -15,12 +15,15 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     // One variant per subcommand; keep one line each so parallel edits stay simple.
+    /// Fit hyperelastic potentials to uniaxial/equibiaxial/pure-shear CSV data (offline).
+    Identify(cmd::identify::IdentifyArgs),
 }
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
         // One arm per subcommand.
+        Command::Identify(args) => cmd::identify::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -1,1 +1,3 @@
 //! The subcommands of `dicstream`, one module each.
+
+pub mod identify;
