@@ -5,12 +5,23 @@
 
 mod error;
 mod image_io;
+pub mod motion;
 mod natural_sort;
+pub mod parallel;
+mod render_exact;
+mod render_fast;
 mod replay;
+mod scenario;
 mod source;
+pub mod speckle;
 
 pub use error::ProducerError;
 pub use image_io::{decode_into, read_image, read_shape, Image16, ImageShape};
+pub use motion::{Affine, Bulge, Chirp, Motion};
 pub use natural_sort::natural_cmp;
+pub use render_exact::{gauss_legendre, ExactRenderer};
+pub use render_fast::FastRenderer;
 pub use replay::{list_images, Replay, IMAGE_EXTENSIONS};
+pub use scenario::{Scenario, ScenarioKind, SCENARIO_NAMES};
 pub use source::{FrameDims, FrameInfo, FrameSource, Truth};
+pub use speckle::{Speckle, SpeckleParams};
