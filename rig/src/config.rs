@@ -1,35 +1,52 @@
-//! Configuration of a rig run: sampling, plant parameters, gains.
+//! Configuration of a rig run: sampling, plant parameters, gains, specimen, limits.
 
 use crate::control::ControlGains;
 use crate::hydraulics::ACTUATOR_COUNT;
+use crate::limits::{ChannelLimits, LimitActions, Limits};
 use crate::params::ActuatorParams;
+use crate::specimen::SpecimenConfig;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct RigConfig {
     /// Control rate of the digital controller (Schenck-class: 5 kHz).
     pub control_hz: f64,
-    /// Plant sub-steps per control period (4 ⇒ 20 kHz plant, ω·h ≤ 0.06 at 144 Hz).
+    /// Plant sub-steps per control period (4 ⇒ 20 kHz plant, ω·h ≈ 0.05 at 144 Hz).
     pub plant_substeps: u32,
     pub actuators: [ActuatorParams; ACTUATOR_COUNT],
     pub gains: ControlGains,
     /// Standard deviation of the spool null bias drawn per actuator from the seed (fraction of
     /// full opening). Real valves are nulled to a fraction of a percent.
     pub spool_bias_std: f64,
-    /// Load-cell noise, standard deviation (kN).
+    /// Load-cell noise, standard deviation (kN): ≈0.002 % of the 100 kN range.
     pub load_cell_noise_kn: f64,
+    /// The sheet between the X and Y grips; None for an empty machine.
+    pub specimen: Option<SpecimenConfig>,
+    pub limits: Limits,
+    /// Break detector: a pair force that falls below half its 20 ms running mean, once that
+    /// mean exceeds this level, is a break.
+    pub break_detect_min_kn: f64,
 }
 
 impl Default for RigConfig {
     fn default() -> Self {
         let h = ActuatorParams::horizontal();
         let v = ActuatorParams::vertical();
+        let actuators = [h, h, h, h, v, v];
+        let channels =
+            actuators.map(|a| ChannelLimits::for_actuator(a.half_stroke_mm(), a.rated_force_kn));
         RigConfig {
             control_hz: 5000.0,
             plant_substeps: 4,
-            actuators: [h, h, h, h, v, v],
+            actuators,
             gains: ControlGains::default_for_machine(),
             spool_bias_std: 0.002,
             load_cell_noise_kn: 0.002,
+            specimen: Some(SpecimenConfig::default()),
+            limits: Limits {
+                channels,
+                actions: LimitActions::default(),
+            },
+            break_detect_min_kn: 0.05,
         }
     }
 }
@@ -67,6 +84,15 @@ impl RigConfig {
                 self.load_cell_noise_kn
             ));
         }
-        Ok(())
+        if !(self.break_detect_min_kn.is_finite() && self.break_detect_min_kn > 0.0) {
+            return Err(format!(
+                "break_detect_min_kn {} is not > 0",
+                self.break_detect_min_kn
+            ));
+        }
+        if let Some(specimen) = &self.specimen {
+            specimen.validate()?;
+        }
+        self.limits.validate()
     }
 }

@@ -275,6 +275,13 @@ impl Controller {
         }
     }
 
+    /// Follow-up while the hydraulics are off: set-points track the feedback and the loop
+    /// outputs restart from zero, so that pressure returns without a jump.
+    pub fn track(&mut self, feedback: &Feedback) {
+        self.output = [0.0; ACTUATOR_COUNT];
+        self.hold_all(feedback);
+    }
+
     /// Everything to displacement, independent, holding the present position (the action on
     /// a specimen break).
     pub fn displacement_hold(&mut self, feedback: &Feedback) {

@@ -25,6 +25,8 @@ pub enum Refusal {
     ProgramRunning,
     /// No program is loaded, running or held, as the command needs.
     NoProgram { expected: &'static str },
+    /// A latched limit trip (bit set of `RigSnapshot::limits_tripped`); reset limits first.
+    LimitTripped { bits: u32 },
     /// The command is malformed (parse errors of program files and the like).
     Invalid { reason: String },
 }
@@ -53,6 +55,12 @@ impl fmt::Display for Refusal {
             }
             Refusal::ProgramRunning => write!(f, "a program is running: hold or stop it first"),
             Refusal::NoProgram { expected } => write!(f, "no program {expected}"),
+            Refusal::LimitTripped { bits } => {
+                write!(
+                    f,
+                    "limits are tripped (bits {bits:#010x}): reset limits first"
+                )
+            }
             Refusal::Invalid { reason } => write!(f, "invalid command: {reason}"),
         }
     }

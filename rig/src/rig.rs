@@ -1,18 +1,28 @@
 //! The rig: hydraulics, controller, specimen, programs and limits, stepped at the control rate
 //! in simulated time. One `step()` is one control period; no allocation inside it.
+//!
+//! Order within a step: program set-points → controller (feedback of the previous step) →
+//! plant with the valve commands of the previous step (one sample of delay) → specimen forces →
+//! sensors (seeded load-cell noise) → snapshot → detectors and their actions.
 
 use crate::actuator::Actuator;
 use crate::config::RigConfig;
 use crate::control::{AxisControl, ControlMode, Controller, Feedback};
 use crate::hydraulics::{Hydraulics, ACTUATOR_COUNT};
 use crate::ids::{ActuatorId, Axis, Channel};
+use crate::limits::{
+    violations, ChannelLimits, ChannelSignals, LimitAction, LimitActions, LimitKind,
+    EMERGENCY_STOP_BIT, SPECIMEN_BREAK_BIT,
+};
+use crate::program::{Program, Run, StopTransition};
 use crate::refusal::Refusal;
-use crate::snapshot::RigSnapshot;
+use crate::snapshot::{ProgramStatus, RigSnapshot, SpecimenKinematics};
+use crate::specimen::Specimen;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-/// What an operator, a program shell or a test asks of the rig.
+/// What an operator, a process shell or a test asks of the rig.
 #[derive(Clone, Debug, PartialEq)]
 pub enum RigCommand {
     /// New set-point of an active channel (mm or kN by its mode), applied as a step.
@@ -30,11 +40,28 @@ pub enum RigCommand {
         axis: Axis,
         control: AxisControl,
     },
+    /// Apply the program's setup (bumpless) and run it from the present set-points.
+    StartProgram(Box<Program>),
+    HoldProgram,
+    ResumeProgram,
+    /// Stop the program; None uses the program's own stop transition.
+    StopProgram {
+        transition: Option<StopTransition>,
+    },
+    SetLimits {
+        actuator: ActuatorId,
+        limits: ChannelLimits,
+    },
+    SetLimitActions(LimitActions),
+    /// Clear latched trips whose condition has cleared.
+    ResetLimits,
     HydraulicsOn,
     HydraulicsOff,
     /// Valves closed, supply off, program stopped; latched until `ResetEmergencyStop`.
     EmergencyStop,
     ResetEmergencyStop,
+    /// Tear the specimen now (to exercise the break detector).
+    BreakSpecimen,
 }
 
 pub struct Rig {
@@ -46,14 +73,23 @@ pub struct Rig {
     valve_delayed: [f64; ACTUATOR_COUNT],
     external_force_n: [f64; ACTUATOR_COUNT],
     feedback: Feedback,
+    specimen: Option<Specimen>,
+    kinematics: SpecimenKinematics,
     rng: ChaCha8Rng,
     hydraulics_on: bool,
     emergency_stop: bool,
+    run: Option<Run>,
+    program: ProgramStatus,
+    /// Latched trips (bits of `LimitKind::bit`, break and emergency stop).
+    tripped: u32,
+    /// 20 ms running mean of each pair force, for the break detector.
+    pair_force_mean_kn: [f64; 3],
     snapshot: RigSnapshot,
 }
 
 impl Rig {
-    /// A rig at rest, actuators at mid stroke, hydraulics on, displacement control holding.
+    /// A rig at rest, actuators at mid stroke (the specimen mounted there, unloaded),
+    /// hydraulics on, every actuator in displacement control holding its position.
     pub fn new(config: RigConfig, seed: u64) -> Result<Rig, Refusal> {
         config
             .validate()
@@ -64,22 +100,34 @@ impl Rig {
             let bias = (z * config.spool_bias_std).clamp(-0.05, 0.05);
             Actuator::new(config.actuators[i], 0.0, bias)
         });
-        let hydraulics = Hydraulics::new(actuators);
+        let specimen = match &config.specimen {
+            Some(c) => {
+                Some(Specimen::new(c.clone()).map_err(|reason| Refusal::Invalid { reason })?)
+            }
+            None => None,
+        };
         let feedback = Feedback::default();
         let controller = Controller::new(config.gains, &feedback);
         let mut rig = Rig {
             dt_s: config.dt_s(),
             config,
-            hydraulics,
+            hydraulics: Hydraulics::new(actuators),
             controller,
             valve_delayed: [0.0; ACTUATOR_COUNT],
             external_force_n: [0.0; ACTUATOR_COUNT],
             feedback,
+            specimen,
+            kinematics: SpecimenKinematics::default(),
             rng,
             hydraulics_on: true,
             emergency_stop: false,
+            run: None,
+            program: ProgramStatus::Idle,
+            tripped: 0,
+            pair_force_mean_kn: [0.0; 3],
             snapshot: RigSnapshot::default(),
         };
+        rig.load_specimen();
         rig.read_sensors();
         rig.publish();
         Ok(rig)
@@ -97,11 +145,22 @@ impl Rig {
         self.dt_s
     }
 
+    pub fn specimen(&self) -> Option<&Specimen> {
+        self.specimen.as_ref()
+    }
+
     /// One control period.
     pub fn step(&mut self) {
-        let outputs = *self.controller.update(&self.feedback, self.dt_s);
-        let supply_on = self.hydraulics_on;
-        let applied = if supply_on {
+        if self.program == ProgramStatus::Running || self.program == ProgramStatus::Stopped {
+            self.advance_program();
+        }
+        if self.hydraulics_on {
+            self.controller.update(&self.feedback, self.dt_s);
+        } else {
+            self.controller.track(&self.feedback);
+        }
+        let outputs = *self.controller.output();
+        let applied = if self.hydraulics_on {
             self.valve_delayed
         } else {
             [0.0; ACTUATOR_COUNT]
@@ -110,44 +169,111 @@ impl Rig {
             self.dt_s,
             self.config.plant_substeps,
             &applied,
-            supply_on,
+            self.hydraulics_on,
             &self.external_force_n,
         );
         self.valve_delayed = outputs;
         self.snapshot.step += 1;
+        self.load_specimen();
         self.read_sensors();
         self.publish();
+        self.detect();
     }
 
     /// Steps until the simulated time reaches `t_s` (bounded by the step count it implies).
     pub fn advance_to(&mut self, t_s: f64) {
-        assert!(t_s.is_finite());
+        assert!(t_s.is_finite() && t_s < 1.0e7, "advance_to({t_s})");
         let target_step = (t_s * self.config.control_hz).round().max(0.0) as u64;
         while self.snapshot.step < target_step {
             self.step();
         }
     }
 
+    /// Apply a command now (between steps); the snapshot shows its effect at once.
     pub fn command(&mut self, command: RigCommand) -> Result<(), Refusal> {
+        let result = self.apply(command);
+        self.publish();
+        result
+    }
+
+    fn apply(&mut self, command: RigCommand) -> Result<(), Refusal> {
         match command {
             RigCommand::SetSetpoint { channel, value } => {
                 if !value.is_finite() {
                     return Err(Refusal::NotFinite { what: "set-point" });
                 }
-                self.check_active(channel)?;
+                self.refuse_if_program_active()?;
+                let mode = self.check_active(channel)?;
+                self.check_level(channel, mode, value)?;
                 self.controller.set_setpoint(channel, value);
                 Ok(())
             }
             RigCommand::SetActuatorMode { actuator, mode } => {
-                let channel = Channel::Actuator(actuator);
-                self.check_active(channel)?;
+                self.refuse_if_program_active()?;
+                self.check_active(Channel::Actuator(actuator))?;
                 self.controller
                     .set_actuator_mode(actuator, mode, &self.feedback);
                 Ok(())
             }
             RigCommand::SetAxisControl { axis, control } => {
+                self.refuse_if_program_active()?;
                 self.controller
                     .set_axis_control(axis, control, &self.feedback);
+                Ok(())
+            }
+            RigCommand::StartProgram(program) => self.start_program(&program),
+            RigCommand::HoldProgram => {
+                if self.program != ProgramStatus::Running {
+                    return Err(Refusal::NoProgram {
+                        expected: "running",
+                    });
+                }
+                self.program = ProgramStatus::Held;
+                Ok(())
+            }
+            RigCommand::ResumeProgram => {
+                if self.program != ProgramStatus::Held {
+                    return Err(Refusal::NoProgram { expected: "held" });
+                }
+                self.refuse_if_unsafe()?;
+                self.program = ProgramStatus::Running;
+                Ok(())
+            }
+            RigCommand::StopProgram { transition } => {
+                if !matches!(self.program, ProgramStatus::Running | ProgramStatus::Held) {
+                    return Err(Refusal::NoProgram {
+                        expected: "running or held",
+                    });
+                }
+                let run = self.run.as_mut().expect("a running program has a run");
+                let transition = transition.unwrap_or(run.stop);
+                let rate = run.stop_rate_per_s;
+                run.stop(transition, rate);
+                self.program = ProgramStatus::Stopped;
+                Ok(())
+            }
+            RigCommand::SetLimits { actuator, limits } => {
+                limits
+                    .validate()
+                    .map_err(|reason| Refusal::Invalid { reason })?;
+                self.config.limits.channels[actuator.index()] = limits;
+                Ok(())
+            }
+            RigCommand::SetLimitActions(actions) => {
+                self.config.limits.actions = actions;
+                Ok(())
+            }
+            RigCommand::ResetLimits => {
+                // Only trips whose condition has cleared are reset.
+                let mut still = 0;
+                for id in ActuatorId::ALL {
+                    still |= violations(
+                        &self.config.limits.channels[id.index()],
+                        &self.signals(id),
+                        id.index(),
+                    );
+                }
+                self.tripped &= still | EMERGENCY_STOP_BIT;
                 Ok(())
             }
             RigCommand::HydraulicsOn => {
@@ -155,32 +281,243 @@ impl Rig {
                     return Err(Refusal::EmergencyStopLatched);
                 }
                 if !self.hydraulics_on {
-                    // Restart holding the present state: no jump when pressure returns.
-                    self.controller.hold_all(&self.feedback);
+                    self.controller.track(&self.feedback);
                     self.hydraulics_on = true;
                 }
                 Ok(())
             }
             RigCommand::HydraulicsOff => {
-                self.hydraulics_on = false;
+                self.hydraulics_off();
                 Ok(())
             }
             RigCommand::EmergencyStop => {
                 self.emergency_stop = true;
-                self.hydraulics_on = false;
+                self.tripped |= EMERGENCY_STOP_BIT;
+                self.hydraulics_off();
                 Ok(())
             }
             RigCommand::ResetEmergencyStop => {
                 self.emergency_stop = false;
+                self.tripped &= !EMERGENCY_STOP_BIT;
                 Ok(())
             }
+            RigCommand::BreakSpecimen => match self.specimen.as_mut() {
+                Some(specimen) => {
+                    specimen.break_now();
+                    Ok(())
+                }
+                None => Err(Refusal::Invalid {
+                    reason: "no specimen is mounted".into(),
+                }),
+            },
         }
+    }
+
+    fn refuse_if_program_active(&self) -> Result<(), Refusal> {
+        match self.program {
+            ProgramStatus::Running | ProgramStatus::Held => Err(Refusal::ProgramRunning),
+            _ => Ok(()),
+        }
+    }
+
+    fn refuse_if_unsafe(&self) -> Result<(), Refusal> {
+        if self.emergency_stop {
+            return Err(Refusal::EmergencyStopLatched);
+        }
+        if !self.hydraulics_on {
+            return Err(Refusal::HydraulicsOff);
+        }
+        if self.tripped != 0 {
+            return Err(Refusal::LimitTripped { bits: self.tripped });
+        }
+        Ok(())
+    }
+
+    fn start_program(&mut self, program: &Program) -> Result<(), Refusal> {
+        self.refuse_if_program_active()?;
+        self.refuse_if_unsafe()?;
+        program
+            .validate()
+            .map_err(|reason| Refusal::Invalid { reason })?;
+        let saved = self.controller.clone();
+        let result = self.bind_program(program);
+        if result.is_err() {
+            self.controller = saved;
+        }
+        result
+    }
+
+    fn bind_program(&mut self, program: &Program) -> Result<(), Refusal> {
+        for &(axis, control) in &program.setup {
+            if self.controller.axis_control(axis) != control {
+                self.controller
+                    .set_axis_control(axis, control, &self.feedback);
+            }
+        }
+        let mut start_levels = Vec::with_capacity(program.channels.len());
+        for &(channel, _) in &program.channels {
+            self.check_active(channel)?;
+            start_levels.push(self.controller.setpoint(channel));
+        }
+        let run = Run::bind(program, &start_levels);
+        for (channel, envelope) in run.envelopes() {
+            let mode = self.check_active(channel)?;
+            self.check_level(channel, mode, envelope.min)?;
+            self.check_level(channel, mode, envelope.max)?;
+            if mode == ControlMode::Displacement {
+                let per_actuator = match channel {
+                    Channel::Elongation(_) => 0.5 * envelope.max_rate_per_s,
+                    _ => envelope.max_rate_per_s,
+                };
+                let limit = self.rate_limit_mm_s(channel);
+                if per_actuator > limit {
+                    return Err(Refusal::BeyondLimit {
+                        channel,
+                        what: "rate (mm/s per actuator)",
+                        value: per_actuator,
+                        limit,
+                    });
+                }
+            }
+        }
+        self.run = Some(run);
+        self.program = ProgramStatus::Running;
+        Ok(())
+    }
+
+    fn rate_limit_mm_s(&self, channel: Channel) -> f64 {
+        let axis = match channel {
+            Channel::Actuator(id) => return self.config.limits.channels[id.index()].rate_max_mm_s,
+            Channel::Elongation(axis) | Channel::Centre(axis) => axis,
+        };
+        let c = &self.config.limits.channels;
+        c[axis.plus().index()]
+            .rate_max_mm_s
+            .min(c[axis.minus().index()].rate_max_mm_s)
     }
 
     fn check_active(&self, channel: Channel) -> Result<ControlMode, Refusal> {
         self.controller
             .channel_mode(channel)
             .ok_or(Refusal::ChannelInactive { channel })
+    }
+
+    /// Refuses a level of `channel` that would put an actuator beyond its stroke or force
+    /// limits (elongation and centre are mapped to the two actuator positions).
+    fn check_level(&self, channel: Channel, mode: ControlMode, value: f64) -> Result<(), Refusal> {
+        if !value.is_finite() {
+            return Err(Refusal::NotFinite { what: "level" });
+        }
+        let limits = &self.config.limits.channels;
+        let stroke = |id: ActuatorId, position_mm: f64| {
+            let l = &limits[id.index()];
+            if position_mm > l.stroke_max_mm {
+                Err(Refusal::BeyondLimit {
+                    channel,
+                    what: "stroke (mm)",
+                    value: position_mm,
+                    limit: l.stroke_max_mm,
+                })
+            } else if position_mm < l.stroke_min_mm {
+                Err(Refusal::BeyondLimit {
+                    channel,
+                    what: "stroke (mm)",
+                    value: position_mm,
+                    limit: l.stroke_min_mm,
+                })
+            } else {
+                Ok(())
+            }
+        };
+        let force = |id: ActuatorId, force_kn: f64| {
+            let l = &limits[id.index()];
+            if force_kn > l.force_max_kn {
+                Err(Refusal::BeyondLimit {
+                    channel,
+                    what: "force (kN)",
+                    value: force_kn,
+                    limit: l.force_max_kn,
+                })
+            } else if force_kn < l.force_min_kn {
+                Err(Refusal::BeyondLimit {
+                    channel,
+                    what: "force (kN)",
+                    value: force_kn,
+                    limit: l.force_min_kn,
+                })
+            } else {
+                Ok(())
+            }
+        };
+        match (channel, mode) {
+            (Channel::Actuator(id), ControlMode::Displacement) => stroke(id, value),
+            (Channel::Actuator(id), ControlMode::Force) => force(id, value),
+            (Channel::Elongation(axis), ControlMode::Displacement) => {
+                let centre = self.controller.setpoint(Channel::Centre(axis));
+                stroke(axis.plus(), 0.5 * value + centre)?;
+                stroke(axis.minus(), 0.5 * value - centre)
+            }
+            (Channel::Elongation(axis), ControlMode::Force) => {
+                force(axis.plus(), value)?;
+                force(axis.minus(), value)
+            }
+            (Channel::Centre(axis), _) => {
+                let half = match self.controller.channel_mode(Channel::Elongation(axis)) {
+                    Some(ControlMode::Displacement) => {
+                        0.5 * self.controller.setpoint(Channel::Elongation(axis))
+                    }
+                    _ => 0.5 * self.feedback.elongation_mm(axis),
+                };
+                stroke(axis.plus(), half + value)?;
+                stroke(axis.minus(), half - value)
+            }
+        }
+    }
+
+    fn advance_program(&mut self) {
+        let Some(run) = self.run.as_mut() else {
+            return;
+        };
+        let controller = &mut self.controller;
+        run.advance(self.dt_s, |channel, value| {
+            debug_assert!(value.is_finite());
+            if controller.channel_mode(channel).is_some() {
+                controller.set_setpoint(channel, value);
+            }
+        });
+        if self.program == ProgramStatus::Running && run.is_finished() {
+            self.program = ProgramStatus::Finished;
+        }
+    }
+
+    fn hydraulics_off(&mut self) {
+        self.hydraulics_on = false;
+        self.stop_program_here();
+    }
+
+    /// Stop the program where it is (the transition of limit actions and breaks).
+    fn stop_program_here(&mut self) {
+        if let (ProgramStatus::Running | ProgramStatus::Held, Some(run)) =
+            (self.program, self.run.as_mut())
+        {
+            let rate = run.stop_rate_per_s;
+            run.stop(StopTransition::Stay, rate);
+            self.program = ProgramStatus::Stopped;
+        }
+    }
+
+    fn load_specimen(&mut self) {
+        let positions = self.feedback_positions();
+        let Some(specimen) = self.specimen.as_mut() else {
+            return;
+        };
+        let response = specimen.respond(&positions);
+        self.external_force_n = response.grip_force_n;
+        self.kinematics = response.kinematics;
+    }
+
+    fn feedback_positions(&self) -> [f64; ACTUATOR_COUNT] {
+        std::array::from_fn(|i| self.hydraulics.actuators[i].position_mm())
     }
 
     fn read_sensors(&mut self) {
@@ -192,11 +529,84 @@ impl Rig {
         }
     }
 
+    fn signals(&self, id: ActuatorId) -> ChannelSignals {
+        let a = &self.snapshot.actuators[id.index()];
+        ChannelSignals {
+            position_mm: a.position_mm,
+            velocity_mm_s: a.velocity_mm_s,
+            force_kn: a.force_kn,
+            error: if self.hydraulics_on { a.error } else { 0.0 },
+            error_is_force: self.controller.position_command_mm(id).is_none(),
+            plant_finite: self.hydraulics.actuators[id.index()].is_finite(),
+        }
+    }
+
+    /// Limit detectors and the break detector, then their actions (rising edges only).
+    fn detect(&mut self) {
+        let mut now = 0;
+        for id in ActuatorId::ALL {
+            now |= violations(
+                &self.config.limits.channels[id.index()],
+                &self.signals(id),
+                id.index(),
+            );
+        }
+        let mut rising = now & !self.tripped;
+        // Break detector on the X and Y pairs.
+        let alpha = self.dt_s / 0.020;
+        for axis in [Axis::X, Axis::Y] {
+            let a = axis.index();
+            let force_kn = self.feedback.pair_force_kn(axis);
+            let mean = self.pair_force_mean_kn[a];
+            if mean > self.config.break_detect_min_kn
+                && force_kn < 0.5 * mean
+                && self.tripped & SPECIMEN_BREAK_BIT == 0
+            {
+                rising |= SPECIMEN_BREAK_BIT;
+            }
+            self.pair_force_mean_kn[a] = mean + alpha * (force_kn - mean);
+        }
+        if rising == 0 {
+            return;
+        }
+        self.tripped |= rising;
+        let actions = self.config.limits.actions;
+        let mut worst: Option<LimitAction> = None;
+        for kind in LimitKind::ALL {
+            let any = ActuatorId::ALL
+                .iter()
+                .any(|id| rising & kind.bit(id.index()) != 0);
+            if any {
+                worst = worst.max(Some(actions.of(kind)));
+            }
+        }
+        if rising & SPECIMEN_BREAK_BIT != 0 {
+            // A break: displacement hold everywhere, program stopped.
+            self.stop_program_here();
+            self.controller.displacement_hold(&self.feedback);
+        }
+        match worst {
+            None | Some(LimitAction::Indicate) => {}
+            Some(LimitAction::ProgramHold) => {
+                if self.program == ProgramStatus::Running {
+                    self.program = ProgramStatus::Held;
+                }
+            }
+            Some(LimitAction::ProgramStop) => self.stop_program_here(),
+            Some(LimitAction::HydraulicsOff) => self.hydraulics_off(),
+        }
+        self.publish();
+    }
+
     fn publish(&mut self) {
         let s = &mut self.snapshot;
         s.t_s = s.step as f64 * self.dt_s;
         s.hydraulics_on = self.hydraulics_on;
         s.emergency_stop = self.emergency_stop;
+        s.program = self.program;
+        s.program_t_s = self.run.as_ref().map_or(0.0, |r| r.t_s);
+        s.limits_tripped = self.tripped;
+        s.specimen = self.kinematics;
         s.supply_flow_scale = self.hydraulics.last_flow_scale;
         for id in ActuatorId::ALL {
             let i = id.index();
@@ -213,7 +623,12 @@ impl Rig {
                     a.error = command - a.position_mm;
                 }
                 None => {
-                    a.command = self.controller.setpoint(Channel::Actuator(id));
+                    a.command = match self.controller.axis_control(id.axis()) {
+                        AxisControl::Independent => self.controller.setpoint(Channel::Actuator(id)),
+                        AxisControl::Centroid(_) => {
+                            self.controller.setpoint(Channel::Elongation(id.axis()))
+                        }
+                    };
                     a.error = a.command - a.force_kn;
                 }
             }

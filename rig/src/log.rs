@@ -1,0 +1,69 @@
+//! The CSV log of the rig: one header, one row per logged snapshot. Rows are formatted into a
+//! caller-owned `String` (reused, so no allocation once it has grown).
+
+use crate::ids::{ActuatorId, Axis};
+use crate::snapshot::{ProgramStatus, RigSnapshot};
+use std::fmt::Write;
+
+pub fn csv_header() -> String {
+    let mut h = String::from("t_s,program,hydraulics_on,limits_tripped");
+    for id in ActuatorId::ALL {
+        let n = id.name();
+        for field in ["position_mm", "command", "error", "force_kn", "valve"] {
+            let _ = write!(h, ",{n}_{field}");
+        }
+    }
+    for axis in Axis::ALL {
+        let n = axis.name();
+        let _ = write!(h, ",{n}_centre_mm,{n}_elongation_mm,{n}_force_kn");
+    }
+    h.push_str(",stretch_x,stretch_y,rotation_deg,centre_x_mm,centre_y_mm,broken");
+    h
+}
+
+pub fn program_code(status: ProgramStatus) -> u8 {
+    match status {
+        ProgramStatus::Idle => 0,
+        ProgramStatus::Running => 1,
+        ProgramStatus::Held => 2,
+        ProgramStatus::Stopped => 3,
+        ProgramStatus::Finished => 4,
+    }
+}
+
+/// Appends one row (with its newline) to `out`.
+pub fn write_csv_row(s: &RigSnapshot, out: &mut String) {
+    let _ = write!(
+        out,
+        "{:.6},{},{},{}",
+        s.t_s,
+        program_code(s.program),
+        u8::from(s.hydraulics_on),
+        s.limits_tripped
+    );
+    for a in &s.actuators {
+        let _ = write!(
+            out,
+            ",{:.6},{:.6},{:.6},{:.6},{:.6}",
+            a.position_mm, a.command, a.error, a.force_kn, a.valve
+        );
+    }
+    for x in &s.axes {
+        let _ = write!(
+            out,
+            ",{:.6},{:.6},{:.6}",
+            x.centre_mm, x.elongation_mm, x.force_kn
+        );
+    }
+    let k = &s.specimen;
+    let _ = writeln!(
+        out,
+        ",{:.6},{:.6},{:.4},{:.6},{:.6},{}",
+        k.stretch_x,
+        k.stretch_y,
+        k.rotation_deg,
+        k.centre_x_mm,
+        k.centre_y_mm,
+        u8::from(k.broken)
+    );
+}
