@@ -3,6 +3,7 @@
 //! Pure library, no IPC: the streaming loop (`stream`) and the `dicstream` commands call it
 //! through the [`FrameSource`] seam.
 
+pub mod camera;
 mod error;
 mod image_io;
 pub mod motion;
@@ -12,9 +13,11 @@ mod render_exact;
 mod render_fast;
 mod replay;
 mod scenario;
+mod simulated;
 mod source;
 pub mod speckle;
 
+pub use camera::{CameraModel, BIT_DEPTHS};
 pub use error::ProducerError;
 pub use image_io::{decode_into, read_image, read_shape, Image16, ImageShape};
 pub use motion::{Affine, Bulge, Chirp, Motion};
@@ -23,5 +26,8 @@ pub use render_exact::{gauss_legendre, ExactRenderer};
 pub use render_fast::FastRenderer;
 pub use replay::{list_images, Replay, IMAGE_EXTENSIONS};
 pub use scenario::{Scenario, ScenarioKind, SCENARIO_NAMES};
+pub use simulated::{
+    motion_reach_px, MotionSource, RendererKind, ScenarioTimeline, SimulatedCamera, SimulatedConfig,
+};
 pub use source::{FrameDims, FrameInfo, FrameSource, Truth};
 pub use speckle::{Speckle, SpeckleParams};

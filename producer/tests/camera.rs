@@ -1,0 +1,150 @@
+//! Camera model: range per bit depth, saturation, seed reproducibility, noise standard
+//! deviation; the simulated camera as a frame source.
+
+use producer::{
+    CameraModel, FrameSource, Scenario, ScenarioTimeline, SimulatedCamera, SimulatedConfig,
+    BIT_DEPTHS,
+};
+
+const W: usize = 128;
+const H: usize = 96;
+
+fn ramp_pattern() -> Vec<f32> {
+    (0..W * H)
+        .map(|i| (i % W) as f32 / (W - 1) as f32)
+        .collect()
+}
+
+#[test]
+fn values_stay_in_range_for_every_bit_depth() {
+    for bits in BIT_DEPTHS {
+        let camera = CameraModel::with_bit_depth(bits);
+        camera.validate().unwrap();
+        let mut out = vec![0u16; W * H];
+        camera.expose(0, &ramp_pattern(), W, &mut out, 2);
+        let max = u32::from(*out.iter().max().unwrap());
+        assert!(max < 1 << bits, "{bits} bit: {max}");
+        // White (p = 1) near 90 % of full scale, black near 5 %.
+        let full = f64::from((1u32 << bits) - 1);
+        assert!(
+            f64::from(max) > 0.85 * full && f64::from(max) < 0.97 * full,
+            "{bits}: {max}"
+        );
+    }
+    assert!(CameraModel::with_bit_depth(9).validate().is_err());
+}
+
+#[test]
+fn saturation_clips_to_full_scale() {
+    let camera = CameraModel {
+        gain_dn_per_e: 1.0,
+        ..CameraModel::with_bit_depth(12)
+    };
+    let mut out = vec![0u16; W * H];
+    camera.expose(0, &ramp_pattern(), W, &mut out, 1);
+    assert_eq!(*out.iter().max().unwrap(), 4095);
+    assert!(out.iter().filter(|&&v| v == 4095).count() > W * H / 2);
+    let dark = CameraModel {
+        offset_dn: -1000.0,
+        ..CameraModel::noiseless(12)
+    };
+    dark.expose(0, &ramp_pattern(), W, &mut out, 1);
+    assert_eq!(*out.iter().min().unwrap(), 0);
+}
+
+#[test]
+fn noise_is_reproducible_and_thread_independent() {
+    let camera = CameraModel::with_bit_depth(16);
+    let pattern = ramp_pattern();
+    let mut a = vec![0u16; W * H];
+    let mut b = vec![0u16; W * H];
+    camera.expose(3, &pattern, W, &mut a, 1);
+    camera.expose(3, &pattern, W, &mut b, 3);
+    assert_eq!(a, b, "same seed and frame, other thread count");
+    camera.expose(4, &pattern, W, &mut b, 1);
+    assert_ne!(a, b, "another frame has another noise");
+    let other = CameraModel { seed: 2, ..camera };
+    other.expose(3, &pattern, W, &mut b, 1);
+    assert_ne!(a, b, "another seed has another noise");
+}
+
+#[test]
+fn noise_standard_deviation_matches_the_model() {
+    let p = 0.5f32;
+    let pattern = vec![p; W * H];
+    let mut out = vec![0u16; W * H];
+    for (shot, read) in [(false, 20.0), (true, 0.0), (true, 20.0)] {
+        let camera = CameraModel {
+            shot_noise: shot,
+            read_noise_dn: read,
+            ..CameraModel::with_bit_depth(16)
+        };
+        camera.expose(0, &pattern, W, &mut out, 2);
+        let n = out.len() as f64;
+        let mean = out.iter().map(|&v| f64::from(v)).sum::<f64>() / n;
+        let var = out
+            .iter()
+            .map(|&v| (f64::from(v) - mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
+        let electrons = camera.illumination_e * f64::from(p);
+        let expected_mean = camera.offset_dn + camera.gain_dn_per_e * electrons;
+        let shot_var = if shot {
+            camera.gain_dn_per_e.powi(2) * electrons
+        } else {
+            0.0
+        };
+        let expected_std = (shot_var + read * read + 1.0 / 12.0).sqrt();
+        let std = var.sqrt();
+        eprintln!("shot {shot}, read {read} DN: std {std:.3} DN, model {expected_std:.3} DN");
+        let mean_tolerance = 0.5 + 4.0 * expected_std / n.sqrt();
+        assert!(
+            (mean - expected_mean).abs() < mean_tolerance,
+            "mean {mean} vs {expected_mean}"
+        );
+        assert!(
+            (std / expected_std - 1.0).abs() < 0.05,
+            "std {std} vs {expected_std}"
+        );
+    }
+}
+
+#[test]
+fn simulated_camera_streams_frames_with_truth() {
+    let scenario = Scenario::parse("rotation:angle_deg=2", W as u32, H as u32).unwrap();
+    let mut config = SimulatedConfig::new(W as u32, H as u32);
+    config.camera = CameraModel::with_bit_depth(10);
+    config.threads = 2;
+    config.camera.blur_sigma_px = 0.7;
+    let timeline = ScenarioTimeline {
+        scenario,
+        frames: 3,
+    };
+    let mut camera = SimulatedCamera::new(config, Box::new(timeline)).unwrap();
+    assert_eq!(camera.dims().bit_depth, 10);
+    assert_eq!(camera.frames_total(), Some(3));
+    let mut out = vec![0u16; W * H];
+    let mut frames = Vec::new();
+    while let Some(info) = camera.next_frame(&mut out).unwrap() {
+        let truth = info.truth.expect("simulated frames carry truth");
+        assert_eq!(truth.scenario_id, 2);
+        assert!(truth.homogeneous);
+        assert!(out.iter().all(|&v| v < 1024));
+        frames.push((info.index, truth.f[1][0], out.clone()));
+    }
+    assert_eq!(frames.len(), 3);
+    assert_eq!(frames[0].1, 0.0);
+    assert!((frames[2].1 - 2f64.to_radians().sin()).abs() < 1e-15);
+    assert_ne!(frames[0].2, frames[2].2);
+    // Reproducible from the seeds.
+    let timeline = ScenarioTimeline {
+        scenario,
+        frames: 3,
+    };
+    let mut again = SimulatedCamera::new(config, Box::new(timeline)).unwrap();
+    again.next_frame(&mut out).unwrap();
+    assert_eq!(out, frames[0].2);
+    // A wrong buffer is an error, not a panic.
+    let mut small = vec![0u16; 10];
+    assert!(again.next_frame(&mut small).is_err());
+}
