@@ -8,12 +8,14 @@
 //! - [`stability`]: Drucker stability along the load paths.
 //! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
 //! - [`plot`]: PNG plots of the data, fits, f(I1) and g(I2) (plotters, bitmap backend).
+//! - [`online`]: pairing strains with rig forces, accumulating the load path, refitting (no IPC).
 
 pub mod data;
 pub mod fit;
 pub mod law;
 pub mod lsq;
 pub mod models;
+pub mod online;
 pub mod plot;
 pub mod route;
 pub mod stability;
