@@ -17,6 +17,8 @@ enum Command {
     // One variant per subcommand; keep one line each so parallel edits stay simple.
     /// Fit hyperelastic potentials to uniaxial/equibiaxial/pure-shear CSV data (offline).
     Identify(cmd::identify::IdentifyArgs),
+    /// Live identification process: fields + rig/state in, identification reports out.
+    Identifier(cmd::identifier::IdentifierArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -24,6 +26,7 @@ fn main() -> std::process::ExitCode {
     let result: anyhow::Result<()> = match cli.command {
         // One arm per subcommand.
         Command::Identify(args) => cmd::identify::run(args),
+        Command::Identifier(args) => cmd::identifier::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -1,4 +1,5 @@
-//! Hyperelastic identification of rubber-like materials (paper section 4). Pure library: no IPC.
+//! Hyperelastic identification of rubber-like materials (paper section 4). Everything but
+//! [`process`] is pure (no IPC) and tested without shared memory.
 //!
 //! - [`law`]: the invariant-based law W(I1, I2) with f(I1), g(I2) (eqs 18-25), Smactane™ default.
 //! - [`data`]: load cases, kinematics, stresses from forces, the CSV reader.
@@ -9,6 +10,8 @@
 //! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
 //! - [`plot`]: PNG plots of the data, fits, f(I1) and g(I2) (plotters, bitmap backend).
 //! - [`online`]: pairing strains with rig forces, accumulating the load path, refitting (no IPC).
+//! - [`process`]: the live `identifier` process shell over iceoryx2 (`wire` services).
+//! - [`report`]: JSON of fits, atomic file writes.
 
 pub mod data;
 pub mod fit;
@@ -17,5 +20,7 @@ pub mod lsq;
 pub mod models;
 pub mod online;
 pub mod plot;
+pub mod process;
+pub mod report;
 pub mod route;
 pub mod stability;

@@ -5,8 +5,9 @@ use anyhow::{bail, Context};
 use identifier::data::{read_curve_csv, Curve, LoadCase};
 use identifier::fit::{fit_ranked, Fit, FitOptions, ResidualKind};
 use identifier::models::parse_model_list;
+use identifier::report::fit_json;
 use identifier::route::paper_route;
-use serde_json::{json, Map, Value};
+use serde_json::{json, Value};
 use std::path::PathBuf;
 
 /// Residual measure on the command line.
@@ -103,50 +104,6 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         bail!("no model could be fitted");
     }
     Ok(())
-}
-
-fn finite(v: f64) -> Value {
-    if v.is_finite() {
-        json!(v)
-    } else {
-        Value::Null
-    }
-}
-
-fn fit_json(fit: &Fit) -> Value {
-    let mut params = Map::new();
-    let mut stderr = Map::new();
-    for ((name, value), std) in fit.param_names.iter().zip(&fit.params).zip(&fit.stderr) {
-        params.insert(name.clone(), finite(*value));
-        stderr.insert(name.clone(), std.map_or(Value::Null, finite));
-    }
-    let mut r2 = Map::new();
-    let mut rms = Map::new();
-    for c in &fit.cases {
-        r2.insert(c.case.name().into(), finite(c.r2));
-        rms.insert(c.case.name().into(), finite(c.rms_mpa));
-    }
-    let mut stable = Map::new();
-    let mut unstable = Map::new();
-    for s in &fit.stability {
-        stable.insert(s.case.name().into(), finite(s.stable_up_to));
-        unstable.insert(
-            s.case.name().into(),
-            s.unstable_from.map_or(Value::Null, finite),
-        );
-    }
-    json!({
-        "model": fit.model.name(),
-        "params": params,
-        "stderr": stderr,
-        "rms_mpa": finite(fit.rms_mpa),
-        "rms_by_case_mpa": rms,
-        "r2": r2,
-        "aic": finite(fit.aic),
-        "stable_up_to": stable,
-        "unstable_from": unstable,
-        "converged": fit.converged,
-    })
 }
 
 fn print_table(fits: &[Fit], curves: &[Curve]) {

@@ -1,3 +1,4 @@
 //! The subcommands of `dicstream`, one module each.
 
 pub mod identify;
+pub mod identifier;

@@ -1,0 +1,225 @@
+//! The live `identifier` process: subscribes to `fields` and `rig/state`, feeds the pure
+//! [`OnlineIdentifier`], publishes an `identification` report after each refit, and writes
+//! the final fits as JSON (atomically) when it stops. Sleeps in a WaitSet: no polling.
+
+use crate::models::Model;
+use crate::online::{FieldOutcome, FieldSample, OnlineConfig, OnlineIdentifier, RigSample};
+use crate::report::{fit_json, write_atomically};
+use iceoryx2::prelude::*;
+use iceoryx2::waitset::WaitSetRunResult;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+use wire::identification::{RankedModel, MAX_COEFFICIENTS, MAX_RANKED};
+use wire::pubsub::{SliceSubscriber, ValuePublisher, ValueSubscriber};
+use wire::{
+    services, FieldHeader, FieldNode, IdentificationReport, Instance, RigState, StrainMeasure,
+};
+
+/// Settings of the process.
+#[derive(Clone, Debug)]
+pub struct ProcessConfig {
+    pub instance: String,
+    /// Final JSON (written atomically at the end).
+    pub output_json: PathBuf,
+    /// Stop after this many fields (None: until SIGINT/SIGTERM or idle timeout).
+    pub max_fields: Option<u64>,
+    /// Stop after this long without any sample (None: never).
+    pub idle_timeout: Option<Duration>,
+    pub online: OnlineConfig,
+}
+
+/// What the run did.
+#[derive(Clone, Debug, Default)]
+pub struct ProcessSummary {
+    pub fields_received: u64,
+    pub rig_samples_received: u64,
+    pub reports_published: u64,
+    pub points: [usize; 3],
+    pub best_model: Option<String>,
+}
+
+type BoxError = Box<dyn std::error::Error + Send + Sync>;
+
+/// How long one WaitSet wait lasts before the idle clock is checked.
+const WAIT_SLICE: Duration = Duration::from_millis(200);
+
+fn rig_sample(state: &RigState) -> RigSample {
+    let a = &state.actuators;
+    RigSample {
+        sample_id: state.sample_id,
+        force_x_n: 500.0 * (a[0].force_kn + a[1].force_kn),
+        force_y_n: 500.0 * (a[2].force_kn + a[3].force_kn),
+        section_x_mm2: state.specimen_section_x_mm2,
+        section_y_mm2: state.specimen_section_y_mm2,
+    }
+}
+
+fn field_sample(header: &FieldHeader) -> Option<FieldSample> {
+    if header.rig_sample_id == wire::NO_RIG_SAMPLE || header.layout_version != wire::LAYOUT_VERSION
+    {
+        return None;
+    }
+    let gauge = header.gauge_of(StrainMeasure::Log);
+    Some(FieldSample {
+        frame_id: header.frame_id,
+        rig_sample_id: header.rig_sample_id,
+        t_capture_ns: header.t_capture_ns,
+        log_strain_xx: gauge.exx,
+        log_strain_yy: gauge.eyy,
+    })
+}
+
+/// Builds the wire report from the ranked fits (best first).
+pub fn build_report(
+    fits: &[crate::fit::Fit],
+    points: [usize; 3],
+    frame: Option<(u64, u64)>,
+) -> IdentificationReport {
+    let mut report = IdentificationReport {
+        points: points.map(|p| p as u32),
+        ..IdentificationReport::default()
+    };
+    if let Some((frame_id, t_capture_ns)) = frame {
+        report.frame_id = frame_id;
+        report.t_capture_ns = t_capture_ns;
+    }
+    if let Some(ldr) = fits
+        .iter()
+        .find(|f| matches!(f.model, Model::LambertDianiRey { .. }))
+    {
+        if let Model::LambertDianiRey { f_degree, g_degree } = ldr.model {
+            let (na, nb) = (
+                (f_degree + 1).min(MAX_COEFFICIENTS),
+                (g_degree + 1).min(MAX_COEFFICIENTS),
+            );
+            for i in 0..na {
+                report.a[i] = ldr.params[i];
+                report.a_stderr[i] = ldr.stderr[i].unwrap_or(f64::NAN);
+            }
+            for i in 0..nb {
+                report.b[i] = ldr.params[f_degree + 1 + i];
+                report.b_stderr[i] = ldr.stderr[f_degree + 1 + i].unwrap_or(f64::NAN);
+            }
+            report.a_count = na as u32;
+            report.b_count = nb as u32;
+            report.rms_mpa = ldr.rms_mpa;
+        }
+    }
+    for (slot, fit) in report.ranking.iter_mut().zip(fits.iter().take(MAX_RANKED)) {
+        let mut ranked = RankedModel {
+            name: [0; 24],
+            aic: fit.aic,
+            rms_mpa: fit.rms_mpa,
+        };
+        wire::text::write_fixed(&mut ranked.name, &fit.model.name());
+        *slot = ranked;
+    }
+    report.ranked_count = fits.len().min(MAX_RANKED) as u32;
+    report
+}
+
+/// Runs the process until a termination signal, `max_fields`, or the idle timeout.
+pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
+    let instance = Instance::new(&config.instance)?;
+    let (node, cleaned) = instance.create_node("identifier")?;
+    if cleaned > 0 {
+        eprintln!(
+            "identifier: cleaned {cleaned} dead node(s) of instance {}",
+            instance.name()
+        );
+    }
+    let fields: SliceSubscriber<FieldNode, FieldHeader> =
+        SliceSubscriber::create(&node, &services::FIELDS)?;
+    let rig: ValueSubscriber<RigState> = ValueSubscriber::create(&node, &services::RIG_STATE)?;
+    let publisher: ValuePublisher<IdentificationReport> =
+        ValuePublisher::create(&node, &services::IDENTIFICATION)?;
+    let waitset = WaitSetBuilder::new().create::<ipc::Service>()?;
+    let fields_guard = waitset.attach_notification(fields.listener())?;
+    let rig_guard = waitset.attach_notification(rig.listener())?;
+
+    let mut online = OnlineIdentifier::new(config.online.clone());
+    let mut summary = ProcessSummary::default();
+    let mut last_fits = Vec::new();
+    let mut last_activity = Instant::now();
+    let mut failure: Option<BoxError> = None;
+    loop {
+        let mut stop = false;
+        let mut accepted_any = false;
+        let result = waitset.wait_and_process_once_with_timeout(
+            |id| {
+                let mut step = || -> Result<(), BoxError> {
+                    if id.has_event_from(&rig_guard) {
+                        rig.clear_events();
+                    }
+                    if id.has_event_from(&fields_guard) {
+                        fields.clear_events();
+                    }
+                    // Rig first: fields name rig samples.
+                    while let Some(state) = rig.receive()? {
+                        summary.rig_samples_received += 1;
+                        for (_, outcome) in online.push_rig(rig_sample(&state)) {
+                            accepted_any |= matches!(outcome, FieldOutcome::Accepted { .. });
+                        }
+                    }
+                    while let Some(sample) = fields.receive()? {
+                        summary.fields_received += 1;
+                        if let Some(field) = field_sample(sample.user_header()) {
+                            accepted_any |=
+                                matches!(online.push_field(field), FieldOutcome::Accepted { .. });
+                        }
+                    }
+                    Ok(())
+                };
+                if let Err(e) = step() {
+                    failure = Some(e);
+                    return CallbackProgression::Stop;
+                }
+                CallbackProgression::Continue
+            },
+            WAIT_SLICE,
+        )?;
+        if let Some(e) = failure.take() {
+            return Err(e);
+        }
+        match result {
+            WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt => stop = true,
+            _ => {}
+        }
+        if accepted_any {
+            last_activity = Instant::now();
+            if let Some(fits) = online.refit() {
+                let mut report = build_report(&fits, online.point_counts(), online.last_accepted);
+                report.t_published_ns = wire::monotonic_ns();
+                publisher.publish(report)?;
+                summary.reports_published += 1;
+                last_fits = fits;
+            }
+        }
+        if config
+            .max_fields
+            .is_some_and(|m| summary.fields_received >= m)
+        {
+            stop = true;
+        }
+        if config
+            .idle_timeout
+            .is_some_and(|t| last_activity.elapsed() > t)
+        {
+            stop = true;
+        }
+        if stop {
+            break;
+        }
+    }
+    summary.points = online.point_counts();
+    summary.best_model = last_fits.first().map(|f| f.model.name());
+    let json = serde_json::json!({
+        "points": {"uniaxial": summary.points[0], "equibiaxial": summary.points[1], "pure_shear": summary.points[2]},
+        "fields_received": summary.fields_received,
+        "rig_samples_received": summary.rig_samples_received,
+        "pairing": {"accepted": online.counters.accepted, "skipped": online.counters.skipped, "dropped": online.counters.dropped},
+        "fits": last_fits.iter().map(fit_json).collect::<Vec<_>>(),
+    });
+    write_atomically(&config.output_json, &serde_json::to_string_pretty(&json)?)?;
+    Ok(summary)
+}

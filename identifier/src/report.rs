@@ -1,0 +1,59 @@
+//! JSON form of fits: `{"model", "params", "stderr", "rms_mpa", "rms_by_case_mpa", "r2",
+//! "aic", "stable_up_to", "unstable_from", "converged"}`; non-finite numbers become null.
+
+use crate::fit::Fit;
+use serde_json::{json, Map, Value};
+
+fn finite(v: f64) -> Value {
+    if v.is_finite() {
+        json!(v)
+    } else {
+        Value::Null
+    }
+}
+
+/// One fit as JSON.
+pub fn fit_json(fit: &Fit) -> Value {
+    let mut params = Map::new();
+    let mut stderr = Map::new();
+    for ((name, value), std) in fit.param_names.iter().zip(&fit.params).zip(&fit.stderr) {
+        params.insert(name.clone(), finite(*value));
+        stderr.insert(name.clone(), std.map_or(Value::Null, finite));
+    }
+    let mut r2 = Map::new();
+    let mut rms = Map::new();
+    for c in &fit.cases {
+        r2.insert(c.case.name().into(), finite(c.r2));
+        rms.insert(c.case.name().into(), finite(c.rms_mpa));
+    }
+    let mut stable = Map::new();
+    let mut unstable = Map::new();
+    for s in &fit.stability {
+        stable.insert(s.case.name().into(), finite(s.stable_up_to));
+        unstable.insert(
+            s.case.name().into(),
+            s.unstable_from.map_or(Value::Null, finite),
+        );
+    }
+    json!({
+        "model": fit.model.name(),
+        "params": params,
+        "stderr": stderr,
+        "rms_mpa": finite(fit.rms_mpa),
+        "rms_by_case_mpa": rms,
+        "r2": r2,
+        "aic": finite(fit.aic),
+        "stable_up_to": stable,
+        "unstable_from": unstable,
+        "converged": fit.converged,
+    })
+}
+
+/// Writes `text` to `path` atomically (temporary file in the same folder, then rename).
+pub fn write_atomically(path: &std::path::Path, text: &str) -> std::io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = std::path::PathBuf::from(tmp);
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path)
+}

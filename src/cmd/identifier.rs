@@ -1,0 +1,60 @@
+//! `dicstream identifier`: the live identification process (subscribes to `fields` and
+//! `rig/state`, publishes `identification`, writes the final fits as JSON).
+
+use identifier::models::parse_model_list;
+use identifier::online::OnlineConfig;
+use identifier::process::{run as run_process, ProcessConfig};
+use std::path::PathBuf;
+use std::time::Duration;
+
+#[derive(clap::Args, Debug)]
+pub struct IdentifierArgs {
+    /// Instance name (shared-memory prefix); runs with different names never meet.
+    #[arg(long, default_value_t = wire::Instance::default_name())]
+    pub instance: String,
+    /// Final fits, written atomically when the process stops.
+    #[arg(long, default_value = "identification.json")]
+    pub output: PathBuf,
+    /// Models ranked at each refit: NAME[,NAME...] or `all` (slow: refits run per point).
+    #[arg(
+        long,
+        default_value = "lambert-diani-rey,neo-hookean,mooney,yeoh,gent,hart-smith"
+    )]
+    pub model: String,
+    /// Stop after this many fields.
+    #[arg(long)]
+    pub max_fields: Option<u64>,
+    /// Stop after this many seconds without data.
+    #[arg(long)]
+    pub idle_timeout_s: Option<f64>,
+}
+
+pub fn run(args: IdentifierArgs) -> anyhow::Result<()> {
+    let models = parse_model_list(&args.model).map_err(anyhow::Error::msg)?;
+    let idle_timeout = match args.idle_timeout_s {
+        Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
+        Some(s) => anyhow::bail!("--idle-timeout-s must be a positive number of seconds, got {s}"),
+        None => None,
+    };
+    let config = ProcessConfig {
+        instance: args.instance,
+        output_json: args.output.clone(),
+        max_fields: args.max_fields,
+        idle_timeout,
+        online: OnlineConfig {
+            models,
+            ..OnlineConfig::default()
+        },
+    };
+    let summary = run_process(config).map_err(|e| anyhow::anyhow!("identifier process: {e}"))?;
+    eprintln!(
+        "identifier: {} fields, {} rig samples, {} reports; points uniaxial/equibiaxial/pure shear = {:?}; best {}; wrote {}",
+        summary.fields_received,
+        summary.rig_samples_received,
+        summary.reports_published,
+        summary.points,
+        summary.best_model.as_deref().unwrap_or("none"),
+        args.output.display()
+    );
+    Ok(())
+}
