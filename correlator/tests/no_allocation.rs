@@ -1,0 +1,77 @@
+//! No allocation per frame in steady state: a counting global allocator watches `correlate`
+//! after a warm-up frame, for every reference and guess mode, on 2 threads.
+
+mod common;
+
+use common::{render, translation};
+use correlator::{Correlator, CorrelatorSettings, GuessMode, ReferenceMode};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn steady_state_allocates_nothing() {
+    let (w, h) = (192, 192);
+    let frames: Vec<Vec<u16>> = (0..5)
+        .map(|k| {
+            render(
+                w,
+                h,
+                8.0,
+                translation(0.3 * k as f64, -0.2 * k as f64),
+                0.01,
+                k as u64,
+            )
+        })
+        .collect();
+    let modes = [
+        (ReferenceMode::Fixed, GuessMode::Correli),
+        (ReferenceMode::Fixed, GuessMode::Predict),
+        (ReferenceMode::Incremental, GuessMode::Predict),
+        (ReferenceMode::AUTO_DEFAULT, GuessMode::Predict),
+    ];
+    for (reference, guess) in modes {
+        let settings = CorrelatorSettings {
+            zoi_px: 32,
+            step_px: 16,
+            reference,
+            guess,
+            threads: 2,
+            ..Default::default()
+        };
+        let mut correlator = Correlator::new(settings, w, h).unwrap();
+        correlator.set_reference(&frames[0]).unwrap();
+        correlator.correlate(&frames[1]).unwrap();
+        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        let mut valid = 0;
+        for frame in &frames[2..] {
+            valid += correlator.correlate(frame).unwrap().valid;
+        }
+        let allocated = ALLOCATIONS.load(Ordering::SeqCst) - before;
+        assert!(valid > 0);
+        assert_eq!(
+            allocated, 0,
+            "{reference:?} {guess:?}: {allocated} allocations in 3 frames"
+        );
+    }
+}

@@ -1,0 +1,76 @@
+//! Paper Table 1: 7 % equibiaxial stretch. With the paper's guess (global U0, V0 for every ZOI)
+//! s = 5 fails and s = 7 works; the predictor (grow from the centre) fixes s = 5.
+
+mod common;
+
+use common::{render, stretch};
+use correlator::{Correlator, CorrelatorSettings, Field, GuessMode, NodeStatus, StrainMeasure};
+
+fn run(reference: &[u16], deformed: &[u16], zoi_px: usize, guess: GuessMode) -> Field {
+    let settings = CorrelatorSettings {
+        zoi_px,
+        step_px: 16,
+        guess,
+        strain: StrainMeasure::Small,
+        ..Default::default()
+    };
+    let mut correlator = Correlator::new(settings, 512, 512).unwrap();
+    correlator.set_reference(reference).unwrap();
+    correlator.correlate(deformed).unwrap().clone()
+}
+
+#[test]
+fn table1_equibiaxial_seven_percent() {
+    let (w, h) = (512, 512);
+    let centre = [(w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0];
+    let reference = render(w, h, 8.0, stretch(0.0, 0.0, centre), 0.01, 1);
+    let deformed = render(w, h, 8.0, stretch(0.07, 0.07, centre), 0.01, 2);
+    let exact = 0.07;
+    eprintln!(
+        "guess    s  valid      small exx   small eyy   small exy   log exx (exact {:.4})",
+        1.07f64.ln()
+    );
+    let gauge_error = |zoi_px: usize, guess: GuessMode| {
+        let field = run(&reference, &deformed, zoi_px, guess);
+        let g = field.gauge;
+        eprintln!(
+            "{:8} {} {:4}/{:4}   {:+.4}     {:+.4}     {:+.4}     {:+.4}",
+            format!("{guess:?}"),
+            zoi_px.trailing_zeros(),
+            field.valid,
+            field.nodes.len(),
+            g.small.exx,
+            g.small.eyy,
+            g.small.exy,
+            g.log.exx
+        );
+        // Border nodes whose content leaves the image are OutsideImage (correctly); count the rest.
+        let inside = field
+            .nodes
+            .iter()
+            .filter(|n| n.status != NodeStatus::OutsideImage)
+            .count();
+        let valid_fraction = field.valid as f64 / inside as f64;
+        let error = (g.small.exx - exact)
+            .abs()
+            .max((g.small.eyy - exact).abs())
+            .max(g.small.exy.abs());
+        (error, valid_fraction)
+    };
+    let (correli5, valid5) = gauge_error(32, GuessMode::Correli);
+    let _ = gauge_error(64, GuessMode::Correli);
+    let (correli7, valid7) = gauge_error(128, GuessMode::Correli);
+    let (predict5, valid_predict5) = gauge_error(32, GuessMode::Predict);
+    assert!(
+        correli5 > 5e-3 || valid5 < 0.8,
+        "s = 5 with the paper's guess should fail"
+    );
+    assert!(
+        correli7 < 1e-3 && valid7 > 0.99,
+        "s = 7 should work: error {correli7}, valid {valid7}"
+    );
+    assert!(
+        predict5 < 1e-3 && valid_predict5 > 0.99,
+        "predictor at s = 5: error {predict5}, valid {valid_predict5}"
+    );
+}
