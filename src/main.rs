@@ -19,6 +19,10 @@ enum Command {
     Identify(cmd::identify::IdentifyArgs),
     /// Live identification process: fields + rig/state in, identification reports out.
     Identifier(cmd::identifier::IdentifierArgs),
+    /// Simulated ASTREE machine: publishes rig/state, answers rig/command, logs rig.csv.
+    Rig(cmd::rig::RigArgs),
+    /// Write simulated speckle images with their exact ground truth (truth.csv).
+    Synth(cmd::synth::SynthArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -27,6 +31,8 @@ fn main() -> std::process::ExitCode {
         // One arm per subcommand.
         Command::Identify(args) => cmd::identify::run(args),
         Command::Identifier(args) => cmd::identifier::run(args),
+        Command::Rig(args) => cmd::rig::run(args),
+        Command::Synth(args) => cmd::synth::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -4,8 +4,10 @@
 //! through the [`FrameSource`] seam.
 
 pub mod camera;
+mod cli;
 mod error;
 mod image_io;
+mod image_out;
 pub mod motion;
 mod natural_sort;
 pub mod parallel;
@@ -18,8 +20,10 @@ mod source;
 pub mod speckle;
 
 pub use camera::{CameraModel, BIT_DEPTHS};
+pub use cli::{RendererArg, SimArgs};
 pub use error::ProducerError;
 pub use image_io::{decode_into, read_image, read_shape, Image16, ImageShape};
+pub use image_out::{write_atomic, write_frame, ImageFormatOut};
 pub use motion::{Affine, Bulge, Chirp, Motion};
 pub use natural_sort::natural_cmp;
 pub use render_exact::{gauss_legendre, ExactRenderer};

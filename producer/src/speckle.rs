@@ -32,7 +32,7 @@ impl Default for SpeckleParams {
     fn default() -> Self {
         SpeckleParams {
             size_px: 4.0,
-            density: 0.6,
+            density: 0.35,
             contrast: 0.9,
             seed: 1,
         }

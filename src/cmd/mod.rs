@@ -2,3 +2,5 @@
 
 pub mod identify;
 pub mod identifier;
+pub mod rig;
+pub mod synth;
