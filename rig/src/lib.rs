@@ -3,6 +3,8 @@
 //! specimen. A deterministic library stepped in simulated time; the process shell is separate.
 
 pub mod actuator;
+pub mod builtin;
+pub mod codes;
 pub mod config;
 pub mod control;
 pub mod hydraulics;
@@ -11,6 +13,7 @@ pub mod limits;
 pub mod log;
 pub mod params;
 pub mod pidf;
+pub mod process;
 pub mod program;
 pub mod refusal;
 pub mod rig;

@@ -145,6 +145,20 @@ impl Specimen {
         self.broken = true;
     }
 
+    /// Current cross-sections normal to X and Y (mm²) at stretches (λx, λy), for Cauchy
+    /// stress = force / section: w t / λx and L t / λy (incompressible sheet).
+    pub fn current_sections_mm2(&self, stretch_x: f64, stretch_y: f64) -> [f64; 2] {
+        let g = &self.config.geometry;
+        let y_reference_mm = match self.config.loading {
+            Loading::Equibiaxial => g.gauge_length_mm,
+            _ => g.width_mm,
+        };
+        [
+            g.width_mm * g.thickness_mm / stretch_x.max(1e-6),
+            y_reference_mm * g.thickness_mm / stretch_y.max(1e-6),
+        ]
+    }
+
     /// Stretches (λx, λy) for the given grip displacements (mm, outward positive).
     pub fn stretches(&self, position_mm: &[f64; ACTUATOR_COUNT]) -> (f64, f64) {
         let g = &self.config.geometry;

@@ -1,0 +1,99 @@
+//! `dicstream rig`: the simulated ASTREE machine as a process (publishes `rig/state`, answers
+//! `rig/command`, logs `rig.csv`).
+
+use rig::builtin::BuiltinTest;
+use rig::process::{run as run_process, ProcessOptions, Speed};
+use rig::{Program, RigConfig};
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug)]
+pub struct RigArgs {
+    /// Instance name (shared-memory prefix); runs with different names never meet.
+    #[arg(long, default_value_t = wire::Instance::default_name())]
+    pub instance: String,
+    /// Program file (TOML) started at once.
+    #[arg(long, conflicts_with = "test")]
+    pub program: Option<PathBuf>,
+    /// Built-in test started at once: uniaxial or equibiaxial (mounts its specimen).
+    #[arg(long)]
+    pub test: Option<String>,
+    /// Stretch rate of the built-in test (/s).
+    #[arg(long, default_value_t = 1e-3)]
+    pub rate: f64,
+    /// Final stretch λ of the built-in test.
+    #[arg(long, default_value_t = 2.0)]
+    pub stretch: f64,
+    /// realtime, a factor N (N× real time) or max.
+    #[arg(long, default_value = "realtime")]
+    pub speed: String,
+    /// CSV log of the rig state, flushed as it goes.
+    #[arg(long)]
+    pub log: Option<PathBuf>,
+    /// Log rate (Hz of simulated time).
+    #[arg(long, default_value_t = 100.0)]
+    pub log_hz: f64,
+    /// Publication rate of rig/state (Hz of simulated time).
+    #[arg(long, default_value_t = 500.0)]
+    pub publish_hz: f64,
+    /// Seed of the simulation (valve offsets, load-cell noise).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Stop after this much simulated time (s).
+    #[arg(long)]
+    pub duration_s: Option<f64>,
+    /// Stop once the started program has finished (or was stopped).
+    #[arg(long)]
+    pub exit_when_done: bool,
+}
+
+pub fn run(args: RigArgs) -> anyhow::Result<()> {
+    let speed = Speed::parse(&args.speed).map_err(anyhow::Error::msg)?;
+    let mut config = RigConfig::default();
+    let program = match (&args.program, &args.test) {
+        (Some(path), _) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| anyhow::anyhow!("program {}: {e}", path.display()))?;
+            let base = path.parent().map(PathBuf::from).unwrap_or_default();
+            Some(Program::from_toml(&text, &base).map_err(anyhow::Error::msg)?)
+        }
+        (None, Some(name)) => {
+            let test = BuiltinTest::parse(name).ok_or_else(|| {
+                anyhow::anyhow!("--test {name:?}: expected uniaxial or equibiaxial")
+            })?;
+            config.specimen = Some(test.specimen());
+            Some(
+                test.program(args.rate, args.stretch)
+                    .map_err(anyhow::Error::msg)?,
+            )
+        }
+        (None, None) => None,
+    };
+    let options = ProcessOptions {
+        instance: args.instance,
+        config,
+        seed: args.seed,
+        program,
+        test_rate_per_s: args.rate,
+        test_stretch: args.stretch,
+        speed,
+        publish_hz: args.publish_hz,
+        log_path: args.log.clone(),
+        log_hz: args.log_hz,
+        duration_s: args.duration_s,
+        exit_when_done: args.exit_when_done,
+    };
+    let summary = run_process(options).map_err(|e| anyhow::anyhow!("rig process: {e}"))?;
+    eprintln!(
+        "rig: {:.1} s simulated in {:.1} s wall ({:.0}x), {} samples published, {} log rows, \
+         commands {} accepted / {} refused, limits tripped {:#x}",
+        summary.simulated_s,
+        summary.wall_s,
+        summary.simulated_s / summary.wall_s.max(1e-9),
+        summary.samples_published,
+        summary.rows_logged,
+        summary.commands_accepted,
+        summary.commands_refused,
+        summary.limits_tripped
+    );
+    Ok(())
+}
