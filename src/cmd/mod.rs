@@ -1,5 +1,6 @@
 //! The subcommands of `dicstream`, one module each.
 
+pub mod correlate;
 pub mod identify;
 pub mod identifier;
 pub mod rig;
