@@ -6,7 +6,7 @@ use crate::mesh::Mesh;
 use crate::pool::{Pool, SharedSlice};
 use crate::settings::{CorrelatorSettings, GuessMode, ReferenceMode, Roi, SettingsError};
 use crate::strain::{gauge, node_strains, AffineSums};
-use crate::zoi::{Image, ReferenceSpectra, TimeSplit, ZoiResult};
+use crate::zoi::{spectrum_len, Image, ReferenceSpectra, TimeSplit, ZoiResult};
 use rustfft::num_complex::Complex32;
 
 /// Per-node state of the current reference image.
@@ -58,7 +58,7 @@ impl Correlator {
         let roi = settings.resolve_roi(width_px, height_px)?;
         let mesh = Mesh::new(roi, settings.zoi_px, settings.step_px);
         let nodes = mesh.len();
-        let n2 = settings.zoi_px * settings.zoi_px;
+        let n2 = spectrum_len(settings.zoi_px);
         let zero = Complex32::new(0.0, 0.0);
         let mut field = Field {
             nx: mesh.nx,
@@ -174,7 +174,7 @@ impl Correlator {
             }
         }
         self.global.set_reference(image);
-        let n2 = n * n;
+        let n2 = spectrum_len(n);
         let plain = SharedSlice::new(&mut self.plain_spectra);
         let windowed = SharedSlice::new(&mut self.windowed_spectra);
         let ref_nodes = SharedSlice::new(&mut self.ref_nodes);
@@ -213,7 +213,7 @@ impl Correlator {
 
     fn run_zois(&mut self, image: Image) {
         let n = self.settings.zoi_px;
-        let n2 = n * n;
+        let n2 = spectrum_len(n);
         let max_iterations = self.settings.max_iterations;
         let use_previous = self.settings.guess == GuessMode::Predict && self.has_previous;
         let needs_global = !use_previous || self.previous.iter().any(|p| p.is_none());

@@ -27,6 +27,7 @@ mod global;
 mod mesh;
 mod peak;
 mod pool;
+mod real_fft2d;
 pub mod settings;
 pub mod strain;
 mod window;

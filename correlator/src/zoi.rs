@@ -3,9 +3,10 @@
 //! iterations while the interpolated maximum increases. A `ZoiEngine` owns its FFT plans and
 //! buffers (one per worker thread) and never allocates after `new`.
 
-use crate::fft2d::{signed_frequency, Fft2d};
+use crate::fft2d::signed_frequency;
 use crate::field::NodeStatus;
 use crate::peak::quadratic_peak_3x3;
+use crate::real_fft2d::RealFft2d;
 use crate::window::modified_hanning_2d;
 use rustfft::num_complex::Complex32;
 
@@ -63,16 +64,26 @@ pub struct TimeSplit {
     pub other_ns: u64,
 }
 
+/// Length of the cached half spectrum of one ZOI of side n.
+pub fn spectrum_len(n: usize) -> usize {
+    (n / 2 + 1) * n
+}
+
 pub struct ZoiEngine {
     n: usize,
-    fft: Fft2d,
+    fft: RealFft2d,
     window: Vec<f32>,
     window_sum: f32,
     /// Zero-mean deformed ZOI (spatial, real).
     g_spatial: Vec<f32>,
     /// Spectrum of `g_spatial` at the integer position.
     g_spectrum: Vec<Complex32>,
+    /// Half-spectrum work buffer.
     work: Vec<Complex32>,
+    /// Windowed (or normalised) ZOI, real.
+    windowed: Vec<f32>,
+    /// Correlation map, real, row-major, unnormalised (times n²).
+    corr: Vec<f32>,
     phase_x: Vec<Complex32>,
     phase_y: Vec<Complex32>,
     pub profile: bool,
@@ -103,12 +114,14 @@ impl ZoiEngine {
         let window_sum = window.iter().sum();
         Self {
             n,
-            fft: Fft2d::new(n),
+            fft: RealFft2d::new(n),
             window,
             window_sum,
             g_spatial: vec![0.0; n * n],
-            g_spectrum: vec![zero; n * n],
-            work: vec![zero; n * n],
+            g_spectrum: vec![zero; spectrum_len(n)],
+            work: vec![zero; spectrum_len(n)],
+            windowed: vec![0.0; n * n],
+            corr: vec![0.0; n * n],
             phase_x: vec![zero; n],
             phase_y: vec![zero; n],
             profile: false,
@@ -128,8 +141,8 @@ impl ZoiEngine {
     ) -> bool {
         let n = self.n;
         assert!(image.contains_block(x0 as i64, y0 as i64, n));
-        assert_eq!(plain.len(), n * n);
-        assert_eq!(windowed.len(), n * n);
+        assert_eq!(plain.len(), spectrum_len(n));
+        assert_eq!(windowed.len(), spectrum_len(n));
         let contrast_ok = self.extract_zero_mean(image, x0, y0);
         if !contrast_ok {
             plain.fill(Complex32::new(0.0, 0.0));
@@ -137,16 +150,17 @@ impl ZoiEngine {
             return false;
         }
         let norm = self.g_spatial.iter().map(|&g| g * g).sum::<f32>().sqrt();
-        for (p, &g) in plain.iter_mut().zip(&self.g_spatial) {
-            *p = Complex32::new(g / norm, 0.0);
+        for (p, &g) in self.windowed.iter_mut().zip(&self.g_spatial) {
+            *p = g / norm;
         }
-        self.fft.forward(plain);
-        let Some(norm_w) = self.window_into(windowed) else {
-            return false;
-        };
-        let _ = norm_w;
-        self.fft.forward(windowed);
-        true
+        self.fft.forward(&self.windowed, plain);
+        let mut real = std::mem::take(&mut self.windowed);
+        let ok = self.window_into(&mut real).is_some();
+        if ok {
+            self.fft.forward(&real, windowed);
+        }
+        self.windowed = real;
+        ok
     }
 
     /// Copies the n x n block at (x0, y0) into `g_spatial` minus its mean; false if flat.
@@ -174,7 +188,7 @@ impl ZoiEngine {
 
     /// Writes w (g - weighted mean) / norm into `out` (real parts); returns the norm before
     /// normalisation, or None when the windowed ZOI is flat.
-    fn window_into(&self, out: &mut [Complex32]) -> Option<f32> {
+    fn window_into(&self, out: &mut [f32]) -> Option<f32> {
         let mut weighted = 0.0f32;
         for (&w, &g) in self.window.iter().zip(&self.g_spatial) {
             weighted += w * g;
@@ -184,14 +198,14 @@ impl ZoiEngine {
         for ((o, &w), &g) in out.iter_mut().zip(&self.window).zip(&self.g_spatial) {
             let v = w * (g - mean);
             sum_sq += v * v;
-            *o = Complex32::new(v, 0.0);
+            *o = v;
         }
         let norm = sum_sq.sqrt();
         let floor = MIN_STD_COUNTS * (self.window_sum).sqrt();
         if norm.is_finite() && norm >= floor {
             let inv = 1.0 / norm;
             for o in out.iter_mut() {
-                o.re *= inv;
+                *o *= inv;
             }
             Some(norm)
         } else {
@@ -247,10 +261,7 @@ impl ZoiEngine {
             if pass == 1 {
                 break;
             }
-            for (s, &g) in self.g_spectrum.iter_mut().zip(&self.g_spatial) {
-                *s = Complex32::new(g, 0.0);
-            }
-            self.fft.forward(&mut self.g_spectrum);
+            self.fft.forward(&self.g_spatial, &mut self.g_spectrum);
             for ((w, &g), &f) in self
                 .work
                 .iter_mut()
@@ -259,7 +270,7 @@ impl ZoiEngine {
             {
                 *w = g * f.conj();
             }
-            self.fft.inverse(&mut self.work);
+            self.fft.inverse(&mut self.work, &mut self.corr);
             timer.lap(&mut self.split.fft_ns);
             let (dx, dy) = self.argmax_wrapped();
             timer.lap(&mut self.split.peak_ns);
@@ -271,10 +282,7 @@ impl ZoiEngine {
             iy += dy;
         }
         if !spectrum_valid {
-            for (s, &g) in self.g_spectrum.iter_mut().zip(&self.g_spatial) {
-                *s = Complex32::new(g, 0.0);
-            }
-            self.fft.forward(&mut self.g_spectrum);
+            self.fft.forward(&self.g_spatial, &mut self.g_spectrum);
             timer.lap(&mut self.split.fft_ns);
         }
         // Sub-pixel iterations: window, correlate, quadratic peak, Fourier shift.
@@ -289,20 +297,19 @@ impl ZoiEngine {
                 self.shift_into_spatial(shift);
                 timer.lap(&mut self.split.shift_ns);
             }
-            let mut work = std::mem::take(&mut self.work);
-            let windowed = self.window_into(&mut work);
+            let mut real = std::mem::take(&mut self.windowed);
+            let windowed = self.window_into(&mut real);
+            self.windowed = real;
             timer.lap(&mut self.split.window_ns);
             if windowed.is_none() {
-                self.work = work;
                 result.status = NodeStatus::LowContrast;
                 return result;
             }
-            self.fft.forward(&mut work);
-            for (w, &f) in work.iter_mut().zip(reference.windowed) {
+            self.fft.forward(&self.windowed, &mut self.work);
+            for (w, &f) in self.work.iter_mut().zip(reference.windowed) {
                 *w *= f.conj();
             }
-            self.fft.inverse(&mut work);
-            self.work = work;
+            self.fft.inverse(&mut self.work, &mut self.corr);
             timer.lap(&mut self.split.fft_ns);
             let (px, py) = self.argmax_near_zero();
             let neighbourhood = self.neighbourhood(px, py, scale);
@@ -350,8 +357,12 @@ impl ZoiEngine {
             self.phase_x[k] = Complex32::new(cx as f32, sx as f32);
             self.phase_y[k] = Complex32::new(cy as f32, sy as f32);
         }
-        // Transposed spectrum layout: index kx * n + ky.
-        for kx in 0..n {
+        // Nyquist bins: +n/2 and -n/2 are the same bin; the symmetric shift factor is their
+        // mean, cos(π d), which keeps the shifted ZOI real without favouring a direction.
+        self.phase_x[n / 2] = Complex32::new((std::f64::consts::PI * d.0).cos() as f32, 0.0);
+        self.phase_y[n / 2] = Complex32::new((std::f64::consts::PI * d.1).cos() as f32, 0.0);
+        // Half-spectrum layout: index kx * n + ky, kx in 0..=n/2.
+        for kx in 0..=n / 2 {
             let px = self.phase_x[kx];
             let row = &mut self.work[kx * n..(kx + 1) * n];
             let src = &self.g_spectrum[kx * n..(kx + 1) * n];
@@ -359,10 +370,10 @@ impl ZoiEngine {
                 *w = g * (px * py);
             }
         }
-        self.fft.inverse(&mut self.work);
+        self.fft.inverse(&mut self.work, &mut self.g_spatial);
         let scale = 1.0 / (n * n) as f32;
-        for (g, w) in self.g_spatial.iter_mut().zip(&self.work) {
-            *g = w.re * scale;
+        for g in self.g_spatial.iter_mut() {
+            *g *= scale;
         }
     }
 
@@ -371,9 +382,9 @@ impl ZoiEngine {
         let n = self.n;
         let mut best = f32::NEG_INFINITY;
         let mut best_index = 0;
-        for (i, c) in self.work.iter().enumerate() {
-            if c.re > best {
-                best = c.re;
+        for (i, &c) in self.corr.iter().enumerate() {
+            if c > best {
+                best = c;
                 best_index = i;
             }
         }
@@ -393,7 +404,7 @@ impl ZoiEngine {
         let mut at = (0, 0);
         for dy in -1i64..=1 {
             for dx in -1i64..=1 {
-                let v = self.work[self.wrap_index(dx, dy)].re;
+                let v = self.corr[self.wrap_index(dx, dy)];
                 if v > best {
                     best = v;
                     at = (dx, dy);
@@ -416,7 +427,7 @@ impl ZoiEngine {
         for (row, values) in c.iter_mut().enumerate() {
             for (col, v) in values.iter_mut().enumerate() {
                 let idx = self.wrap_index(px + col as i64 - 1, py + row as i64 - 1);
-                *v = self.work[idx].re * scale;
+                *v = self.corr[idx] * scale;
             }
         }
         c

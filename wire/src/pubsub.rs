@@ -106,13 +106,13 @@ where
     }
 
     /// Loans a slice of `len` elements in shared memory, lets `fill` write the header and every
-    /// element in place (no copy), sends it and wakes the subscribers. Returns how many
-    /// subscribers received it.
+    /// element in place (no copy), sends it and wakes the subscribers. `fill` returns `false` to
+    /// send nothing (the loan goes back). Returns how many subscribers received the sample.
     pub fn publish<E>(
         &self,
         len: usize,
-        fill: impl FnOnce(&mut H, &mut [T]) -> Result<(), E>,
-    ) -> Result<Result<usize, E>, InstanceError> {
+        fill: impl FnOnce(&mut H, &mut [T]) -> Result<bool, E>,
+    ) -> Result<Result<Option<usize>, E>, InstanceError> {
         assert!(
             len <= self.max_len,
             "slice of {len} beyond the {} the service was sized for",
@@ -137,12 +137,14 @@ where
             (unsafe { &mut *header }, sample.payload_mut())
         };
         *header = H::default();
-        if let Err(e) = fill(header, payload) {
-            return Ok(Err(e));
+        match fill(header, payload) {
+            Err(e) => return Ok(Err(e)),
+            Ok(false) => return Ok(Ok(None)),
+            Ok(true) => {}
         }
         let delivered = sample.send().map_err(|e| spec_error(&e))?;
         self.notifier.notify().map_err(|e| spec_error(&e))?;
-        Ok(Ok(delivered))
+        Ok(Ok(Some(delivered)))
     }
 }
 

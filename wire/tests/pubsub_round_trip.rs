@@ -29,11 +29,11 @@ fn frame_and_value_round_trip_then_no_leftovers() {
                 header.height_px = height as u32;
                 header.bit_depth = 12;
                 header.pixel_checksum = pixel_checksum(pixels);
-                Ok::<(), ()>(())
+                Ok::<bool, ()>(true)
             })
             .unwrap()
             .unwrap();
-        assert_eq!(delivered, 1);
+        assert_eq!(delivered, Some(1));
         let sample = subscriber.receive().unwrap().expect("a frame");
         let header = *sample.user_header();
         header.validate(sample.payload().len()).unwrap();
