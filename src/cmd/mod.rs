@@ -1,7 +1,7 @@
 //! The subcommands of `dicstream`, one module each.
 
 pub mod correlate;
-pub mod identify;
 pub mod identifier;
+pub mod identify;
 pub mod rig;
 pub mod synth;
