@@ -18,6 +18,7 @@ mod scenario;
 mod simulated;
 mod source;
 pub mod speckle;
+pub mod stream;
 
 pub use camera::{CameraModel, BIT_DEPTHS};
 pub use cli::{RendererArg, SimArgs};
