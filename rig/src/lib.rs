@@ -4,6 +4,7 @@
 
 pub mod actuator;
 pub mod builtin;
+pub mod campaign;
 pub mod codes;
 pub mod config;
 pub mod control;
@@ -20,6 +21,7 @@ pub mod rig;
 pub mod snapshot;
 pub mod specimen;
 
+pub use campaign::{Campaign, CampaignEvent, CampaignTest};
 pub use config::RigConfig;
 pub use control::{AxisControl, ControlGains, ControlMode};
 pub use ids::{ActuatorId, Axis, Channel};

@@ -4,6 +4,7 @@
 //! as it goes. All IPC of the crate lives in this file; the core knows nothing of it.
 
 use crate::builtin::BuiltinTest;
+use crate::campaign::{Campaign, CampaignEvent};
 use crate::codes;
 use crate::config::RigConfig;
 use crate::control::{AxisControl, ControlMode};
@@ -51,6 +52,9 @@ pub struct ProcessOptions {
     pub seed: u64,
     /// Started at once, if any.
     pub program: Option<Program>,
+    /// Tests run one after the other (each mounts its specimen), if any; exclusive with
+    /// `program`.
+    pub campaign: Option<Campaign>,
     /// Stretch rate and level of the built-in tests started over `rig/command`.
     pub test_rate_per_s: f64,
     pub test_stretch: f64,
@@ -120,6 +124,13 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
     };
     let mut row = String::with_capacity(2048);
 
+    if options.program.is_some() && options.campaign.is_some() {
+        return Err("a program and a campaign cannot run together: choose one".into());
+    }
+    if let Some(campaign) = &options.campaign {
+        campaign.check_against(&options.config)?;
+    }
+    let mut campaign = options.campaign.clone();
     let mut rig = Rig::new(options.config.clone(), options.seed)?;
     let mut summary = ProcessSummary::default();
     if let Some(program) = &options.program {
@@ -152,6 +163,21 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
                 .map_err(|e| format!("rig/command reply: {e:?}"))?;
         }
 
+        if let Some(campaign) = campaign.as_mut() {
+            match campaign.advance(&mut rig) {
+                Ok(CampaignEvent::Started { index, test }) => eprintln!(
+                    "rig: campaign test {}/{}: {:?} to λ {} at {} /s, started at t = {:.1} s",
+                    index + 1,
+                    campaign.tests().len(),
+                    test.test,
+                    test.stretch,
+                    test.rate_per_s,
+                    rig.state().t_s
+                ),
+                Ok(CampaignEvent::Busy | CampaignEvent::Done) => {}
+                Err(refusal) => return Err(format!("campaign halted: {refusal}").into()),
+            }
+        }
         for _ in 0..publish_every {
             rig.step();
             if let Some(w) = log.as_mut() {
@@ -177,14 +203,22 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
         if options.duration_s.is_some_and(|d| s.t_s >= d) {
             break;
         }
-        if options.exit_when_done && !program_active && options.program.is_some() {
-            break;
+        if options.exit_when_done {
+            let done = match &campaign {
+                Some(c) => c.is_done(&rig),
+                None => !program_active && options.program.is_some(),
+            };
+            if done {
+                break;
+            }
         }
         // Pacing: the wall clock follows simulated time / factor.
         let factor = match options.speed {
             Speed::Realtime => Some(1.0),
             Speed::Factor(f) => Some(f),
-            Speed::Max if program_active => None,
+            Speed::Max if program_active || campaign.as_ref().is_some_and(|c| !c.is_done(&rig)) => {
+                None
+            }
             Speed::Max => Some(1.0),
         };
         match factor {

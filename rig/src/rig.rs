@@ -17,7 +17,7 @@ use crate::limits::{
 use crate::program::{Program, Run, StopTransition};
 use crate::refusal::Refusal;
 use crate::snapshot::{ProgramStatus, RigSnapshot, SpecimenKinematics};
-use crate::specimen::Specimen;
+use crate::specimen::{Specimen, SpecimenConfig};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -62,7 +62,13 @@ pub enum RigCommand {
     ResetEmergencyStop,
     /// Tear the specimen now (to exercise the break detector).
     BreakSpecimen,
+    /// Mount another specimen (or none): only with no program active and the grips back at the
+    /// mounting position (every elongation within [`MOUNT_TOLERANCE_MM`]).
+    MountSpecimen(Option<Box<SpecimenConfig>>),
 }
+
+/// How far from the mounting position (zero elongation) the grips may be for a specimen change.
+pub const MOUNT_TOLERANCE_MM: f64 = 0.5;
 
 pub struct Rig {
     config: RigConfig,
@@ -301,6 +307,33 @@ impl Rig {
                 self.tripped &= !EMERGENCY_STOP_BIT;
                 Ok(())
             }
+            RigCommand::MountSpecimen(config) => {
+                self.refuse_if_program_active()?;
+                for axis in Axis::ALL {
+                    let elongation_mm = self.snapshot.axes[axis.index()].elongation_mm;
+                    if elongation_mm.abs() > MOUNT_TOLERANCE_MM {
+                        return Err(Refusal::Invalid {
+                            reason: format!(
+                                "{axis:?} elongation is {elongation_mm:.2} mm: unload to within \
+                                 {MOUNT_TOLERANCE_MM} mm of the mounting position before changing \
+                                 the specimen"
+                            ),
+                        });
+                    }
+                }
+                let specimen = match &config {
+                    Some(c) => Some(
+                        Specimen::new((**c).clone())
+                            .map_err(|reason| Refusal::Invalid { reason })?,
+                    ),
+                    None => None,
+                };
+                self.specimen = specimen;
+                self.config.specimen = config.map(|c| *c);
+                self.load_specimen();
+                self.read_sensors();
+                Ok(())
+            }
             RigCommand::BreakSpecimen => match self.specimen.as_mut() {
                 Some(specimen) => {
                     specimen.break_now();
@@ -509,6 +542,8 @@ impl Rig {
     fn load_specimen(&mut self) {
         let positions = self.feedback_positions();
         let Some(specimen) = self.specimen.as_mut() else {
+            self.external_force_n = [0.0; ACTUATOR_COUNT];
+            self.kinematics = SpecimenKinematics::default();
             return;
         };
         let response = specimen.respond(&positions);

@@ -30,6 +30,7 @@ fn state_is_published_and_commands_are_answered() {
         config: RigConfig::default(),
         seed: 1,
         program: None,
+        campaign: None,
         test_rate_per_s: 1e-3,
         test_stretch: 2.0,
         speed: Speed::Factor(5.0),

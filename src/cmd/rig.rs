@@ -3,7 +3,7 @@
 
 use rig::builtin::BuiltinTest;
 use rig::process::{run as run_process, ProcessOptions, Speed};
-use rig::{Program, RigConfig};
+use rig::{Campaign, Program, RigConfig};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
@@ -14,9 +14,14 @@ pub struct RigArgs {
     /// Program file (TOML) started at once.
     #[arg(long, conflicts_with = "test")]
     pub program: Option<PathBuf>,
-    /// Built-in test started at once: uniaxial or equibiaxial (mounts its specimen).
-    #[arg(long)]
+    /// Built-in test started at once: uniaxial or equibiaxial (mounts its specimen), or
+    /// `campaign`: the paper's uniaxial then equibiaxial tests (see --campaign).
+    #[arg(long, conflicts_with = "campaign")]
     pub test: Option<String>,
+    /// Tests run one after the other, each on its own specimen, unloading between them:
+    /// TEST:STRETCH@RATE,... e.g. uniaxial:3@0.08,equibiaxial:2@0.04
+    #[arg(long, conflicts_with = "program")]
+    pub campaign: Option<String>,
     /// Stretch rate of the built-in test (/s).
     #[arg(long, default_value_t = 1e-3)]
     pub rate: f64,
@@ -49,7 +54,13 @@ pub struct RigArgs {
 pub fn run(args: RigArgs) -> anyhow::Result<()> {
     let speed = Speed::parse(&args.speed).map_err(anyhow::Error::msg)?;
     let mut config = RigConfig::default();
-    let program = match (&args.program, &args.test) {
+    let campaign = match (&args.campaign, args.test.as_deref()) {
+        (Some(spec), _) => Some(Campaign::parse(spec).map_err(anyhow::Error::msg)?),
+        (None, Some("campaign")) => Some(Campaign::paper()),
+        _ => None,
+    };
+    let test = args.test.as_deref().filter(|t| *t != "campaign");
+    let program = match (&args.program, test) {
         (Some(path), _) => {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| anyhow::anyhow!("program {}: {e}", path.display()))?;
@@ -58,7 +69,7 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         }
         (None, Some(name)) => {
             let test = BuiltinTest::parse(name).ok_or_else(|| {
-                anyhow::anyhow!("--test {name:?}: expected uniaxial or equibiaxial")
+                anyhow::anyhow!("--test {name:?}: expected uniaxial, equibiaxial or campaign")
             })?;
             config.specimen = Some(test.specimen());
             Some(
@@ -73,6 +84,7 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         config,
         seed: args.seed,
         program,
+        campaign,
         test_rate_per_s: args.rate,
         test_stretch: args.stretch,
         speed,

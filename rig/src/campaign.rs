@@ -1,0 +1,254 @@
+//! A test campaign: built-in tests run one after the other on one rig, each on its own
+//! specimen (the paper's section 4: a uniaxial test, then an equibiaxial test). Each test
+//! loads to its stretch, holds, unloads to the mounting position; the next specimen is then
+//! mounted and its test started. Pure logic on [`Rig`]: the process shell calls
+//! [`Campaign::advance`] between steps.
+
+use crate::builtin::BuiltinTest;
+use crate::config::RigConfig;
+use crate::program::{Program, Step};
+use crate::refusal::Refusal;
+use crate::rig::{Rig, RigCommand};
+use crate::snapshot::ProgramStatus;
+
+/// One test of a campaign: a built-in test to a stretch at a stretch rate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CampaignTest {
+    pub test: BuiltinTest,
+    /// Final stretch λ of the loading ramp.
+    pub stretch: f64,
+    /// Stretch rate of the loading ramp (/s of simulated time).
+    pub rate_per_s: f64,
+}
+
+/// How fast a test unloads, relative to its loading rate.
+pub const UNLOAD_RATE_FACTOR: f64 = 5.0;
+/// Hold at the mounting position after unloading (s).
+pub const UNLOADED_HOLD_S: f64 = 0.5;
+
+impl CampaignTest {
+    /// The test's program: hold, ramp to the stretch, hold, ramp back to zero elongation at
+    /// [`UNLOAD_RATE_FACTOR`] times the rate, hold.
+    pub fn program(&self) -> Result<Program, String> {
+        let mut program = self.test.program(self.rate_per_s, self.stretch)?;
+        let geometry = self.test.specimen().geometry;
+        for (_, steps) in &mut program.channels {
+            steps.push(Step::Ramp {
+                to: 0.0,
+                rate_per_s: UNLOAD_RATE_FACTOR * self.rate_per_s * geometry.gauge_length_mm,
+                relative: false,
+            });
+            steps.push(Step::Hold {
+                duration_s: UNLOADED_HOLD_S,
+            });
+        }
+        program.name = format!("{} and back", program.name);
+        program.validate()?;
+        Ok(program)
+    }
+
+    /// `uniaxial:3@0.08` = uniaxial to λ 3 at 0.08 /s.
+    pub fn parse(text: &str) -> Result<CampaignTest, String> {
+        let expected = "expected TEST:STRETCH@RATE, e.g. uniaxial:3@0.08";
+        let (name, rest) = text
+            .trim()
+            .split_once(':')
+            .ok_or_else(|| format!("campaign test {text:?}: {expected}"))?;
+        let (stretch, rate) = rest
+            .split_once('@')
+            .ok_or_else(|| format!("campaign test {text:?}: {expected}"))?;
+        let test = BuiltinTest::parse(name.trim()).ok_or_else(|| {
+            format!("campaign test {text:?}: unknown test {name:?} (uniaxial or equibiaxial)")
+        })?;
+        let number = |what: &str, value: &str| {
+            value
+                .trim()
+                .parse::<f64>()
+                .map_err(|_| format!("campaign test {text:?}: {what} {value:?} is not a number"))
+        };
+        let test = CampaignTest {
+            test,
+            stretch: number("stretch", stretch)?,
+            rate_per_s: number("rate", rate)?,
+        };
+        test.program()
+            .map_err(|e| format!("campaign test {text:?}: {e}"))?;
+        Ok(test)
+    }
+}
+
+/// What [`Campaign::advance`] did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CampaignEvent {
+    /// Nothing new: a test is under way (or held, or stopped by a limit: the campaign waits).
+    Busy,
+    /// Test `index` (from 0) was mounted and started.
+    Started { index: usize, test: CampaignTest },
+    /// Every test has run.
+    Done,
+}
+
+/// Tests in order, and which one is next.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Campaign {
+    tests: Vec<CampaignTest>,
+    next: usize,
+}
+
+impl Campaign {
+    /// The paper's campaign on the default specimen, sized for a one-minute live bench: uniaxial
+    /// tension to λ 3 (the range of the paper's Figs. 7-8), then equibiaxial tension to λ 2
+    /// (Figs. 13-14). Fast rates: the specimen law is rate independent.
+    pub fn paper() -> Campaign {
+        Campaign::new(vec![
+            CampaignTest {
+                test: BuiltinTest::Uniaxial,
+                stretch: 3.0,
+                rate_per_s: 0.08,
+            },
+            CampaignTest {
+                test: BuiltinTest::Equibiaxial,
+                stretch: 2.0,
+                rate_per_s: 0.04,
+            },
+        ])
+        .expect("the paper campaign is valid")
+    }
+
+    pub fn new(tests: Vec<CampaignTest>) -> Result<Campaign, String> {
+        if tests.is_empty() {
+            return Err("a campaign needs at least one test".into());
+        }
+        for test in &tests {
+            test.program()?;
+        }
+        Ok(Campaign { tests, next: 0 })
+    }
+
+    /// `uniaxial:3@0.08,equibiaxial:2@0.04`.
+    pub fn parse(text: &str) -> Result<Campaign, String> {
+        let tests = text
+            .split(',')
+            .filter(|t| !t.trim().is_empty())
+            .map(CampaignTest::parse)
+            .collect::<Result<Vec<_>, _>>()?;
+        Campaign::new(tests)
+    }
+
+    pub fn tests(&self) -> &[CampaignTest] {
+        &self.tests
+    }
+
+    /// Simulated duration of the whole campaign (s), for planning.
+    pub fn duration_s(&self) -> f64 {
+        self.tests
+            .iter()
+            .map(|t| {
+                let ramp_s = (t.stretch - 1.0) / t.rate_per_s;
+                2.0 + ramp_s * (1.0 + 1.0 / UNLOAD_RATE_FACTOR) + UNLOADED_HOLD_S
+            })
+            .sum()
+    }
+
+    /// Checks every test against the limits of `config` as the rig itself would when the test
+    /// starts (stroke, force range, rate), so a campaign beyond the machine is refused before
+    /// anything runs, with the test named.
+    pub fn check_against(&self, config: &RigConfig) -> Result<(), String> {
+        for (k, test) in self.tests.iter().enumerate() {
+            let describe = || {
+                format!(
+                    "campaign test {} ({:?} to λ {} at {} /s)",
+                    k + 1,
+                    test.test,
+                    test.stretch,
+                    test.rate_per_s
+                )
+            };
+            let mut scratch_config = config.clone();
+            scratch_config.specimen = Some(test.test.specimen());
+            let mut rig =
+                Rig::new(scratch_config, 0).map_err(|e| format!("{}: {e}", describe()))?;
+            let program = test.program().map_err(|e| format!("{}: {e}", describe()))?;
+            rig.command(RigCommand::StartProgram(Box::new(program)))
+                .map_err(|e| format!("{} is refused by the rig: {e}", describe()))?;
+        }
+        Ok(())
+    }
+
+    /// Between steps: once the rig is idle (no test yet, or the last one finished), mount the
+    /// next test's specimen and start it. A test stopped by a limit or a command halts the
+    /// campaign where it is (the operator decides).
+    pub fn advance(&mut self, rig: &mut Rig) -> Result<CampaignEvent, Refusal> {
+        let status = rig.state().program;
+        let ready = match status {
+            ProgramStatus::Idle => self.next == 0,
+            ProgramStatus::Finished => true,
+            ProgramStatus::Running | ProgramStatus::Held | ProgramStatus::Stopped => false,
+        };
+        if !ready {
+            return Ok(CampaignEvent::Busy);
+        }
+        let Some(&test) = self.tests.get(self.next) else {
+            return Ok(CampaignEvent::Done);
+        };
+        let program = test
+            .program()
+            .map_err(|reason| Refusal::Invalid { reason })?;
+        rig.command(RigCommand::MountSpecimen(Some(Box::new(
+            test.test.specimen(),
+        ))))?;
+        rig.command(RigCommand::StartProgram(Box::new(program)))?;
+        let index = self.next;
+        self.next += 1;
+        Ok(CampaignEvent::Started { index, test })
+    }
+
+    /// True once every test was started and the rig has finished the last one.
+    pub fn is_done(&self, rig: &Rig) -> bool {
+        self.next == self.tests.len() && rig.state().program == ProgramStatus::Finished
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_refuses_with_reasons() {
+        let c = Campaign::parse("uniaxial:3@0.08, equibiaxial:2@0.04").unwrap();
+        assert_eq!(c.tests().len(), 2);
+        assert_eq!(c.tests()[1].test, BuiltinTest::Equibiaxial);
+        assert!(Campaign::parse("").unwrap_err().contains("at least one"));
+        assert!(Campaign::parse("shear:2@0.1")
+            .unwrap_err()
+            .contains("unknown test"));
+        assert!(Campaign::parse("uniaxial:two@0.1")
+            .unwrap_err()
+            .contains("not a number"));
+        assert!(Campaign::parse("uniaxial:3")
+            .unwrap_err()
+            .contains("STRETCH@RATE"));
+        assert!(Campaign::parse("uniaxial:0.5@0.1")
+            .unwrap_err()
+            .contains("stretch"));
+        assert!(Campaign::parse("uniaxial:NaN@0.1").is_err());
+    }
+
+    #[test]
+    fn a_stretch_beyond_the_stroke_is_refused_before_the_run() {
+        let config = RigConfig::default();
+        Campaign::paper().check_against(&config).unwrap();
+        // 100 mm gauge to λ 7: 300 mm per actuator, beyond the 250 mm stroke.
+        let error = Campaign::parse("uniaxial:7@0.08")
+            .unwrap()
+            .check_against(&config)
+            .unwrap_err();
+        assert!(error.contains("campaign test 1"), "{error}");
+        assert!(error.contains("stroke"), "{error}");
+        let error = Campaign::parse("equibiaxial:1.5@50")
+            .unwrap()
+            .check_against(&config)
+            .unwrap_err();
+        assert!(error.contains("rate"), "{error}");
+    }
+}
