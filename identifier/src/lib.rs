@@ -15,6 +15,7 @@
 
 pub mod data;
 pub mod fit;
+pub mod journal;
 pub mod law;
 pub mod lsq;
 pub mod models;

@@ -268,6 +268,23 @@ impl OnlineIdentifier {
         }
     }
 
+    /// Puts back a point accepted by an earlier run (from its journal), with the same
+    /// loading-branch rule as live points; returns whether it was kept.
+    pub fn restore(&mut self, case: LoadCase, stretch: f64, nominal_stress_mpa: f64) -> bool {
+        let points = &mut self.points[case_index(case)];
+        let increasing = points
+            .last()
+            .is_none_or(|&(last, _)| stretch >= last + self.config.min_stretch_increment);
+        let ok = stretch > 1.0
+            && nominal_stress_mpa.is_finite()
+            && increasing
+            && points.len() < self.config.max_points_per_case;
+        if ok {
+            points.push((stretch, nominal_stress_mpa));
+        }
+        ok
+    }
+
     /// Points accepted per case, in [`LoadCase::ALL`] order.
     pub fn point_counts(&self) -> [usize; 3] {
         [

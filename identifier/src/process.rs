@@ -19,8 +19,12 @@ use wire::{
 #[derive(Clone, Debug)]
 pub struct ProcessConfig {
     pub instance: String,
-    /// Final JSON (written atomically at the end).
+    /// The fits as JSON, written atomically at most once a second while points come in and
+    /// at the end, so a killed process leaves its last fits.
     pub output_json: PathBuf,
+    /// Journal of accepted points (see [`crate::journal`]): read back at start, appended as
+    /// points are accepted. None: no journal.
+    pub journal: Option<PathBuf>,
     /// Stop after this many fields (None: until SIGINT/SIGTERM or idle timeout).
     pub max_fields: Option<u64>,
     /// Stop after this long without any sample (None: never).
@@ -134,12 +138,32 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
     let publisher: ValuePublisher<IdentificationReport> =
         ValuePublisher::create(&node, &services::IDENTIFICATION)?;
     let waitset = WaitSetBuilder::new().create::<ipc::Service>()?;
+    eprintln!("identifier: ready (instance {})", instance.name());
     let fields_guard = waitset.attach_notification(fields.listener())?;
     let rig_guard = waitset.attach_notification(rig.listener())?;
 
     let mut online = OnlineIdentifier::new(config.online.clone());
+    let mut journal = match &config.journal {
+        Some(path) => {
+            let restored = crate::journal::read(path)?;
+            let kept = restored
+                .iter()
+                .filter(|p| online.restore(p.case, p.stretch, p.nominal_stress_mpa))
+                .count();
+            if !restored.is_empty() {
+                eprintln!(
+                    "identifier: rebuilt the load path from {}: {kept} of {} points",
+                    path.display(),
+                    restored.len()
+                );
+            }
+            Some(crate::journal::JournalWriter::open(path)?)
+        }
+        None => None,
+    };
     let mut summary = ProcessSummary::default();
     let mut last_fits = Vec::new();
+    let mut last_json_write: Option<Instant> = None;
     let mut last_activity = Instant::now();
     let mut failure: Option<BoxError> = None;
     loop {
@@ -155,17 +179,36 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
                         fields.clear_events();
                     }
                     // Rig first: fields name rig samples.
+                    let mut record = |field: &FieldSample, outcome: FieldOutcome| {
+                        if let FieldOutcome::Accepted {
+                            case,
+                            stretch,
+                            nominal_stress_mpa,
+                        } = outcome
+                        {
+                            accepted_any = true;
+                            if let Some(journal) = journal.as_mut() {
+                                journal.append(&crate::journal::JournalPoint {
+                                    case,
+                                    stretch,
+                                    nominal_stress_mpa,
+                                    frame_id: field.frame_id,
+                                })?;
+                            }
+                        }
+                        Ok::<(), String>(())
+                    };
                     while let Some(state) = rig.receive()? {
                         summary.rig_samples_received += 1;
-                        for (_, outcome) in online.push_rig(rig_sample(&state)) {
-                            accepted_any |= matches!(outcome, FieldOutcome::Accepted { .. });
+                        for (field, outcome) in online.push_rig(rig_sample(&state)) {
+                            record(&field, outcome)?;
                         }
                     }
                     while let Some(sample) = fields.receive()? {
                         summary.fields_received += 1;
                         if let Some(field) = field_sample(sample.user_header()) {
-                            accepted_any |=
-                                matches!(online.push_field(field), FieldOutcome::Accepted { .. });
+                            let outcome = online.push_field(field);
+                            record(&field, outcome)?;
                         }
                     }
                     Ok(())
@@ -193,6 +236,13 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
                 publisher.publish(report)?;
                 summary.reports_published += 1;
                 last_fits = fits;
+                if last_json_write.is_none_or(|t| t.elapsed() >= Duration::from_secs(1)) {
+                    write_atomically(
+                        &config.output_json,
+                        &final_json(&summary, &online, &last_fits)?,
+                    )?;
+                    last_json_write = Some(Instant::now());
+                }
             }
         }
         if config
@@ -211,15 +261,32 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
             break;
         }
     }
-    summary.points = online.point_counts();
+    if last_fits.is_empty() {
+        // Restored points and nothing new: still report the fits of the path.
+        last_fits = online.refit().unwrap_or_default();
+    }
     summary.best_model = last_fits.first().map(|f| f.model.name());
+    write_atomically(
+        &config.output_json,
+        &final_json(&summary, &online, &last_fits)?,
+    )?;
+    summary.points = online.point_counts();
+    Ok(summary)
+}
+
+/// The JSON of `identification.json`: points per case, pairing counters, ranked fits.
+fn final_json(
+    summary: &ProcessSummary,
+    online: &OnlineIdentifier,
+    fits: &[crate::fit::Fit],
+) -> Result<String, BoxError> {
+    let points = online.point_counts();
     let json = serde_json::json!({
-        "points": {"uniaxial": summary.points[0], "equibiaxial": summary.points[1], "pure_shear": summary.points[2]},
+        "points": {"uniaxial": points[0], "equibiaxial": points[1], "pure_shear": points[2]},
         "fields_received": summary.fields_received,
         "rig_samples_received": summary.rig_samples_received,
         "pairing": {"accepted": online.counters.accepted, "skipped": online.counters.skipped, "dropped": online.counters.dropped},
-        "fits": last_fits.iter().map(fit_json).collect::<Vec<_>>(),
+        "fits": fits.iter().map(fit_json).collect::<Vec<_>>(),
     });
-    write_atomically(&config.output_json, &serde_json::to_string_pretty(&json)?)?;
-    Ok(summary)
+    Ok(serde_json::to_string_pretty(&json)?)
 }

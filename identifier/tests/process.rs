@@ -18,9 +18,12 @@ fn live_process_identifies_smactane() {
     let name = format!("idtest_{}", std::process::id());
     let instance = Instance::new(&name).unwrap();
     let output = std::env::temp_dir().join(format!("{name}_identification.json"));
+    let journal = std::env::temp_dir().join(format!("{name}_points.csv"));
+    let _ = std::fs::remove_file(&journal);
     let config = ProcessConfig {
         instance: name.clone(),
         output_json: output.clone(),
+        journal: Some(journal.clone()),
         max_fields: Some(2 * STEPS),
         idle_timeout: Some(Duration::from_secs(20)),
         online: OnlineConfig::default(),
@@ -128,6 +131,24 @@ fn live_process_identifies_smactane() {
     assert_eq!(json["points"]["uniaxial"], STEPS);
     assert!(json["fits"].as_array().is_some_and(|f| !f.is_empty()));
     std::fs::remove_file(&output).unwrap();
+
+    // A restarted identifier (same journal) rebuilds the whole path before any new data.
+    let again = ProcessConfig {
+        instance: name.clone(),
+        output_json: output.clone(),
+        journal: Some(journal.clone()),
+        max_fields: None,
+        idle_timeout: Some(Duration::from_millis(300)),
+        online: OnlineConfig::default(),
+    };
+    let summary = run(again).unwrap();
+    assert_eq!(summary.points, [STEPS as usize, STEPS as usize, 0]);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&output).unwrap()).unwrap();
+    assert_eq!(json["points"]["equibiaxial"], STEPS);
+    assert!(json["fits"].as_array().is_some_and(|f| !f.is_empty()));
+    std::fs::remove_file(&output).unwrap();
+    std::fs::remove_file(&journal).unwrap();
     instance.remove_leftover_files();
     assert!(instance.leftover_files().is_empty());
 }

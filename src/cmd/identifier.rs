@@ -15,6 +15,10 @@ pub struct IdentifierArgs {
     /// Final fits, written atomically when the process stops.
     #[arg(long, default_value = "identification.json")]
     pub output: PathBuf,
+    /// Journal of accepted load-path points: read back at start (a restarted identifier
+    /// rebuilds its path from it), appended as points are accepted.
+    #[arg(long)]
+    pub journal: Option<PathBuf>,
     /// Models ranked at each refit: NAME[,NAME...] or `all` (slow: refits run per point).
     #[arg(
         long,
@@ -39,6 +43,7 @@ pub fn run(args: IdentifierArgs) -> anyhow::Result<()> {
     let config = ProcessConfig {
         instance: args.instance,
         output_json: args.output.clone(),
+        journal: args.journal.clone(),
         max_fields: args.max_fields,
         idle_timeout,
         online: OnlineConfig {
