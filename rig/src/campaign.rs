@@ -10,6 +10,8 @@ use crate::program::{Program, Step};
 use crate::refusal::Refusal;
 use crate::rig::{Rig, RigCommand};
 use crate::snapshot::ProgramStatus;
+use crate::specimen::SpecimenConfig;
+use identifier::law::InvariantLaw;
 
 /// One test of a campaign: a built-in test to a stretch at a stretch rate.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -93,6 +95,8 @@ pub enum CampaignEvent {
 pub struct Campaign {
     tests: Vec<CampaignTest>,
     next: usize,
+    /// The material of every specimen; None: each built-in specimen's own (Smactane).
+    law: Option<InvariantLaw>,
 }
 
 impl Campaign {
@@ -122,7 +126,26 @@ impl Campaign {
         for test in &tests {
             test.program()?;
         }
-        Ok(Campaign { tests, next: 0 })
+        Ok(Campaign {
+            tests,
+            next: 0,
+            law: None,
+        })
+    }
+
+    /// Every specimen of the campaign made of `law` instead of the default material.
+    pub fn with_law(mut self, law: InvariantLaw) -> Campaign {
+        self.law = Some(law);
+        self
+    }
+
+    /// The specimen test `test` mounts.
+    pub fn specimen_of(&self, test: &CampaignTest) -> SpecimenConfig {
+        let mut specimen = test.test.specimen();
+        if let Some(law) = &self.law {
+            specimen.law = law.clone();
+        }
+        specimen
     }
 
     /// `uniaxial:3@0.08,equibiaxial:2@0.04`.
@@ -165,7 +188,7 @@ impl Campaign {
                 )
             };
             let mut scratch_config = config.clone();
-            scratch_config.specimen = Some(test.test.specimen());
+            scratch_config.specimen = Some(self.specimen_of(test));
             let mut rig =
                 Rig::new(scratch_config, 0).map_err(|e| format!("{}: {e}", describe()))?;
             let program = test.program().map_err(|e| format!("{}: {e}", describe()))?;
@@ -195,7 +218,7 @@ impl Campaign {
             .program()
             .map_err(|reason| Refusal::Invalid { reason })?;
         rig.command(RigCommand::MountSpecimen(Some(Box::new(
-            test.test.specimen(),
+            self.specimen_of(&test),
         ))))?;
         rig.command(RigCommand::StartProgram(Box::new(program)))?;
         let index = self.next;

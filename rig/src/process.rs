@@ -92,6 +92,12 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
     let publish_every = (control_hz / options.publish_hz).round().max(1.0) as u64;
     let log_every = (control_hz / options.log_hz).round().max(1.0) as u64;
 
+    if options.program.is_some() && options.campaign.is_some() {
+        return Err("a program and a campaign cannot run together: choose one".into());
+    }
+    if let Some(campaign) = &options.campaign {
+        campaign.check_against(&options.config)?;
+    }
     let instance = wire::Instance::new(&options.instance)?;
     let (node, removed) = instance.create_node("rig")?;
     if removed > 0 {
@@ -112,6 +118,7 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
         .create()
         .map_err(|e| format!("server {}: {e:?}", wire::services::RIG_COMMAND))?;
 
+    eprintln!("rig: ready (instance {})", instance.name());
     let mut log = match &options.log_path {
         Some(path) => {
             let file =
@@ -124,12 +131,6 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
     };
     let mut row = String::with_capacity(2048);
 
-    if options.program.is_some() && options.campaign.is_some() {
-        return Err("a program and a campaign cannot run together: choose one".into());
-    }
-    if let Some(campaign) = &options.campaign {
-        campaign.check_against(&options.config)?;
-    }
     let mut campaign = options.campaign.clone();
     let mut rig = Rig::new(options.config.clone(), options.seed)?;
     let mut summary = ProcessSummary::default();

@@ -22,6 +22,13 @@ pub struct RigArgs {
     /// TEST:STRETCH@RATE,... e.g. uniaxial:3@0.08,equibiaxial:2@0.04
     #[arg(long, conflicts_with = "program")]
     pub campaign: Option<String>,
+    /// Material of the campaign's specimens: ln f(I1) = Σ a_i (I1 − 3)^i, a_0,a_1,... (f in MPa;
+    /// eq. 22) [default: Smactane, Table 3 n = 2]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub law_f: Option<Vec<f64>>,
+    /// ln g(I2) = Σ b_i (I2 − 3)^i, b_0,b_1,... (g in MPa; eq. 25) [default: Smactane, Table 4]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub law_g: Option<Vec<f64>>,
     /// Stretch rate of the built-in test (/s).
     #[arg(long, default_value_t = 1e-3)]
     pub rate: f64,
@@ -58,6 +65,22 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         (Some(spec), _) => Some(Campaign::parse(spec).map_err(anyhow::Error::msg)?),
         (None, Some("campaign")) => Some(Campaign::paper()),
         _ => None,
+    };
+    let campaign = match (campaign, &args.law_f, &args.law_g) {
+        (Some(c), f, g) if f.is_some() || g.is_some() => {
+            let mut law = identifier::law::InvariantLaw::smactane();
+            if let Some(a) = f {
+                law.f = identifier::law::InvariantFn::ExpPoly(a.clone());
+            }
+            if let Some(b) = g {
+                law.g = identifier::law::InvariantFn::ExpPoly(b.clone());
+            }
+            Some(c.with_law(law))
+        }
+        (None, Some(_), _) | (None, _, Some(_)) => {
+            anyhow::bail!("--law-f / --law-g apply to a campaign (--campaign or --test campaign)")
+        }
+        (c, _, _) => c,
     };
     let test = args.test.as_deref().filter(|t| *t != "campaign");
     let program = match (&args.program, test) {
