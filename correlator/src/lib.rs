@@ -25,6 +25,7 @@ mod fft2d;
 pub mod field;
 mod global;
 mod mesh;
+pub mod output;
 mod peak;
 mod pool;
 mod real_fft2d;

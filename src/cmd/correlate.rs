@@ -7,10 +7,9 @@
 
 use anyhow::{bail, Context, Result};
 use correlator::{
-    Correlator, CorrelatorSettings, Field, GaugeStrains, GuessMode, NodeStatus, ReferenceMode, Roi,
+    Correlator, CorrelatorSettings, Field, GaugeStrains, GuessMode, ReferenceMode, Roi,
     StrainMeasure,
 };
-use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -178,13 +177,17 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
         let t = Instant::now();
         let field = correlator.correlate(&image.pixels)?;
         let elapsed_ms = t.elapsed().as_secs_f64() * 1e3;
-        field_csv(field, &mut text);
+        correlator::output::field_csv(field, &mut text);
         write(
             &args.out.join(format!("field_{index:04}.csv")),
             text.as_bytes(),
         )?;
         if args.vtk {
-            field_vtk(field, index, &mut text);
+            correlator::output::field_vtk(
+                field,
+                &format!("dicstream correlate field {index:04}"),
+                &mut text,
+            );
             write(
                 &args.out.join(format!("field_{index:04}.vtk")),
                 text.as_bytes(),
@@ -252,133 +255,19 @@ fn settings_json(args: &CorrelateArgs, correlator: &Correlator) -> serde_json::V
     })
 }
 
-/// The CSV contract of issue 3: header `x,y,u,v,exx,eyy,exy,score,iterations,status`.
-fn field_csv(field: &Field, text: &mut String) {
-    text.clear();
-    text.push_str("x,y,u,v,exx,eyy,exy,score,iterations,status\n");
-    for n in &field.nodes {
-        let _ = writeln!(
-            text,
-            "{},{},{:.6},{:.6},{:.7},{:.7},{:.7},{:.5},{},{}",
-            n.x_px,
-            n.y_px,
-            n.u_px,
-            n.v_px,
-            n.exx,
-            n.eyy,
-            n.exy,
-            n.score,
-            n.iterations,
-            n.status.word()
-        );
-    }
-}
-
-/// Legacy VTK structured grid at the reference node positions (z = 0).
-fn field_vtk(field: &Field, index: usize, text: &mut String) {
-    text.clear();
-    let count = field.nodes.len();
-    let _ = write!(
-        text,
-        "# vtk DataFile Version 3.0\ndicstream correlate field {index:04}\nASCII\nDATASET STRUCTURED_GRID\nDIMENSIONS {} {} 1\nPOINTS {count} double\n",
-        field.nx, field.ny
-    );
-    for n in &field.nodes {
-        let _ = writeln!(text, "{} {} 0", n.x_px, n.y_px);
-    }
-    let _ = writeln!(text, "POINT_DATA {count}\nVECTORS displacement_px double");
-    for n in &field.nodes {
-        let _ = writeln!(text, "{} {} 0", n.u_px, n.v_px);
-    }
-    type Get = fn(&correlator::Node) -> f64;
-    let scalars: [(&str, Get); 6] = [
-        ("exx", |n| n.exx),
-        ("eyy", |n| n.eyy),
-        ("exy", |n| n.exy),
-        ("score", |n| n.score),
-        ("iterations", |n| n.iterations as f64),
-        ("valid", |n| f64::from(u8::from(n.status == NodeStatus::Ok))),
-    ];
-    for (name, get) in scalars {
-        let _ = writeln!(text, "SCALARS {name} double 1\nLOOKUP_TABLE default");
-        for n in &field.nodes {
-            let _ = writeln!(text, "{}", get(n));
-        }
-    }
-}
-
-/// RGB PNG: the reference in grey, overlaid inside the mesh with a blue-to-red map of `value`
-/// (bilinear between valid nodes, range = min..max over valid nodes).
+/// PNG of `value` over the reference image (see `correlator::output::colour_map_rgb`).
 fn colour_map(
     reference: &producer::Image16,
     field: &Field,
     value: impl Fn(&correlator::Node) -> f64,
 ) -> Result<Vec<u8>> {
+    let (rgb, _range) = correlator::output::colour_map_rgb(
+        &reference.pixels,
+        reference.width as usize,
+        field,
+        value,
+    );
     let (w, h) = (reference.width as usize, reference.height as usize);
-    let max_grey = reference.pixels.iter().copied().max().unwrap_or(1).max(1) as f64;
-    let valid: Vec<f64> = field
-        .nodes
-        .iter()
-        .filter(|n| n.status == NodeStatus::Ok)
-        .map(&value)
-        .collect();
-    let (lo, hi) = valid
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
-    let span = if hi > lo { hi - lo } else { 1.0 };
-    let mut rgb = vec![0u8; w * h * 3];
-    for (k, &p) in reference.pixels.iter().enumerate() {
-        let g = (255.0 * p as f64 / max_grey) as u8;
-        rgb[3 * k..3 * k + 3].copy_from_slice(&[g, g, g]);
-    }
-    if field.nx >= 2 && field.ny >= 2 && !valid.is_empty() {
-        let first = field.node(0, 0);
-        let last = field.node(field.nx - 1, field.ny - 1);
-        let (sx, sy) = (
-            (last.x_px - first.x_px) / (field.nx - 1) as f64,
-            (last.y_px - first.y_px) / (field.ny - 1) as f64,
-        );
-        for y in first.y_px.ceil() as usize..=(last.y_px.floor() as usize).min(h - 1) {
-            for x in first.x_px.ceil() as usize..=(last.x_px.floor() as usize).min(w - 1) {
-                let fx = (x as f64 - first.x_px) / sx;
-                let fy = (y as f64 - first.y_px) / sy;
-                let (i, j) = (
-                    (fx as usize).min(field.nx - 2),
-                    (fy as usize).min(field.ny - 2),
-                );
-                let (tx, ty) = (fx - i as f64, fy - j as f64);
-                let corners = [
-                    (i, j, (1.0 - tx) * (1.0 - ty)),
-                    (i + 1, j, tx * (1.0 - ty)),
-                    (i, j + 1, (1.0 - tx) * ty),
-                    (i + 1, j + 1, tx * ty),
-                ];
-                let (mut sum, mut weight) = (0.0, 0.0);
-                for (ci, cj, wgt) in corners {
-                    let node = field.node(ci, cj);
-                    if node.status == NodeStatus::Ok {
-                        sum += wgt * value(node);
-                        weight += wgt;
-                    }
-                }
-                if weight <= 1e-9 {
-                    continue;
-                }
-                let t = ((sum / weight - lo) / span).clamp(0.0, 1.0);
-                let colour = [
-                    255.0 * t,
-                    255.0 * (1.0 - (2.0 * t - 1.0).abs()),
-                    255.0 * (1.0 - t),
-                ];
-                let px = &mut rgb[3 * (y * w + x)..3 * (y * w + x) + 3];
-                for (c, &col) in px.iter_mut().zip(&colour) {
-                    *c = (0.35 * *c as f64 + 0.65 * col) as u8;
-                }
-            }
-        }
-    }
     let mut bytes = Vec::new();
     image::ImageEncoder::write_image(
         image::codecs::png::PngEncoder::new(&mut bytes),

@@ -1,0 +1,228 @@
+//! Field files, one format each, shared by every tool that writes fields (`dicstream
+//! correlate`, the live bench's results): the CSV contract, legacy VTK structured grids for
+//! ParaView, and an RGB colour map of a node value over a grey image.
+
+use crate::field::{Field, Node, NodeStatus};
+use std::fmt::Write as _;
+
+/// The CSV contract: header `x,y,u,v,exx,eyy,exy,score,iterations,status`, one row per node
+/// (row-major), x/y the ZOI centre in the reference image (px), u/v in px, status a word.
+pub fn field_csv(field: &Field, text: &mut String) {
+    text.clear();
+    text.push_str("x,y,u,v,exx,eyy,exy,score,iterations,status\n");
+    for n in &field.nodes {
+        let _ = writeln!(
+            text,
+            "{},{},{:.6},{:.6},{:.7},{:.7},{:.7},{:.5},{},{}",
+            n.x_px,
+            n.y_px,
+            n.u_px,
+            n.v_px,
+            n.exx,
+            n.eyy,
+            n.exy,
+            n.score,
+            n.iterations,
+            n.status.word()
+        );
+    }
+}
+
+/// Legacy VTK structured grid at the reference node positions (z = 0), titled `title`.
+pub fn field_vtk(field: &Field, title: &str, text: &mut String) {
+    text.clear();
+    let count = field.nodes.len();
+    let title: String = title.chars().filter(|c| *c != '\n').take(200).collect();
+    let _ = write!(
+        text,
+        "# vtk DataFile Version 3.0\n{title}\nASCII\nDATASET STRUCTURED_GRID\nDIMENSIONS {} {} 1\nPOINTS {count} double\n",
+        field.nx, field.ny
+    );
+    for n in &field.nodes {
+        let _ = writeln!(text, "{} {} 0", n.x_px, n.y_px);
+    }
+    let _ = writeln!(text, "POINT_DATA {count}\nVECTORS displacement_px double");
+    for n in &field.nodes {
+        let _ = writeln!(text, "{} {} 0", n.u_px, n.v_px);
+    }
+    type Get = fn(&Node) -> f64;
+    let scalars: [(&str, Get); 6] = [
+        ("exx", |n| n.exx),
+        ("eyy", |n| n.eyy),
+        ("exy", |n| n.exy),
+        ("score", |n| n.score),
+        ("iterations", |n| n.iterations as f64),
+        ("valid", |n| f64::from(u8::from(n.status == NodeStatus::Ok))),
+    ];
+    for (name, get) in scalars {
+        let _ = writeln!(text, "SCALARS {name} double 1\nLOOKUP_TABLE default");
+        for n in &field.nodes {
+            let _ = writeln!(text, "{}", get(n));
+        }
+    }
+}
+
+/// Range of a colour map: the values at its blue and red ends.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ColourRange {
+    pub low: f64,
+    pub high: f64,
+}
+
+/// RGB bytes (row-major, 3 per pixel) of the grey image `grey` (`width` px wide), overlaid
+/// inside the mesh with a blue-to-red map of `value` (bilinear between valid nodes, range =
+/// min..max over valid nodes). Returns the range used.
+pub fn colour_map_rgb(
+    grey: &[u16],
+    width: usize,
+    field: &Field,
+    value: impl Fn(&Node) -> f64,
+) -> (Vec<u8>, ColourRange) {
+    assert!(width > 0 && grey.len().is_multiple_of(width), "image shape");
+    let (w, h) = (width, grey.len() / width);
+    let max_grey = grey.iter().copied().max().unwrap_or(1).max(1) as f64;
+    let valid: Vec<f64> = field
+        .nodes
+        .iter()
+        .filter(|n| n.status == NodeStatus::Ok)
+        .map(&value)
+        .filter(|v| v.is_finite())
+        .collect();
+    let (lo, hi) = valid
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let mut rgb = vec![0u8; w * h * 3];
+    for (k, &p) in grey.iter().enumerate() {
+        let g = (255.0 * p as f64 / max_grey) as u8;
+        rgb[3 * k..3 * k + 3].copy_from_slice(&[g, g, g]);
+    }
+    if field.nx >= 2 && field.ny >= 2 && !valid.is_empty() {
+        let first = field.node(0, 0);
+        let last = field.node(field.nx - 1, field.ny - 1);
+        let (sx, sy) = (
+            (last.x_px - first.x_px) / (field.nx - 1) as f64,
+            (last.y_px - first.y_px) / (field.ny - 1) as f64,
+        );
+        let x_range =
+            first.x_px.max(0.0).ceil() as usize..=(last.x_px.floor().max(0.0) as usize).min(w - 1);
+        for y in
+            first.y_px.max(0.0).ceil() as usize..=(last.y_px.floor().max(0.0) as usize).min(h - 1)
+        {
+            for x in x_range.clone() {
+                let fx = (x as f64 - first.x_px) / sx;
+                let fy = (y as f64 - first.y_px) / sy;
+                let (i, j) = (
+                    (fx as usize).min(field.nx - 2),
+                    (fy as usize).min(field.ny - 2),
+                );
+                let (tx, ty) = (fx - i as f64, fy - j as f64);
+                let corners = [
+                    (i, j, (1.0 - tx) * (1.0 - ty)),
+                    (i + 1, j, tx * (1.0 - ty)),
+                    (i, j + 1, (1.0 - tx) * ty),
+                    (i + 1, j + 1, tx * ty),
+                ];
+                let (mut sum, mut weight) = (0.0, 0.0);
+                for (ci, cj, wgt) in corners {
+                    let node = field.node(ci, cj);
+                    let v = value(node);
+                    if node.status == NodeStatus::Ok && v.is_finite() {
+                        sum += wgt * v;
+                        weight += wgt;
+                    }
+                }
+                if weight <= 1e-9 {
+                    continue;
+                }
+                let t = ((sum / weight - lo) / span).clamp(0.0, 1.0);
+                let colour = [
+                    255.0 * t,
+                    255.0 * (1.0 - (2.0 * t - 1.0).abs()),
+                    255.0 * (1.0 - t),
+                ];
+                let px = &mut rgb[3 * (y * w + x)..3 * (y * w + x) + 3];
+                for (c, &col) in px.iter_mut().zip(&colour) {
+                    *c = (0.35 * *c as f64 + 0.65 * col) as u8;
+                }
+            }
+        }
+    }
+    let range = if valid.is_empty() {
+        ColourRange {
+            low: 0.0,
+            high: 0.0,
+        }
+    } else {
+        ColourRange { low: lo, high: hi }
+    };
+    (rgb, range)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn field() -> Field {
+        let mut nodes = Vec::new();
+        for j in 0..3 {
+            for i in 0..4 {
+                nodes.push(Node {
+                    x_px: 2.0 + 4.0 * i as f64,
+                    y_px: 2.0 + 4.0 * j as f64,
+                    u_px: 0.1 * i as f64,
+                    exx: i as f64,
+                    status: if (i, j) == (3, 2) {
+                        NodeStatus::LowContrast
+                    } else {
+                        NodeStatus::Ok
+                    },
+                    ..Node::default()
+                });
+            }
+        }
+        Field {
+            nx: 4,
+            ny: 3,
+            nodes,
+            ..Field::default()
+        }
+    }
+
+    #[test]
+    fn csv_and_vtk_have_one_row_per_node() {
+        let f = field();
+        let mut text = String::new();
+        field_csv(&f, &mut text);
+        assert_eq!(text.lines().count(), 13);
+        assert!(text.starts_with("x,y,u,v,exx,eyy,exy,score,iterations,status\n"));
+        assert!(text.lines().last().unwrap().ends_with("low_contrast"));
+        field_vtk(&f, "test\ntitle", &mut text);
+        assert!(text.contains("DIMENSIONS 4 3 1"));
+        assert!(text.contains("testtitle"));
+        assert_eq!(text.matches("LOOKUP_TABLE").count(), 6);
+    }
+
+    #[test]
+    fn colour_map_spans_the_valid_values() {
+        let f = field();
+        let grey = vec![100u16; 16 * 12];
+        let (rgb, range) = colour_map_rgb(&grey, 16, &f, |n| n.exx);
+        assert_eq!(rgb.len(), 16 * 12 * 3);
+        assert_eq!(
+            range,
+            ColourRange {
+                low: 0.0,
+                high: 3.0
+            }
+        );
+        // Left column of nodes (exx 0) is blue, right column (exx 3) red.
+        let px = |x: usize, y: usize| &rgb[3 * (y * 16 + x)..3 * (y * 16 + x) + 3];
+        assert!(px(2, 2)[2] > px(2, 2)[0]);
+        assert!(px(14, 2)[0] > px(14, 2)[2]);
+        // Outside the mesh: grey.
+        assert_eq!(px(0, 0), &[255, 255, 255]);
+    }
+}
