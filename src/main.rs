@@ -21,6 +21,8 @@ enum Command {
     Identify(cmd::identify::IdentifyArgs),
     /// Live identification process: fields + rig/state in, identification reports out.
     Identifier(cmd::identifier::IdentifierArgs),
+    /// The whole simulated bench: rig, camera, correlator, identifier; live status; results.
+    Run(cmd::run::RunArgs),
     /// Simulated ASTREE machine: publishes rig/state, answers rig/command, logs rig.csv.
     Rig(cmd::rig::RigArgs),
     /// Write simulated speckle images with their exact ground truth (truth.csv).
@@ -35,6 +37,7 @@ fn main() -> std::process::ExitCode {
         Command::Identify(args) => cmd::identify::run(args),
         Command::Identifier(args) => cmd::identifier::run(args),
         Command::Rig(args) => cmd::rig::run(args),
+        Command::Run(args) => cmd::run::run(args),
         Command::Synth(args) => cmd::synth::run(args),
     };
     match result {

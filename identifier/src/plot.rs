@@ -60,14 +60,17 @@ pub fn text_available() -> bool {
 /// A fitted invariant function with its legend label.
 type LabelledFn = (String, InvariantFn);
 
-struct Series {
-    label: String,
-    points: Vec<(f64, f64)>,
+/// One series of a chart.
+pub struct Series {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
     /// Markers (data) rather than a line (model).
-    markers: bool,
+    pub markers: bool,
 }
 
-fn chart(
+/// A PNG chart of `series` (lines, or markers for data) with a legend, at `path`. Text only
+/// where a system font is found (see [`text_available`]).
+pub fn chart(
     path: &Path,
     title: &str,
     x_desc: &str,

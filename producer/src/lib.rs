@@ -32,7 +32,8 @@ pub use render_fast::FastRenderer;
 pub use replay::{list_images, Replay, IMAGE_EXTENSIONS};
 pub use scenario::{Scenario, ScenarioKind, SCENARIO_NAMES};
 pub use simulated::{
-    motion_reach_px, MotionSource, RendererKind, ScenarioTimeline, SimulatedCamera, SimulatedConfig,
+    motion_reach_px, MotionSource, RendererKind, ScenarioTimeline, SimulatedCamera,
+    SimulatedConfig, MAX_SIDE_PX,
 };
 pub use source::{FrameDims, FrameInfo, FrameSource, Truth};
 pub use speckle::{Speckle, SpeckleParams};

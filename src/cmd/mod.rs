@@ -4,4 +4,5 @@ pub mod correlate;
 pub mod identifier;
 pub mod identify;
 pub mod rig;
+pub mod run;
 pub mod synth;

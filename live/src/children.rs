@@ -1,0 +1,378 @@
+//! The bench's processes as children of `dicstream run`: spawned from the same binary, each
+//! in its own process group (a Ctrl-C reaches only the supervisor, which then stops them in
+//! order) and with a parent-death signal (a supervisor killed with SIGKILL takes them along).
+//! Their stdout and stderr go, line by line, to `logs/<role>.log`; a line ending in `ready`
+//! after the role's name marks the process ready. Exits are noticed as they happen and
+//! reported with the exit status or signal and the last lines the process printed.
+
+use crossbeam::channel::{unbounded, Receiver, Sender};
+use std::collections::VecDeque;
+use std::io::{BufRead, Write};
+use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
+
+/// The processes of the bench.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Role {
+    Rig,
+    Producer,
+    Correlator,
+    Identifier,
+}
+
+impl Role {
+    pub const ALL: [Role; 4] = [
+        Role::Rig,
+        Role::Producer,
+        Role::Correlator,
+        Role::Identifier,
+    ];
+
+    /// The `dicstream` subcommand, also the log file name and the prefix of its lines.
+    pub fn name(self) -> &'static str {
+        match self {
+            Role::Rig => "rig",
+            Role::Producer => "producer",
+            Role::Correlator => "correlator",
+            Role::Identifier => "identifier",
+        }
+    }
+}
+
+/// Lines kept per process for the report of its death.
+const LAST_LINES: usize = 6;
+
+enum Event {
+    Line {
+        role: Role,
+        generation: u32,
+        line: String,
+    },
+}
+
+struct Managed {
+    role: Role,
+    args: Vec<String>,
+    child: Option<Child>,
+    /// Starts so far; lines of older generations are stale.
+    generation: u32,
+    ready: bool,
+    last_lines: VecDeque<String>,
+}
+
+/// A process that ended, and how.
+#[derive(Clone, Debug)]
+pub struct Exit {
+    pub role: Role,
+    pub pid: u32,
+    /// `exit status 0`, `exit status 1`, `killed by signal 9 (SIGKILL)`.
+    pub how: String,
+    pub success: bool,
+    /// The last lines it printed, oldest first.
+    pub last_lines: Vec<String>,
+}
+
+/// Describes an exit status the way a test engineer reads it.
+pub fn describe_status(status: ExitStatus) -> String {
+    if let Some(code) = status.code() {
+        return format!("exit status {code}");
+    }
+    match status.signal() {
+        Some(signal) => {
+            let name = match signal {
+                libc::SIGKILL => " (SIGKILL)",
+                libc::SIGTERM => " (SIGTERM)",
+                libc::SIGINT => " (SIGINT)",
+                libc::SIGSEGV => " (SIGSEGV)",
+                libc::SIGBUS => " (SIGBUS: out of shared memory?)",
+                libc::SIGABRT => " (SIGABRT)",
+                _ => "",
+            };
+            format!("killed by signal {signal}{name}")
+        }
+        None => "ended".into(),
+    }
+}
+
+/// The children of one run.
+pub struct Supervisor {
+    exe: PathBuf,
+    log_dir: PathBuf,
+    children: Vec<Managed>,
+    tx: Sender<Event>,
+    rx: Receiver<Event>,
+}
+
+impl Supervisor {
+    /// Children run `exe` (the `dicstream` binary) and log into `log_dir`.
+    pub fn new(exe: &Path, log_dir: &Path) -> Result<Supervisor, String> {
+        std::fs::create_dir_all(log_dir)
+            .map_err(|e| format!("cannot create {}: {e}", log_dir.display()))?;
+        let (tx, rx) = unbounded();
+        Ok(Supervisor {
+            exe: exe.to_path_buf(),
+            log_dir: log_dir.to_path_buf(),
+            children: Vec::new(),
+            tx,
+            rx,
+        })
+    }
+
+    fn managed(&mut self, role: Role) -> &mut Managed {
+        self.children
+            .iter_mut()
+            .find(|m| m.role == role)
+            .expect("role was spawned")
+    }
+
+    /// Starts `dicstream <role> <args...>`.
+    pub fn spawn(&mut self, role: Role, args: Vec<String>) -> Result<u32, String> {
+        if !self.children.iter().any(|m| m.role == role) {
+            self.children.push(Managed {
+                role,
+                args: Vec::new(),
+                child: None,
+                generation: 0,
+                ready: false,
+                last_lines: VecDeque::new(),
+            });
+        }
+        let exe = self.exe.clone();
+        let log_path = self.log_dir.join(format!("{}.log", role.name()));
+        let tx = self.tx.clone();
+        let managed = self.managed(role);
+        assert!(
+            managed.child.is_none(),
+            "{} is already running",
+            role.name()
+        );
+        managed.args = args;
+        managed.generation += 1;
+        managed.ready = false;
+        managed.last_lines.clear();
+        let generation = managed.generation;
+        let (reader, writer) =
+            std::io::pipe().map_err(|e| format!("{}: cannot make a pipe: {e}", role.name()))?;
+        let writer_err = writer
+            .try_clone()
+            .map_err(|e| format!("{}: cannot make a pipe: {e}", role.name()))?;
+        let mut command = Command::new(&exe);
+        command
+            .arg(role.name())
+            .args(&managed.args)
+            .stdin(Stdio::null())
+            .stdout(writer)
+            .stderr(writer_err)
+            .process_group(0);
+        // SAFETY: prctl is async-signal-safe; it only sets this child's parent-death signal.
+        unsafe {
+            command.pre_exec(|| {
+                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+        let child = command
+            .spawn()
+            .map_err(|e| format!("cannot start {} {}: {e}", exe.display(), role.name()))?;
+        drop(command);
+        let pid = child.id();
+        managed.child = Some(child);
+        let mut log = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&log_path)
+            .map_err(|e| format!("{}: {e}", log_path.display()))?;
+        let _ = writeln!(log, "--- start {generation} (pid {pid})");
+        std::thread::Builder::new()
+            .name(format!("{}-log", role.name()))
+            .spawn(move || {
+                for line in std::io::BufReader::new(reader).lines() {
+                    let Ok(line) = line else { break };
+                    let _ = writeln!(log, "{line}");
+                    if tx
+                        .send(Event::Line {
+                            role,
+                            generation,
+                            line,
+                        })
+                        .is_err()
+                    {
+                        break;
+                    }
+                }
+            })
+            .map_err(|e| format!("cannot start a log thread: {e}"))?;
+        Ok(pid)
+    }
+
+    /// Takes in one printed line: readiness, last lines.
+    fn absorb(&mut self, event: Event) {
+        let Event::Line {
+            role,
+            generation,
+            line,
+        } = event;
+        let managed = self.managed(role);
+        if generation != managed.generation {
+            return;
+        }
+        if line.starts_with(&format!("{}: ready", role.name())) {
+            managed.ready = true;
+        }
+        if managed.last_lines.len() == LAST_LINES {
+            managed.last_lines.pop_front();
+        }
+        managed.last_lines.push_back(line);
+    }
+
+    /// Takes in the lines printed so far.
+    fn drain_lines(&mut self) {
+        while let Ok(event) = self.rx.try_recv() {
+            self.absorb(event);
+        }
+    }
+
+    pub fn is_ready(&mut self, role: Role) -> bool {
+        self.drain_lines();
+        self.managed(role).ready
+    }
+
+    pub fn pid(&self, role: Role) -> Option<u32> {
+        self.children
+            .iter()
+            .find(|m| m.role == role)
+            .and_then(|m| m.child.as_ref())
+            .map(Child::id)
+    }
+
+    pub fn is_running(&self, role: Role) -> bool {
+        self.pid(role).is_some()
+    }
+
+    /// Waits (bounded) until `role` says it is ready; an exit or the timeout is an error with
+    /// the process's last lines.
+    pub fn wait_ready(&mut self, role: Role, timeout: Duration) -> Result<(), String> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if self.is_ready(role) {
+                return Ok(());
+            }
+            if let Some(exit) = self.reap().into_iter().find(|e| e.role == role) {
+                return Err(format!(
+                    "{} stopped before it was ready ({}):\n  {}",
+                    role.name(),
+                    exit.how,
+                    exit.last_lines.join("\n  ")
+                ));
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Err(format!(
+                    "{} was not ready after {:.0} s; its last lines:\n  {}",
+                    role.name(),
+                    timeout.as_secs_f64(),
+                    self.managed(role)
+                        .last_lines
+                        .iter()
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join("\n  ")
+                ));
+            }
+            // Sleep on the line channel: a line (possibly "ready") wakes us at once.
+            let slice = (deadline - now).min(Duration::from_millis(100));
+            if let Ok(event) = self.rx.recv_timeout(slice) {
+                self.absorb(event);
+            }
+        }
+    }
+
+    /// Children that have ended since the last call.
+    pub fn reap(&mut self) -> Vec<Exit> {
+        self.drain_lines();
+        let mut exits = Vec::new();
+        for managed in &mut self.children {
+            let Some(child) = managed.child.as_mut() else {
+                continue;
+            };
+            if let Ok(Some(status)) = child.try_wait() {
+                exits.push(Exit {
+                    role: managed.role,
+                    pid: child.id(),
+                    how: describe_status(status),
+                    success: status.success(),
+                    last_lines: managed.last_lines.iter().cloned().collect(),
+                });
+                managed.child = None;
+            }
+        }
+        if !exits.is_empty() {
+            // Lines printed just before the exit may still be in the pipe.
+            std::thread::sleep(Duration::from_millis(20));
+            self.drain_lines();
+            for exit in &mut exits {
+                let m = self.managed(exit.role);
+                exit.last_lines = m.last_lines.iter().cloned().collect();
+            }
+        }
+        exits
+    }
+
+    /// Starts `role` again with the arguments of its last start, or `args` if given.
+    pub fn restart(&mut self, role: Role, args: Option<Vec<String>>) -> Result<u32, String> {
+        let args = args.unwrap_or_else(|| self.managed(role).args.clone());
+        self.spawn(role, args)
+    }
+
+    /// Sends SIGTERM, waits up to `timeout`, then SIGKILL. Returns how it ended, or None if it
+    /// was not running.
+    pub fn stop(&mut self, role: Role, timeout: Duration) -> Option<String> {
+        let managed = self.children.iter_mut().find(|m| m.role == role)?;
+        let mut child = managed.child.take()?;
+        let pid = child.id() as libc::pid_t;
+        // SAFETY: signalling our own child by pid; it has not been reaped yet, so the pid is ours.
+        unsafe {
+            libc::kill(pid, libc::SIGTERM);
+        }
+        let deadline = Instant::now() + timeout;
+        loop {
+            match child.try_wait() {
+                Ok(Some(status)) => return Some(describe_status(status)),
+                Ok(None) if Instant::now() < deadline => {
+                    std::thread::sleep(Duration::from_millis(20));
+                }
+                _ => {
+                    let _ = child.kill();
+                    let status = child.wait().ok()?;
+                    return Some(format!(
+                        "{} after SIGTERM timed out",
+                        describe_status(status)
+                    ));
+                }
+            }
+        }
+    }
+
+    /// Stops every child, in the given order.
+    pub fn stop_all(&mut self, order: &[Role], timeout: Duration) -> Vec<(Role, String)> {
+        order
+            .iter()
+            .filter_map(|&role| self.stop(role, timeout).map(|how| (role, how)))
+            .collect()
+    }
+}
+
+impl Drop for Supervisor {
+    fn drop(&mut self) {
+        for managed in &mut self.children {
+            if let Some(mut child) = managed.child.take() {
+                let _ = child.kill();
+                let _ = child.wait();
+            }
+        }
+    }
+}

@@ -1,0 +1,565 @@
+//! The configuration of a live bench run (`dicstream run --config FILE.toml`): every knob of
+//! the camera, correlator, rig campaign, specimen and identifier, with defaults that run the
+//! paper's campaign in about a minute. Unknown keys are refused (a typo must not silently
+//! fall back to a default), and [`RunConfig::validate`] refuses, before any process starts,
+//! what the processes would refuse later: a ZOI larger than the image, a campaign beyond the
+//! rig's stroke or rate limits, a frame the shared memory cannot hold.
+
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunConfig {
+    pub run: RunSection,
+    pub camera: CameraSection,
+    pub correlator: CorrelatorSection,
+    pub rig: RigSection,
+    pub specimen: SpecimenSection,
+    pub identifier: IdentifierSection,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunSection {
+    /// Parent folder of the per-run results folders (`<results_dir>/<date-time>/`).
+    pub results_dir: String,
+    /// Restart a process that dies, at most `max_restarts` times per process.
+    pub restart: bool,
+    pub max_restarts: u32,
+    /// Write the field of every Nth correlated frame (CSV, and VTK with `vtk`).
+    pub fields_every: u32,
+    pub vtk: bool,
+    /// Seconds between two status lines.
+    pub status_interval_s: f64,
+    /// Seconds a process gets to stop after SIGTERM before SIGKILL.
+    pub stop_timeout_s: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CameraSection {
+    pub width_px: u32,
+    pub height_px: u32,
+    pub fps: f64,
+    pub bit_depth: u8,
+    /// Scale of the image of the specimen (mm per px).
+    pub mm_per_px: f64,
+    pub speckle_size_px: f64,
+    pub seed: u64,
+    /// Rendering threads of the simulated camera.
+    pub threads: usize,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CorrelatorSection {
+    pub zoi_px: usize,
+    pub step_px: usize,
+    pub threads: usize,
+    /// Strain measure of the node strains: log, green, nominal or small.
+    pub strain: String,
+    /// Reference: fixed, incremental or auto.
+    pub reference: String,
+    /// Initial guess: predict or correli.
+    pub guess: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RigSection {
+    /// Simulated time per wall time (1 = real time).
+    pub speed: f64,
+    /// Rate of `rig/state` and of `rig.csv` (Hz of simulated time).
+    pub publish_hz: f64,
+    pub log_hz: f64,
+    pub seed: u64,
+    /// The tests, in order; each mounts its own specimen and unloads at the end.
+    pub tests: Vec<TestSection>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TestSection {
+    /// uniaxial or equibiaxial.
+    pub kind: String,
+    pub stretch: f64,
+    pub rate_per_s: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SpecimenSection {
+    /// ln f(I1) = Σ a_i (I1 − 3)^i (eq. 22), f in MPa.
+    pub law_f: Vec<f64>,
+    /// ln g(I2) = Σ b_i (I2 − 3)^i (eq. 25), g in MPa.
+    pub law_g: Vec<f64>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct IdentifierSection {
+    /// Models ranked at each refit, NAME[,NAME...] or all.
+    pub models: String,
+}
+
+impl Default for RunSection {
+    fn default() -> Self {
+        RunSection {
+            results_dir: "results".into(),
+            restart: true,
+            max_restarts: 3,
+            fields_every: 10,
+            vtk: false,
+            status_interval_s: 1.0,
+            stop_timeout_s: 5.0,
+        }
+    }
+}
+
+impl Default for CameraSection {
+    fn default() -> Self {
+        CameraSection {
+            width_px: 1024,
+            height_px: 1024,
+            fps: 10.0,
+            bit_depth: 8,
+            mm_per_px: 0.015,
+            speckle_size_px: 4.0,
+            seed: 1,
+            threads: 1,
+        }
+    }
+}
+
+impl Default for CorrelatorSection {
+    fn default() -> Self {
+        CorrelatorSection {
+            zoi_px: 32,
+            step_px: 16,
+            threads: 2,
+            strain: "log".into(),
+            reference: "auto".into(),
+            guess: "predict".into(),
+        }
+    }
+}
+
+impl Default for RigSection {
+    fn default() -> Self {
+        let tests = rig::Campaign::paper()
+            .tests()
+            .iter()
+            .map(|t| TestSection {
+                kind: test_kind_name(t.test).into(),
+                stretch: t.stretch,
+                rate_per_s: t.rate_per_s,
+            })
+            .collect();
+        RigSection {
+            speed: 1.0,
+            publish_hz: 200.0,
+            log_hz: 50.0,
+            seed: 1,
+            tests,
+        }
+    }
+}
+
+impl Default for SpecimenSection {
+    fn default() -> Self {
+        let law = identifier::law::InvariantLaw::smactane();
+        SpecimenSection {
+            law_f: law.f.coefficients().to_vec(),
+            law_g: law.g.coefficients().to_vec(),
+        }
+    }
+}
+
+impl Default for IdentifierSection {
+    fn default() -> Self {
+        IdentifierSection {
+            models: "lambert-diani-rey,neo-hookean,mooney,yeoh,gent,hart-smith".into(),
+        }
+    }
+}
+
+fn test_kind_name(test: rig::builtin::BuiltinTest) -> &'static str {
+    match test {
+        rig::builtin::BuiltinTest::Uniaxial => "uniaxial",
+        rig::builtin::BuiltinTest::Equibiaxial => "equibiaxial",
+    }
+}
+
+/// Largest stretch rate the live bench accepts (/s of simulated time): beyond it the camera
+/// sees too much motion between frames at the default rate.
+const MAX_SIMULATED_SPEED: f64 = 20.0;
+
+impl RunConfig {
+    /// Parses a TOML file's text; errors name the file and the offending key or line.
+    pub fn from_toml(text: &str, source: &str) -> Result<RunConfig, String> {
+        toml::from_str(text).map_err(|e| format!("{source}: {e}"))
+    }
+
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).expect("the run configuration serialises")
+    }
+
+    /// The campaign the rig runs.
+    pub fn campaign(&self) -> Result<rig::Campaign, String> {
+        let spec = self.campaign_spec();
+        let campaign = rig::Campaign::parse(&spec).map_err(|e| format!("[rig] tests: {e}"))?;
+        Ok(campaign.with_law(self.law()?))
+    }
+
+    /// `uniaxial:3@0.08,...`, the rig's `--campaign` argument.
+    pub fn campaign_spec(&self) -> String {
+        self.rig
+            .tests
+            .iter()
+            .map(|t| format!("{}:{}@{}", t.kind, t.stretch, t.rate_per_s))
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+
+    /// The specimen material.
+    pub fn law(&self) -> Result<identifier::law::InvariantLaw, String> {
+        use identifier::law::{InvariantFn, InvariantLaw};
+        for (name, coefficients) in [
+            ("law_f", &self.specimen.law_f),
+            ("law_g", &self.specimen.law_g),
+        ] {
+            if coefficients.is_empty() || coefficients.iter().any(|c| !c.is_finite()) {
+                return Err(format!(
+                    "[specimen] {name} = {coefficients:?}: expected one or more finite numbers"
+                ));
+            }
+        }
+        let law = InvariantLaw {
+            f: InvariantFn::ExpPoly(self.specimen.law_f.clone()),
+            g: InvariantFn::ExpPoly(self.specimen.law_g.clone()),
+        };
+        let young_mpa = law.small_strain_young_modulus_mpa();
+        if !(young_mpa.is_finite() && young_mpa > 0.0) {
+            return Err(format!(
+                "[specimen] the law has a small-strain Young's modulus of {young_mpa} MPa: \
+                 expected a positive stiffness"
+            ));
+        }
+        Ok(law)
+    }
+
+    /// Largest stretch any test reaches: the camera's pattern must cover it.
+    pub fn max_stretch(&self) -> f64 {
+        self.rig.tests.iter().map(|t| t.stretch).fold(1.0, f64::max)
+    }
+
+    /// The correlator settings the live correlator will run with.
+    pub fn correlator_settings(&self) -> Result<correlator::CorrelatorSettings, String> {
+        use correlator::{GuessMode, ReferenceMode, StrainMeasure};
+        let c = &self.correlator;
+        let strain = match c.strain.as_str() {
+            "log" => StrainMeasure::Log,
+            "green" => StrainMeasure::Green,
+            "nominal" => StrainMeasure::Nominal,
+            "small" => StrainMeasure::Small,
+            other => {
+                return Err(format!(
+                    "[correlator] strain = {other:?}: expected log, green, nominal or small"
+                ))
+            }
+        };
+        let reference = match c.reference.as_str() {
+            "fixed" => ReferenceMode::Fixed,
+            "incremental" => ReferenceMode::Incremental,
+            "auto" => ReferenceMode::AUTO_DEFAULT,
+            other => {
+                return Err(format!(
+                    "[correlator] reference = {other:?}: expected fixed, incremental or auto"
+                ))
+            }
+        };
+        let guess = match c.guess.as_str() {
+            "predict" => GuessMode::Predict,
+            "correli" => GuessMode::Correli,
+            other => {
+                return Err(format!(
+                    "[correlator] guess = {other:?}: expected predict or correli"
+                ))
+            }
+        };
+        let settings = correlator::CorrelatorSettings {
+            zoi_px: c.zoi_px,
+            step_px: c.step_px,
+            threads: c.threads,
+            strain,
+            reference,
+            guess,
+            ..correlator::CorrelatorSettings::default()
+        };
+        settings
+            .validate()
+            .map_err(|e| format!("[correlator] {e}"))?;
+        settings
+            .resolve_roi(
+                self.camera.width_px as usize,
+                self.camera.height_px as usize,
+            )
+            .map_err(|e| {
+                format!(
+                    "[correlator] with the {}x{} px camera: {e}",
+                    self.camera.width_px, self.camera.height_px
+                )
+            })?;
+        Ok(settings)
+    }
+
+    /// Everything a process would refuse, refused now with the section and key named.
+    pub fn validate(&self) -> Result<(), String> {
+        let r = &self.run;
+        if r.results_dir.trim().is_empty() {
+            return Err("[run] results_dir is empty".into());
+        }
+        if r.fields_every == 0 {
+            return Err("[run] fields_every = 0: expected 1 or more (1 = every field)".into());
+        }
+        for (name, v) in [
+            ("status_interval_s", r.status_interval_s),
+            ("stop_timeout_s", r.stop_timeout_s),
+        ] {
+            if !(v.is_finite() && v > 0.0 && v <= 3600.0) {
+                return Err(format!("[run] {name} = {v}: expected (0, 3600] s"));
+            }
+        }
+        let c = &self.camera;
+        for (name, side) in [("width_px", c.width_px), ("height_px", c.height_px)] {
+            if !(64..=producer::MAX_SIDE_PX).contains(&side) {
+                return Err(format!(
+                    "[camera] {name} = {side}: expected 64 to {} px",
+                    producer::MAX_SIDE_PX
+                ));
+            }
+        }
+        if !(c.fps.is_finite() && c.fps > 0.0 && c.fps <= 1000.0) {
+            return Err(format!("[camera] fps = {}: expected (0, 1000]", c.fps));
+        }
+        if !producer::BIT_DEPTHS.contains(&c.bit_depth) {
+            return Err(format!(
+                "[camera] bit_depth = {}: expected one of {:?}",
+                c.bit_depth,
+                producer::BIT_DEPTHS
+            ));
+        }
+        if !(c.mm_per_px.is_finite() && c.mm_per_px > 0.0) {
+            return Err(format!(
+                "[camera] mm_per_px = {}: expected a positive scale",
+                c.mm_per_px
+            ));
+        }
+        producer::SpeckleParams {
+            size_px: c.speckle_size_px,
+            ..producer::SpeckleParams::default()
+        }
+        .validate()
+        .map_err(|e| format!("[camera] {e}"))?;
+        if !(1..=64).contains(&c.threads) {
+            return Err(format!(
+                "[camera] threads = {}: expected 1 to 64",
+                c.threads
+            ));
+        }
+        self.correlator_settings()?;
+        let g = &self.rig;
+        if !(g.speed.is_finite() && g.speed > 0.0 && g.speed <= MAX_SIMULATED_SPEED) {
+            return Err(format!(
+                "[rig] speed = {}: expected (0, {MAX_SIMULATED_SPEED}] times real time",
+                g.speed
+            ));
+        }
+        let rig_config = rig::RigConfig::default();
+        for (name, hz) in [("publish_hz", g.publish_hz), ("log_hz", g.log_hz)] {
+            if !(hz.is_finite() && hz > 0.0 && hz <= rig_config.control_hz) {
+                return Err(format!(
+                    "[rig] {name} = {hz}: expected (0, {}] Hz",
+                    rig_config.control_hz
+                ));
+            }
+        }
+        let campaign = self.campaign()?;
+        campaign
+            .check_against(&rig_config)
+            .map_err(|e| format!("[rig] {e}"))?;
+        identifier::models::parse_model_list(&self.identifier.models)
+            .map_err(|e| format!("[identifier] models: {e}"))?;
+        Ok(())
+    }
+
+    /// Wall-clock length of the campaign (s).
+    pub fn campaign_wall_s(&self) -> Result<f64, String> {
+        Ok(self.campaign()?.duration_s() / self.rig.speed)
+    }
+
+    /// The defaults as a commented TOML file to start from (`dicstream run --print-config`).
+    pub fn commented_defaults() -> String {
+        let d = RunConfig::default();
+        let mut t = String::new();
+        let _ = writeln!(
+            t,
+            "# dicstream run configuration. Every key is optional: a missing key takes the value\n\
+             # shown here. Unknown keys are refused.\n"
+        );
+        let _ = writeln!(t, "[run]");
+        let _ = writeln!(
+            t,
+            "# Parent folder of the per-run results folders (<results_dir>/<date-time>/).\n\
+             results_dir = {:?}\n\
+             # Restart a process that dies (at most max_restarts times each).\n\
+             restart = {}\nmax_restarts = {}\n\
+             # Keep the field of every Nth correlated frame (fields/field_<frame>.csv, and .vtk).\n\
+             fields_every = {}\nvtk = {}\n\
+             # Seconds between two status lines, and given to a process to stop before SIGKILL.\n\
+             status_interval_s = {:?}\nstop_timeout_s = {:?}\n",
+            d.run.results_dir,
+            d.run.restart,
+            d.run.max_restarts,
+            d.run.fields_every,
+            d.run.vtk,
+            d.run.status_interval_s,
+            d.run.stop_timeout_s
+        );
+        let c = &d.camera;
+        let _ = writeln!(
+            t,
+            "[camera]\n\
+             # The simulated camera renders the specimen as the rig deforms it.\n\
+             width_px = {}\nheight_px = {}\nfps = {:?}\n\
+             # 8, 10, 12 or 16 bit.\n\
+             bit_depth = {}\n\
+             # Image scale of the specimen, mm per px.\n\
+             mm_per_px = {:?}\n\
+             # Speckle spot size (FWHM), px; seed of the pattern and the noise.\n\
+             speckle_size_px = {:?}\nseed = {}\n\
+             # Rendering threads (the correlator wants the cores more).\n\
+             threads = {}\n",
+            c.width_px,
+            c.height_px,
+            c.fps,
+            c.bit_depth,
+            c.mm_per_px,
+            c.speckle_size_px,
+            c.seed,
+            c.threads
+        );
+        let k = &d.correlator;
+        let _ = writeln!(
+            t,
+            "[correlator]\n\
+             # ZOI side 2^s px and distance between ZOI centres px (paper section 3.b).\n\
+             zoi_px = {}\nstep_px = {}\nthreads = {}\n\
+             # Node strain measure: log (m = 0), green (m = 1), nominal (m = 1/2) or small.\n\
+             strain = {:?}\n\
+             # Reference: fixed, incremental (consecutive frames) or auto (renewed when the\n\
+             # displacement or the score call for it, mesh followed).\n\
+             reference = {:?}\n\
+             # Initial guess per ZOI: predict (previous field, neighbours) or correli (paper).\n\
+             guess = {:?}\n",
+            k.zoi_px, k.step_px, k.threads, k.strain, k.reference, k.guess
+        );
+        let g = &d.rig;
+        let _ = writeln!(
+            t,
+            "[rig]\n\
+             # Simulated time per wall time; rig/state and rig.csv rates, Hz of simulated time.\n\
+             speed = {:?}\npublish_hz = {:?}\nlog_hz = {:?}\nseed = {}\n",
+            g.speed, g.publish_hz, g.log_hz, g.seed
+        );
+        let _ = writeln!(
+            t,
+            "# The campaign, in order: each test mounts its specimen (uniaxial: a 100 x 20 x 2 mm\n\
+             # strip; equibiaxial: a 100 x 100 x 2 mm cruciform centre), ramps the elongation to\n\
+             # `stretch` at `rate_per_s` in centroid control, holds, unloads."
+        );
+        for test in &g.tests {
+            let _ = writeln!(
+                t,
+                "[[rig.tests]]\nkind = {:?}\nstretch = {:?}\nrate_per_s = {:?}\n",
+                test.kind, test.stretch, test.rate_per_s
+            );
+        }
+        let s = &d.specimen;
+        let _ = writeln!(
+            t,
+            "[specimen]\n\
+             # Material of the specimens: ln f(I1) = sum a_i (I1 - 3)^i and\n\
+             # ln g(I2) = sum b_i (I2 - 3)^i (eqs. 22, 25; f, g in MPa). Default: Smactane,\n\
+             # Tables 3 and 4 (n = 2). A virtual test must give them back.\n\
+             law_f = {:?}\nlaw_g = {:?}\n",
+            s.law_f, s.law_g
+        );
+        let _ = writeln!(
+            t,
+            "[identifier]\n\
+             # Models ranked at each refit (see `dicstream identify --help`), or all.\n\
+             models = {:?}",
+            d.identifier.models
+        );
+        t
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn commented_defaults_parse_back_to_the_defaults() {
+        let text = RunConfig::commented_defaults();
+        let parsed = RunConfig::from_toml(&text, "defaults").unwrap();
+        assert_eq!(parsed, RunConfig::default());
+        RunConfig::default().validate().unwrap();
+        let round = RunConfig::from_toml(&RunConfig::default().to_toml(), "round").unwrap();
+        assert_eq!(round, RunConfig::default());
+        assert_eq!(
+            RunConfig::default().campaign_spec(),
+            "uniaxial:3@0.08,equibiaxial:2@0.04"
+        );
+    }
+
+    #[test]
+    fn bad_configurations_are_refused_with_the_key_named() {
+        let unknown = RunConfig::from_toml("[camera]\nwidht_px = 512\n", "my.toml").unwrap_err();
+        assert!(
+            unknown.contains("my.toml") && unknown.contains("widht_px"),
+            "{unknown}"
+        );
+        let refuse = |toml: &str, expected: &str| {
+            let config = RunConfig::from_toml(toml, "t.toml").unwrap();
+            let error = config.validate().unwrap_err();
+            assert!(error.contains(expected), "{toml}: {error}");
+        };
+        refuse(
+            "[camera]\nwidth_px = 128\nheight_px = 128\n[correlator]\nzoi_px = 256\n",
+            "larger than the ROI",
+        );
+        refuse("[correlator]\nzoi_px = 48\n", "power of two");
+        refuse(
+            "[[rig.tests]]\nkind = \"uniaxial\"\nstretch = 7.0\nrate_per_s = 0.08\n",
+            "stroke",
+        );
+        refuse(
+            "[[rig.tests]]\nkind = \"equibiaxial\"\nstretch = 1.5\nrate_per_s = 50.0\n",
+            "rate",
+        );
+        refuse(
+            "[[rig.tests]]\nkind = \"shear\"\nstretch = 1.5\nrate_per_s = 0.1\n",
+            "unknown test",
+        );
+        refuse("[rig]\ntests = []\n", "at least one");
+        refuse("[rig]\nspeed = 1000.0\n", "speed");
+        refuse("[camera]\nfps = -1.0\n", "fps");
+        refuse("[camera]\nbit_depth = 9\n", "bit_depth");
+        refuse("[specimen]\nlaw_f = []\n", "law_f");
+        refuse("[identifier]\nmodels = \"nope\"\n", "models");
+        refuse("[correlator]\nreference = \"sometimes\"\n", "reference");
+    }
+}

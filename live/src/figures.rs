@@ -1,0 +1,96 @@
+//! The run's PNG figures, drawn at the end from what the run wrote: the stress-stretch curves
+//! of both tests with the fitted models and the paper's f(I1) and g(I2) plots (Figs. 7, 8, 13,
+//! 14, from the identifier's journal), the strain map of the last field over the reference
+//! image (Fig. 12d), and the latency distribution.
+
+use crate::latency::Latency;
+use identifier::data::{Curve, LoadCase};
+use identifier::fit::{fit_ranked, FitOptions};
+use identifier::plot::{chart, Series};
+use std::path::{Path, PathBuf};
+
+/// The load path of the journal as curves (cases with enough points).
+pub fn journal_curves(journal: &Path) -> Result<Vec<Curve>, String> {
+    let points = identifier::journal::read(journal)?;
+    let mut curves = Vec::new();
+    for case in LoadCase::ALL {
+        let (stretch, stress): (Vec<f64>, Vec<f64>) = points
+            .iter()
+            .filter(|p| p.case == case)
+            .map(|p| (p.stretch, p.nominal_stress_mpa))
+            .unzip();
+        if stretch.len() >= identifier::data::MIN_POINTS_PER_CURVE {
+            if let Ok(curve) = Curve::new(case, stretch, stress) {
+                curves.push(curve);
+            }
+        }
+    }
+    Ok(curves)
+}
+
+/// Stress-stretch per case with the ranked fits, f(I1) and g(I2) with the paper's route, into
+/// `dir`. Returns the files written.
+pub fn identification_figures(
+    dir: &Path,
+    journal: &Path,
+    models: &str,
+) -> Result<Vec<PathBuf>, String> {
+    let curves = journal_curves(journal)?;
+    if curves.is_empty() {
+        return Ok(Vec::new());
+    }
+    let models = identifier::models::parse_model_list(models)?;
+    let (fits, _failures) = fit_ranked(&models, &curves, &FitOptions::default());
+    let route = identifier::route::paper_route(&curves, 2, 2).ok();
+    identifier::plot::write_plots(dir, &curves, &fits, route.as_ref()).map_err(|e| e.to_string())
+}
+
+/// RGB colour map of the last field's exx over the reference image, as PNG at `path`.
+pub fn strain_map(
+    path: &Path,
+    grey: &[u16],
+    width: usize,
+    field: &correlator::Field,
+) -> Result<(), String> {
+    let (rgb, _range) = correlator::output::colour_map_rgb(grey, width, field, |n| n.exx);
+    let height = grey.len() / width;
+    let mut bytes = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut bytes),
+        &rgb,
+        width as u32,
+        height as u32,
+        image::ExtendedColorType::Rgb8,
+    )
+    .map_err(|e| format!("{}: {e}", path.display()))?;
+    crate::results::write_atomic(path, &bytes)
+}
+
+/// Latency (ms) against log10 of 1/(1 − percentile), the usual HdrHistogram plot.
+pub fn latency_png(path: &Path, curves: &[(&str, &Latency)]) -> Result<(), String> {
+    let series: Vec<Series> = curves
+        .iter()
+        .filter(|(_, l)| l.count() > 0)
+        .map(|(label, latency)| Series {
+            label: format!("{label} ({} samples)", latency.count()),
+            points: latency
+                .distribution()
+                .into_iter()
+                .filter(|&(_, q)| q < 1.0)
+                .map(|(ms, q)| ((1.0 / (1.0 - q)).log10(), ms))
+                .collect(),
+            markers: false,
+        })
+        .collect();
+    if series.is_empty() {
+        return Ok(());
+    }
+    chart(
+        path,
+        "latency from capture",
+        "percentile (log10 1/(1-p): 1 = 90 %, 2 = 99 %, 3 = 99.9 %)",
+        "latency (ms)",
+        &series,
+    )
+    .map_err(|e| e.to_string())
+}

@@ -1,0 +1,388 @@
+//! `frames.csv`: one row per correlated frame, everything a test engineer plots afterwards
+//! — ids and times, the gauge strains of the four measures, the stretches and invariants
+//! they give, the rig's forces and Cauchy stresses at the frame's rig sample, the latency,
+//! and, for simulated frames, the correlator's actual error against the ground truth.
+
+use crate::truth;
+use std::collections::VecDeque;
+use std::fmt::Write as _;
+use wire::{FieldHeader, FieldNode, GroundTruth, RigState, StrainMeasure};
+
+/// Column names, in order.
+pub const COLUMNS: [&str; 40] = [
+    "frame_id",
+    "reference_frame_id",
+    "rig_sample_id",
+    "t_capture_s",
+    "t_sim_s",
+    "load_case",
+    "small_exx",
+    "small_eyy",
+    "small_exy",
+    "green_exx",
+    "green_eyy",
+    "green_exy",
+    "nominal_exx",
+    "nominal_eyy",
+    "nominal_exy",
+    "log_exx",
+    "log_eyy",
+    "log_exy",
+    "stretch_x",
+    "stretch_y",
+    "i1",
+    "i2",
+    "force_x_n",
+    "force_y_n",
+    "cauchy_x_mpa",
+    "cauchy_y_mpa",
+    "rig_stretch_x",
+    "rig_stretch_y",
+    "nodes",
+    "valid_nodes",
+    "u_mean_px",
+    "v_mean_px",
+    "disp_error_mean_px",
+    "disp_error_max_px",
+    "log_exx_error",
+    "log_eyy_error",
+    "latency_field_ms",
+    "latency_seen_ms",
+    "correlate_ms",
+    "frames_dropped",
+];
+
+pub fn csv_header() -> String {
+    COLUMNS.join(",")
+}
+
+/// Recent rig samples by id, bounded: fields name the sample their frame was taken at.
+#[derive(Debug)]
+pub struct RigHistory {
+    samples: VecDeque<RigState>,
+    capacity: usize,
+}
+
+impl RigHistory {
+    pub fn new(capacity: usize) -> RigHistory {
+        assert!(capacity > 0);
+        RigHistory {
+            samples: VecDeque::with_capacity(capacity),
+            capacity,
+        }
+    }
+
+    /// Adds a sample; a sample id that goes back (a restarted rig) clears the history.
+    pub fn push(&mut self, state: RigState) {
+        if self
+            .samples
+            .back()
+            .is_some_and(|last| state.sample_id <= last.sample_id)
+        {
+            self.samples.clear();
+        }
+        if self.samples.len() == self.capacity {
+            self.samples.pop_front();
+        }
+        self.samples.push_back(state);
+    }
+
+    pub fn get(&self, sample_id: u64) -> Option<&RigState> {
+        self.samples
+            .binary_search_by_key(&sample_id, |s| s.sample_id)
+            .ok()
+            .map(|i| &self.samples[i])
+    }
+
+    pub fn latest(&self) -> Option<&RigState> {
+        self.samples.back()
+    }
+}
+
+/// Recent frames' ground truth by frame id, bounded (the truth of a field's origin frame).
+#[derive(Debug)]
+pub struct TruthHistory {
+    truths: VecDeque<(u64, GroundTruth)>,
+    capacity: usize,
+}
+
+impl TruthHistory {
+    pub fn new(capacity: usize) -> TruthHistory {
+        assert!(capacity > 0);
+        TruthHistory {
+            truths: VecDeque::with_capacity(capacity),
+            capacity,
+        }
+    }
+
+    /// Adds a frame's truth; ids going back (a restarted camera) clear the history.
+    pub fn push(&mut self, frame_id: u64, truth: GroundTruth) {
+        if self.truths.back().is_some_and(|(id, _)| frame_id <= *id) {
+            self.truths.clear();
+        }
+        if self.truths.len() == self.capacity {
+            self.truths.pop_front();
+        }
+        self.truths.push_back((frame_id, truth));
+    }
+
+    pub fn get(&self, frame_id: u64) -> Option<&GroundTruth> {
+        self.truths
+            .binary_search_by_key(&frame_id, |(id, _)| *id)
+            .ok()
+            .map(|i| &self.truths[i].1)
+    }
+}
+
+/// One row of `frames.csv`. Absent values are written as empty cells.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameRow {
+    pub frame_id: u64,
+    pub reference_frame_id: u64,
+    pub rig_sample_id: Option<u64>,
+    pub t_capture_s: f64,
+    pub t_sim_s: Option<f64>,
+    pub load_case: u32,
+    /// Gauge strains in the order of [`StrainMeasure::ALL`], each (exx, eyy, exy).
+    pub gauge: [[f64; 3]; 4],
+    pub stretch: [f64; 2],
+    pub invariants: [f64; 2],
+    pub force_n: Option<[f64; 2]>,
+    pub cauchy_mpa: Option<[f64; 2]>,
+    pub rig_stretch: Option<[f64; 2]>,
+    pub nodes: usize,
+    pub valid_nodes: u32,
+    pub u_mean_px: f64,
+    pub v_mean_px: f64,
+    /// Mean and max displacement error (px) over valid nodes.
+    pub displacement_error_px: Option<[f64; 2]>,
+    /// Measured minus true gauge log strain, exx and eyy.
+    pub log_strain_error: Option<[f64; 2]>,
+    pub latency_field_ms: f64,
+    pub latency_seen_ms: f64,
+    pub correlate_ms: f64,
+    pub frames_dropped: u64,
+}
+
+impl FrameRow {
+    /// Builds the row of one field. `rig` is the field's rig sample, `origin_truth` the truth
+    /// of the frame its node positions are measured in (its reference frame), `t0_ns` the
+    /// run's start and `seen_ns` when the monitor received the field.
+    pub fn new(
+        header: &FieldHeader,
+        nodes: &[FieldNode],
+        rig: Option<&RigState>,
+        origin_truth: Option<&GroundTruth>,
+        t0_ns: u64,
+        seen_ns: u64,
+    ) -> FrameRow {
+        let gauge = StrainMeasure::ALL.map(|m| {
+            let g = header.gauge_of(m);
+            [g.exx, g.eyy, g.exy]
+        });
+        let log = header.gauge_of(StrainMeasure::Log);
+        let stretch = [log.exx.exp(), log.eyy.exp()];
+        let l3 = 1.0 / (stretch[0] * stretch[1]);
+        let invariants = [
+            stretch[0].powi(2) + stretch[1].powi(2) + l3.powi(2),
+            stretch[0].powi(-2) + stretch[1].powi(-2) + l3.powi(-2),
+        ];
+        let force_n = rig.map(|s| {
+            let a = &s.actuators;
+            [
+                500.0 * (a[0].force_kn + a[1].force_kn),
+                500.0 * (a[2].force_kn + a[3].force_kn),
+            ]
+        });
+        let cauchy_mpa = rig.zip(force_n).map(|(s, f)| {
+            let stress = |force: f64, section: f64| {
+                if section > 0.0 {
+                    force / section
+                } else {
+                    0.0
+                }
+            };
+            [
+                stress(f[0], s.specimen_section_x_mm2),
+                stress(f[1], s.specimen_section_y_mm2),
+            ]
+        });
+        let truth_pair = (header.has_truth == 1)
+            .then_some(origin_truth)
+            .flatten()
+            .map(|origin| (&header.truth, origin));
+        let displacement_error_px = truth_pair
+            .and_then(|(current, origin)| truth::displacement_error(nodes, current, origin))
+            .map(|(mean, max, _)| [mean, max]);
+        let log_strain_error = truth_pair
+            .and_then(|(current, origin)| truth::relative_gradient(current, origin))
+            .and_then(|f| truth::log_strain(&f))
+            .map(|t| [log.exx - t[0], log.eyy - t[1]]);
+        let ms = |ns: u64| ns as f64 * 1e-6;
+        FrameRow {
+            frame_id: header.frame_id,
+            reference_frame_id: header.reference_frame_id,
+            rig_sample_id: (header.rig_sample_id != wire::NO_RIG_SAMPLE)
+                .then_some(header.rig_sample_id),
+            t_capture_s: header.t_capture_ns.saturating_sub(t0_ns) as f64 * 1e-9,
+            t_sim_s: rig.map(|s| s.t_sim_s),
+            load_case: rig.map_or(0, |s| s.load_case),
+            gauge,
+            stretch,
+            invariants,
+            force_n,
+            cauchy_mpa,
+            rig_stretch: rig.map(|s| [s.specimen_stretch_x, s.specimen_stretch_y]),
+            nodes: nodes.len(),
+            valid_nodes: header.valid_nodes,
+            u_mean_px: header.u_mean_px,
+            v_mean_px: header.v_mean_px,
+            displacement_error_px,
+            log_strain_error,
+            latency_field_ms: ms(header.t_published_ns.saturating_sub(header.t_capture_ns)),
+            latency_seen_ms: ms(seen_ns.saturating_sub(header.t_capture_ns)),
+            correlate_ms: ms(header.correlate_ns),
+            frames_dropped: header.frames_dropped,
+        }
+    }
+
+    /// Appends the CSV line (with its newline) to `out`.
+    pub fn write_csv(&self, out: &mut String) {
+        fn opt<T: std::fmt::Display>(out: &mut String, v: Option<T>) {
+            if let Some(v) = v {
+                let _ = write!(out, "{v}");
+            }
+            out.push(',');
+        }
+        fn pair(out: &mut String, v: Option<[f64; 2]>) {
+            opt(out, v.map(|p| p[0]));
+            opt(out, v.map(|p| p[1]));
+        }
+        let _ = write!(out, "{},{},", self.frame_id, self.reference_frame_id);
+        opt(out, self.rig_sample_id);
+        let _ = write!(out, "{:.6},", self.t_capture_s);
+        opt(out, self.t_sim_s.map(|t| format!("{t:.4}")));
+        let _ = write!(out, "{},", self.load_case);
+        for g in &self.gauge {
+            for v in g {
+                let _ = write!(out, "{v:.7},");
+            }
+        }
+        let _ = write!(
+            out,
+            "{:.6},{:.6},{:.6},{:.6},",
+            self.stretch[0], self.stretch[1], self.invariants[0], self.invariants[1]
+        );
+        pair(out, self.force_n);
+        pair(out, self.cauchy_mpa);
+        pair(out, self.rig_stretch);
+        let _ = write!(
+            out,
+            "{},{},{:.5},{:.5},",
+            self.nodes, self.valid_nodes, self.u_mean_px, self.v_mean_px
+        );
+        pair(out, self.displacement_error_px);
+        pair(out, self.log_strain_error);
+        let _ = writeln!(
+            out,
+            "{:.3},{:.3},{:.3},{}",
+            self.latency_field_ms, self.latency_seen_ms, self.correlate_ms, self.frames_dropped
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wire::{GaugeStrain, NodeStatus};
+
+    #[test]
+    fn row_has_every_column_and_the_truth_error() {
+        let lx = 1.5f64;
+        let truth = GroundTruth {
+            deformation_gradient: [lx, 0.0, 0.0, 1.0 / lx.sqrt()],
+            translation_px: [0.0, 0.0],
+            centre_px: [64.0, 64.0],
+        };
+        let mut header = FieldHeader {
+            frame_id: 12,
+            rig_sample_id: 40,
+            t_capture_ns: 2_000_000_000,
+            t_published_ns: 2_050_000_000,
+            has_truth: 1,
+            truth,
+            valid_nodes: 1,
+            ..FieldHeader::default()
+        };
+        // Measured log strain 1 % above the truth along x.
+        header.gauge[StrainMeasure::Log as usize] = GaugeStrain {
+            exx: lx.ln() + 0.01,
+            eyy: -0.5 * lx.ln(),
+            exy: 0.0,
+        };
+        let nodes = [FieldNode {
+            x_px: 74.0,
+            y_px: 64.0,
+            u_px: 5.0 + 0.25,
+            v_px: 0.0,
+            status: NodeStatus::Ok as u32,
+            ..FieldNode::default()
+        }];
+        let mut rig = RigState {
+            sample_id: 40,
+            t_sim_s: 3.5,
+            specimen_section_x_mm2: 40.0 / lx,
+            load_case: 1,
+            ..RigState::default()
+        };
+        rig.actuators[0].force_kn = 0.1;
+        rig.actuators[1].force_kn = 0.1;
+        let row = FrameRow::new(
+            &header,
+            &nodes,
+            Some(&rig),
+            Some(&GroundTruth::IDENTITY),
+            1_000_000_000,
+            2_060_000_000,
+        );
+        assert!((row.stretch[0] - lx * 0.01f64.exp()).abs() < 1e-12);
+        assert_eq!(row.force_n.unwrap()[0], 100.0);
+        assert!((row.cauchy_mpa.unwrap()[0] - 100.0 * lx / 40.0).abs() < 1e-12);
+        let [mean, max] = row.displacement_error_px.unwrap();
+        assert!((mean - 0.25).abs() < 1e-5 && (max - 0.25).abs() < 1e-5);
+        assert!((row.log_strain_error.unwrap()[0] - 0.01).abs() < 1e-9);
+        assert!((row.latency_field_ms - 50.0).abs() < 1e-9);
+        assert!((row.t_capture_s - 1.0).abs() < 1e-12);
+        let mut line = String::new();
+        row.write_csv(&mut line);
+        assert_eq!(line.trim_end().split(',').count(), COLUMNS.len());
+        // Without rig sample and truth: empty cells, same count.
+        header.has_truth = 0;
+        let row = FrameRow::new(&header, &nodes, None, None, 0, 0);
+        line.clear();
+        row.write_csv(&mut line);
+        assert_eq!(line.trim_end().split(',').count(), COLUMNS.len());
+        assert!(line.contains(",,"));
+    }
+
+    #[test]
+    fn histories_pair_by_id_and_forget_on_restart() {
+        let mut rigs = RigHistory::new(3);
+        for id in 0..5 {
+            rigs.push(RigState {
+                sample_id: id,
+                ..RigState::default()
+            });
+        }
+        assert!(rigs.get(1).is_none());
+        assert_eq!(rigs.get(3).unwrap().sample_id, 3);
+        rigs.push(RigState::default());
+        assert!(rigs.get(3).is_none());
+        assert_eq!(rigs.latest().unwrap().sample_id, 0);
+        let mut truths = TruthHistory::new(2);
+        truths.push(0, GroundTruth::IDENTITY);
+        truths.push(1, GroundTruth::IDENTITY);
+        truths.push(2, GroundTruth::IDENTITY);
+        assert!(truths.get(0).is_none() && truths.get(2).is_some());
+    }
+}

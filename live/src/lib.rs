@@ -1,0 +1,24 @@
+//! The live bench as a user meets it: `dicstream run` starts rig, camera, correlator and
+//! identifier as separate processes on one instance, watches every service, shows a status
+//! line, restarts a process that dies (if asked), stops everything in order, and keeps the
+//! results of the run in a folder of its own.
+//!
+//! Pure parts (configuration, `frames.csv` rows, ground-truth errors, latency histograms,
+//! acceptance, results files) are separate from the shells that talk to processes
+//! ([`children`]) and to shared memory ([`subscriptions`]); [`run`] ties them together.
+
+pub mod acceptance;
+pub mod children;
+pub mod config;
+pub mod figures;
+pub mod frames;
+pub mod latency;
+pub mod recorder;
+pub mod results;
+pub mod run;
+pub mod status;
+pub mod subscriptions;
+pub mod truth;
+
+pub use config::RunConfig;
+pub use run::{run, Ending, RunOptions, RunReport};

@@ -1,0 +1,214 @@
+//! What the run's monitor keeps of the samples it sees, without any IPC: it pairs fields with
+//! rig samples and frame truths, writes `frames.csv` and every Nth field as it goes, records
+//! the latencies, and remembers what the status line and the final figures need.
+
+use crate::frames::{FrameRow, RigHistory, TruthHistory};
+use crate::latency::Latency;
+use crate::results::{write_atomic, CsvAppender, ResultsDir};
+use wire::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, RigState};
+
+/// Rig samples and frame truths kept for pairing (about 40 s at 200 Hz, 100 s at 10 fps).
+const RIG_HISTORY: usize = 8192;
+const TRUTH_HISTORY: usize = 1024;
+
+/// Settings of the recorder.
+#[derive(Clone, Debug)]
+pub struct RecorderSettings {
+    pub fields_every: u32,
+    pub vtk: bool,
+}
+
+pub struct Recorder {
+    settings: RecorderSettings,
+    results: ResultsDir,
+    frames_csv: CsvAppender,
+    /// Monotonic ns of the run's start: frames.csv times count from it.
+    t0_ns: u64,
+    rigs: RigHistory,
+    truths: TruthHistory,
+    pub latency_field: Latency,
+    pub latency_identification: Latency,
+    /// Frames seen on `frames` (the monitor may miss some: its queue drops when it is slow).
+    pub frames_seen: u64,
+    pub last_frame_id: Option<u64>,
+    pub fields_seen: u64,
+    pub last_field: Option<FieldHeader>,
+    /// Nodes of the last field (buffer reused).
+    pub last_nodes: Vec<FieldNode>,
+    pub last_report: Option<IdentificationReport>,
+    pub rig_samples_seen: u64,
+    /// First frame of the run (the correlator's first reference) for the strain map.
+    pub first_frame: Option<(FrameHeader, Vec<u16>)>,
+    /// Largest measured stretch per load case code (1 uniaxial, 2 equibiaxial).
+    pub max_stretch: [f64; 3],
+    row: String,
+    text: String,
+    /// Errors writing results (the run goes on, the error is reported once).
+    pub write_error: Option<String>,
+}
+
+impl Recorder {
+    pub fn new(
+        results: &ResultsDir,
+        settings: RecorderSettings,
+        t0_ns: u64,
+    ) -> Result<Recorder, String> {
+        assert!(settings.fields_every > 0);
+        Ok(Recorder {
+            frames_csv: CsvAppender::create(&results.frames_csv(), &crate::frames::csv_header())?,
+            results: results.clone(),
+            settings,
+            t0_ns,
+            rigs: RigHistory::new(RIG_HISTORY),
+            truths: TruthHistory::new(TRUTH_HISTORY),
+            latency_field: Latency::new(),
+            latency_identification: Latency::new(),
+            frames_seen: 0,
+            last_frame_id: None,
+            fields_seen: 0,
+            last_field: None,
+            last_nodes: Vec::new(),
+            last_report: None,
+            rig_samples_seen: 0,
+            first_frame: None,
+            max_stretch: [1.0; 3],
+            row: String::with_capacity(1024),
+            text: String::new(),
+            write_error: None,
+        })
+    }
+
+    fn note_error(&mut self, result: Result<(), String>) {
+        if let Err(e) = result {
+            if self.write_error.is_none() {
+                eprintln!("run: cannot write results: {e}");
+                self.write_error = Some(e);
+            }
+        }
+    }
+
+    /// A frame header (and its pixels, kept only for the first frame).
+    pub fn on_frame(&mut self, header: &FrameHeader, pixels: &[u16]) {
+        self.frames_seen += 1;
+        self.last_frame_id = Some(header.frame_id);
+        if header.has_truth == 1 {
+            self.truths.push(header.frame_id, header.truth);
+        }
+        if self.first_frame.is_none() && header.validate(pixels.len()).is_ok() {
+            self.first_frame = Some((*header, pixels.to_vec()));
+        }
+    }
+
+    pub fn on_rig(&mut self, state: RigState) {
+        self.rig_samples_seen += 1;
+        self.rigs.push(state);
+    }
+
+    pub fn latest_rig(&self) -> Option<&RigState> {
+        self.rigs.latest()
+    }
+
+    /// A field: its `frames.csv` row, its files every Nth frame, its latency.
+    pub fn on_field(&mut self, header: &FieldHeader, nodes: &[FieldNode], seen_ns: u64) {
+        self.fields_seen += 1;
+        self.latency_field
+            .record_ns(header.t_published_ns.saturating_sub(header.t_capture_ns));
+        let rig = (header.rig_sample_id != wire::NO_RIG_SAMPLE)
+            .then(|| self.rigs.get(header.rig_sample_id))
+            .flatten();
+        let origin = self.truths.get(header.reference_frame_id);
+        let row = FrameRow::new(header, nodes, rig, origin, self.t0_ns, seen_ns);
+        if let Some(case) = rig.map(|s| s.load_case as usize).filter(|&c| c < 3) {
+            let stretch = row.stretch[0].max(row.stretch[1]);
+            if header.valid_nodes > 0 && stretch.is_finite() {
+                self.max_stretch[case] = self.max_stretch[case].max(stretch);
+            }
+        }
+        self.row.clear();
+        row.write_csv(&mut self.row);
+        let line = std::mem::take(&mut self.row);
+        let result = self.frames_csv.append(&line);
+        self.row = line;
+        self.note_error(result);
+        if header
+            .frame_id
+            .is_multiple_of(u64::from(self.settings.fields_every))
+        {
+            let result = self.write_field_files(header, nodes);
+            self.note_error(result);
+        }
+        self.last_field = Some(*header);
+        self.last_nodes.clear();
+        self.last_nodes.extend_from_slice(nodes);
+    }
+
+    pub fn on_report(&mut self, report: IdentificationReport) {
+        self.latency_identification
+            .record_ns(report.t_published_ns.saturating_sub(report.t_capture_ns));
+        self.last_report = Some(report);
+    }
+
+    fn write_field_files(
+        &mut self,
+        header: &FieldHeader,
+        nodes: &[FieldNode],
+    ) -> Result<(), String> {
+        let field = to_correlator_field(header, nodes);
+        let stem = self
+            .results
+            .fields()
+            .join(format!("field_{:06}", header.frame_id));
+        correlator::output::field_csv(&field, &mut self.text);
+        write_atomic(&stem.with_extension("csv"), self.text.as_bytes())?;
+        if self.settings.vtk {
+            correlator::output::field_vtk(
+                &field,
+                &format!("dicstream run field of frame {}", header.frame_id),
+                &mut self.text,
+            );
+            write_atomic(&stem.with_extension("vtk"), self.text.as_bytes())?;
+        }
+        Ok(())
+    }
+}
+
+/// A field from the wire as the correlator's own type (for the shared file writers).
+pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correlator::Field {
+    use correlator::NodeStatus as S;
+    let status = |code: u32| match wire::NodeStatus::from_code(code) {
+        Some(wire::NodeStatus::Ok) => S::Ok,
+        Some(wire::NodeStatus::NotConverged) => S::NotConverged,
+        Some(wire::NodeStatus::LowContrast) => S::LowContrast,
+        _ => S::OutsideImage,
+    };
+    let nodes: Vec<correlator::Node> = nodes
+        .iter()
+        .map(|n| correlator::Node {
+            x_px: f64::from(n.x_px),
+            y_px: f64::from(n.y_px),
+            u_px: f64::from(n.u_px),
+            v_px: f64::from(n.v_px),
+            exx: f64::from(n.exx),
+            eyy: f64::from(n.eyy),
+            exy: f64::from(n.exy),
+            score: f64::from(n.score),
+            iterations: n.iterations,
+            status: status(n.status),
+        })
+        .collect();
+    let (nx, ny) = (header.mesh_cols as usize, header.mesh_rows as usize);
+    let (nx, ny) = if nx * ny == nodes.len() {
+        (nx, ny)
+    } else {
+        (nodes.len(), 1)
+    };
+    correlator::Field {
+        nx,
+        ny,
+        valid: nodes.iter().filter(|n| n.status == S::Ok).count(),
+        nodes,
+        u_mean_px: header.u_mean_px,
+        v_mean_px: header.v_mean_px,
+        ..correlator::Field::default()
+    }
+}

@@ -1,0 +1,588 @@
+//! `dicstream run`: the whole bench. Checks the configuration, makes the results folder,
+//! starts identifier, correlator, producer and rig as child processes on a fresh instance
+//! (each waited for until ready), watches every service from the monitor, prints a status
+//! line once a second, handles deaths (reported, restarted if configured), stops everything
+//! in order on completion or Ctrl-C, then writes the latency histograms, figures and
+//! `summary.json`, and leaves nothing in `/dev/shm`.
+
+use crate::acceptance::{accept, Acceptance};
+use crate::children::{Exit, Role, Supervisor};
+use crate::config::RunConfig;
+use crate::latency::Percentiles;
+use crate::recorder::{Recorder, RecorderSettings};
+use crate::results::{write_atomic, ResultsDir};
+use crate::subscriptions::Subscriptions;
+use iceoryx2::prelude::*;
+use iceoryx2::waitset::WaitSetRunResult;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    pub config: RunConfig,
+    /// The `dicstream` binary the children run.
+    pub exe: PathBuf,
+    /// Instance name; default `run_<pid>`.
+    pub instance: Option<String>,
+    /// Results folder; default `<results_dir>/<date-time>/`.
+    pub results: Option<PathBuf>,
+    /// Print the status line (otherwise only the start and the end are printed).
+    pub status: bool,
+}
+
+/// How the run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Ending {
+    /// The campaign ran to its end.
+    Completed,
+    /// Ctrl-C or SIGTERM.
+    Interrupted,
+    /// A process died and could not be restarted.
+    Failed,
+}
+
+/// What the run did, also written as `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunReport {
+    pub results: PathBuf,
+    pub instance: String,
+    pub ending: Ending,
+    pub failure: Option<String>,
+    pub wall_s: f64,
+    pub frames_captured: u64,
+    pub fields: u64,
+    pub frames_dropped_by_correlator: u64,
+    pub identification_reports: u64,
+    pub restarts: Vec<String>,
+    pub latency_field_ms: Percentiles,
+    pub latency_identification_ms: Percentiles,
+    /// Mean over frames of the mean node displacement error against the truth (px), and the
+    /// worst node error of the run.
+    pub displacement_error_mean_px: Option<f64>,
+    pub acceptance: Option<Acceptance>,
+    pub leftover_shm_files: usize,
+}
+
+/// Seconds a process gets to say it is ready.
+const READY_TIMEOUT: Duration = Duration::from_secs(120);
+/// Longest wait for the correlator and identifier to finish the last frames.
+const DRAIN_TIMEOUT: Duration = Duration::from_secs(10);
+const WAIT_SLICE: Duration = Duration::from_millis(200);
+
+fn fmt_list(values: &[f64]) -> String {
+    values
+        .iter()
+        .map(|v| format!("{v:e}"))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// The command line of each child.
+pub fn child_args(
+    role: Role,
+    config: &RunConfig,
+    instance: &str,
+    results: &ResultsDir,
+) -> Vec<String> {
+    let path = |p: PathBuf| p.to_string_lossy().into_owned();
+    let mut args = vec!["--instance".to_string(), instance.to_string()];
+    let c = &config.camera;
+    let k = &config.correlator;
+    let g = &config.rig;
+    let extra: Vec<String> = match role {
+        Role::Rig => vec![
+            "--campaign".into(),
+            config.campaign_spec(),
+            format!("--law-f={}", fmt_list(&config.specimen.law_f)),
+            format!("--law-g={}", fmt_list(&config.specimen.law_g)),
+            "--speed".into(),
+            g.speed.to_string(),
+            "--publish-hz".into(),
+            g.publish_hz.to_string(),
+            "--log".into(),
+            path(results.rig_csv()),
+            "--log-hz".into(),
+            g.log_hz.to_string(),
+            "--seed".into(),
+            g.seed.to_string(),
+            "--exit-when-done".into(),
+        ],
+        Role::Producer => vec![
+            "--follow-rig".into(),
+            "--fps".into(),
+            c.fps.to_string(),
+            "--width".into(),
+            c.width_px.to_string(),
+            "--height".into(),
+            c.height_px.to_string(),
+            "--bit-depth".into(),
+            c.bit_depth.to_string(),
+            "--mm-per-px".into(),
+            c.mm_per_px.to_string(),
+            "--max-stretch".into(),
+            config.max_stretch().to_string(),
+            "--speckle-size-px".into(),
+            c.speckle_size_px.to_string(),
+            "--seed".into(),
+            c.seed.to_string(),
+            "--threads".into(),
+            c.threads.to_string(),
+        ],
+        Role::Correlator => vec![
+            "--zoi".into(),
+            k.zoi_px.to_string(),
+            "--step".into(),
+            k.step_px.to_string(),
+            "--threads".into(),
+            k.threads.to_string(),
+            "--strain".into(),
+            k.strain.clone(),
+            "--reference-mode".into(),
+            k.reference.clone(),
+            "--guess".into(),
+            k.guess.clone(),
+            "--state-dir".into(),
+            path(results.correlator_state()),
+        ],
+        Role::Identifier => vec![
+            "--output".into(),
+            path(results.identification_json()),
+            "--journal".into(),
+            path(results.journal()),
+            "--model".into(),
+            config.identifier.models.clone(),
+        ],
+    };
+    args.extend(extra);
+    args
+}
+
+/// Shared memory the run's services need (bytes), checked against `/dev/shm` at start.
+pub fn shm_needed_bytes(config: &RunConfig) -> Result<u64, String> {
+    let frames =
+        producer::stream::frames_shm_bytes(config.camera.width_px, config.camera.height_px);
+    let settings = config.correlator_settings()?;
+    let roi = settings
+        .resolve_roi(
+            config.camera.width_px as usize,
+            config.camera.height_px as usize,
+        )
+        .map_err(|e| e.to_string())?;
+    let nodes = (roi.width_px / settings.step_px + 1) * (roi.height_px / settings.step_px + 1);
+    let fields = wire::services::FIELDS.shm_bytes(
+        std::mem::size_of::<wire::FieldHeader>(),
+        nodes * std::mem::size_of::<wire::FieldNode>(),
+    );
+    let small = wire::services::RIG_STATE.shm_bytes(0, std::mem::size_of::<wire::RigState>())
+        + wire::services::IDENTIFICATION
+            .shm_bytes(0, std::mem::size_of::<wire::IdentificationReport>());
+    Ok(frames + fields + small)
+}
+
+fn start_order() -> [Role; 4] {
+    // Consumers first, so that nothing the rig and the camera publish is missed.
+    [
+        Role::Identifier,
+        Role::Correlator,
+        Role::Producer,
+        Role::Rig,
+    ]
+}
+
+/// Stops in the order data flows: the source first, each consumer after.
+const STOP_ORDER: [Role; 4] = [
+    Role::Rig,
+    Role::Producer,
+    Role::Correlator,
+    Role::Identifier,
+];
+
+pub fn run(options: RunOptions) -> Result<RunReport, String> {
+    let config = &options.config;
+    config.validate()?;
+    let instance_name = options
+        .instance
+        .clone()
+        .unwrap_or_else(|| format!("run_{}", std::process::id()));
+    let instance = wire::Instance::new(&instance_name).map_err(|e| e.to_string())?;
+    wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes(config)?)
+        .map_err(|e| e.to_string())?;
+    let results = match &options.results {
+        Some(root) => ResultsDir::at(root)?,
+        None => ResultsDir::create_dated(Path::new(&config.run.results_dir))?,
+    };
+    write_atomic(
+        &results.config(),
+        format!(
+            "# The configuration of this run (dicstream run --config {} reruns it).\n{}",
+            results.config().display(),
+            config.to_toml()
+        )
+        .as_bytes(),
+    )?;
+    println!(
+        "run: results in {}, instance {instance_name}, campaign {} (about {:.0} s)",
+        results.root.display(),
+        config.campaign_spec(),
+        config.campaign_wall_s()?
+    );
+    let started = Instant::now();
+    let t0_ns = wire::monotonic_ns();
+    let mut supervisor = Supervisor::new(&options.exe, &results.logs())?;
+    let outcome = {
+        let (node, _) = instance.create_node("monitor").map_err(|e| e.to_string())?;
+        let subscriptions = Subscriptions::new(&node)?;
+        let mut recorder = Recorder::new(
+            &results,
+            RecorderSettings {
+                fields_every: config.run.fields_every,
+                vtk: config.run.vtk,
+            },
+            t0_ns,
+        )?;
+        let mut state = LoopState::default();
+        let result =
+            start_children(&mut supervisor, config, &instance_name, &results).and_then(|()| {
+                event_loop(
+                    &subscriptions,
+                    &mut recorder,
+                    &mut supervisor,
+                    config,
+                    &instance_name,
+                    &results,
+                    options.status,
+                    started,
+                    &mut state,
+                )
+            });
+        let stopped = supervisor.stop_all(
+            &STOP_ORDER,
+            Duration::from_secs_f64(config.run.stop_timeout_s),
+        );
+        for (role, how) in stopped {
+            eprintln!("run: stopped {} ({how})", role.name());
+        }
+        // Samples published while stopping (last fields, last report).
+        let _ = subscriptions.drain(&mut recorder);
+        (result, recorder, state)
+    };
+    let (result, recorder, state) = outcome;
+    drop(supervisor);
+    instance.cleanup_dead_nodes();
+    instance.remove_leftover_files();
+    let leftover_shm_files = instance.leftover_files().len();
+    let (ending, failure) = match result {
+        Ok(ending) => (ending, None),
+        Err(e) => (Ending::Failed, Some(e)),
+    };
+    finish(
+        config,
+        &results,
+        &instance_name,
+        recorder,
+        state,
+        ending,
+        failure,
+        started,
+        leftover_shm_files,
+    )
+}
+
+fn start_children(
+    supervisor: &mut Supervisor,
+    config: &RunConfig,
+    instance: &str,
+    results: &ResultsDir,
+) -> Result<(), String> {
+    for role in start_order() {
+        supervisor.spawn(role, child_args(role, config, instance, results))?;
+        supervisor.wait_ready(role, READY_TIMEOUT)?;
+        println!(
+            "run: {} ready (pid {})",
+            role.name(),
+            supervisor.pid(role).unwrap_or(0)
+        );
+    }
+    Ok(())
+}
+
+/// What the loop learnt that the end of the run reports.
+#[derive(Default)]
+struct LoopState {
+    restarts: Vec<String>,
+    restart_counts: [u32; 4],
+}
+
+enum Phase {
+    Running,
+    /// The campaign is over and the camera stopped: the correlator and the identifier finish.
+    Draining {
+        since: Instant,
+        last_frame: Option<u64>,
+    },
+}
+
+#[allow(clippy::too_many_arguments)]
+fn event_loop(
+    subscriptions: &Subscriptions,
+    recorder: &mut Recorder,
+    supervisor: &mut Supervisor,
+    config: &RunConfig,
+    instance: &str,
+    results: &ResultsDir,
+    status: bool,
+    started: Instant,
+    state: &mut LoopState,
+) -> Result<Ending, String> {
+    let waitset = WaitSetBuilder::new()
+        .create::<ipc::Service>()
+        .map_err(|e| format!("monitor WaitSet: {e:?}"))?;
+    let mut guards = Vec::new();
+    for listener in subscriptions.listeners() {
+        guards.push(
+            waitset
+                .attach_notification(listener)
+                .map_err(|e| format!("monitor WaitSet: {e:?}"))?,
+        );
+    }
+    let status_every = Duration::from_secs_f64(config.run.status_interval_s);
+    let mut next_status = Instant::now() + status_every;
+    let mut phase = Phase::Running;
+    let stop_timeout = Duration::from_secs_f64(config.run.stop_timeout_s);
+    loop {
+        let woke = waitset
+            .wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, WAIT_SLICE)
+            .map_err(|e| format!("monitor WaitSet: {e:?}"))?;
+        if matches!(
+            woke,
+            WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt
+        ) {
+            println!("run: interrupted, stopping the processes");
+            return Ok(Ending::Interrupted);
+        }
+        subscriptions.drain(recorder)?;
+
+        for exit in supervisor.reap() {
+            let campaign_done = exit.role == Role::Rig && exit.success;
+            if campaign_done && matches!(phase, Phase::Running) {
+                println!("run: campaign finished; stopping the camera, finishing the last frames");
+                supervisor.stop(Role::Producer, stop_timeout);
+                subscriptions.drain(recorder)?;
+                phase = Phase::Draining {
+                    since: Instant::now(),
+                    last_frame: recorder.last_frame_id,
+                };
+                continue;
+            }
+            handle_death(exit, supervisor, config, instance, results, state)?;
+        }
+
+        if let Phase::Draining { since, last_frame } = phase {
+            let caught_up = match (last_frame, recorder.last_field) {
+                (Some(frame), Some(field)) => field.frame_id >= frame,
+                (None, _) => true,
+                _ => false,
+            };
+            if caught_up || since.elapsed() > DRAIN_TIMEOUT {
+                if !caught_up {
+                    eprintln!("run: the correlator did not finish the last frames in time");
+                }
+                supervisor.stop(Role::Correlator, stop_timeout);
+                // The identifier refits on the last points, then writes its final fits.
+                let quiet_since = Instant::now();
+                while quiet_since.elapsed() < Duration::from_millis(500) {
+                    std::thread::sleep(Duration::from_millis(50));
+                    subscriptions.drain(recorder)?;
+                }
+                supervisor.stop(Role::Identifier, stop_timeout);
+                subscriptions.drain(recorder)?;
+                return Ok(Ending::Completed);
+            }
+        }
+
+        if status && Instant::now() >= next_status {
+            println!(
+                "{}",
+                crate::status::status_line(recorder, started.elapsed().as_secs_f64())
+            );
+            next_status += status_every;
+            if next_status < Instant::now() {
+                next_status = Instant::now() + status_every;
+            }
+        }
+    }
+}
+
+fn handle_death(
+    exit: Exit,
+    supervisor: &mut Supervisor,
+    config: &RunConfig,
+    instance: &str,
+    results: &ResultsDir,
+    state: &mut LoopState,
+) -> Result<(), String> {
+    let role = exit.role;
+    let report = format!(
+        "{} (pid {}) died: {}{}",
+        role.name(),
+        exit.pid,
+        exit.how,
+        if exit.last_lines.is_empty() {
+            String::new()
+        } else {
+            format!("; its last lines:\n    {}", exit.last_lines.join("\n    "))
+        }
+    );
+    eprintln!("run: {report}");
+    let count = &mut state.restart_counts[role as usize];
+    if !config.run.restart || *count >= config.run.max_restarts {
+        return Err(format!(
+            "{report}\n(restart {}; {} of {} restarts used)",
+            if config.run.restart { "on" } else { "off" },
+            count,
+            config.run.max_restarts
+        ));
+    }
+    *count += 1;
+    let pid = supervisor.restart(role, Some(child_args(role, config, instance, results)))?;
+    supervisor.wait_ready(role, READY_TIMEOUT)?;
+    let note = format!(
+        "{} restarted (pid {pid}, restart {} of {}) after: {}",
+        role.name(),
+        count,
+        config.run.max_restarts,
+        exit.how
+    );
+    println!("run: {note}");
+    state.restarts.push(note);
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    config: &RunConfig,
+    results: &ResultsDir,
+    instance: &str,
+    recorder: Recorder,
+    state: LoopState,
+    ending: Ending,
+    failure: Option<String>,
+    started: Instant,
+    leftover_shm_files: usize,
+) -> Result<RunReport, String> {
+    let mut notes = Vec::new();
+    let mut keep = |what: &str, result: Result<(), String>| {
+        if let Err(e) = result {
+            notes.push(format!("{what}: {e}"));
+        }
+    };
+    keep(
+        "latency.hgrm",
+        write_atomic(
+            &results.path("latency.hgrm"),
+            recorder.latency_field.hgrm().as_bytes(),
+        ),
+    );
+    keep(
+        "latency_identification.hgrm",
+        write_atomic(
+            &results.path("latency_identification.hgrm"),
+            recorder.latency_identification.hgrm().as_bytes(),
+        ),
+    );
+    keep(
+        "latency.png",
+        crate::figures::latency_png(
+            &results.path("latency.png"),
+            &[
+                ("capture to field", &recorder.latency_field),
+                (
+                    "capture to identification",
+                    &recorder.latency_identification,
+                ),
+            ],
+        ),
+    );
+    keep(
+        "identification figures",
+        crate::figures::identification_figures(
+            &results.root,
+            &results.journal(),
+            &config.identifier.models,
+        )
+        .map(|_| ()),
+    );
+    if let (Some((frame, pixels)), Some(field)) = (&recorder.first_frame, &recorder.last_field) {
+        let field = crate::recorder::to_correlator_field(field, &recorder.last_nodes);
+        keep(
+            "strain_map.png",
+            crate::figures::strain_map(
+                &results.path("strain_map.png"),
+                pixels,
+                frame.width_px as usize,
+                &field,
+            ),
+        );
+    }
+    let acceptance = recorder.last_report.map(|report| {
+        let truth = config.law().expect("validated law");
+        let tested =
+            |case: usize| (recorder.max_stretch[case] > 1.01).then_some(recorder.max_stretch[case]);
+        accept(
+            &truth,
+            &report.a[..report.a_count as usize],
+            &report.b[..report.b_count as usize],
+            tested(1),
+            tested(2),
+        )
+    });
+    let displacement_error_mean_px = mean_displacement_error(&results.frames_csv());
+    let report = RunReport {
+        results: results.root.clone(),
+        instance: instance.to_string(),
+        ending,
+        failure,
+        wall_s: started.elapsed().as_secs_f64(),
+        frames_captured: recorder.last_frame_id.map_or(0, |id| id + 1),
+        fields: recorder.fields_seen,
+        frames_dropped_by_correlator: recorder.last_field.map_or(0, |f| f.frames_dropped),
+        identification_reports: recorder.latency_identification.count(),
+        restarts: state.restarts,
+        latency_field_ms: recorder.latency_field.percentiles(),
+        latency_identification_ms: recorder.latency_identification.percentiles(),
+        displacement_error_mean_px,
+        acceptance,
+        leftover_shm_files,
+    };
+    let mut json = serde_json::to_value(&report).map_err(|e| e.to_string())?;
+    if !notes.is_empty() {
+        json["notes"] = serde_json::json!(notes);
+        for note in &notes {
+            eprintln!("run: {note}");
+        }
+    }
+    write_atomic(
+        &results.summary_json(),
+        serde_json::to_string_pretty(&json)
+            .map_err(|e| e.to_string())?
+            .as_bytes(),
+    )?;
+    Ok(report)
+}
+
+/// Mean of the `disp_error_mean_px` column of `frames.csv`, if any frame has it.
+fn mean_displacement_error(frames_csv: &Path) -> Option<f64> {
+    let text = std::fs::read_to_string(frames_csv).ok()?;
+    let mut lines = text.lines();
+    let column = lines
+        .next()?
+        .split(',')
+        .position(|c| c == "disp_error_mean_px")?;
+    let values: Vec<f64> = lines
+        .filter_map(|l| l.split(',').nth(column)?.parse().ok())
+        .collect();
+    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+}

@@ -1,0 +1,137 @@
+//! The exact motion of simulated frames, compared with what the correlator measured. A frame's
+//! ground truth maps the undeformed pattern to the image: x = F (X − c) + c + t. A field's
+//! nodes sit in the image of the frame it is measured from (the origin frame); the true
+//! displacement of the node at x0 is φ_k(φ_o⁻¹(x0)) − x0, and the true strain comes from the
+//! relative gradient F_k F_o⁻¹.
+
+use nalgebra::{Matrix2, SymmetricEigen, Vector2};
+use wire::{FieldNode, GroundTruth, NodeStatus};
+
+fn gradient(truth: &GroundTruth) -> Matrix2<f64> {
+    let [a, b, c, d] = truth.deformation_gradient;
+    Matrix2::new(a, b, c, d)
+}
+
+/// x = φ(X).
+pub fn forward(truth: &GroundTruth, material_px: Vector2<f64>) -> Vector2<f64> {
+    let c = Vector2::from(truth.centre_px);
+    gradient(truth) * (material_px - c) + c + Vector2::from(truth.translation_px)
+}
+
+/// X = φ⁻¹(x); None when F is singular.
+pub fn inverse(truth: &GroundTruth, image_px: Vector2<f64>) -> Option<Vector2<f64>> {
+    let c = Vector2::from(truth.centre_px);
+    let f_inv = gradient(truth).try_inverse()?;
+    Some(f_inv * (image_px - c - Vector2::from(truth.translation_px)) + c)
+}
+
+/// Gradient of the motion from the origin frame's image to the current frame's image.
+pub fn relative_gradient(current: &GroundTruth, origin: &GroundTruth) -> Option<Matrix2<f64>> {
+    Some(gradient(current) * gradient(origin).try_inverse()?)
+}
+
+/// Logarithmic (Hencky) strain ½ ln(FᵀF) as (exx, eyy, exy); None when F is singular.
+pub fn log_strain(f: &Matrix2<f64>) -> Option<[f64; 3]> {
+    let c = f.transpose() * f;
+    let eigen = SymmetricEigen::new(c);
+    if eigen
+        .eigenvalues
+        .iter()
+        .any(|&v| !(v > 0.0 && v.is_finite()))
+    {
+        return None;
+    }
+    let log = eigen.eigenvectors
+        * Matrix2::from_diagonal(&eigen.eigenvalues.map(|v| 0.5 * v.ln()))
+        * eigen.eigenvectors.transpose();
+    Some([log[(0, 0)], log[(1, 1)], log[(0, 1)]])
+}
+
+/// Mean and largest displacement error (px) over the valid nodes, and how many there were.
+pub fn displacement_error(
+    nodes: &[FieldNode],
+    current: &GroundTruth,
+    origin: &GroundTruth,
+) -> Option<(f64, f64, usize)> {
+    let (mut sum, mut max, mut count) = (0.0, 0.0f64, 0usize);
+    for node in nodes {
+        if node.status != NodeStatus::Ok as u32 {
+            continue;
+        }
+        let x0 = Vector2::new(f64::from(node.x_px), f64::from(node.y_px));
+        let material = inverse(origin, x0)?;
+        let truth = forward(current, material) - x0;
+        let measured = Vector2::new(f64::from(node.u_px), f64::from(node.v_px));
+        let error = (measured - truth).norm();
+        sum += error;
+        max = max.max(error);
+        count += 1;
+    }
+    (count > 0).then(|| (sum / count as f64, max, count))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stretch(lx: f64, ly: f64, centre: [f64; 2]) -> GroundTruth {
+        GroundTruth {
+            deformation_gradient: [lx, 0.0, 0.0, ly],
+            translation_px: [0.0, 0.0],
+            centre_px: centre,
+        }
+    }
+
+    #[test]
+    fn maps_invert_and_compose() {
+        let a = 0.3f64;
+        let t = GroundTruth {
+            deformation_gradient: [1.2 * a.cos(), -a.sin(), 1.2 * a.sin(), a.cos()],
+            translation_px: [3.0, -2.0],
+            centre_px: [50.0, 40.0],
+        };
+        let p = Vector2::new(10.0, 70.0);
+        let back = inverse(&t, forward(&t, p)).unwrap();
+        assert!((back - p).norm() < 1e-12);
+        // A rotation has zero log strain; a stretch has ln λ.
+        let rotation = Matrix2::new(a.cos(), -a.sin(), a.sin(), a.cos());
+        let e = log_strain(&rotation).unwrap();
+        assert!(e.iter().all(|v| v.abs() < 1e-12), "{e:?}");
+        let e = log_strain(&Matrix2::new(2.0, 0.0, 0.0, 0.5)).unwrap();
+        assert!((e[0] - 2f64.ln()).abs() < 1e-12 && (e[1] - 0.5f64.ln()).abs() < 1e-12);
+        // Relative gradient from λ 1.5 to λ 3 is 2.
+        let g =
+            relative_gradient(&stretch(3.0, 1.0, [0.0; 2]), &stretch(1.5, 1.0, [0.0; 2])).unwrap();
+        assert!((g[(0, 0)] - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn displacement_error_of_an_exact_field_is_zero() {
+        let origin = stretch(1.1, 1.0, [100.0, 100.0]);
+        let current = stretch(1.32, 1.0, [100.0, 100.0]);
+        let mut nodes = Vec::new();
+        for (x, y) in [(20.0f32, 30.0f32), (150.0, 100.0), (100.0, 180.0)] {
+            // Reference image point x0 = φ_o(P); P = (x0 - c)/1.1 + c; now at c + 1.32 (P - c).
+            let u = (x - 100.0) * (1.32 / 1.1 - 1.0);
+            nodes.push(FieldNode {
+                x_px: x,
+                y_px: y,
+                u_px: u,
+                v_px: 0.0,
+                status: NodeStatus::Ok as u32,
+                ..FieldNode::default()
+            });
+        }
+        nodes.push(FieldNode {
+            u_px: 99.0,
+            status: NodeStatus::OutsideImage as u32,
+            ..FieldNode::default()
+        });
+        let (mean, max, count) = displacement_error(&nodes, &current, &origin).unwrap();
+        assert_eq!(count, 3);
+        assert!(mean < 1e-4 && max < 1e-4, "{mean} {max}");
+        nodes[0].v_px = 0.5;
+        let (_, max, _) = displacement_error(&nodes, &current, &origin).unwrap();
+        assert!((max - 0.5).abs() < 1e-4);
+    }
+}

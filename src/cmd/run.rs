@@ -1,0 +1,104 @@
+//! `dicstream run`: the whole simulated bench (rig, camera, correlator, identifier as
+//! processes), live status, results folder. See the `live` crate.
+
+use live::{Ending, RunConfig, RunOptions};
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug)]
+pub struct RunArgs {
+    /// Configuration file (TOML); missing keys take their defaults (see --print-config).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Print the default configuration as a commented TOML file and exit.
+    #[arg(long)]
+    pub print_config: bool,
+    /// Results folder of this run [default: <results_dir>/<date-time>/].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Instance name (shared-memory prefix) [default: run_<pid>].
+    #[arg(long)]
+    pub instance: Option<String>,
+    /// No status line (start and end only).
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn run(args: RunArgs) -> anyhow::Result<()> {
+    if args.print_config {
+        print!("{}", RunConfig::commented_defaults());
+        return Ok(());
+    }
+    let config = match &args.config {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| anyhow::anyhow!("--config {}: {e}", path.display()))?;
+            RunConfig::from_toml(&text, &path.display().to_string()).map_err(anyhow::Error::msg)?
+        }
+        None => RunConfig::default(),
+    };
+    config
+        .validate()
+        .map_err(|e| anyhow::anyhow!("configuration refused: {e}"))?;
+    let exe = std::env::current_exe()
+        .map_err(|e| anyhow::anyhow!("cannot find the dicstream binary: {e}"))?;
+    let report = live::run(RunOptions {
+        config,
+        exe,
+        instance: args.instance,
+        results: args.out,
+        status: !args.quiet,
+    })
+    .map_err(anyhow::Error::msg)?;
+    println!(
+        "run: {:?} after {:.1} s: {} frames captured, {} correlated, {} dropped by the correlator; \
+         latency capture to field p50 {:.0} ms p99 {:.0} ms, to identification p50 {:.0} ms",
+        report.ending,
+        report.wall_s,
+        report.frames_captured,
+        report.fields,
+        report.frames_dropped_by_correlator,
+        report.latency_field_ms.p50,
+        report.latency_field_ms.p99,
+        report.latency_identification_ms.p50,
+    );
+    if let Some(error) = report.displacement_error_mean_px {
+        println!("run: mean displacement error against the ground truth {error:.4} px");
+    }
+    match &report.acceptance {
+        Some(a) => {
+            let describe = |name: &str, c: Option<live::acceptance::CaseComparison>| match c {
+                Some(c) => format!(
+                    "{name} to λ {:.2}: worst stress error {:.2} % at λ {:.2}",
+                    c.max_stretch,
+                    100.0 * c.max_relative_error,
+                    c.at_stretch
+                ),
+                None => format!("{name}: not tested"),
+            };
+            println!(
+                "run: identified a = {:?}, b = {:?}\nrun: {}; {} -> {} (tolerance {:.0} %)",
+                a.a,
+                a.b,
+                describe("uniaxial", a.uniaxial),
+                describe("equibiaxial", a.equibiaxial),
+                if a.passed { "PASSED" } else { "NOT PASSED" },
+                100.0 * a.tolerance
+            );
+        }
+        None => println!("run: nothing identified"),
+    }
+    println!("run: results in {}", report.results.display());
+    if report.leftover_shm_files > 0 {
+        eprintln!(
+            "run: warning: {} shared-memory files of instance {} are left in /dev/shm",
+            report.leftover_shm_files, report.instance
+        );
+    }
+    match report.ending {
+        Ending::Completed | Ending::Interrupted => Ok(()),
+        Ending::Failed => anyhow::bail!(
+            "the run failed: {}",
+            report.failure.as_deref().unwrap_or("unknown")
+        ),
+    }
+}
