@@ -60,6 +60,9 @@ struct Managed {
     generation: u32,
     ready: bool,
     last_lines: VecDeque<String>,
+    /// CPU time (s) of earlier generations, and the last sample of the current one.
+    cpu_s_ended: f64,
+    cpu_s_current: f64,
 }
 
 /// A process that ended, and how.
@@ -137,6 +140,8 @@ impl Supervisor {
                 generation: 0,
                 ready: false,
                 last_lines: VecDeque::new(),
+                cpu_s_ended: 0.0,
+                cpu_s_current: 0.0,
             });
         }
         let exe = self.exe.clone();
@@ -152,6 +157,7 @@ impl Supervisor {
         managed.generation += 1;
         managed.ready = false;
         managed.last_lines.clear();
+        managed.cpu_s_ended += std::mem::take(&mut managed.cpu_s_current);
         let generation = managed.generation;
         let (reader, writer) =
             std::io::pipe().map_err(|e| format!("{}: cannot make a pipe: {e}", role.name()))?;
@@ -291,6 +297,24 @@ impl Supervisor {
         }
     }
 
+    /// Reads the CPU time of every running child (call it now and then: the time of a process
+    /// is known up to its last sample once it has ended).
+    pub fn sample_cpu(&mut self) {
+        for managed in &mut self.children {
+            if let Some(cpu_s) = managed.child.as_ref().and_then(|c| process_cpu_s(c.id())) {
+                managed.cpu_s_current = cpu_s;
+            }
+        }
+    }
+
+    /// CPU seconds (user + system, all threads) of `role` over all its starts, as last sampled.
+    pub fn cpu_seconds(&self, role: Role) -> f64 {
+        self.children
+            .iter()
+            .find(|m| m.role == role)
+            .map_or(0.0, |m| m.cpu_s_ended + m.cpu_s_current)
+    }
+
     /// Children that have ended since the last call.
     pub fn reap(&mut self) -> Vec<Exit> {
         self.drain_lines();
@@ -366,6 +390,25 @@ impl Supervisor {
     }
 }
 
+/// User + system CPU time of process `pid` (s), from `/proc/<pid>/stat`.
+pub fn process_cpu_s(pid: u32) -> Option<f64> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // Fields after the command name (which may hold spaces) start after the last ')'.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    // utime and stime are fields 14 and 15 of stat(5); `rest` starts at field 3.
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    // SAFETY: sysconf has no preconditions.
+    let ticks = unsafe { libc::sysconf(libc::_SC_CLK_TCK) } as f64;
+    (ticks > 0.0).then(|| (utime + stime) / ticks)
+}
+
+/// CPU time of this process so far (s).
+pub fn own_cpu_s() -> f64 {
+    process_cpu_s(std::process::id()).unwrap_or(0.0)
+}
+
 impl Drop for Supervisor {
     fn drop(&mut self) {
         for managed in &mut self.children {
@@ -374,5 +417,34 @@ impl Drop for Supervisor {
                 let _ = child.wait();
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cpu_time_of_this_process_grows() {
+        let before = own_cpu_s();
+        let mut x = 0u64;
+        let start = Instant::now();
+        while start.elapsed() < Duration::from_millis(200) {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+        }
+        assert!(x != 1);
+        assert!(own_cpu_s() > before);
+        assert!(process_cpu_s(u32::MAX).is_none());
+    }
+
+    #[test]
+    fn statuses_read_like_a_shell() {
+        let status = Command::new("sh").args(["-c", "exit 3"]).status().unwrap();
+        assert_eq!(describe_status(status), "exit status 3");
+        let status = Command::new("sh")
+            .args(["-c", "kill -9 $$"])
+            .status()
+            .unwrap();
+        assert_eq!(describe_status(status), "killed by signal 9 (SIGKILL)");
     }
 }

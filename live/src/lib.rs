@@ -13,6 +13,7 @@ pub mod config;
 pub mod figures;
 pub mod frames;
 pub mod latency;
+pub mod pipeline;
 pub mod recorder;
 pub mod results;
 pub mod run;

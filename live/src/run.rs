@@ -57,6 +57,10 @@ pub struct RunReport {
     pub frames_dropped_by_correlator: u64,
     pub identification_reports: u64,
     pub restarts: Vec<String>,
+    /// CPU seconds used per process (user + system, all threads), and as a share of one core
+    /// over the run's wall time (1.0 = one core busy all along).
+    pub cpu_s: std::collections::BTreeMap<String, f64>,
+    pub cpu_cores: std::collections::BTreeMap<String, f64>,
     pub latency_field_ms: Percentiles,
     pub latency_identification_ms: Percentiles,
     /// Mean over frames of the mean node displacement error against the truth (px), and the
@@ -258,6 +262,8 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
                     &mut state,
                 )
             });
+        supervisor.sample_cpu();
+        let cpu_s = Role::ALL.map(|role| (role.name(), supervisor.cpu_seconds(role)));
         let stopped = supervisor.stop_all(
             &STOP_ORDER,
             Duration::from_secs_f64(config.run.stop_timeout_s),
@@ -267,9 +273,13 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
         }
         // Samples published while stopping (last fields, last report).
         let _ = subscriptions.drain(&mut recorder);
-        (result, recorder, state)
+        (result, recorder, state, cpu_s)
     };
-    let (result, recorder, state) = outcome;
+    let (result, recorder, mut state, cpu_s) = outcome;
+    state.cpu_s = cpu_s.into_iter().map(|(n, s)| (n.to_string(), s)).collect();
+    state
+        .cpu_s
+        .insert("monitor".to_string(), crate::children::own_cpu_s());
     drop(supervisor);
     instance.cleanup_dead_nodes();
     instance.remove_leftover_files();
@@ -314,6 +324,8 @@ fn start_children(
 struct LoopState {
     restarts: Vec<String>,
     restart_counts: [u32; 4],
+    /// CPU seconds per process (children by role, and this monitor).
+    cpu_s: std::collections::BTreeMap<String, f64>,
 }
 
 enum Phase {
@@ -403,11 +415,14 @@ fn event_loop(
             }
         }
 
-        if status && Instant::now() >= next_status {
-            println!(
-                "{}",
-                crate::status::status_line(recorder, started.elapsed().as_secs_f64())
-            );
+        if Instant::now() >= next_status {
+            supervisor.sample_cpu();
+            if status {
+                println!(
+                    "{}",
+                    crate::status::status_line(recorder, started.elapsed().as_secs_f64())
+                );
+            }
             next_status += status_every;
             if next_status < Instant::now() {
                 next_status = Instant::now() + status_every;
@@ -540,17 +555,25 @@ fn finish(
         )
     });
     let displacement_error_mean_px = mean_displacement_error(&results.frames_csv());
+    let wall_s = started.elapsed().as_secs_f64();
+    let cpu_cores = state
+        .cpu_s
+        .iter()
+        .map(|(name, s)| (name.clone(), s / wall_s.max(1e-9)))
+        .collect();
     let report = RunReport {
         results: results.root.clone(),
         instance: instance.to_string(),
         ending,
         failure,
-        wall_s: started.elapsed().as_secs_f64(),
+        wall_s,
         frames_captured: recorder.last_frame_id.map_or(0, |id| id + 1),
         fields: recorder.fields_seen,
         frames_dropped_by_correlator: recorder.last_field.map_or(0, |f| f.frames_dropped),
         identification_reports: recorder.latency_identification.count(),
         restarts: state.restarts,
+        cpu_s: state.cpu_s,
+        cpu_cores,
         latency_field_ms: recorder.latency_field.percentiles(),
         latency_identification_ms: recorder.latency_identification.percentiles(),
         displacement_error_mean_px,
