@@ -30,6 +30,8 @@ pub struct StreamReport {
     pub frames_sent: u64,
     /// From the first frame slot (after the first rig sample when following the rig) to the end.
     pub elapsed_s: f64,
+    /// From the first frame sent to the last one.
+    pub send_span_s: f64,
     /// Frames that had no subscriber at the moment they were sent.
     pub frames_unseen: u64,
     /// Frame slots skipped because the rig state lay outside the camera's envelope.
@@ -43,8 +45,12 @@ pub struct StreamReport {
 }
 
 impl StreamReport {
+    /// Frames per second actually sent: frame intervals over the time between the first and
+    /// the last frame (frames over the elapsed time when fewer than two were sent).
     pub fn rate_hz(&self) -> f64 {
-        if self.elapsed_s > 0.0 {
+        if self.frames_sent >= 2 && self.send_span_s > 0.0 {
+            (self.frames_sent - 1) as f64 / self.send_span_s
+        } else if self.elapsed_s > 0.0 {
             self.frames_sent as f64 / self.elapsed_s
         } else {
             0.0
@@ -126,6 +132,8 @@ struct Shell {
     start: Instant,
     /// Frame slots elapsed (sent or skipped): the pacing clock.
     slots: u64,
+    /// When the first frame was sent.
+    first_sent: Option<Instant>,
     limit: u64,
     report: StreamReport,
 }
@@ -154,6 +162,7 @@ impl Shell {
                 .map(|fps| Duration::from_secs_f64(1.0 / fps)),
             start: Instant::now(),
             slots: 0,
+            first_sent: None,
             limit: settings.max_frames.unwrap_or(u64::MAX),
             report: StreamReport::default(),
         })
@@ -234,6 +243,8 @@ impl Shell {
             Some(_) => {}
         }
         self.report.frames_sent += 1;
+        let first_sent = *self.first_sent.get_or_insert_with(Instant::now);
+        self.report.send_span_s = first_sent.elapsed().as_secs_f64();
         if sent_header.rig_sample_id != wire::NO_RIG_SAMPLE {
             self.report.last_rig_sample_id = Some(sent_header.rig_sample_id);
         }
@@ -348,4 +359,37 @@ fn wait_error(e: &dyn std::fmt::Debug) -> StreamError {
         service: services::RIG_STATE.name.to_string(),
         detail: format!("waitset: {e:?}"),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rate_counts_intervals_between_the_first_and_the_last_frame() {
+        let report = StreamReport {
+            frames_sent: 31,
+            elapsed_s: 3.05,
+            send_span_s: 3.0,
+            ..StreamReport::default()
+        };
+        assert!((report.rate_hz() - 10.0).abs() < 1e-12);
+        let single = StreamReport {
+            frames_sent: 1,
+            elapsed_s: 0.5,
+            ..StreamReport::default()
+        };
+        assert!((single.rate_hz() - 2.0).abs() < 1e-12);
+        assert_eq!(StreamReport::default().rate_hz(), 0.0);
+    }
+
+    #[test]
+    fn frames_service_is_sized_from_the_frame() {
+        let small = frames_shm_bytes(256, 256);
+        let big = frames_shm_bytes(1024, 1024);
+        assert!(big > 10 * small, "{small} {big}");
+        // Every sample the service may hold at once (per publisher) fits.
+        let samples = services::FRAMES.max_publishers * services::FRAMES.pool_samples();
+        assert!(big >= samples as u64 * 2 * 1024 * 1024);
+    }
 }
