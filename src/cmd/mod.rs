@@ -3,5 +3,7 @@
 pub mod correlate;
 pub mod identifier;
 pub mod identify;
+pub mod producer;
 pub mod rig;
 pub mod synth;
+pub mod tap;
