@@ -525,9 +525,9 @@ mod tests {
         let m = f.motion_of(&k);
         let (s, c) = 1.5f64.to_radians().sin_cos();
         let expected = [[c * 1.3, -s * 0.9], [s * 1.3, c * 0.9]];
-        for i in 0..2 {
-            for j in 0..2 {
-                assert!((m.truth.f[i][j] - expected[i][j]).abs() < 1e-15);
+        for (row, expected_row) in m.truth.f.iter().zip(expected) {
+            for (value, want) in row.iter().zip(expected_row) {
+                assert!((value - want).abs() < 1e-15);
             }
         }
         assert!((m.truth.translation_px[0] - 10.0).abs() < 1e-12);
@@ -638,8 +638,10 @@ mod tests {
     fn bad_settings_are_refused() {
         let bad =
             |config: RigFollowConfig| RigFollower::new(config, 64, 64).unwrap_err().to_string();
-        let mut c = RigFollowConfig::default();
-        c.mm_per_px = 0.0;
+        let c = RigFollowConfig {
+            mm_per_px: 0.0,
+            ..RigFollowConfig::default()
+        };
         assert!(bad(c).contains("mm-per-px"));
         let mut c = RigFollowConfig::default();
         c.envelope.max_stretch = 0.5;

@@ -115,7 +115,7 @@ impl IdTracker {
 }
 
 /// The last sample seen, kept to summarise it.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 enum LastSample {
     Frame {
         header: FrameHeader,
@@ -128,7 +128,8 @@ enum LastSample {
         state: RigState,
     },
     Identification {
-        report: IdentificationReport,
+        // Boxed: a report is three times a frame header (and comes a few times a second).
+        report: Box<IdentificationReport>,
     },
 }
 
@@ -209,9 +210,11 @@ impl LastSample {
                         .collect::<Vec<_>>()
                         .join(" ")
                 };
-                let best = (report.ranked_count > 0)
-                    .then(|| wire::text::read_fixed(&report.ranking[0].name))
-                    .unwrap_or_else(|| "-".to_string());
+                let best = if report.ranked_count > 0 {
+                    wire::text::read_fixed(&report.ranking[0].name)
+                } else {
+                    "-".to_string()
+                };
                 format!(
                     "identification at frame {}: points uniaxial {} equibiaxial {} shear {}, \
                      a [{}], b [{}], rms {:.4} MPa, best {best}",
@@ -278,7 +281,7 @@ impl LastSample {
 }
 
 /// One received sample, as the statistics see it.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct Observation {
     /// The id that should be consecutive, if the service has one.
     id: Option<u64>,
@@ -392,7 +395,7 @@ impl TapStats {
                 self.drops_text(self.window_drops),
                 self.drops_text(self.ids.drops),
                 latency_text(&self.window_latency_ns),
-                self.last.map(|l| l.line()).unwrap_or_default()
+                self.last.as_ref().map(|l| l.line()).unwrap_or_default()
             )
         };
         self.window_received = 0;
@@ -459,7 +462,7 @@ impl TapStats {
             "latency_from": self.kind.latency_from(),
             "latency_us": latency,
             "stopped_by": stopped_by,
-            "last": self.last.map(|l| l.json()),
+            "last": self.last.as_ref().map(|l| l.json()),
         })
     }
 }
@@ -576,7 +579,9 @@ impl Tap {
                 received_ns: wire::monotonic_ns(),
                 checksum_ok: None,
                 invalid: report.layout_version != wire::LAYOUT_VERSION,
-                last: LastSample::Identification { report },
+                last: LastSample::Identification {
+                    report: Box::new(report),
+                },
             }),
         })
     }
@@ -787,7 +792,9 @@ mod tests {
                 received_ns: 5,
                 checksum_ok: None,
                 invalid: false,
-                last: LastSample::Identification { report },
+                last: LastSample::Identification {
+                    report: Box::new(report),
+                },
             });
         }
         let json = stats.json("inst", 1.0, "signal");
