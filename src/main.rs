@@ -21,12 +21,16 @@ enum Command {
     Identify(cmd::identify::IdentifyArgs),
     /// Live identification process: fields + rig/state in, identification reports out.
     Identifier(cmd::identifier::IdentifierArgs),
-    /// The whole simulated bench: rig, camera, correlator, identifier; live status; results.
-    Run(cmd::run::RunArgs),
+    /// Camera process: publishes frames (scenario, replay, or following the rig state).
+    Producer(cmd::producer::ProducerArgs),
     /// Simulated ASTREE machine: publishes rig/state, answers rig/command, logs rig.csv.
     Rig(cmd::rig::RigArgs),
+    /// The whole simulated bench: rig, camera, correlator, identifier; live status; results.
+    Run(cmd::run::RunArgs),
     /// Write simulated speckle images with their exact ground truth (truth.csv).
     Synth(cmd::synth::SynthArgs),
+    /// Watch a service (frames, fields, rig/state, identification): rate, drops, latency.
+    Tap(cmd::tap::TapArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -36,9 +40,11 @@ fn main() -> std::process::ExitCode {
         Command::Correlate(args) => cmd::correlate::run(args),
         Command::Identify(args) => cmd::identify::run(args),
         Command::Identifier(args) => cmd::identifier::run(args),
+        Command::Producer(args) => cmd::producer::run(args),
         Command::Rig(args) => cmd::rig::run(args),
         Command::Run(args) => cmd::run::run(args),
         Command::Synth(args) => cmd::synth::run(args),
+        Command::Tap(args) => cmd::tap::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

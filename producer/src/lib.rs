@@ -1,7 +1,7 @@
 //! Frame producer: simulated speckle camera with exact ground truth, and image-folder replay.
 //!
-//! Pure library, no IPC: the streaming loop (`stream`) and the `dicstream` commands call it
-//! through the [`FrameSource`] seam.
+//! Pure library, no IPC, except the thin streaming shell (`stream`), which publishes what a
+//! [`FrameSource`] (scenario, replay) or the rig-driven [`RigCamera`] renders.
 
 pub mod camera;
 mod cli;
@@ -14,6 +14,7 @@ pub mod parallel;
 mod render_exact;
 mod render_fast;
 mod replay;
+mod rig_follow;
 mod scenario;
 mod simulated;
 mod source;
@@ -30,6 +31,11 @@ pub use natural_sort::natural_cmp;
 pub use render_exact::{gauss_legendre, ExactRenderer};
 pub use render_fast::FastRenderer;
 pub use replay::{list_images, Replay, IMAGE_EXTENSIONS};
+pub use rig_follow::{
+    NextMotion, RigCamera, RigEnvelope, RigFollowConfig, RigFollower, RigKinematics, RigMotion,
+    DEFAULT_MAX_OFFSET_MM, DEFAULT_MAX_ROTATION_DEG, DEFAULT_MAX_STRETCH, DEFAULT_MM_PER_PX,
+    RIG_SCENARIO_ID,
+};
 pub use scenario::{Scenario, ScenarioKind, SCENARIO_NAMES};
 pub use simulated::{
     motion_reach_px, MotionSource, RendererKind, ScenarioTimeline, SimulatedCamera,

@@ -16,7 +16,12 @@ pub const IMAGE_EXTENSIONS: [&str; 4] = ["png", "tif", "tiff", "bmp"];
 pub struct Replay {
     files: Vec<PathBuf>,
     shape: ImageShape,
+    /// Position of the next file in `files`.
     next_index: usize,
+    /// Frames given so far, over every pass (the `FrameInfo::index`).
+    frames_given: u64,
+    /// Starts again from the first file after the last one, endlessly.
+    looping: bool,
     scratch: Vec<u8>,
 }
 
@@ -50,6 +55,8 @@ impl Replay {
             files,
             shape,
             next_index: 0,
+            frames_given: 0,
+            looping: false,
             scratch: Vec::with_capacity(shape.len_px() * 2),
         })
     }
@@ -63,6 +70,12 @@ impl Replay {
     pub fn rewind(&mut self) {
         self.next_index = 0;
     }
+
+    /// With `looping`, the sequence starts again from the first file after the last one and
+    /// never ends (`frames_total` is then `None`); frame indices keep counting up.
+    pub fn set_looping(&mut self, looping: bool) {
+        self.looping = looping;
+    }
 }
 
 impl FrameSource for Replay {
@@ -75,11 +88,14 @@ impl FrameSource for Replay {
     }
 
     fn frames_total(&self) -> Option<u64> {
-        Some(self.files.len() as u64)
+        (!self.looping).then_some(self.files.len() as u64)
     }
 
     fn next_frame(&mut self, out: &mut [u16]) -> Result<Option<FrameInfo>, ProducerError> {
         check_buffer(self.dims(), out)?;
+        if self.looping && self.next_index >= self.files.len() {
+            self.rewind();
+        }
         let Some(file) = self.files.get(self.next_index) else {
             return Ok(None);
         };
@@ -96,9 +112,14 @@ impl FrameSource for Replay {
                 expected_bit_depth: self.shape.bit_depth,
             });
         }
-        let index = self.next_index as u64;
+        let index = self.frames_given;
         self.next_index += 1;
-        Ok(Some(FrameInfo { index, truth: None }))
+        self.frames_given += 1;
+        Ok(Some(FrameInfo {
+            index,
+            truth: None,
+            rig_sample_id: None,
+        }))
     }
 }
 

@@ -1,6 +1,10 @@
 //! The simulated camera: a speckle pattern rendered under the motion a [`MotionSource`] gives
-//! for each frame (a scenario timeline now, the rig state later), exposed by the camera model
-//! straight into the caller's buffer. All buffers are made at construction.
+//! for each frame (a scenario timeline), exposed by the camera model straight into the caller's
+//! buffer. All buffers are made at construction.
+//!
+//! A [`MotionSource`] is pulled by frame index. A motion pushed from outside (the rig state, see
+//! [`crate::RigCamera`]) instead builds the camera for a known reach with
+//! [`SimulatedCamera::for_reach`] and renders each motion with [`SimulatedCamera::render_frame`].
 
 use crate::camera::{Blur, CameraModel};
 use crate::error::ProducerError;
@@ -137,7 +141,8 @@ pub struct SimulatedCamera {
     config: SimulatedConfig,
     speckle: Speckle,
     renderer: Renderer,
-    motions: Box<dyn MotionSource>,
+    /// `None` for a camera driven from outside through [`SimulatedCamera::render_frame`].
+    motions: Option<Box<dyn MotionSource>>,
     pattern: Vec<f32>,
     blur: Option<Blur>,
     next_index: u64,
@@ -153,6 +158,30 @@ impl SimulatedCamera {
     pub fn new(
         config: SimulatedConfig,
         motions: Box<dyn MotionSource>,
+    ) -> Result<Self, ProducerError> {
+        let reach_px = motions.reach_px(config.width, config.height);
+        Self::build(config, reach_px, Some(motions))
+    }
+
+    /// A camera without a motion source, whose pattern covers `reach_px` beyond the image on
+    /// every side: the caller renders each motion with [`SimulatedCamera::render_frame`] and
+    /// must keep φ⁻¹ of every image pixel within that reach. As a [`FrameSource`] it gives no
+    /// frame.
+    pub fn for_reach(config: SimulatedConfig, reach_px: f64) -> Result<Self, ProducerError> {
+        if !(reach_px.is_finite() && reach_px >= 0.0) {
+            return Err(ProducerError::InvalidParameter {
+                name: "reach_px".to_owned(),
+                value: reach_px.to_string(),
+                expected: "a finite, non-negative pattern reach in px".to_owned(),
+            });
+        }
+        Self::build(config, reach_px, None)
+    }
+
+    fn build(
+        config: SimulatedConfig,
+        reach_px: f64,
+        motions: Option<Box<dyn MotionSource>>,
     ) -> Result<Self, ProducerError> {
         for (name, side) in [("width", config.width), ("height", config.height)] {
             if !(8..=MAX_SIDE_PX).contains(&side) {
@@ -180,7 +209,7 @@ impl SimulatedCamera {
             });
         }
         let threads = config.threads.max(1);
-        let margin_px = motions.reach_px(config.width, config.height) + EXTRA_MARGIN_PX;
+        let margin_px = reach_px + EXTRA_MARGIN_PX;
         assert!(margin_px.is_finite(), "motion reach is not finite");
         let x_range = [-margin_px, f64::from(config.width) - 1.0 + margin_px];
         let y_range = [-margin_px, f64::from(config.height) - 1.0 + margin_px];
@@ -266,13 +295,20 @@ impl FrameSource for SimulatedCamera {
     }
 
     fn frames_total(&self) -> Option<u64> {
-        self.motions.frames_total()
+        match &self.motions {
+            Some(motions) => motions.frames_total(),
+            None => Some(0),
+        }
     }
 
     fn next_frame(&mut self, out: &mut [u16]) -> Result<Option<FrameInfo>, ProducerError> {
         check_buffer(self.dims(), out)?;
         let index = self.next_index;
-        let Some((motion, truth)) = self.motions.next_motion(index) else {
+        let Some((motion, truth)) = self
+            .motions
+            .as_mut()
+            .and_then(|motions| motions.next_motion(index))
+        else {
             return Ok(None);
         };
         self.render_frame(&motion, index, out)?;
@@ -280,6 +316,7 @@ impl FrameSource for SimulatedCamera {
         Ok(Some(FrameInfo {
             index,
             truth: Some(truth),
+            rig_sample_id: None,
         }))
     }
 }

@@ -29,6 +29,9 @@ pub struct FrameInfo {
     pub index: u64,
     /// The imposed motion for simulated frames; `None` for replay.
     pub truth: Option<Truth>,
+    /// The rig sample (`wire::RigState::sample_id`) the frame was rendered from, for a
+    /// rig-driven camera; `None` otherwise.
+    pub rig_sample_id: Option<u64>,
 }
 
 /// Frame geometry of a source.

@@ -200,3 +200,27 @@ fn replays_dic_challenge_sample5_when_present() {
     }
     assert_eq!(frames, 3);
 }
+
+#[test]
+fn looping_replay_starts_again_and_keeps_counting() {
+    let dir = temp_dir("loop");
+    write_gray8(&dir.join("f1.png"), 4, 3, 1);
+    write_gray8(&dir.join("f2.png"), 4, 3, 2);
+    let mut replay = Replay::open(&dir).expect("open replay");
+    replay.set_looping(true);
+    assert_eq!(replay.frames_total(), None);
+    let mut out = vec![0u16; replay.dims().len_px()];
+    let first = read_image(&replay.files()[0]).unwrap().pixels;
+    let second = read_image(&replay.files()[1]).unwrap().pixels;
+    for k in 0..5u64 {
+        let info = replay
+            .next_frame(&mut out)
+            .unwrap()
+            .expect("a looping replay never ends");
+        assert_eq!(info.index, k);
+        assert_eq!(&out, if k % 2 == 0 { &first } else { &second });
+    }
+    replay.set_looping(false);
+    assert_eq!(replay.frames_total(), Some(2));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -3,6 +3,8 @@
 pub mod correlate;
 pub mod identifier;
 pub mod identify;
+pub mod producer;
 pub mod rig;
 pub mod run;
 pub mod synth;
+pub mod tap;

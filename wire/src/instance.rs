@@ -143,6 +143,13 @@ impl Instance {
             .signal_handling_mode(SignalHandlingMode::HandleTerminationRequests)
             .create::<ipc::Service>()
             .map_err(|e| node_error(format!("{e:?}")))?;
+        // iceoryx2 installs its SIGINT/SIGTERM handler lazily, on the first termination check:
+        // do it now, so a signal between here and the process's first wait is not fatal. The
+        // check consumes a request that was already recorded: raise it again, now handled.
+        if node.wait(std::time::Duration::ZERO).is_err() {
+            // SAFETY: raise(3) with a valid signal number; the handler is installed.
+            unsafe { libc::raise(libc::SIGTERM) };
+        }
         Ok((node, removed))
     }
 

@@ -1,0 +1,200 @@
+//! `dicstream producer`: the camera process. Publishes `frames` (zero-copy `[u16]` slices behind
+//! a `FrameHeader`) from a simulated scenario, a replayed image folder, or the rig state
+//! (`--follow-rig`), paced to `--fps`. Says "ready" on stderr once the publisher exists and
+//! prints one final line on stdout (also after SIGINT/SIGTERM, then exits 0).
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use producer::stream::{
+    check_shm_for_frames, stream, stream_following_rig, StreamEvent, StreamReport, StreamSettings,
+};
+use producer::{
+    FrameSource, Replay, RigCamera, RigEnvelope, RigFollowConfig, SimArgs, DEFAULT_MAX_OFFSET_MM,
+    DEFAULT_MAX_ROTATION_DEG, DEFAULT_MAX_STRETCH, DEFAULT_MM_PER_PX,
+};
+
+/// Options of `dicstream producer`.
+#[derive(Debug, clap::Args)]
+pub struct ProducerArgs {
+    #[command(flatten)]
+    pub sim: SimArgs,
+    /// Replay images instead of simulating: a folder (every .png/.tif/.tiff/.bmp, natural
+    /// order) or a glob such as 'dir/img_*.tif'
+    #[arg(long, value_name = "DIR|GLOB", conflicts_with_all = ["scenario", "params", "width", "height", "follow_rig"])]
+    pub replay: Option<PathBuf>,
+    /// With --replay: start again from the first image after the last one, endlessly
+    #[arg(long = "loop", requires = "replay")]
+    pub looping: bool,
+    /// Render each frame from the most recent rig/state sample (the rig deforms the specimen);
+    /// waits for the first sample
+    #[arg(long, conflicts_with_all = ["scenario", "params"])]
+    pub follow_rig: bool,
+    /// With --follow-rig: image scale, mm per px
+    #[arg(long, default_value_t = DEFAULT_MM_PER_PX, requires = "follow_rig")]
+    pub mm_per_px: f64,
+    /// With --follow-rig: largest stretch the camera can show, both axes (the pattern also
+    /// covers the lateral contraction max^-1/2); rig states beyond are skipped and counted
+    #[arg(long, default_value_t = DEFAULT_MAX_STRETCH, requires = "follow_rig")]
+    pub max_stretch: f64,
+    /// With --follow-rig: largest specimen rotation the camera can show, degrees
+    #[arg(long, default_value_t = DEFAULT_MAX_ROTATION_DEG, requires = "follow_rig")]
+    pub max_rotation_deg: f64,
+    /// With --follow-rig: largest specimen centre offset the camera can show, mm per axis
+    #[arg(long, default_value_t = DEFAULT_MAX_OFFSET_MM, requires = "follow_rig")]
+    pub max_offset_mm: f64,
+    /// Frames per second to pace to (0: as fast as frames render)
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
+    /// Frames to send. A scenario ramps over them [default: 100]; a replay sends each image
+    /// once [default: all] (endlessly with --loop); --follow-rig runs until stopped [default]
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// Instance name (shared-memory prefix); runs with different names never meet
+    #[arg(long, default_value_t = wire::Instance::default_name())]
+    pub instance: String,
+}
+
+/// Frames of a scenario when `--frames` is not given.
+const DEFAULT_SCENARIO_FRAMES: u64 = 100;
+
+pub fn run(args: ProducerArgs) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        args.fps.is_finite() && args.fps >= 0.0,
+        "--fps {}: expected a rate in frames per second, or 0 for as fast as possible",
+        args.fps
+    );
+    anyhow::ensure!(
+        args.frames != Some(0),
+        "--frames 0: expected at least 1 frame"
+    );
+    let instance = wire::Instance::new(&args.instance)?;
+    let settings = StreamSettings {
+        fps: (args.fps > 0.0).then_some(args.fps),
+        max_frames: args.frames,
+    };
+    let mut warned_beyond = false;
+    let mut on_event = |event: StreamEvent| match event {
+        StreamEvent::Ready {
+            dims,
+            dead_nodes_cleaned,
+        } => {
+            if dead_nodes_cleaned > 0 {
+                eprintln!(
+                    "producer: cleaned {dead_nodes_cleaned} dead node(s) of instance {}",
+                    instance.name()
+                );
+            }
+            eprintln!(
+                "producer: ready (instance {}, {}x{} px, {} bit)",
+                instance.name(),
+                dims.width,
+                dims.height,
+                dims.bit_depth
+            );
+        }
+        StreamEvent::WaitingForRig => eprintln!(
+            "producer: waiting for the first rig/state sample of instance {} (start `dicstream \
+             rig --instance {}`)",
+            instance.name(),
+            instance.name()
+        ),
+        StreamEvent::RigArrived { sample_id } => {
+            eprintln!("producer: following the rig from sample {sample_id}")
+        }
+        StreamEvent::RigBeyond {
+            sample_id, reason, ..
+        } => {
+            if !warned_beyond {
+                warned_beyond = true;
+                eprintln!(
+                    "producer: warning: rig sample {sample_id} is beyond what the camera can \
+                     show: {reason}; such frames are skipped and counted (this warning is shown \
+                     once)"
+                );
+            }
+        }
+        StreamEvent::Frame(_) => {}
+    };
+
+    let (report, source_line) = if args.follow_rig {
+        let config = args.sim.config()?;
+        check_shm_for_frames(config.width, config.height)?;
+        let follow = RigFollowConfig {
+            mm_per_px: args.mm_per_px,
+            envelope: RigEnvelope {
+                max_stretch: args.max_stretch,
+                max_rotation_rad: args.max_rotation_deg.to_radians(),
+                max_offset_mm: args.max_offset_mm,
+            },
+        };
+        let mut camera =
+            RigCamera::new(config, follow).context("building the rig-driven camera")?;
+        let report = stream_following_rig(&mut camera, &instance, &settings, &mut on_event)?;
+        let line = format!(
+            "{} rig samples received, last frame at rig sample {}",
+            report.rig_samples_received,
+            report
+                .last_rig_sample_id
+                .map_or_else(|| "-".to_string(), |id| id.to_string())
+        );
+        (report, line)
+    } else if let Some(source) = &args.replay {
+        let mut replay = Replay::open(source)?;
+        let dims = replay.dims();
+        check_shm_for_frames(dims.width, dims.height)?;
+        replay.set_looping(args.looping);
+        let line = format!(
+            "replay of {} image(s) from {}{}",
+            replay.files().len(),
+            source.display(),
+            if args.looping { ", looping" } else { "" }
+        );
+        let report = stream(&mut replay, &instance, &settings, &mut on_event)?;
+        (report, line)
+    } else {
+        // Cheap checks first (scenario, camera, /dev/shm), then the costly pattern.
+        let scenario = args.sim.scenario()?;
+        args.sim.config()?;
+        check_shm_for_frames(args.sim.width, args.sim.height)?;
+        let frames = args.frames.unwrap_or(DEFAULT_SCENARIO_FRAMES);
+        let mut camera = args
+            .sim
+            .build(frames)
+            .context("building the simulated camera")?;
+        let report = stream(&mut camera, &instance, &settings, &mut on_event)?;
+        let line = format!(
+            "scenario {} over {frames} frames",
+            if args.sim.params.is_empty() {
+                scenario.kind.name().to_string()
+            } else {
+                args.sim.scenario_spec()
+            }
+        );
+        (report, line)
+    };
+    println!("{}", final_line(&report, args.fps, &source_line));
+    Ok(())
+}
+
+/// The one line a run ends with.
+fn final_line(report: &StreamReport, fps: f64, source: &str) -> String {
+    let asked = if fps > 0.0 {
+        format!("{fps} asked")
+    } else {
+        "unpaced".to_string()
+    };
+    let mut line = format!(
+        "producer: {} frames sent in {:.2} s ({:.1} fps measured, {asked}), {} received by \
+         nobody, {} skipped (rig beyond the envelope); {source}",
+        report.frames_sent,
+        report.elapsed_s,
+        report.rate_hz(),
+        report.frames_unseen,
+        report.frames_beyond_envelope,
+    );
+    if report.interrupted {
+        line.push_str("; stopped by signal");
+    }
+    line
+}
