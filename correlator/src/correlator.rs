@@ -148,6 +148,61 @@ impl Correlator {
         Ok(())
     }
 
+    /// Image size this correlator was made for (width, height) in px.
+    pub fn image_size(&self) -> (usize, usize) {
+        (self.width_px, self.height_px)
+    }
+
+    /// The current reference image (row-major), or None before the first reference.
+    pub fn reference_pixels(&self) -> Option<&[u16]> {
+        self.has_reference
+            .then_some(self.reference_pixels.as_slice())
+    }
+
+    /// Total displacement (px) of every node, row-major, when the current reference was taken:
+    /// zero for a reference given to `set_reference`, the accumulated field after an
+    /// incremental or automatic reference update. With [`Correlator::reference_pixels`] this is
+    /// everything [`Correlator::restore_reference`] needs to resume measuring the same total
+    /// displacement in another process.
+    pub fn reference_base_px(&self) -> impl ExactSizeIterator<Item = (f64, f64)> + '_ {
+        self.ref_nodes.iter().map(|r| r.base_px)
+    }
+
+    /// Resumes against a saved reference: its pixels and the per-node base displacements read
+    /// from [`Correlator::reference_base_px`] (one pair per node, row-major). Afterwards the
+    /// correlator is in the state it was right after that reference was taken, except that the
+    /// previous frame's field is unknown (the predictor grows from the centre once).
+    pub fn restore_reference(
+        &mut self,
+        pixels: &[u16],
+        base_px: &[(f64, f64)],
+    ) -> Result<(), SettingsError> {
+        self.check_size("reference", pixels)?;
+        if base_px.len() != self.ref_nodes.len() {
+            return Err(SettingsError::BaseLength {
+                got: base_px.len(),
+                expected: self.ref_nodes.len(),
+            });
+        }
+        if let Some(k) = base_px
+            .iter()
+            .position(|b| !(b.0.is_finite() && b.1.is_finite()))
+        {
+            return Err(SettingsError::BaseNotFinite { node: k });
+        }
+        for ((k, r), &base) in self.ref_nodes.iter_mut().enumerate().zip(base_px) {
+            *r = RefNode {
+                top_left: self.mesh.top_left[k],
+                base_px: base,
+                ..RefNode::default()
+            };
+        }
+        self.previous.fill(None);
+        self.has_previous = false;
+        self.take_reference(pixels);
+        Ok(())
+    }
+
     /// Copies the pixels as the current reference and prepares the spectra of every node at its
     /// followed position (`ref_nodes[k].base_px` must be set).
     fn take_reference(&mut self, pixels: &[u16]) {
