@@ -17,6 +17,8 @@ enum Command {
     // One variant per subcommand; keep one line each so parallel edits stay simple.
     /// Offline correlation of image files: fields (CSV, VTK, PNG) and summary.json.
     Correlate(cmd::correlate::CorrelateArgs),
+    /// Live correlation process: frames in, fields out (zero-copy); resumes from --state-dir.
+    Correlator(cmd::correlator::CorrelatorArgs),
     /// Fit hyperelastic potentials to uniaxial/equibiaxial/pure-shear CSV data (offline).
     Identify(cmd::identify::IdentifyArgs),
     /// Live identification process: fields + rig/state in, identification reports out.
@@ -32,6 +34,7 @@ fn main() -> std::process::ExitCode {
     let result: anyhow::Result<()> = match cli.command {
         // One arm per subcommand.
         Command::Correlate(args) => cmd::correlate::run(args),
+        Command::Correlator(args) => cmd::correlator::run(args),
         Command::Identify(args) => cmd::identify::run(args),
         Command::Identifier(args) => cmd::identifier::run(args),
         Command::Rig(args) => cmd::rig::run(args),

@@ -78,7 +78,7 @@ pub struct CorrelateArgs {
     pub png: bool,
 }
 
-fn parse_roi(text: &str) -> Result<Roi, String> {
+pub(crate) fn parse_roi(text: &str) -> Result<Roi, String> {
     let values: Vec<usize> = text
         .split(',')
         .map(|v| v.trim().parse::<usize>())

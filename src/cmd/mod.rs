@@ -1,6 +1,7 @@
 //! The subcommands of `dicstream`, one module each.
 
 pub mod correlate;
+pub mod correlator;
 pub mod identifier;
 pub mod identify;
 pub mod rig;
