@@ -36,6 +36,7 @@ mod real_fft2d;
 pub mod settings;
 pub mod state;
 pub mod strain;
+pub mod timing;
 mod window;
 mod zoi;
 

@@ -1,5 +1,6 @@
 //! The subcommands of `dicstream`, one module each.
 
+pub mod bench;
 pub mod correlate;
 pub mod correlator;
 pub mod identifier;
