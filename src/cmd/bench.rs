@@ -98,7 +98,7 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    if args.threads.is_empty() || args.threads.iter().any(|&t| t == 0) {
+    if args.threads.is_empty() || args.threads.contains(&0) {
         bail!("--threads: expected positive thread counts, e.g. 1,2");
     }
     let (w, h) = (args.width, args.height);
