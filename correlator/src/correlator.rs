@@ -35,7 +35,8 @@ pub struct Correlator {
     has_reference: bool,
     ref_nodes: Vec<RefNode>,
     plain_spectra: Vec<Complex32>,
-    windowed_spectra: Vec<Complex32>,
+    /// Windowed, normalised reference ZOIs (n² per node, spatial).
+    windowed_references: Vec<f32>,
     /// Initial guess per node against the current reference (px).
     guesses: Vec<(f64, f64)>,
     results: Vec<ZoiResult>,
@@ -84,7 +85,7 @@ impl Correlator {
             has_reference: false,
             ref_nodes,
             plain_spectra: vec![zero; nodes * n2],
-            windowed_spectra: vec![zero; nodes * n2],
+            windowed_references: vec![0.0; nodes * settings.zoi_px * settings.zoi_px],
             guesses: vec![(0.0, 0.0); nodes],
             results: vec![ZoiResult::default(); nodes],
             previous: vec![None; nodes],
@@ -231,7 +232,7 @@ impl Correlator {
         self.global.set_reference(image);
         let n2 = spectrum_len(n);
         let plain = SharedSlice::new(&mut self.plain_spectra);
-        let windowed = SharedSlice::new(&mut self.windowed_spectra);
+        let windowed = SharedSlice::new(&mut self.windowed_references);
         let ref_nodes = SharedSlice::new(&mut self.ref_nodes);
         self.pool.run(self.mesh.len(), &|engine, k| {
             // SAFETY: item k touches only node k's slots.
@@ -239,7 +240,8 @@ impl Correlator {
             if r.status != NodeStatus::Ok {
                 return;
             }
-            let (p, w) = unsafe { (plain.slice_mut(k * n2, n2), windowed.slice_mut(k * n2, n2)) };
+            let nn = n * n;
+            let (p, w) = unsafe { (plain.slice_mut(k * n2, n2), windowed.slice_mut(k * nn, nn)) };
             if !engine.prepare_reference(image, r.top_left.0, r.top_left.1, p, w) {
                 r.status = NodeStatus::LowContrast;
                 unsafe { ref_nodes.write(k, r) };
@@ -287,7 +289,7 @@ impl Correlator {
             };
         }
         let plain = &self.plain_spectra;
-        let windowed = &self.windowed_spectra;
+        let windowed = &self.windowed_references;
         let ref_nodes = &self.ref_nodes;
         let guesses = &self.guesses;
         let results = SharedSlice::new(&mut self.results);
@@ -301,7 +303,7 @@ impl Correlator {
             } else {
                 let spectra = ReferenceSpectra {
                     plain: &plain[k * n2..(k + 1) * n2],
-                    windowed: &windowed[k * n2..(k + 1) * n2],
+                    windowed: &windowed[k * n * n..(k + 1) * n * n],
                 };
                 engine.correlate(
                     &spectra,

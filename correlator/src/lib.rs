@@ -34,6 +34,7 @@ mod pool;
 pub mod process;
 mod real_fft2d;
 pub mod settings;
+mod simd;
 pub mod state;
 pub mod strain;
 pub mod timing;

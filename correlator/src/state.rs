@@ -618,7 +618,7 @@ mod tests {
         std::fs::write(state.path(), &bytes).unwrap();
         let error = state.load().unwrap_err().to_string();
         assert!(error.contains("checksum"), "{error}");
-        std::fs::write(state.path(), &bytes[..100]).unwrap();
+        std::fs::write(state.path(), &bytes[..200]).unwrap();
         let error = state.load().unwrap_err().to_string();
         assert!(error.contains("needs"), "{error}");
         // No temporary file is left behind.
