@@ -126,9 +126,10 @@ impl CorrelateArgs {
     }
 }
 
-fn load(path: &Path) -> Result<producer::Image16> {
-    // producer's errors already name the file and what was expected.
-    Ok(producer::read_image(path)?)
+pub(crate) fn load(path: &Path) -> Result<producer::Image16> {
+    // producer's errors already name the file, what was expected and their cause: keep the
+    // message only (as a chain, the cause would be printed twice).
+    producer::read_image(path).map_err(|e| anyhow::Error::msg(e.to_string()))
 }
 
 fn write(path: &Path, bytes: &[u8]) -> Result<()> {

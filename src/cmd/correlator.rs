@@ -90,8 +90,7 @@ pub fn run(args: CorrelatorArgs) -> Result<()> {
     };
     let reference = match &args.reference {
         Some(path) => {
-            // producer's errors name the file and what was expected.
-            let image = producer::read_image(path)?;
+            let image = super::correlate::load(path)?;
             Some(ReferenceImage {
                 width_px: image.width as usize,
                 height_px: image.height as usize,
