@@ -281,11 +281,34 @@ impl Correlator {
         };
         self.field.global_px = global;
         let global_guess = (global.0 as f64, global.1 as f64);
+        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
         for (k, guess) in self.guesses.iter_mut().enumerate() {
             let base = self.ref_nodes[k].base_px;
-            *guess = match (use_previous, self.previous[k]) {
-                (true, Some(p)) => (p.0 - base.0, p.1 - base.1),
-                _ => global_guess,
+            // A node without a previous value (it failed or was outside the image) starts from
+            // its neighbours' previous values: the global (U0, V0) can be far from it (a stretch
+            // about the centre has U0 = 0 while its border moves by pixels) and would make it
+            // correlate the wrong area.
+            let previous = match (use_previous, self.previous[k]) {
+                (false, _) => None,
+                (true, Some(p)) => Some(p),
+                (true, None) => {
+                    let (i, j) = (k % nx, k / nx);
+                    let (mut su, mut sv, mut count) = (0.0, 0.0, 0.0);
+                    for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
+                        for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
+                            if let Some(p) = self.previous[jj * nx + ii] {
+                                su += p.0;
+                                sv += p.1;
+                                count += 1.0;
+                            }
+                        }
+                    }
+                    (count > 0.0).then(|| (su / count, sv / count))
+                }
+            };
+            *guess = match previous {
+                Some(p) => (p.0 - base.0, p.1 - base.1),
+                None => global_guess,
             };
         }
         let plain = &self.plain_spectra;
