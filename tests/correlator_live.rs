@@ -261,7 +261,8 @@ fn a_burst_is_dropped_and_counted_never_queued() {
 
 /// Bad frames over the wire are logged errors, never a crash: a header whose size disagrees
 /// with its payload, an unknown bit depth, an old layout version, another size than the
-/// reference. A flat frame gives a field of low-contrast nodes, no NaN.
+/// reference. A flat first frame is not taken as the reference; a flat frame later gives a
+/// field of low-contrast nodes, no NaN.
 #[test]
 fn bad_frames_are_logged_and_skipped() {
     let mut bench = Bench::new("bad_input", W * H);
@@ -269,43 +270,48 @@ fn bad_frames_are_logged_and_skipped() {
     bench.proc(p).wait_line("correlator: ready");
     let (still, truth0) = translation(0.0, 0.0);
     let reference = render(W, H, &still, 7);
+    let flat = vec![1000u16; W * H];
+
+    // 0. A flat first frame (lens cap on) is not taken as the reference.
+    bench.send_frame(Bench::header(100, W, H, &flat, None), &flat);
+    let line = bench.proc(p).wait_line("frame 100 rejected");
+    assert!(line.contains("flat"), "{line}");
 
     // 1. Header says 256 x 257, the payload holds 256 x 256.
-    let mut lying = Bench::header(0, W, H, &reference, Some(truth0));
+    let mut lying = Bench::header(101, W, H, &reference, Some(truth0));
     lying.height_px = H as u32 + 1;
     bench.send_frame(lying, &reference);
-    let line = bench.proc(p).wait_line("frame 0 rejected");
+    let line = bench.proc(p).wait_line("frame 101 rejected");
     assert!(line.contains("payload holds 65536"), "{line}");
     // 2. Bit depth 9.
-    let mut odd = Bench::header(1, W, H, &reference, Some(truth0));
+    let mut odd = Bench::header(102, W, H, &reference, Some(truth0));
     odd.bit_depth = 9;
     bench.send_frame(odd, &reference);
-    let line = bench.proc(p).wait_line("frame 1 rejected");
+    let line = bench.proc(p).wait_line("frame 102 rejected");
     assert!(line.contains("bit depth 9"), "{line}");
     // 3. Another layout version.
-    let mut old = Bench::header(2, W, H, &reference, Some(truth0));
+    let mut old = Bench::header(103, W, H, &reference, Some(truth0));
     old.layout_version = 0;
     bench.send_frame(old, &reference);
-    bench.proc(p).wait_line("frame 2 rejected");
+    bench.proc(p).wait_line("frame 103 rejected");
     // 4. A good frame: the reference.
-    let header = Bench::header(3, W, H, &reference, Some(truth0));
+    let header = Bench::header(104, W, H, &reference, Some(truth0));
     bench.send_frame(header, &reference);
     let field = bench.next_field();
-    assert_eq!(field.header.frame_id, 3);
-    assert_eq!(field.header.reference_frame_id, 3);
+    assert_eq!(field.header.frame_id, 104);
+    assert_eq!(field.header.reference_frame_id, 104);
     // 5. A consistent frame of another size.
     let small = render(128, 128, &still, 8);
-    bench.send_frame(Bench::header(4, 128, 128, &small, None), &small);
-    let line = bench.proc(p).wait_line("frame 4 rejected");
+    bench.send_frame(Bench::header(105, 128, 128, &small, None), &small);
+    let line = bench.proc(p).wait_line("frame 105 rejected");
     assert!(
         line.contains("128x128 px but the reference is 256x256 px"),
         "{line}"
     );
     // 6. A flat frame: every node low contrast, nothing NaN.
-    let flat = vec![1000u16; W * H];
-    bench.send_frame(Bench::header(5, W, H, &flat, None), &flat);
+    bench.send_frame(Bench::header(106, W, H, &flat, None), &flat);
     let field = bench.next_field();
-    assert_eq!(field.header.frame_id, 5);
+    assert_eq!(field.header.frame_id, 106);
     assert_eq!(field.header.valid_nodes, 0);
     assert!(field
         .nodes
@@ -326,16 +332,30 @@ fn bad_frames_are_logged_and_skipped() {
     // 7. The process is still measuring.
     let (moved, truth) = translation(0.4, -0.3);
     let pixels = render(W, H, &moved, 9);
-    bench.send_frame(Bench::header(6, W, H, &pixels, Some(truth)), &pixels);
+    bench.send_frame(Bench::header(107, W, H, &pixels, Some(truth)), &pixels);
     let field = bench.next_field();
-    assert_eq!(field.header.frame_id, 6);
+    assert_eq!(field.header.frame_id, 107);
     let [(mu, _), (mv, _)] = field.error_stats(&truth);
     assert!(mu.abs() < 0.01 && mv.abs() < 0.01);
     let proc = bench.proc(p);
     proc.signal("TERM");
     assert!(proc.wait_exit().success());
     let last = proc.final_line();
-    assert_eq!(number_after(&last, "rejected"), 4, "{last}");
+    assert_eq!(number_after(&last, "rejected"), 5, "{last}");
     assert_eq!(number_after(&last, "correlated"), 3, "{last}");
+    bench.finish();
+}
+
+/// --idle-timeout-s: the process stops by itself when no frame comes, with status 0.
+#[test]
+fn idle_timeout_ends_the_process() {
+    let mut bench = Bench::new("idle", W * H);
+    let p = bench.spawn_correlator(&["--idle-timeout-s", "0.5"]);
+    let proc = bench.proc(p);
+    proc.wait_line("correlator: ready");
+    assert!(proc.wait_exit().success());
+    let last = proc.final_line();
+    assert!(last.contains("idle timeout"), "{last}");
+    assert_eq!(number_after(&last, "frames in"), 0, "{last}");
     bench.finish();
 }

@@ -160,6 +160,18 @@ impl Correlator {
             .then_some(self.reference_pixels.as_slice())
     }
 
+    /// Nodes of the current reference that have enough texture to be correlated (0 for a flat
+    /// image, or before the first reference).
+    pub fn reference_textured_nodes(&self) -> usize {
+        if !self.has_reference {
+            return 0;
+        }
+        self.ref_nodes
+            .iter()
+            .filter(|r| r.status == NodeStatus::Ok)
+            .count()
+    }
+
     /// Total displacement (px) of every node, row-major, when the current reference was taken:
     /// zero for a reference given to `set_reference`, the accumulated field after an
     /// incremental or automatic reference update. With [`Correlator::reference_pixels`] this is

@@ -368,6 +368,13 @@ impl Live {
                 },
             )?;
         correlator.set_reference(&image.pixels)?;
+        if correlator.reference_textured_nodes() == 0 {
+            return Err(format!(
+                "reference image {} is flat: no ZOI has texture to correlate",
+                image.label
+            )
+            .into());
+        }
         let (nx, ny) = correlator.mesh_size();
         self.open_publisher(node, nx * ny)?;
         self.correlator = Some(correlator);
@@ -413,20 +420,12 @@ impl Live {
         }
         let (w, h) = (header.width_px as usize, header.height_px as usize);
         let mut new_reference = false;
-        match &self.correlator {
-            None => match Correlator::new(self.settings.clone(), w, h) {
-                Ok(mut correlator) => {
-                    correlator.set_reference(pixels)?;
-                    let (nx, ny) = correlator.mesh_size();
-                    self.open_publisher(node, nx * ny)?;
-                    self.correlator = Some(correlator);
-                    self.reference_frame_id = Some(header.frame_id);
-                    new_reference = true;
-                    eprintln!(
-                        "correlator: frame {} ({w}x{h} px, {} bit) is the reference; mesh {nx}x{ny} nodes",
-                        header.frame_id, header.bit_depth
-                    );
-                }
+        // No correlator yet, or one made for a flat first frame of another size.
+        let fits = |c: &Correlator| c.image_size() == (w, h);
+        if self.reference_frame_id.is_none() && !self.correlator.as_ref().is_some_and(fits) {
+            self.correlator = None;
+            match Correlator::new(self.settings.clone(), w, h) {
+                Ok(correlator) => self.correlator = Some(correlator),
                 Err(e) => {
                     self.reject(
                         header.frame_id,
@@ -434,7 +433,33 @@ impl Live {
                     );
                     return Ok(());
                 }
-            },
+            }
+        }
+        match &mut self.correlator {
+            // The first frame of the right size becomes the reference, unless it is flat
+            // (lens cap, lights off): then every later field would be invalid.
+            Some(correlator)
+                if self.reference_frame_id.is_none() && correlator.image_size() == (w, h) =>
+            {
+                correlator.set_reference(pixels)?;
+                if correlator.reference_textured_nodes() == 0 {
+                    self.reject(
+                        header.frame_id,
+                        &"it is flat (no ZOI has texture): not taken as the reference; waiting for a textured frame",
+                    );
+                    return Ok(());
+                }
+                let (nx, ny) = correlator.mesh_size();
+                if self.publisher.is_none() {
+                    self.open_publisher(node, nx * ny)?;
+                }
+                self.reference_frame_id = Some(header.frame_id);
+                new_reference = true;
+                eprintln!(
+                    "correlator: frame {} ({w}x{h} px, {} bit) is the reference; mesh {nx}x{ny} nodes",
+                    header.frame_id, header.bit_depth
+                );
+            }
             Some(correlator) if correlator.image_size() != (w, h) => {
                 let (rw, rh) = correlator.image_size();
                 self.reject(
@@ -445,7 +470,7 @@ impl Live {
                 );
                 return Ok(());
             }
-            Some(_) => {}
+            _ => {}
         }
         let correlator = self.correlator.as_mut().expect("made above");
         let reference_frame_id = self.reference_frame_id.expect("set with the correlator");
