@@ -49,6 +49,20 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
+/// Removes the instance's shared-memory files and the state folder, even when the test fails.
+struct Cleanup {
+    instance: Instance,
+    state_dir: std::path::PathBuf,
+}
+
+impl Drop for Cleanup {
+    fn drop(&mut self) {
+        self.instance.cleanup_dead_nodes();
+        self.instance.remove_leftover_files();
+        let _ = std::fs::remove_dir_all(&self.state_dir);
+    }
+}
+
 const W: usize = 128;
 const FRAMES: u64 = 14;
 /// Fields received before counting starts (publisher, caches and histograms warmed up).
@@ -63,6 +77,10 @@ fn steady_state_allocations(
     let instance = Instance::new(&name).unwrap();
     let state_dir = std::env::temp_dir().join(format!("{name}_state"));
     let _ = std::fs::remove_dir_all(&state_dir);
+    let cleanup = Cleanup {
+        instance: Instance::new(&name).unwrap(),
+        state_dir: state_dir.clone(),
+    };
     let mut config = ProcessConfig::new(
         &name,
         CorrelatorSettings {
@@ -151,8 +169,9 @@ fn steady_state_allocations(
     if with_state {
         assert!(summary.state_saves >= FRAMES - 1, "{summary:?}");
     }
-    instance.remove_leftover_files();
-    let _ = std::fs::remove_dir_all(&state_dir);
+    drop(cleanup);
+    let left = instance.leftover_files();
+    assert!(left.is_empty(), "left in shared memory: {left:?}");
     let frames_counted = FRAMES - 1 - WARM_UP;
     (after - before, frames_counted)
 }
