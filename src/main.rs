@@ -15,8 +15,12 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     // One variant per subcommand; keep one line each so parallel edits stay simple.
+    /// Speed benchmarks a user can reproduce (`bench correlate`).
+    Bench(cmd::bench::BenchArgs),
     /// Offline correlation of image files: fields (CSV, VTK, PNG) and summary.json.
     Correlate(cmd::correlate::CorrelateArgs),
+    /// Live correlation process: frames in, fields out (zero-copy); resumes from --state-dir.
+    Correlator(cmd::correlator::CorrelatorArgs),
     /// Fit hyperelastic potentials to uniaxial/equibiaxial/pure-shear CSV data (offline).
     Identify(cmd::identify::IdentifyArgs),
     /// Live identification process: fields + rig/state in, identification reports out.
@@ -37,7 +41,9 @@ fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result: anyhow::Result<()> = match cli.command {
         // One arm per subcommand.
+        Command::Bench(args) => cmd::bench::run(args),
         Command::Correlate(args) => cmd::correlate::run(args),
+        Command::Correlator(args) => cmd::correlator::run(args),
         Command::Identify(args) => cmd::identify::run(args),
         Command::Identifier(args) => cmd::identifier::run(args),
         Command::Producer(args) => cmd::producer::run(args),

@@ -2,6 +2,9 @@
 //! reference, a 0.37 / -0.21 px translation, 1 and 2 threads. Reports the median of several
 //! frames in ZOIs/s and frames/s, then the time split (FFT, window, peak, shift) measured on
 //! separate profiled frames (profiling reads the clock in the hot loop, so it is off for timing).
+//! FFT: the integer step's transforms; peak: the 3x3 windowed correlation values (direct sums)
+//! and the quadratic fit; shift: the Fourier shift (phase ramp and inverse transform).
+//! `dicstream bench correlate` measures the same and adds a plain 2-D FFT timing and --json.
 
 use correlator::{Correlator, CorrelatorSettings, GuessMode};
 use producer::motion::Affine;

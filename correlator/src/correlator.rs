@@ -35,7 +35,8 @@ pub struct Correlator {
     has_reference: bool,
     ref_nodes: Vec<RefNode>,
     plain_spectra: Vec<Complex32>,
-    windowed_spectra: Vec<Complex32>,
+    /// Windowed, normalised reference ZOIs (n² per node, spatial).
+    windowed_references: Vec<f32>,
     /// Initial guess per node against the current reference (px).
     guesses: Vec<(f64, f64)>,
     results: Vec<ZoiResult>,
@@ -84,7 +85,7 @@ impl Correlator {
             has_reference: false,
             ref_nodes,
             plain_spectra: vec![zero; nodes * n2],
-            windowed_spectra: vec![zero; nodes * n2],
+            windowed_references: vec![0.0; nodes * settings.zoi_px * settings.zoi_px],
             guesses: vec![(0.0, 0.0); nodes],
             results: vec![ZoiResult::default(); nodes],
             previous: vec![None; nodes],
@@ -148,6 +149,73 @@ impl Correlator {
         Ok(())
     }
 
+    /// Image size this correlator was made for (width, height) in px.
+    pub fn image_size(&self) -> (usize, usize) {
+        (self.width_px, self.height_px)
+    }
+
+    /// The current reference image (row-major), or None before the first reference.
+    pub fn reference_pixels(&self) -> Option<&[u16]> {
+        self.has_reference
+            .then_some(self.reference_pixels.as_slice())
+    }
+
+    /// Nodes of the current reference that have enough texture to be correlated (0 for a flat
+    /// image, or before the first reference).
+    pub fn reference_textured_nodes(&self) -> usize {
+        if !self.has_reference {
+            return 0;
+        }
+        self.ref_nodes
+            .iter()
+            .filter(|r| r.status == NodeStatus::Ok)
+            .count()
+    }
+
+    /// Total displacement (px) of every node, row-major, when the current reference was taken:
+    /// zero for a reference given to `set_reference`, the accumulated field after an
+    /// incremental or automatic reference update. With [`Correlator::reference_pixels`] this is
+    /// everything [`Correlator::restore_reference`] needs to resume measuring the same total
+    /// displacement in another process.
+    pub fn reference_base_px(&self) -> impl ExactSizeIterator<Item = (f64, f64)> + '_ {
+        self.ref_nodes.iter().map(|r| r.base_px)
+    }
+
+    /// Resumes against a saved reference: its pixels and the per-node base displacements read
+    /// from [`Correlator::reference_base_px`] (one pair per node, row-major). Afterwards the
+    /// correlator is in the state it was right after that reference was taken, except that the
+    /// previous frame's field is unknown (the predictor grows from the centre once).
+    pub fn restore_reference(
+        &mut self,
+        pixels: &[u16],
+        base_px: &[(f64, f64)],
+    ) -> Result<(), SettingsError> {
+        self.check_size("reference", pixels)?;
+        if base_px.len() != self.ref_nodes.len() {
+            return Err(SettingsError::BaseLength {
+                got: base_px.len(),
+                expected: self.ref_nodes.len(),
+            });
+        }
+        if let Some(k) = base_px
+            .iter()
+            .position(|b| !(b.0.is_finite() && b.1.is_finite()))
+        {
+            return Err(SettingsError::BaseNotFinite { node: k });
+        }
+        for ((k, r), &base) in self.ref_nodes.iter_mut().enumerate().zip(base_px) {
+            *r = RefNode {
+                top_left: self.mesh.top_left[k],
+                base_px: base,
+                ..RefNode::default()
+            };
+        }
+        self.previous.fill(None);
+        self.has_previous = false;
+        self.take_reference(pixels);
+        Ok(())
+    }
+
     /// Copies the pixels as the current reference and prepares the spectra of every node at its
     /// followed position (`ref_nodes[k].base_px` must be set).
     fn take_reference(&mut self, pixels: &[u16]) {
@@ -176,7 +244,7 @@ impl Correlator {
         self.global.set_reference(image);
         let n2 = spectrum_len(n);
         let plain = SharedSlice::new(&mut self.plain_spectra);
-        let windowed = SharedSlice::new(&mut self.windowed_spectra);
+        let windowed = SharedSlice::new(&mut self.windowed_references);
         let ref_nodes = SharedSlice::new(&mut self.ref_nodes);
         self.pool.run(self.mesh.len(), &|engine, k| {
             // SAFETY: item k touches only node k's slots.
@@ -184,7 +252,8 @@ impl Correlator {
             if r.status != NodeStatus::Ok {
                 return;
             }
-            let (p, w) = unsafe { (plain.slice_mut(k * n2, n2), windowed.slice_mut(k * n2, n2)) };
+            let nn = n * n;
+            let (p, w) = unsafe { (plain.slice_mut(k * n2, n2), windowed.slice_mut(k * nn, nn)) };
             if !engine.prepare_reference(image, r.top_left.0, r.top_left.1, p, w) {
                 r.status = NodeStatus::LowContrast;
                 unsafe { ref_nodes.write(k, r) };
@@ -224,15 +293,38 @@ impl Correlator {
         };
         self.field.global_px = global;
         let global_guess = (global.0 as f64, global.1 as f64);
+        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
         for (k, guess) in self.guesses.iter_mut().enumerate() {
             let base = self.ref_nodes[k].base_px;
-            *guess = match (use_previous, self.previous[k]) {
-                (true, Some(p)) => (p.0 - base.0, p.1 - base.1),
-                _ => global_guess,
+            // A node without a previous value (it failed or was outside the image) starts from
+            // its neighbours' previous values: the global (U0, V0) can be far from it (a stretch
+            // about the centre has U0 = 0 while its border moves by pixels) and would make it
+            // correlate the wrong area.
+            let previous = match (use_previous, self.previous[k]) {
+                (false, _) => None,
+                (true, Some(p)) => Some(p),
+                (true, None) => {
+                    let (i, j) = (k % nx, k / nx);
+                    let (mut su, mut sv, mut count) = (0.0, 0.0, 0.0);
+                    for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
+                        for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
+                            if let Some(p) = self.previous[jj * nx + ii] {
+                                su += p.0;
+                                sv += p.1;
+                                count += 1.0;
+                            }
+                        }
+                    }
+                    (count > 0.0).then(|| (su / count, sv / count))
+                }
+            };
+            *guess = match previous {
+                Some(p) => (p.0 - base.0, p.1 - base.1),
+                None => global_guess,
             };
         }
         let plain = &self.plain_spectra;
-        let windowed = &self.windowed_spectra;
+        let windowed = &self.windowed_references;
         let ref_nodes = &self.ref_nodes;
         let guesses = &self.guesses;
         let results = SharedSlice::new(&mut self.results);
@@ -246,7 +338,7 @@ impl Correlator {
             } else {
                 let spectra = ReferenceSpectra {
                     plain: &plain[k * n2..(k + 1) * n2],
-                    windowed: &windowed[k * n2..(k + 1) * n2],
+                    windowed: &windowed[k * n * n..(k + 1) * n * n],
                 };
                 engine.correlate(
                     &spectra,

@@ -57,16 +57,6 @@ impl Fft2d {
     }
 }
 
-/// Signed frequency of DFT bin k (Nyquist bin counted as +n/2).
-#[inline]
-pub fn signed_frequency(k: usize, n: usize) -> f32 {
-    if k <= n / 2 {
-        k as f32
-    } else {
-        k as f32 - n as f32
-    }
-}
-
 fn transpose(src: &[Complex32], dst: &mut [Complex32], n: usize) {
     const BLOCK: usize = 8;
     for by in (0..n).step_by(BLOCK) {

@@ -19,6 +19,10 @@
 //!
 //! No allocation per ZOI or per frame after `Correlator::new` (the first `set_reference` fills
 //! preallocated caches); worker threads are spawned once and own their FFT plans and buffers.
+//!
+//! The live process shell is [`process`] (the only module that knows iceoryx2: `frames` in,
+//! `fields` out); [`state`] saves and restores the reference so that a restarted process
+//! resumes measuring the same total displacement.
 
 mod correlator;
 mod fft2d;
@@ -28,9 +32,13 @@ mod mesh;
 pub mod output;
 mod peak;
 mod pool;
+pub mod process;
 mod real_fft2d;
 pub mod settings;
+mod simd;
+pub mod state;
 pub mod strain;
+pub mod timing;
 mod window;
 mod zoi;
 

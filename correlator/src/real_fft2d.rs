@@ -60,16 +60,16 @@ impl RealFft2d {
         }
         self.forward
             .process_with_scratch(&mut self.rows, &mut self.scratch);
-        for (p, pair) in self.rows.chunks_exact(n).enumerate() {
-            let (ya, yb) = (2 * p, 2 * p + 1);
-            for k in 0..=n / 2 {
+        // Separate the two rows of each pair, column kx at a time: the writes run along
+        // spectrum[kx * n..] (rows 2p, 2p + 1 side by side), the reads are two per pair.
+        for (k, column) in spectrum.chunks_exact_mut(n).enumerate() {
+            let kc = (n - k) & (n - 1);
+            for (ab, pair) in column.chunks_exact_mut(2).zip(self.rows.chunks_exact(n)) {
                 let z = pair[k];
-                let zc = pair[(n - k) % n].conj();
-                let a = (z + zc) * 0.5;
+                let zc = pair[kc].conj();
                 let d = (z - zc) * 0.5;
-                let b = Complex32::new(d.im, -d.re); // d / j
-                spectrum[k * n + ya] = a;
-                spectrum[k * n + yb] = b;
+                ab[0] = (z + zc) * 0.5;
+                ab[1] = Complex32::new(d.im, -d.re); // d / j
             }
         }
         self.forward
@@ -85,23 +85,20 @@ impl RealFft2d {
         assert_eq!(spectrum.len(), self.spectrum_len());
         self.inverse
             .process_with_scratch(spectrum, &mut self.scratch);
-        // spectrum is now [kx][y]: half spectra of the rows y along x.
-        for (p, pair) in self.rows.chunks_exact_mut(n).enumerate() {
-            let (ya, yb) = (2 * p, 2 * p + 1);
-            for k in 0..n {
-                let (a, b) = if k <= n / 2 {
-                    let (mut a, mut b) = (spectrum[k * n + ya], spectrum[k * n + yb]);
-                    if k == 0 || k == n / 2 {
-                        a.im = 0.0;
-                        b.im = 0.0;
-                    }
-                    (a, b)
+        // spectrum is now [kx][y]: half spectra of the rows y along x. Pack rows 2p, 2p + 1
+        // as a + j b, column kx at a time (reads along spectrum[kx * n..]); the columns
+        // n - kx are the conjugates. Columns 0 and n/2 keep only their real parts' symmetry.
+        let half = n / 2;
+        for (k, column) in spectrum.chunks_exact(n).enumerate() {
+            let edge = k == 0 || k == half;
+            for (ab, pair) in column.chunks_exact(2).zip(self.rows.chunks_exact_mut(n)) {
+                let (mut a, mut b) = (ab[0], ab[1]);
+                if edge {
+                    a.im = 0.0;
+                    b.im = 0.0;
                 } else {
-                    (
-                        spectrum[(n - k) * n + ya].conj(),
-                        spectrum[(n - k) * n + yb].conj(),
-                    )
-                };
+                    pair[n - k] = Complex32::new(a.re + b.im, b.re - a.im); // conj(a) + j conj(b)
+                }
                 pair[k] = Complex32::new(a.re - b.im, a.im + b.re); // a + j b
             }
         }

@@ -151,6 +151,10 @@ pub enum SettingsError {
     },
     #[error("correlate called before set_reference")]
     NoReference,
+    #[error("saved reference has {got} node displacements, expected {expected} (one per node of this mesh): it was written with other settings or another image size")]
+    BaseLength { got: usize, expected: usize },
+    #[error("saved reference displacement of node {node} is not finite")]
+    BaseNotFinite { node: usize },
     #[error("auto reference thresholds invalid: expected 0 < displacement fraction <= 0.5 and 0 <= score < 1")]
     AutoThresholds,
 }

@@ -2,11 +2,16 @@
 //! modified-Hanning windowed correlation, 3x3 quadratic sub-pixel peak and Fourier-shift
 //! iterations while the interpolated maximum increases. A `ZoiEngine` owns its FFT plans and
 //! buffers (one per worker thread) and never allocates after `new`.
+//!
+//! The sub-pixel steps need the windowed correlation only at the 3x3 shifts around its peak, not
+//! the whole map: those values are computed directly as circular dot products of the windowed
+//! ZOIs in space, c(d) = Σ_x g_w(x + d) f_w(x), which is exactly what the inverse FFT of
+//! G_w conj(F_w) gives at d, without the forward and inverse transforms.
 
-use crate::fft2d::signed_frequency;
 use crate::field::NodeStatus;
 use crate::peak::quadratic_peak_3x3;
 use crate::real_fft2d::RealFft2d;
+use crate::simd::{dot, F32x4};
 use crate::window::modified_hanning_2d;
 use rustfft::num_complex::Complex32;
 
@@ -39,8 +44,8 @@ impl Image<'_> {
 pub struct ReferenceSpectra<'a> {
     /// Zero-mean, unit-norm, unwindowed ZOI spectrum (integer step).
     pub plain: &'a [Complex32],
-    /// Window-weighted zero-mean, windowed, unit-norm spectrum (sub-pixel step).
-    pub windowed: &'a [Complex32],
+    /// Window-weighted zero-mean, windowed, unit-norm ZOI, row-major n x n (sub-pixel step).
+    pub windowed: &'a [f32],
 }
 
 /// Result of one ZOI: displacement of the ZOI centre (px) against its reference position.
@@ -55,6 +60,9 @@ pub struct ZoiResult {
 
 /// Accumulated time split of the engine's work (ns), for the benchmark. Counting is off
 /// unless `profile` is set, so the hot loop reads no clock by default.
+/// `fft_ns`: the integer step's transforms; `window_ns`: windowing and normalisation;
+/// `peak_ns`: the 3x3 windowed correlation values (direct sums) and the quadratic fit;
+/// `shift_ns`: the Fourier shift (phase ramp and inverse transform); `other_ns`: extraction.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TimeSplit {
     pub fft_ns: u64,
@@ -67,6 +75,40 @@ pub struct TimeSplit {
 /// Length of the cached half spectrum of one ZOI of side n.
 pub fn spectrum_len(n: usize) -> usize {
     (n / 2 + 1) * n
+}
+
+/// Widest shift (px) at which the windowed correlation is evaluated around zero: the 3x3
+/// neighbourhood of a maximum found within ±1 px.
+const PAD: usize = 2;
+
+/// Three 4-lane dot products sharing one operand: a_j += Σ_c g_j[c] · f[c] (lane-wise).
+struct Mac3 {
+    lanes: [F32x4; 3],
+}
+
+impl Mac3 {
+    fn new() -> Self {
+        Mac3 {
+            lanes: [F32x4::zero(); 3],
+        }
+    }
+
+    #[inline]
+    fn add_row(&mut self, f: &[[f32; 4]], g: [&[[f32; 4]]; 3]) {
+        assert!(g.iter().all(|gj| gj.len() == f.len()));
+        let [mut a0, mut a1, mut a2] = self.lanes;
+        for (((fc, c0), c1), c2) in f.iter().zip(g[0]).zip(g[1]).zip(g[2]) {
+            let fv = F32x4::load(fc);
+            a0 = a0.mul_add(F32x4::load(c0), fv);
+            a1 = a1.mul_add(F32x4::load(c1), fv);
+            a2 = a2.mul_add(F32x4::load(c2), fv);
+        }
+        self.lanes = [a0, a1, a2];
+    }
+
+    fn sums(&self) -> [f32; 3] {
+        self.lanes.map(F32x4::sum)
+    }
 }
 
 pub struct ZoiEngine {
@@ -82,6 +124,9 @@ pub struct ZoiEngine {
     work: Vec<Complex32>,
     /// Windowed (or normalised) ZOI, real.
     windowed: Vec<f32>,
+    /// The windowed ZOI with each row extended by PAD wrapped values on both sides, row
+    /// stride n + 2 PAD: a circular shift by |dx| <= PAD is then a contiguous slice.
+    extended: Vec<f32>,
     /// Correlation map, real, row-major, unnormalised (times n²).
     corr: Vec<f32>,
     phase_x: Vec<Complex32>,
@@ -121,6 +166,7 @@ impl ZoiEngine {
             g_spectrum: vec![zero; spectrum_len(n)],
             work: vec![zero; spectrum_len(n)],
             windowed: vec![0.0; n * n],
+            extended: vec![0.0; n * (n + 2 * PAD)],
             corr: vec![0.0; n * n],
             phase_x: vec![zero; n],
             phase_y: vec![zero; n],
@@ -137,16 +183,16 @@ impl ZoiEngine {
         x0: usize,
         y0: usize,
         plain: &mut [Complex32],
-        windowed: &mut [Complex32],
+        windowed: &mut [f32],
     ) -> bool {
         let n = self.n;
         assert!(image.contains_block(x0 as i64, y0 as i64, n));
         assert_eq!(plain.len(), spectrum_len(n));
-        assert_eq!(windowed.len(), spectrum_len(n));
+        assert_eq!(windowed.len(), n * n);
         let contrast_ok = self.extract_zero_mean(image, x0, y0);
         if !contrast_ok {
             plain.fill(Complex32::new(0.0, 0.0));
-            windowed.fill(Complex32::new(0.0, 0.0));
+            windowed.fill(0.0);
             return false;
         }
         let norm = self.g_spatial.iter().map(|&g| g * g).sum::<f32>().sqrt();
@@ -154,63 +200,76 @@ impl ZoiEngine {
             *p = g / norm;
         }
         self.fft.forward(&self.windowed, plain);
-        let mut real = std::mem::take(&mut self.windowed);
-        let ok = self.window_into(&mut real).is_some();
-        if ok {
-            self.fft.forward(&real, windowed);
+        let ok = self.window_into(windowed).is_some();
+        if !ok {
+            windowed.fill(0.0);
         }
-        self.windowed = real;
         ok
     }
 
     /// Copies the n x n block at (x0, y0) into `g_spatial` minus its mean; false if flat.
     fn extract_zero_mean(&mut self, image: Image, x0: usize, y0: usize) -> bool {
         let n = self.n;
-        let mut sum = 0.0f64;
+        // Exact integer sum of the u16 pixels (n² <= 65536 values: fits in u64 with room).
+        let mut sum = 0u64;
         for row in 0..n {
             let start = (y0 + row) * image.width_px + x0;
             let src = &image.pixels[start..start + n];
             let dst = &mut self.g_spatial[row * n..(row + 1) * n];
+            let mut row_sum = 0u32;
             for (d, &s) in dst.iter_mut().zip(src) {
                 *d = s as f32;
-                sum += s as f64;
+                row_sum += s as u32;
             }
+            sum += row_sum as u64;
         }
-        let mean = (sum / (n * n) as f64) as f32;
-        let mut sum_sq = 0.0f32;
-        for g in self.g_spatial.iter_mut() {
-            *g -= mean;
-            sum_sq += *g * *g;
+        let mean = F32x4::splat((sum as f64 / (n * n) as f64) as f32);
+        let mut sum_sq = F32x4::zero();
+        for chunk in self.g_spatial.as_chunks_mut::<4>().0 {
+            let g = F32x4::load(chunk).sub(mean);
+            g.store(chunk);
+            sum_sq = sum_sq.mul_add(g, g);
         }
-        let std = (sum_sq / (n * n) as f32).sqrt();
+        let std = (sum_sq.sum() / (n * n) as f32).sqrt();
         std >= MIN_STD_COUNTS
     }
 
-    /// Writes w (g - weighted mean) / norm into `out` (real parts); returns the norm before
+    /// Writes w (g - weighted mean) into `out`, row y at `out[offset + y * stride..][..n]`;
+    /// returns the norm of what it wrote, or None when the windowed ZOI is flat.
+    fn window_rows(&self, out: &mut [f32], stride: usize, offset: usize) -> Option<f32> {
+        let n = self.n;
+        assert!(stride >= n && out.len() >= offset + (n - 1) * stride + n);
+        let mean = F32x4::splat(dot(&self.window, &self.g_spatial) / self.window_sum);
+        let mut sum_sq = F32x4::zero();
+        for (y, (w_row, g_row)) in self
+            .window
+            .chunks_exact(n)
+            .zip(self.g_spatial.chunks_exact(n))
+            .enumerate()
+        {
+            let start = offset + y * stride;
+            let o_row = out[start..start + n].as_chunks_mut::<4>().0;
+            let (w_row, g_row) = (w_row.as_chunks::<4>().0, g_row.as_chunks::<4>().0);
+            for ((o, w), g) in o_row.iter_mut().zip(w_row).zip(g_row) {
+                let v = F32x4::load(w).mul(F32x4::load(g).sub(mean));
+                sum_sq = sum_sq.mul_add(v, v);
+                v.store(o);
+            }
+        }
+        let norm = sum_sq.sum().sqrt();
+        let floor = MIN_STD_COUNTS * self.window_sum.sqrt();
+        (norm.is_finite() && norm >= floor).then_some(norm)
+    }
+
+    /// Writes w (g - weighted mean) / norm into `out` (n x n); returns the norm before
     /// normalisation, or None when the windowed ZOI is flat.
     fn window_into(&self, out: &mut [f32]) -> Option<f32> {
-        let mut weighted = 0.0f32;
-        for (&w, &g) in self.window.iter().zip(&self.g_spatial) {
-            weighted += w * g;
+        let norm = self.window_rows(out, self.n, 0)?;
+        let inv = 1.0 / norm;
+        for o in out.iter_mut() {
+            *o *= inv;
         }
-        let mean = weighted / self.window_sum;
-        let mut sum_sq = 0.0f32;
-        for ((o, &w), &g) in out.iter_mut().zip(&self.window).zip(&self.g_spatial) {
-            let v = w * (g - mean);
-            sum_sq += v * v;
-            *o = v;
-        }
-        let norm = sum_sq.sqrt();
-        let floor = MIN_STD_COUNTS * (self.window_sum).sqrt();
-        if norm.is_finite() && norm >= floor {
-            let inv = 1.0 / norm;
-            for o in out.iter_mut() {
-                *o *= inv;
-            }
-            Some(norm)
-        } else {
-            None
-        }
+        Some(norm)
     }
 
     /// Correlates the deformed image around the reference ZOI at (x0, y0), starting from the
@@ -286,7 +345,6 @@ impl ZoiEngine {
             timer.lap(&mut self.split.fft_ns);
         }
         // Sub-pixel iterations: window, correlate, quadratic peak, Fourier shift.
-        let scale = 1.0 / (n * n) as f32;
         let mut shift = (0.0f64, 0.0f64);
         let mut best_value = f64::NEG_INFINITY;
         let mut best_estimate = (0.0f64, 0.0f64);
@@ -297,22 +355,17 @@ impl ZoiEngine {
                 self.shift_into_spatial(shift);
                 timer.lap(&mut self.split.shift_ns);
             }
-            let mut real = std::mem::take(&mut self.windowed);
-            let windowed = self.window_into(&mut real);
-            self.windowed = real;
+            // Windowed straight into the row-extended layout; the 1/norm goes to the values.
+            let mut extended = std::mem::take(&mut self.extended);
+            let norm = self.window_rows(&mut extended, n + 2 * PAD, PAD);
+            self.extended = extended;
             timer.lap(&mut self.split.window_ns);
-            if windowed.is_none() {
+            let Some(norm) = norm else {
                 result.status = NodeStatus::LowContrast;
                 return result;
-            }
-            self.fft.forward(&self.windowed, &mut self.work);
-            for (w, &f) in self.work.iter_mut().zip(reference.windowed) {
-                *w *= f.conj();
-            }
-            self.fft.inverse(&mut self.work, &mut self.corr);
-            timer.lap(&mut self.split.fft_ns);
-            let (px, py) = self.argmax_near_zero();
-            let neighbourhood = self.neighbourhood(px, py, scale);
+            };
+            self.wrap_rows();
+            let (px, py, neighbourhood) = self.peak_neighbourhood(reference.windowed, 1.0 / norm);
             let (fx, fy, value) = quadratic_peak_3x3(&neighbourhood);
             timer.lap(&mut self.split.peak_ns);
             result.iterations = iteration + 1;
@@ -349,18 +402,26 @@ impl ZoiEngine {
     /// g_spatial = real(IFFT(G · exp(+2πj k·d / n))): the deformed ZOI moved back by d.
     fn shift_into_spatial(&mut self, d: (f64, f64)) {
         let n = self.n;
-        let two_pi_over_n = 2.0 * std::f64::consts::PI / n as f64;
-        for k in 0..n {
-            let f = signed_frequency(k, n) as f64;
-            let (sx, cx) = (two_pi_over_n * f * d.0).sin_cos();
-            let (sy, cy) = (two_pi_over_n * f * d.1).sin_cos();
-            self.phase_x[k] = Complex32::new(cx as f32, sx as f32);
-            self.phase_y[k] = Complex32::new(cy as f32, sy as f32);
-        }
-        // Nyquist bins: +n/2 and -n/2 are the same bin; the symmetric shift factor is their
-        // mean, cos(π d), which keeps the shifted ZOI real without favouring a direction.
-        self.phase_x[n / 2] = Complex32::new((std::f64::consts::PI * d.0).cos() as f32, 0.0);
-        self.phase_y[n / 2] = Complex32::new((std::f64::consts::PI * d.1).cos() as f32, 0.0);
+        // exp(2πj f d / n) for the signed frequencies f: powers of one root computed in f64
+        // (error ~1e-16 per step), negative frequencies as conjugates. The 1/n² of the inverse
+        // transform is folded into the x factors.
+        let scale = 1.0 / (n * n) as f64;
+        let fill = |phase: &mut [Complex32], d: f64, scale: f64| {
+            let (s, c) = (2.0 * std::f64::consts::PI * d / n as f64).sin_cos();
+            let (mut re, mut im) = (scale, 0.0f64);
+            for k in 0..n / 2 {
+                phase[k] = Complex32::new(re as f32, im as f32);
+                if k > 0 {
+                    phase[n - k] = Complex32::new(re as f32, -im as f32);
+                }
+                (re, im) = (re * c - im * s, re * s + im * c);
+            }
+            // Nyquist bin: +n/2 and -n/2 are the same bin; the symmetric shift factor is their
+            // mean, cos(π d), which keeps the shifted ZOI real without favouring a direction.
+            phase[n / 2] = Complex32::new((scale * (std::f64::consts::PI * d).cos()) as f32, 0.0);
+        };
+        fill(&mut self.phase_x, d.0, scale);
+        fill(&mut self.phase_y, d.1, 1.0);
         // Half-spectrum layout: index kx * n + ky, kx in 0..=n/2.
         for kx in 0..=n / 2 {
             let px = self.phase_x[kx];
@@ -371,10 +432,6 @@ impl ZoiEngine {
             }
         }
         self.fft.inverse(&mut self.work, &mut self.g_spatial);
-        let scale = 1.0 / (n * n) as f32;
-        for g in self.g_spatial.iter_mut() {
-            *g *= scale;
-        }
     }
 
     /// Integer location of the maximum of the real correlation map, wrapped to [-n/2, n/2).
@@ -398,38 +455,131 @@ impl ZoiEngine {
         (wrap(best_index % n), wrap(best_index / n))
     }
 
-    /// Integer maximum within ±1 px of zero shift (the integer step put the peak there).
-    fn argmax_near_zero(&self) -> (i64, i64) {
-        let mut best = f32::NEG_INFINITY;
-        let mut at = (0, 0);
-        for dy in -1i64..=1 {
-            for dx in -1i64..=1 {
-                let v = self.corr[self.wrap_index(dx, dy)];
+    /// Fills the PAD wrapped values on both sides of every row of `extended`.
+    fn wrap_rows(&mut self) {
+        let n = self.n;
+        for row in self.extended.chunks_exact_mut(n + 2 * PAD) {
+            row.copy_within(n..n + PAD, 0);
+            row.copy_within(PAD..2 * PAD, PAD + n);
+        }
+    }
+
+    /// The windowed correlation c(dx, dy) = Σ g_w(x + dx, y + dy) f_w(x, y) (circular) at the
+    /// 3x3 shifts around `centre` (|centre| < PAD per axis), `[row = dy][col = dx]`, times
+    /// `scale`. Per dy, one pass over the rows: each 4-value chunk of the reference row meets
+    /// the three shifted chunks of the deformed row.
+    fn correlation_3x3(&self, reference: &[f32], centre: (i64, i64), scale: f32) -> [[f32; 3]; 3] {
+        let n = self.n;
+        let stride = n + 2 * PAD;
+        assert!(centre.0.unsigned_abs() < PAD as u64 && centre.1.unsigned_abs() < PAD as u64);
+        assert!(n.is_multiple_of(4) && reference.len() == n * n);
+        let x0 = (PAD as i64 + centre.0 - 1) as usize;
+        let mut out = [[0.0f32; 3]; 3];
+        for (r, out_row) in out.iter_mut().enumerate() {
+            let dy = centre.1 + r as i64 - 1;
+            let mut acc = Mac3::new();
+            for (y, f_row) in reference.chunks_exact(n).enumerate() {
+                let yy = (y as i64 + dy).rem_euclid(n as i64) as usize;
+                let row = &self.extended[yy * stride..(yy + 1) * stride];
+                acc.add_row(
+                    f_row.as_chunks::<4>().0,
+                    [
+                        row[x0..x0 + n].as_chunks::<4>().0,
+                        row[x0 + 1..x0 + 1 + n].as_chunks::<4>().0,
+                        row[x0 + 2..x0 + 2 + n].as_chunks::<4>().0,
+                    ],
+                );
+            }
+            *out_row = acc.sums().map(|v| v * scale);
+        }
+        out
+    }
+
+    /// The integer maximum of the windowed correlation within ±1 px of zero shift (the integer
+    /// step put the peak there) and the 3x3 values around it, `[row = dy][col = dx]`.
+    fn peak_neighbourhood(&self, reference: &[f32], scale: f32) -> (i64, i64, [[f32; 3]; 3]) {
+        let around_zero = self.correlation_3x3(reference, (0, 0), scale);
+        let (mut best, mut at) = (f32::NEG_INFINITY, (0i64, 0i64));
+        for (row, values) in around_zero.iter().enumerate() {
+            for (col, &v) in values.iter().enumerate() {
                 if v > best {
                     best = v;
-                    at = (dx, dy);
+                    at = (col as i64 - 1, row as i64 - 1);
                 }
             }
         }
-        at
+        if at == (0, 0) {
+            (0, 0, around_zero)
+        } else {
+            (at.0, at.1, self.correlation_3x3(reference, at, scale))
+        }
     }
+}
 
-    #[inline]
-    fn wrap_index(&self, dx: i64, dy: i64) -> usize {
-        let n = self.n as i64;
-        let x = dx.rem_euclid(n) as usize;
-        let y = dy.rem_euclid(n) as usize;
-        y * self.n + x
-    }
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-    fn neighbourhood(&self, px: i64, py: i64, scale: f32) -> [[f32; 3]; 3] {
-        let mut c = [[0.0f32; 3]; 3];
-        for (row, values) in c.iter_mut().enumerate() {
-            for (col, v) in values.iter_mut().enumerate() {
-                let idx = self.wrap_index(px + col as i64 - 1, py + row as i64 - 1);
-                *v = self.corr[idx] * scale;
+    /// The direct 3x3 values are the inverse FFT of G_w conj(F_w) at those shifts, wrapped.
+    #[test]
+    fn direct_correlation_matches_the_fft_map() {
+        let n = 32;
+        let mut engine = ZoiEngine::new(n);
+        let texture = |i: usize, a: f32, b: f32| {
+            1000.0 * ((i % n) as f32 * a).sin() * ((i / n) as f32 * b + 0.3).cos()
+        };
+        let reference: Vec<f32> = (0..n * n).map(|i| texture(i, 0.71, 0.43)).collect();
+        let deformed: Vec<f32> = (0..n * n)
+            .map(|i| texture(i + 1, 0.69, 0.45) + 0.1)
+            .collect();
+        // Windowed reference, as prepare_reference caches it.
+        engine.g_spatial.copy_from_slice(&reference);
+        let mut f = vec![0.0f32; n * n];
+        engine.window_into(&mut f).unwrap();
+        engine.g_spatial.copy_from_slice(&deformed);
+        let mut g = vec![0.0f32; n * n];
+        engine.window_into(&mut g).unwrap();
+        // The correlate path: unnormalised into the extended rows, 1/norm on the values.
+        let mut extended = std::mem::take(&mut engine.extended);
+        let norm = engine.window_rows(&mut extended, n + 2 * PAD, PAD).unwrap();
+        engine.extended = extended;
+        engine.wrap_rows();
+        let scale = 1.0 / norm;
+        // FFT map.
+        let zero = Complex32::new(0.0, 0.0);
+        let (mut gs, mut fs) = (vec![zero; spectrum_len(n)], vec![zero; spectrum_len(n)]);
+        engine.fft.forward(&g, &mut gs);
+        engine.fft.forward(&f, &mut fs);
+        for (a, b) in gs.iter_mut().zip(&fs) {
+            *a *= b.conj();
+        }
+        let mut map = vec![0.0f32; n * n];
+        engine.fft.inverse(&mut gs, &mut map);
+        let at = |dx: i64, dy: i64| {
+            map[dy.rem_euclid(n as i64) as usize * n + dx.rem_euclid(n as i64) as usize]
+                / (n * n) as f32
+        };
+        for cy in -1i64..=1 {
+            for cx in -1i64..=1 {
+                let c = engine.correlation_3x3(&f, (cx, cy), scale);
+                for (row, values) in c.iter().enumerate() {
+                    for (col, v) in values.iter().enumerate() {
+                        let (dx, dy) = (cx + col as i64 - 1, cy + row as i64 - 1);
+                        assert!(
+                            (v - at(dx, dy)).abs() < 1e-5,
+                            "({dx}, {dy}): {v} vs {}",
+                            at(dx, dy)
+                        );
+                    }
+                }
             }
         }
-        c
+        let (px, py, c) = engine.peak_neighbourhood(&f, scale);
+        for (row, values) in c.iter().enumerate() {
+            for (col, v) in values.iter().enumerate() {
+                let (dx, dy) = (px + col as i64 - 1, py + row as i64 - 1);
+                assert!((v - at(dx, dy)).abs() < 1e-5);
+            }
+        }
     }
 }

@@ -74,3 +74,60 @@ fn table1_equibiaxial_seven_percent() {
         "predictor at s = 5: error {predict5}, valid {valid_predict5}"
     );
 }
+
+/// The live predictor: frames of an equibiaxial ramp up to 7 % at s = 5, each ZOI starting from
+/// the previous frame's field, are all tracked against the fixed reference (border nodes whose
+/// content left the image excepted), where the paper's guess fails at 7 %.
+#[test]
+fn live_predictor_tracks_a_seven_percent_ramp_at_s5() {
+    let (w, h) = (512, 512);
+    let centre = [(w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0];
+    let reference = render(w, h, 8.0, stretch(0.0, 0.0, centre), 0.01, 1);
+    let settings = |guess| CorrelatorSettings {
+        zoi_px: 32,
+        step_px: 16,
+        guess,
+        strain: StrainMeasure::Small,
+        ..Default::default()
+    };
+    let mut live = Correlator::new(settings(GuessMode::Predict), w, h).unwrap();
+    live.set_reference(&reference).unwrap();
+    let mut paper = Correlator::new(settings(GuessMode::Correli), w, h).unwrap();
+    paper.set_reference(&reference).unwrap();
+    eprintln!(
+        "stretch  predictor valid/inside  small exx eyy     | paper's guess valid/inside  exx"
+    );
+    for step in 1..=7 {
+        let e = 0.01 * step as f64;
+        let deformed = render(w, h, 8.0, stretch(e, e, centre), 0.01, 10 + step);
+        let summary = |field: &Field| {
+            let inside = field
+                .nodes
+                .iter()
+                .filter(|n| n.status != NodeStatus::OutsideImage)
+                .count();
+            (field.valid, inside, field.gauge.small)
+        };
+        let (valid, inside, g) = summary(live.correlate(&deformed).unwrap());
+        let (paper_valid, paper_inside, pg) = summary(paper.correlate(&deformed).unwrap());
+        eprintln!(
+            "{e:.2}     {valid:4}/{inside:4}            {:+.4} {:+.4}  | {paper_valid:4}/{paper_inside:4}                 {:+.4}",
+            g.exx, g.eyy, pg.exx
+        );
+        assert!(
+            valid as f64 > 0.99 * inside as f64,
+            "stretch {e}: {valid} of {inside}"
+        );
+        assert!(
+            (g.exx - e).abs() < 1e-3 && (g.eyy - e).abs() < 1e-3,
+            "{g:?}"
+        );
+        if step == 7 {
+            let error = (pg.exx - e).abs().max((pg.eyy - e).abs());
+            assert!(
+                error > 5e-3 || (paper_valid as f64) < 0.8 * paper_inside as f64,
+                "the paper's guess should fail at 7 %"
+            );
+        }
+    }
+}

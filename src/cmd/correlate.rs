@@ -77,7 +77,7 @@ pub struct CorrelateArgs {
     pub png: bool,
 }
 
-fn parse_roi(text: &str) -> Result<Roi, String> {
+pub(crate) fn parse_roi(text: &str) -> Result<Roi, String> {
     let values: Vec<usize> = text
         .split(',')
         .map(|v| v.trim().parse::<usize>())
@@ -125,9 +125,10 @@ impl CorrelateArgs {
     }
 }
 
-fn load(path: &Path) -> Result<producer::Image16> {
-    // producer's errors already name the file and what was expected.
-    Ok(producer::read_image(path)?)
+pub(crate) fn load(path: &Path) -> Result<producer::Image16> {
+    // producer's errors already name the file, what was expected and their cause: keep the
+    // message only (as a chain, the cause would be printed twice).
+    producer::read_image(path).map_err(|e| anyhow::Error::msg(e.to_string()))
 }
 
 fn write(path: &Path, bytes: &[u8]) -> Result<()> {

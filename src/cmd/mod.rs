@@ -1,6 +1,8 @@
 //! The subcommands of `dicstream`, one module each.
 
+pub mod bench;
 pub mod correlate;
+pub mod correlator;
 pub mod identifier;
 pub mod identify;
 pub mod producer;

@@ -1,0 +1,633 @@
+//! What a live correlator saves so that a restarted one resumes against the same reference:
+//! one binary file, `reference.state`, written atomically (temporary sibling, then rename)
+//! whenever the reference changes, and a human-readable `state.json` beside it.
+//!
+//! `reference.state`, all little-endian:
+//!
+//! | offset | size | content |
+//! |---|---|---|
+//! | 0 | 8 | magic `DICSREF1` |
+//! | 8 | 4 | format version (1) |
+//! | 12 | 8 | width, height (px, u32 each) |
+//! | 20 | 8 | ZOI, step (px, u32 each) |
+//! | 28 | 16 | ROI x, y, width, height (px, u32 each) |
+//! | 44 | 8 | mesh nx, ny (u32 each) |
+//! | 52 | 20 | reference mode, guess, strain measure, max iterations, strain window (u32 each) |
+//! | 72 | 16 | auto thresholds: displacement fraction, mean score (f64 each; 0 unless auto) |
+//! | 88 | 8 | reference frame id (u64; `u64::MAX` for an image file) |
+//! | 96 | 2 w h | reference pixels, row-major u16 |
+//! | … | 16 nx ny | per-node base displacement u, v (px, f64 each): total displacement when the reference was taken |
+//! | … | 8 | checksum (u64) of every byte before it |
+//!
+//! Encoding reuses one buffer, and opening, writing and renaming short paths does not allocate,
+//! so saving on every frame (incremental mode) keeps the live loop allocation-free. Written
+//! files survive a killed process (the rename is atomic); they are not fsynced, so a power cut
+//! may lose the last reference change.
+
+use crate::settings::{CorrelatorSettings, GuessMode, ReferenceMode, SettingsError, StrainMeasure};
+use crate::Correlator;
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+const MAGIC: &[u8; 8] = b"DICSREF1";
+const FORMAT_VERSION: u32 = 1;
+const HEADER_BYTES: usize = 96;
+/// Name of the binary state file inside the state folder.
+pub const STATE_FILE: &str = "reference.state";
+/// Name of the human-readable summary beside it (informative; never read back).
+pub const SUMMARY_FILE: &str = "state.json";
+/// `reference_frame_id` of a reference that came from an image file, not from a frame.
+pub const REFERENCE_FROM_FILE: u64 = u64::MAX;
+
+/// Why a state folder could not be used.
+#[derive(Debug)]
+pub enum StateError {
+    Io { path: PathBuf, detail: String },
+    Corrupt { path: PathBuf, detail: String },
+    Mismatch { path: PathBuf, detail: String },
+    Settings(SettingsError),
+}
+
+impl std::fmt::Display for StateError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StateError::Io { path, detail } => write!(f, "{}: {detail}", path.display()),
+            StateError::Corrupt { path, detail } => write!(
+                f,
+                "{}: not a usable correlator state ({detail}); remove it to start from a new reference",
+                path.display()
+            ),
+            StateError::Mismatch { path, detail } => write!(
+                f,
+                "{} was written with other settings: {detail}; run with the same settings or another --state-dir",
+                path.display()
+            ),
+            StateError::Settings(e) => write!(f, "saved reference refused: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for StateError {}
+
+/// The settings and size a state file was written for, as stored in its header.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Layout {
+    width_px: u32,
+    height_px: u32,
+    zoi_px: u32,
+    step_px: u32,
+    roi: [u32; 4],
+    mesh: [u32; 2],
+    reference_mode: u32,
+    guess: u32,
+    strain: u32,
+    max_iterations: u32,
+    strain_window_nodes: u32,
+    auto: [f64; 2],
+}
+
+impl Layout {
+    fn of(correlator: &Correlator) -> Layout {
+        let s = correlator.settings();
+        let (w, h) = correlator.image_size();
+        let roi = correlator.roi();
+        let (nx, ny) = correlator.mesh_size();
+        let (reference_mode, auto) = match s.reference {
+            ReferenceMode::Fixed => (0, [0.0, 0.0]),
+            ReferenceMode::Incremental => (1, [0.0, 0.0]),
+            ReferenceMode::Auto {
+                max_displacement_zoi_fraction,
+                min_mean_score,
+            } => (2, [max_displacement_zoi_fraction, min_mean_score]),
+        };
+        Layout {
+            width_px: w as u32,
+            height_px: h as u32,
+            zoi_px: s.zoi_px as u32,
+            step_px: s.step_px as u32,
+            roi: [roi.x_px, roi.y_px, roi.width_px, roi.height_px].map(|v| v as u32),
+            mesh: [nx as u32, ny as u32],
+            reference_mode,
+            guess: match s.guess {
+                GuessMode::Correli => 0,
+                GuessMode::Predict => 1,
+            },
+            strain: match s.strain {
+                StrainMeasure::Small => 0,
+                StrainMeasure::Green => 1,
+                StrainMeasure::Nominal => 2,
+                StrainMeasure::Log => 3,
+            },
+            max_iterations: s.max_iterations,
+            strain_window_nodes: s.strain_window_nodes as u32,
+            auto,
+        }
+    }
+
+    fn nodes(&self) -> usize {
+        self.mesh[0] as usize * self.mesh[1] as usize
+    }
+
+    fn pixels(&self) -> usize {
+        self.width_px as usize * self.height_px as usize
+    }
+
+    fn file_bytes(&self) -> usize {
+        HEADER_BYTES + 2 * self.pixels() + 16 * self.nodes() + 8
+    }
+
+    /// The first difference to `wanted` that makes the state unusable, in words.
+    fn difference(&self, wanted: &Layout) -> Option<String> {
+        let pairs: [(&str, String, String); 9] = [
+            (
+                "ZOI",
+                format!("{} px", self.zoi_px),
+                format!("{} px", wanted.zoi_px),
+            ),
+            (
+                "step",
+                format!("{} px", self.step_px),
+                format!("{} px", wanted.step_px),
+            ),
+            (
+                "ROI",
+                format!("{:?}", self.roi),
+                format!("{:?}", wanted.roi),
+            ),
+            (
+                "reference mode",
+                mode_name(self.reference_mode, self.auto),
+                mode_name(wanted.reference_mode, wanted.auto),
+            ),
+            (
+                "guess",
+                guess_name(self.guess).into(),
+                guess_name(wanted.guess).into(),
+            ),
+            (
+                "strain",
+                strain_name(self.strain).into(),
+                strain_name(wanted.strain).into(),
+            ),
+            (
+                "max iterations",
+                self.max_iterations.to_string(),
+                wanted.max_iterations.to_string(),
+            ),
+            (
+                "strain window",
+                self.strain_window_nodes.to_string(),
+                wanted.strain_window_nodes.to_string(),
+            ),
+            (
+                "mesh",
+                format!("{:?}", self.mesh),
+                format!("{:?}", wanted.mesh),
+            ),
+        ];
+        pairs
+            .into_iter()
+            .find(|(_, a, b)| a != b)
+            .map(|(what, saved, asked)| format!("{what} {saved} there, {asked} now"))
+    }
+}
+
+fn mode_name(code: u32, auto: [f64; 2]) -> String {
+    match code {
+        0 => "fixed".into(),
+        1 => "incremental".into(),
+        2 => format!("auto ({} of the ZOI, score {})", auto[0], auto[1]),
+        other => format!("code {other}"),
+    }
+}
+
+fn guess_name(code: u32) -> &'static str {
+    match code {
+        0 => "correli",
+        1 => "predict",
+        _ => "?",
+    }
+}
+
+fn strain_name(code: u32) -> &'static str {
+    ["small", "green", "nominal", "log"]
+        .get(code as usize)
+        .copied()
+        .unwrap_or("?")
+}
+
+/// A 64-bit multiply-xorshift checksum over 8-byte words (the tail byte-wise).
+fn checksum(bytes: &[u8]) -> u64 {
+    const K: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut hash = 0xCBF2_9CE4_8422_2325 ^ bytes.len() as u64;
+    let mut words = bytes.chunks_exact(8);
+    for word in &mut words {
+        let w = u64::from_le_bytes(word.try_into().expect("8 bytes"));
+        hash = (hash ^ w).wrapping_mul(K);
+        hash ^= hash >> 29;
+    }
+    for &b in words.remainder() {
+        hash = (hash ^ b as u64).wrapping_mul(K);
+        hash ^= hash >> 29;
+    }
+    hash
+}
+
+/// A reference read back from a state folder.
+#[derive(Clone, Debug)]
+pub struct SavedReference {
+    pub width_px: usize,
+    pub height_px: usize,
+    pub reference_frame_id: u64,
+    pub pixels: Vec<u16>,
+    pub base_px: Vec<(f64, f64)>,
+    layout: Layout,
+}
+
+impl SavedReference {
+    /// Makes the correlator for these settings at the saved image size and restores the
+    /// reference. Refuses a state written with other settings (a clear message naming the
+    /// first difference).
+    pub fn restore(
+        &self,
+        settings: CorrelatorSettings,
+        path: &Path,
+    ) -> Result<Correlator, StateError> {
+        let mut correlator = Correlator::new(settings, self.width_px, self.height_px)
+            .map_err(StateError::Settings)?;
+        let wanted = Layout::of(&correlator);
+        if let Some(detail) = self.layout.difference(&wanted) {
+            return Err(StateError::Mismatch {
+                path: path.to_path_buf(),
+                detail,
+            });
+        }
+        correlator
+            .restore_reference(&self.pixels, &self.base_px)
+            .map_err(StateError::Settings)?;
+        Ok(correlator)
+    }
+}
+
+/// A state folder: reads the saved reference, writes new ones atomically.
+pub struct StateDir {
+    dir: PathBuf,
+    path: PathBuf,
+    temp: PathBuf,
+    summary_path: PathBuf,
+    summary_temp: PathBuf,
+    /// Reused encoding buffers (sized on the first save).
+    bytes: Vec<u8>,
+    summary: String,
+    pub saves: u64,
+}
+
+impl StateDir {
+    /// Opens (creating it if needed) the folder.
+    pub fn open(dir: &Path) -> Result<StateDir, StateError> {
+        std::fs::create_dir_all(dir).map_err(|e| StateError::Io {
+            path: dir.to_path_buf(),
+            detail: format!("cannot create the state folder: {e}"),
+        })?;
+        let pid = std::process::id();
+        Ok(StateDir {
+            dir: dir.to_path_buf(),
+            path: dir.join(STATE_FILE),
+            temp: dir.join(format!(".{STATE_FILE}.tmp{pid}")),
+            summary_path: dir.join(SUMMARY_FILE),
+            summary_temp: dir.join(format!(".{SUMMARY_FILE}.tmp{pid}")),
+            bytes: Vec::new(),
+            summary: String::with_capacity(4096),
+            saves: 0,
+        })
+    }
+
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The path of the binary state file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The saved reference, or None when the folder holds none yet.
+    pub fn load(&self) -> Result<Option<SavedReference>, StateError> {
+        let bytes = match std::fs::read(&self.path) {
+            Ok(bytes) => bytes,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => {
+                return Err(StateError::Io {
+                    path: self.path.clone(),
+                    detail: format!("cannot read: {e}"),
+                })
+            }
+        };
+        decode(&bytes)
+            .map(Some)
+            .map_err(|detail| StateError::Corrupt {
+                path: self.path.clone(),
+                detail,
+            })
+    }
+
+    /// Writes the correlator's current reference with its frame id, atomically, then the
+    /// human-readable summary. No allocation after the first call.
+    pub fn save(
+        &mut self,
+        correlator: &Correlator,
+        reference_frame_id: u64,
+    ) -> Result<(), StateError> {
+        let layout = Layout::of(correlator);
+        let pixels = correlator
+            .reference_pixels()
+            .expect("save is called once a reference is set");
+        encode(
+            &layout,
+            reference_frame_id,
+            pixels,
+            correlator.reference_base_px(),
+            &mut self.bytes,
+        );
+        write_atomically(&self.temp, &self.path, &self.bytes)?;
+        self.summary.clear();
+        summary_json(
+            &layout,
+            reference_frame_id,
+            self.saves + 1,
+            &mut self.summary,
+        );
+        write_atomically(
+            &self.summary_temp,
+            &self.summary_path,
+            self.summary.as_bytes(),
+        )?;
+        self.saves += 1;
+        Ok(())
+    }
+}
+
+fn write_atomically(temp: &Path, path: &Path, bytes: &[u8]) -> Result<(), StateError> {
+    let io = |what: &str, e: std::io::Error| StateError::Io {
+        path: path.to_path_buf(),
+        detail: format!("cannot {what}: {e}"),
+    };
+    let mut file = std::fs::File::create(temp).map_err(|e| io("create the temporary file", e))?;
+    file.write_all(bytes).map_err(|e| io("write", e))?;
+    drop(file);
+    std::fs::rename(temp, path).map_err(|e| io("rename the temporary file", e))
+}
+
+fn put_u32(out: &mut Vec<u8>, v: u32) {
+    out.extend_from_slice(&v.to_le_bytes());
+}
+
+fn encode(
+    layout: &Layout,
+    reference_frame_id: u64,
+    pixels: &[u16],
+    base_px: impl ExactSizeIterator<Item = (f64, f64)>,
+    out: &mut Vec<u8>,
+) {
+    assert_eq!(pixels.len(), layout.pixels());
+    assert_eq!(base_px.len(), layout.nodes());
+    out.clear();
+    out.reserve(layout.file_bytes());
+    out.extend_from_slice(MAGIC);
+    put_u32(out, FORMAT_VERSION);
+    for v in [
+        layout.width_px,
+        layout.height_px,
+        layout.zoi_px,
+        layout.step_px,
+    ] {
+        put_u32(out, v);
+    }
+    for v in layout.roi.into_iter().chain(layout.mesh) {
+        put_u32(out, v);
+    }
+    for v in [
+        layout.reference_mode,
+        layout.guess,
+        layout.strain,
+        layout.max_iterations,
+        layout.strain_window_nodes,
+    ] {
+        put_u32(out, v);
+    }
+    for v in layout.auto {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&reference_frame_id.to_le_bytes());
+    debug_assert_eq!(out.len(), HEADER_BYTES);
+    for &p in pixels {
+        out.extend_from_slice(&p.to_le_bytes());
+    }
+    for (u, v) in base_px {
+        out.extend_from_slice(&u.to_le_bytes());
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    let sum = checksum(out);
+    out.extend_from_slice(&sum.to_le_bytes());
+    assert_eq!(out.len(), layout.file_bytes());
+}
+
+fn decode(bytes: &[u8]) -> Result<SavedReference, String> {
+    if bytes.len() < HEADER_BYTES + 8 {
+        return Err(format!("{} bytes, shorter than a header", bytes.len()));
+    }
+    if &bytes[..8] != MAGIC {
+        return Err("wrong magic bytes".into());
+    }
+    let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().expect("4 bytes"));
+    let u64_at = |o: usize| u64::from_le_bytes(bytes[o..o + 8].try_into().expect("8 bytes"));
+    let f64_at = |o: usize| f64::from_le_bytes(bytes[o..o + 8].try_into().expect("8 bytes"));
+    let version = u32_at(8);
+    if version != FORMAT_VERSION {
+        return Err(format!(
+            "format version {version}, this build reads {FORMAT_VERSION}"
+        ));
+    }
+    let layout = Layout {
+        width_px: u32_at(12),
+        height_px: u32_at(16),
+        zoi_px: u32_at(20),
+        step_px: u32_at(24),
+        roi: [u32_at(28), u32_at(32), u32_at(36), u32_at(40)],
+        mesh: [u32_at(44), u32_at(48)],
+        reference_mode: u32_at(52),
+        guess: u32_at(56),
+        strain: u32_at(60),
+        max_iterations: u32_at(64),
+        strain_window_nodes: u32_at(68),
+        auto: [f64_at(72), f64_at(80)],
+    };
+    let reference_frame_id = u64_at(88);
+    let expected = (layout.width_px as u64 * layout.height_px as u64)
+        .checked_mul(2)
+        .and_then(|p| p.checked_add(16 * layout.mesh[0] as u64 * layout.mesh[1] as u64))
+        .and_then(|p| p.checked_add(HEADER_BYTES as u64 + 8));
+    if expected != Some(bytes.len() as u64) {
+        return Err(format!(
+            "{} bytes but the header ({}x{} px, mesh {}x{}) needs {expected:?}",
+            bytes.len(),
+            layout.width_px,
+            layout.height_px,
+            layout.mesh[0],
+            layout.mesh[1]
+        ));
+    }
+    let body = bytes.len() - 8;
+    if checksum(&bytes[..body]) != u64_at(body) {
+        return Err("checksum mismatch".into());
+    }
+    let pixel_end = HEADER_BYTES + 2 * layout.pixels();
+    let pixels = bytes[HEADER_BYTES..pixel_end]
+        .chunks_exact(2)
+        .map(|b| u16::from_le_bytes([b[0], b[1]]))
+        .collect();
+    let base_px = bytes[pixel_end..body]
+        .chunks_exact(16)
+        .map(|b| {
+            (
+                f64::from_le_bytes(b[..8].try_into().expect("8 bytes")),
+                f64::from_le_bytes(b[8..].try_into().expect("8 bytes")),
+            )
+        })
+        .collect();
+    Ok(SavedReference {
+        width_px: layout.width_px as usize,
+        height_px: layout.height_px as usize,
+        reference_frame_id,
+        pixels,
+        base_px,
+        layout,
+    })
+}
+
+fn summary_json(layout: &Layout, reference_frame_id: u64, saves: u64, out: &mut String) {
+    // Written with `write!` into a reused String: no allocation once it has grown.
+    let _ = write!(
+        out,
+        "{{\n  \"file\": \"{STATE_FILE}\",\n  \"format_version\": {FORMAT_VERSION},\n"
+    );
+    if reference_frame_id == REFERENCE_FROM_FILE {
+        let _ = writeln!(
+            out,
+            "  \"reference_frame_id\": null,\n  \"reference_from_file\": true,"
+        );
+    } else {
+        let _ = writeln!(
+            out,
+            "  \"reference_frame_id\": {reference_frame_id},\n  \"reference_from_file\": false,"
+        );
+    }
+    let mode = match layout.reference_mode {
+        0 => "fixed",
+        1 => "incremental",
+        2 => "auto",
+        _ => "?",
+    };
+    let _ = write!(
+        out,
+        "  \"saves_by_this_process\": {saves},\n  \"image\": [{}, {}],\n  \"zoi\": {},\n  \"step\": {},\n  \"roi\": [{}, {}, {}, {}],\n  \"mesh\": [{}, {}],\n  \"reference_mode\": \"{mode}\",\n  \"auto_displacement_zoi_fraction\": {},\n  \"auto_min_mean_score\": {},\n  \"guess\": \"{}\",\n  \"strain\": \"{}\",\n  \"max_iterations\": {},\n  \"strain_window_nodes\": {}\n}}\n",
+        layout.width_px,
+        layout.height_px,
+        layout.zoi_px,
+        layout.step_px,
+        layout.roi[0],
+        layout.roi[1],
+        layout.roi[2],
+        layout.roi[3],
+        layout.mesh[0],
+        layout.mesh[1],
+        layout.auto[0],
+        layout.auto[1],
+        guess_name(layout.guess),
+        strain_name(layout.strain),
+        layout.max_iterations,
+        layout.strain_window_nodes,
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn speckle(w: usize, h: usize) -> Vec<u16> {
+        // A deterministic texture (not a real speckle; enough contrast for every ZOI).
+        (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f64, (i / w) as f64);
+                (30000.0 + 12000.0 * (0.7 * x).sin() * (0.45 * y + 0.3 * x).cos()) as u16
+            })
+            .collect()
+    }
+
+    fn temp_dir(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("dicstream_state_{name}_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    #[test]
+    fn round_trip_and_refusals() {
+        let dir = temp_dir("round_trip");
+        let (w, h) = (96, 80);
+        let pixels = speckle(w, h);
+        let settings = CorrelatorSettings {
+            threads: 1,
+            reference: ReferenceMode::Incremental,
+            ..CorrelatorSettings::default()
+        };
+        let mut correlator = Correlator::new(settings.clone(), w, h).unwrap();
+        correlator.set_reference(&pixels).unwrap();
+        let mut state = StateDir::open(&dir).unwrap();
+        assert!(state.load().unwrap().is_none());
+        state.save(&correlator, 42).unwrap();
+        let saved = state.load().unwrap().unwrap();
+        assert_eq!((saved.width_px, saved.height_px), (w, h));
+        assert_eq!(saved.reference_frame_id, 42);
+        assert_eq!(saved.pixels, pixels);
+        let restored = saved.restore(settings.clone(), state.path()).unwrap();
+        assert_eq!(restored.reference_pixels().unwrap(), &pixels[..]);
+        let summary = std::fs::read_to_string(dir.join(SUMMARY_FILE)).unwrap();
+        assert!(summary.contains("\"reference_frame_id\": 42"), "{summary}");
+        assert!(
+            summary.contains("\"reference_mode\": \"incremental\""),
+            "{summary}"
+        );
+        // Other settings: refused with the first difference named.
+        let error = saved
+            .restore(
+                CorrelatorSettings {
+                    step_px: 8,
+                    ..settings.clone()
+                },
+                state.path(),
+            )
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(error.contains("step 16 px there, 8 px now"), "{error}");
+        // A damaged file: refused, not misread.
+        let mut bytes = std::fs::read(state.path()).unwrap();
+        bytes[HEADER_BYTES + 7] ^= 0x40;
+        std::fs::write(state.path(), &bytes).unwrap();
+        let error = state.load().unwrap_err().to_string();
+        assert!(error.contains("checksum"), "{error}");
+        std::fs::write(state.path(), &bytes[..200]).unwrap();
+        let error = state.load().unwrap_err().to_string();
+        assert!(error.contains("needs"), "{error}");
+        // No temporary file is left behind.
+        let leftovers: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .flatten()
+            .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+            .collect();
+        assert!(leftovers.is_empty());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,322 @@
+//! `dicstream bench ...`: speed figures a user can reproduce on their machine. One subcommand
+//! per benchmark (`BenchCommand`); `correlate` measures the correlator on rendered speckle.
+
+use anyhow::{bail, Context, Result};
+use correlator::{Correlator, CorrelatorSettings, GuessMode};
+use producer::motion::Affine;
+use producer::{CameraModel, FastRenderer, Motion, Speckle, SpeckleParams};
+use std::time::Instant;
+
+#[derive(clap::Args, Debug)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    pub command: BenchCommand,
+}
+
+/// The benchmarks (more will be added, e.g. the whole pipeline).
+#[derive(clap::Subcommand, Debug)]
+pub enum BenchCommand {
+    /// Correlator throughput on rendered speckle: ZOIs/s and frames/s per thread count, the
+    /// time split (FFT, window, peak, shift, other) and a plain 2-D FFT timing for scale.
+    Correlate(CorrelateBenchArgs),
+}
+
+#[derive(clap::Args, Debug)]
+pub struct CorrelateBenchArgs {
+    /// Image width in px.
+    #[arg(long, default_value_t = 1024)]
+    pub width: usize,
+    /// Image height in px.
+    #[arg(long, default_value_t = 1024)]
+    pub height: usize,
+    /// ZOI side in px (a power of two).
+    #[arg(long, default_value_t = 32)]
+    pub zoi: usize,
+    /// Distance between ZOI centres in px.
+    #[arg(long, default_value_t = 16)]
+    pub step: usize,
+    /// Thread counts to measure, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    pub threads: Vec<usize>,
+    /// Timed frames per thread count (the median is reported).
+    #[arg(long, default_value_t = 9)]
+    pub frames: usize,
+    /// Initial guess: predict (the live default) or correli (the paper's).
+    #[arg(long, value_enum, default_value = "predict")]
+    pub guess: super::correlate::GuessArg,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Issue 3's speed target: ZOIs per second on two threads at 1024x1024, ZOI 32, step 16.
+const TARGET_ZOIS_PER_S: f64 = 50_000.0;
+/// The imposed sub-pixel translation (px): every ZOI does its sub-pixel iterations.
+const SHIFT_PX: [f64; 2] = [0.37, -0.21];
+
+pub fn run(args: BenchArgs) -> Result<()> {
+    match args.command {
+        BenchCommand::Correlate(args) => correlate(args),
+    }
+}
+
+fn render(
+    renderer: &FastRenderer,
+    motion: Motion,
+    width: usize,
+    height: usize,
+    seed: u64,
+) -> Vec<u16> {
+    let mut pattern = vec![0f32; width * height];
+    renderer.render(&motion, width, &mut pattern);
+    let mut camera = CameraModel::noiseless(16);
+    camera.read_noise_dn = 0.01 * 65535.0;
+    camera.seed = seed;
+    let mut out = vec![0u16; width * height];
+    camera.expose(seed, &pattern, width, &mut out, 2);
+    out
+}
+
+fn median(values: &mut [f64]) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values[values.len() / 2]
+}
+
+struct ThreadRun {
+    threads: usize,
+    median_s: f64,
+    min_s: f64,
+    max_s: f64,
+    nodes: usize,
+    valid: usize,
+    mean_iterations: f64,
+    error_px: [f64; 2],
+    set_reference_ms: f64,
+}
+
+fn correlate(args: CorrelateBenchArgs) -> Result<()> {
+    if args.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    if args.threads.is_empty() || args.threads.contains(&0) {
+        bail!("--threads: expected positive thread counts, e.g. 1,2");
+    }
+    let (w, h) = (args.width, args.height);
+    let guess = match args.guess {
+        super::correlate::GuessArg::Correli => GuessMode::Correli,
+        super::correlate::GuessArg::Predict => GuessMode::Predict,
+    };
+    let settings_for = |threads| CorrelatorSettings {
+        zoi_px: args.zoi,
+        step_px: args.step,
+        threads,
+        guess,
+        ..CorrelatorSettings::default()
+    };
+    // Refuse bad sizes before spending time on rendering.
+    let probe = Correlator::new(settings_for(1), w, h).context("benchmark settings")?;
+    let zois = field_len(&probe);
+    drop(probe);
+    let t = Instant::now();
+    let (ex, ey) = ([-16.0, w as f64 + 16.0], [-16.0, h as f64 + 16.0]);
+    let speckle = Speckle::new(SpeckleParams::default(), ex, ey);
+    let renderer = FastRenderer::new(&speckle, ex, ey, 4, 2);
+    let reference = render(&renderer, Motion::IDENTITY, w, h, 1);
+    let moved = Motion::Affine(Affine {
+        translation_px: SHIFT_PX,
+        ..Affine::IDENTITY
+    });
+    let deformed = render(&renderer, moved, w, h, 2);
+    let render_s = t.elapsed().as_secs_f64();
+    if !args.json {
+        println!(
+            "correlate: {w}x{h} px speckle (producer, 1 % noise, shift {:+.2} {:+.2} px), ZOI {} px, step {} px: {zois} ZOIs, {} guess, median of {} frames (rendered in {render_s:.1} s)",
+            SHIFT_PX[0],
+            SHIFT_PX[1],
+            args.zoi,
+            args.step,
+            format!("{guess:?}").to_lowercase(),
+            args.frames
+        );
+    }
+
+    let mut runs = Vec::new();
+    let mut split = None;
+    for &threads in &args.threads {
+        let mut correlator = Correlator::new(settings_for(threads), w, h)?;
+        let t = Instant::now();
+        correlator.set_reference(&reference)?;
+        let set_reference_ms = t.elapsed().as_secs_f64() * 1e3;
+        correlator.correlate(&deformed)?; // warm-up (the predictor then uses this field)
+        let mut seconds: Vec<f64> = (0..args.frames)
+            .map(|_| {
+                let t = Instant::now();
+                correlator
+                    .correlate(&deformed)
+                    .map(|_| t.elapsed().as_secs_f64())
+            })
+            .collect::<Result<_, _>>()?;
+        let field = correlator.field();
+        let ok: Vec<_> = field
+            .nodes
+            .iter()
+            .filter(|n| n.status == correlator::NodeStatus::Ok)
+            .collect();
+        let count = ok.len().max(1) as f64;
+        let run = ThreadRun {
+            threads,
+            median_s: median(&mut seconds),
+            min_s: seconds[0],
+            max_s: seconds[seconds.len() - 1],
+            nodes: field.nodes.len(),
+            valid: field.valid,
+            mean_iterations: field.nodes.iter().map(|n| n.iterations as f64).sum::<f64>()
+                / field.nodes.len() as f64,
+            error_px: [
+                ok.iter().map(|n| n.u_px).sum::<f64>() / count - SHIFT_PX[0],
+                ok.iter().map(|n| n.v_px).sum::<f64>() / count - SHIFT_PX[1],
+            ],
+            set_reference_ms,
+        };
+        if !args.json {
+            print_run(&run);
+        }
+        runs.push(run);
+        // The time split on one thread: profiling reads the clock in the hot loop, so these
+        // frames are not part of the timings above.
+        if split.is_none() && threads == 1 {
+            correlator.set_profiling(true);
+            const PROFILED: usize = 3;
+            for _ in 0..PROFILED {
+                correlator.correlate(&deformed)?;
+            }
+            split = Some((correlator.time_split(), PROFILED * field_len(&correlator)));
+            correlator.set_profiling(false);
+        }
+    }
+    if split.is_none() {
+        let mut correlator = Correlator::new(settings_for(1), w, h)?;
+        correlator.set_reference(&reference)?;
+        correlator.correlate(&deformed)?;
+        correlator.set_profiling(true);
+        for _ in 0..3 {
+            correlator.correlate(&deformed)?;
+        }
+        split = Some((correlator.time_split(), 3 * field_len(&correlator)));
+    }
+    let (split, profiled_zois) = split.expect("measured above");
+    let fft = correlator::timing::time_ffts(args.zoi, 2000, 7);
+    let two = runs.iter().find(|r| r.threads == 2);
+    let standard = (w, h, args.zoi, args.step) == (1024, 1024, 32, 16);
+
+    let parts = [
+        ("fft", split.fft_ns),
+        ("window", split.window_ns),
+        ("peak", split.peak_ns),
+        ("shift", split.shift_ns),
+        ("other", split.other_ns),
+    ];
+    let total_ns: u64 = parts.iter().map(|p| p.1).sum();
+    if args.json {
+        let json = serde_json::json!({
+            "benchmark": "correlate",
+            "image": [w, h],
+            "zoi": args.zoi,
+            "step": args.step,
+            "guess": format!("{guess:?}").to_lowercase(),
+            "shift_px": SHIFT_PX,
+            "frames_per_run": args.frames,
+            "runs": runs.iter().map(|r| serde_json::json!({
+                "threads": r.threads,
+                "zois": r.nodes,
+                "valid": r.valid,
+                "median_ms": r.median_s * 1e3,
+                "min_ms": r.min_s * 1e3,
+                "max_ms": r.max_s * 1e3,
+                "zois_per_s": r.nodes as f64 / r.median_s,
+                "frames_per_s": 1.0 / r.median_s,
+                "mean_iterations": r.mean_iterations,
+                "mean_error_px": r.error_px,
+                "set_reference_ms": r.set_reference_ms,
+            })).collect::<Vec<_>>(),
+            "time_split_1_thread": {
+                "zois_profiled": profiled_zois,
+                "us_per_zoi": total_ns as f64 / 1e3 / profiled_zois as f64,
+                "percent": parts.iter().map(|(name, ns)| (name.to_string(), serde_json::json!(100.0 * *ns as f64 / total_ns.max(1) as f64))).collect::<serde_json::Map<_, _>>(),
+            },
+            "fft_2d": {
+                "n": fft.n,
+                "complex_forward_us": fft.complex_forward_ns / 1e3,
+                "real_forward_us": fft.real_forward_ns / 1e3,
+                "real_inverse_us": fft.real_inverse_ns / 1e3,
+            },
+            "target": {
+                "zois_per_s_2_threads": TARGET_ZOIS_PER_S,
+                "applies": standard,
+                "measured": two.map(|r| r.nodes as f64 / r.median_s),
+                "met": two.map(|r| r.nodes as f64 / r.median_s >= TARGET_ZOIS_PER_S),
+            },
+        });
+        println!("{}", serde_json::to_string_pretty(&json)?);
+        return Ok(());
+    }
+    let pct = |ns: u64| 100.0 * ns as f64 / total_ns.max(1) as f64;
+    let us = |ns: u64| ns as f64 / 1e3 / profiled_zois as f64;
+    println!(
+        "  time split (1 thread, profiled, {profiled_zois} ZOIs): FFT {:.0} % ({:.1} µs/ZOI), window {:.0} % ({:.1}), peak {:.0} % ({:.1}), shift {:.0} % ({:.1}), other {:.0} % ({:.1}); {:.1} µs per ZOI",
+        pct(split.fft_ns),
+        us(split.fft_ns),
+        pct(split.window_ns),
+        us(split.window_ns),
+        pct(split.peak_ns),
+        us(split.peak_ns),
+        pct(split.shift_ns),
+        us(split.shift_ns),
+        pct(split.other_ns),
+        us(split.other_ns),
+        us(total_ns)
+    );
+    println!(
+        "  {n}x{n} 2-D FFT, one thread (median): complex forward {:.2} µs, real-to-complex forward {:.2} µs, inverse {:.2} µs",
+        fft.complex_forward_ns / 1e3,
+        fft.real_forward_ns / 1e3,
+        fft.real_inverse_ns / 1e3,
+        n = fft.n
+    );
+    match (two, standard) {
+        (Some(r), true) => {
+            let rate = r.nodes as f64 / r.median_s;
+            println!(
+                "  target (issue 3): >= {TARGET_ZOIS_PER_S:.0} ZOIs/s on 2 threads: {} ({rate:.0} ZOIs/s)",
+                if rate >= TARGET_ZOIS_PER_S { "met" } else { "NOT met" }
+            );
+        }
+        _ => println!(
+            "  target (issue 3) applies to 1024x1024, ZOI 32, step 16 on 2 threads: not measured here"
+        ),
+    }
+    Ok(())
+}
+
+fn field_len(correlator: &Correlator) -> usize {
+    let (nx, ny) = correlator.mesh_size();
+    nx * ny
+}
+
+fn print_run(r: &ThreadRun) {
+    println!(
+        "  {} thread(s): {:8.0} ZOIs/s, {:6.2} frames/s, {:7.2} ms/frame (min {:.2}, max {:.2}); {} ZOIs, {} valid, {:.2} iterations/ZOI, mean error u {:+.4} v {:+.4} px; set_reference {:.1} ms",
+        r.threads,
+        r.nodes as f64 / r.median_s,
+        1.0 / r.median_s,
+        r.median_s * 1e3,
+        r.min_s * 1e3,
+        r.max_s * 1e3,
+        r.nodes,
+        r.valid,
+        r.mean_iterations,
+        r.error_px[0],
+        r.error_px[1],
+        r.set_reference_ms
+    );
+}

@@ -1,0 +1,298 @@
+//! `dicstream correlate` end to end: the files other tools read (field_NNNN.csv with its header,
+//! summary.json with its keys, --vtk, --png) and the bad inputs of issue 3 (unreadable file,
+//! images of different sizes, non-power-of-two ZOI, step 0, ZOI larger than the ROI, a flat
+//! image), each a clear message or a per-node status, never a crash or a NaN.
+
+mod harness;
+
+use harness::{render, translation};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const W: usize = 192;
+const H: usize = 160;
+
+/// A folder removed when the test ends, passed or failed.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(label: &str) -> TempDir {
+        let dir = std::env::temp_dir().join(format!("offline_{}_{label}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        TempDir(dir)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn write_png(path: &Path, pixels: &[u16], width: usize, height: usize) {
+    producer::write_frame(
+        path,
+        width as u32,
+        height as u32,
+        16,
+        pixels,
+        producer::ImageFormatOut::Png16,
+        &mut Vec::new(),
+    )
+    .unwrap();
+}
+
+fn dicstream(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_dicstream"))
+        .args(args)
+        .output()
+        .expect("run dicstream")
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn fields_and_summary_follow_the_contract() {
+    let dir = TempDir::new("contract");
+    let shifts = [(0.3, -0.2), (0.75, 0.45)];
+    let reference = dir.0.join("ref.png");
+    write_png(&reference, &render(W, H, &translation(0.0, 0.0).0, 1), W, H);
+    let mut deformed = Vec::new();
+    for (k, &(u, v)) in shifts.iter().enumerate() {
+        let file = dir.0.join(format!("def_{k}.png"));
+        write_png(
+            &file,
+            &render(W, H, &translation(u, v).0, 2 + k as u64),
+            W,
+            H,
+        );
+        deformed.push(file);
+    }
+    let out = dir.0.join("out");
+    let output = dicstream(&[
+        "correlate",
+        path(&reference),
+        path(&deformed[0]),
+        path(&deformed[1]),
+        "--zoi",
+        "32",
+        "--step",
+        "16",
+        "--out",
+        path(&out),
+        "--vtk",
+        "--png",
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    // Not a terminal: no progress bar.
+    assert!(!stderr.contains("frames,"), "{stderr}");
+    for (k, &(u, v)) in shifts.iter().enumerate() {
+        let index = k + 1;
+        let csv = std::fs::read_to_string(out.join(format!("field_{index:04}.csv"))).unwrap();
+        let mut lines = csv.lines();
+        assert_eq!(
+            lines.next(),
+            Some("x,y,u,v,exx,eyy,exy,score,iterations,status")
+        );
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert!(!rows.is_empty());
+        let (mut su, mut sv) = (0.0, 0.0);
+        for row in &rows {
+            assert_eq!(row.len(), 10, "{row:?}");
+            let numbers: Vec<f64> = row[..9].iter().map(|v| v.parse().unwrap()).collect();
+            assert!(numbers.iter().all(|v| v.is_finite()));
+            assert_eq!(row[9], "ok", "{row:?}");
+            su += numbers[2];
+            sv += numbers[3];
+        }
+        let (mu, mv) = (su / rows.len() as f64, sv / rows.len() as f64);
+        eprintln!(
+            "field_{index:04}.csv: {} nodes, mean u {mu:+.4} v {mv:+.4} (truth {u:+.2} {v:+.2})",
+            rows.len()
+        );
+        assert!((mu - u).abs() < 0.01 && (mv - v).abs() < 0.01);
+        let vtk = std::fs::read_to_string(out.join(format!("field_{index:04}.vtk"))).unwrap();
+        assert!(vtk.starts_with("# vtk DataFile Version 3.0"));
+        assert!(vtk.contains("VECTORS displacement_px double"));
+        for map in ["u", "exx"] {
+            let png = producer::read_image(out.join(format!("{map}_{index:04}.png"))).unwrap();
+            assert_eq!((png.width as usize, png.height as usize), (W, H));
+        }
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let frames = summary["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 2);
+    for (k, frame) in frames.iter().enumerate() {
+        assert_eq!(frame["index"], k + 1);
+        assert_eq!(frame["file"], path(&deformed[k]));
+        assert_eq!(frame["nodes"], frame["valid"]);
+        assert!((frame["u_mean"].as_f64().unwrap() - shifts[k].0).abs() < 0.01);
+        assert!((frame["v_mean"].as_f64().unwrap() - shifts[k].1).abs() < 0.01);
+        for measure in ["small", "green", "nominal", "log"] {
+            for component in ["exx", "eyy", "exy"] {
+                let value = frame["gauge"][measure][component].as_f64().unwrap();
+                assert!(value.abs() < 5e-4, "{measure} {component} {value}");
+            }
+        }
+        assert!(frame["elapsed_ms"].as_f64().unwrap() > 0.0);
+    }
+    let settings = &summary["settings"];
+    assert_eq!(settings["zoi"], 32);
+    assert_eq!(settings["step"], 16);
+    assert_eq!(settings["strain"], "log");
+    // No temporary file left behind by the atomic writes.
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn bad_inputs_are_clear_errors() {
+    let dir = TempDir::new("bad");
+    let reference = dir.0.join("ref.png");
+    let image = render(W, H, &translation(0.0, 0.0).0, 1);
+    write_png(&reference, &image, W, H);
+    let out = dir.0.join("out");
+    let refused = |args: &[&str], needle: &str| {
+        let output = dicstream(args);
+        let stderr = String::from_utf8_lossy(&output.stderr).to_string();
+        eprintln!("{args:?}\n  -> {}", stderr.trim());
+        assert!(!output.status.success(), "{args:?} must fail");
+        assert_eq!(
+            output.status.code(),
+            Some(1),
+            "an error, not a crash: {stderr}"
+        );
+        assert!(stderr.contains(needle), "{needle:?} not in {stderr}");
+    };
+    // An unreadable file: named in the message.
+    let garbage = dir.0.join("garbage.png");
+    std::fs::write(&garbage, b"this is not a PNG").unwrap();
+    refused(
+        &[
+            "correlate",
+            path(&reference),
+            path(&garbage),
+            "--out",
+            path(&out),
+        ],
+        "garbage.png",
+    );
+    let missing = dir.0.join("missing.tif");
+    refused(
+        &[
+            "correlate",
+            path(&reference),
+            path(&missing),
+            "--out",
+            path(&out),
+        ],
+        "missing.tif",
+    );
+    let output = dicstream(&[
+        "correlate",
+        path(&reference),
+        path(&missing),
+        "--out",
+        path(&out),
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(
+        stderr.matches("os error 2").count(),
+        1,
+        "cause printed once: {stderr}"
+    );
+    // Images of different sizes.
+    let small = dir.0.join("small.png");
+    write_png(
+        &small,
+        &render(W / 2, H, &translation(0.0, 0.0).0, 2),
+        W / 2,
+        H,
+    );
+    refused(
+        &[
+            "correlate",
+            path(&reference),
+            path(&small),
+            "--out",
+            path(&out),
+        ],
+        "expected 192x160 px like the reference",
+    );
+    // A non-power-of-two ZOI: refused with the nearest power of two.
+    refused(
+        &[
+            "correlate",
+            path(&reference),
+            path(&reference),
+            "--zoi",
+            "30",
+            "--out",
+            path(&out),
+        ],
+        "use 32 px",
+    );
+    // Step 0.
+    refused(
+        &[
+            "correlate",
+            path(&reference),
+            path(&reference),
+            "--step",
+            "0",
+            "--out",
+            path(&out),
+        ],
+        "step 0 px is invalid",
+    );
+    // ZOI larger than the ROI.
+    refused(
+        &[
+            "correlate",
+            path(&reference),
+            path(&reference),
+            "--zoi",
+            "64",
+            "--roi",
+            "0,0,48,48",
+            "--out",
+            path(&out),
+        ],
+        "larger than the ROI",
+    );
+    // A flat image: every node low_contrast in the CSV, numbers finite.
+    let flat = dir.0.join("flat.png");
+    write_png(&flat, &vec![1000u16; W * H], W, H);
+    let output = dicstream(&[
+        "correlate",
+        path(&reference),
+        path(&flat),
+        "--out",
+        path(&out),
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("field_0001.csv")).unwrap();
+    for line in csv.lines().skip(1) {
+        let row: Vec<&str> = line.split(',').collect();
+        assert_eq!(row[9], "low_contrast", "{line}");
+        assert!(
+            row[..9]
+                .iter()
+                .all(|v| v.parse::<f64>().unwrap().is_finite()),
+            "{line}"
+        );
+    }
+}

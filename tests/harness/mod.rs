@@ -1,0 +1,395 @@
+//! Harness of the process tests: a test bench per test (its own instance name from the pid
+//! and the test name), the test process as camera (frames rendered with the producer crate,
+//! published with `wire::pubsub`) and as field reader, `dicstream` children with their stderr
+//! collected line by line, and a Drop guard that kills the children and removes the instance's
+//! shared-memory files and the test folders even when the test fails.
+#![allow(dead_code)]
+
+use producer::motion::Affine;
+use producer::{CameraModel, ExactRenderer, Motion, Speckle, SpeckleParams};
+use std::io::BufRead;
+use std::path::PathBuf;
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::mpsc::{Receiver, RecvTimeoutError};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use wire::pubsub::{SlicePublisher, SliceSubscriber};
+use wire::{services, FieldHeader, FieldNode, FrameHeader, GroundTruth, Instance};
+
+/// Generous bound on every wait, so a broken process fails the test instead of hanging it.
+pub const PATIENCE: Duration = Duration::from_secs(120);
+
+/// A field copied out of shared memory.
+#[derive(Clone, Debug)]
+pub struct FieldCopy {
+    pub header: FieldHeader,
+    pub nodes: Vec<FieldNode>,
+}
+
+impl FieldCopy {
+    /// Mean and standard deviation of (u - u_true, v - v_true) over the nodes with status ok.
+    pub fn error_stats(&self, truth: &GroundTruth) -> [(f64, f64); 2] {
+        let ok: Vec<&FieldNode> = self
+            .nodes
+            .iter()
+            .filter(|n| n.status == wire::NodeStatus::Ok as u32)
+            .collect();
+        let errors: Vec<(f64, f64)> = ok
+            .iter()
+            .map(|n| {
+                let (u, v) = truth.displacement_px(n.x_px as f64, n.y_px as f64);
+                (n.u_px as f64 - u, n.v_px as f64 - v)
+            })
+            .collect();
+        let count = errors.len() as f64;
+        let stats = |pick: fn(&(f64, f64)) -> f64| {
+            let mean = errors.iter().map(pick).sum::<f64>() / count;
+            let var = errors.iter().map(|e| (pick(e) - mean).powi(2)).sum::<f64>() / count;
+            (mean, var.sqrt())
+        };
+        [stats(|e| e.0), stats(|e| e.1)]
+    }
+}
+
+/// One `dicstream` child and its stderr.
+pub struct Proc {
+    child: Child,
+    lines: Receiver<String>,
+    log: Arc<Mutex<Vec<String>>>,
+}
+
+impl Proc {
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// Everything the child wrote to stderr so far.
+    pub fn stderr(&self) -> String {
+        self.log.lock().unwrap().join("\n")
+    }
+
+    /// Waits for a stderr line containing `needle`; returns it.
+    pub fn wait_line(&mut self, needle: &str) -> String {
+        let deadline = Instant::now() + PATIENCE;
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.lines.recv_timeout(left) {
+                Ok(line) if line.contains(needle) => return line,
+                Ok(_) => {}
+                Err(RecvTimeoutError::Timeout) => {
+                    panic!("no line with {needle:?}; stderr so far:\n{}", self.stderr())
+                }
+                Err(RecvTimeoutError::Disconnected) => panic!(
+                    "the process ended without a line with {needle:?}; stderr:\n{}",
+                    self.stderr()
+                ),
+            }
+        }
+    }
+
+    /// Sends a signal by name (INT, TERM, KILL) with kill(1).
+    pub fn signal(&self, name: &str) {
+        let status = Command::new("kill")
+            .arg(format!("-{name}"))
+            .arg(self.pid().to_string())
+            .status()
+            .expect("run kill");
+        assert!(status.success(), "kill -{name} {}", self.pid());
+    }
+
+    /// Waits (bounded) for the child to end.
+    pub fn wait_exit(&mut self) -> ExitStatus {
+        let deadline = Instant::now() + PATIENCE;
+        loop {
+            if let Some(status) = self.child.try_wait().expect("try_wait") {
+                // Let the reader thread collect the last lines.
+                let until = Instant::now() + Duration::from_secs(5);
+                while Instant::now() < until {
+                    match self.lines.recv_timeout(Duration::from_millis(100)) {
+                        Err(RecvTimeoutError::Disconnected) => break,
+                        _ => continue,
+                    }
+                }
+                return status;
+            }
+            assert!(
+                Instant::now() < deadline,
+                "process did not exit; stderr:\n{}",
+                self.stderr()
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    /// The line of the final summary ("correlator: stopped ...").
+    pub fn final_line(&self) -> String {
+        self.log
+            .lock()
+            .unwrap()
+            .iter()
+            .find(|l| l.starts_with("correlator: stopped"))
+            .cloned()
+            .unwrap_or_else(|| panic!("no final line; stderr:\n{}", self.stderr()))
+    }
+}
+
+/// A number that follows `label ` in `line` (e.g. "dropped 12").
+pub fn number_after(line: &str, label: &str) -> u64 {
+    let at = line
+        .find(&format!("{label} "))
+        .unwrap_or_else(|| panic!("{label:?} not in {line:?}"));
+    line[at + label.len() + 1..]
+        .chars()
+        .take_while(|c| c.is_ascii_digit())
+        .collect::<String>()
+        .parse()
+        .unwrap_or_else(|_| panic!("no number after {label:?} in {line:?}"))
+}
+
+struct Io {
+    frames: SlicePublisher<u16, FrameHeader>,
+    fields: SliceSubscriber<FieldNode, FieldHeader>,
+    // Dropped last: the ports above belong to it.
+    _node: iceoryx2::prelude::Node<iceoryx2::prelude::ipc::Service>,
+}
+
+/// One test's bench: instance, camera and field reader, children, folders.
+pub struct Bench {
+    pub name: String,
+    pub instance: Instance,
+    io: Option<Io>,
+    procs: Vec<Proc>,
+    dirs: Vec<PathBuf>,
+}
+
+impl Bench {
+    /// `test` must be unique within its test binary; frames up to `max_pixels` values.
+    pub fn new(test: &str, max_pixels: usize) -> Bench {
+        let mut name = format!("t{}_{test}", std::process::id());
+        name.truncate(wire::instance::MAX_NAME_LEN);
+        let instance = Instance::new(&name).unwrap();
+        instance.remove_leftover_files();
+        let (node, _) = instance.create_node("testbench").unwrap();
+        let frames = SlicePublisher::create(&node, &services::FRAMES, max_pixels).unwrap();
+        let fields = SliceSubscriber::create(&node, &services::FIELDS).unwrap();
+        Bench {
+            name,
+            instance,
+            io: Some(Io {
+                frames,
+                fields,
+                _node: node,
+            }),
+            procs: Vec::new(),
+            dirs: Vec::new(),
+        }
+    }
+
+    /// A fresh folder removed with the bench.
+    pub fn temp_dir(&mut self, label: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("{}_{label}", self.name));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        self.dirs.push(dir.clone());
+        dir
+    }
+
+    /// Starts `dicstream correlator --instance NAME ARGS...`; returns its index.
+    pub fn spawn_correlator(&mut self, args: &[&str]) -> usize {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_dicstream"))
+            .arg("correlator")
+            .arg("--instance")
+            .arg(&self.name)
+            .args(args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawn dicstream");
+        let stderr = child.stderr.take().unwrap();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let log = Arc::new(Mutex::new(Vec::new()));
+        let log_writer = Arc::clone(&log);
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(stderr).lines() {
+                let Ok(line) = line else { break };
+                eprintln!("  [child] {line}");
+                log_writer.lock().unwrap().push(line.clone());
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        self.procs.push(Proc {
+            child,
+            lines: rx,
+            log,
+        });
+        self.procs.len() - 1
+    }
+
+    pub fn proc(&mut self, index: usize) -> &mut Proc {
+        &mut self.procs[index]
+    }
+
+    /// Publishes one frame; returns how many subscribers received it.
+    pub fn send_frame(&self, header: FrameHeader, pixels: &[u16]) -> usize {
+        let io = self.io.as_ref().unwrap();
+        io.frames
+            .publish(pixels.len(), |h, out| {
+                *h = header;
+                out.copy_from_slice(pixels);
+                Ok::<bool, ()>(true)
+            })
+            .unwrap()
+            .unwrap()
+            .unwrap()
+    }
+
+    /// A consistent header for `pixels` of `width` x `height` (16 bit, with the checksum).
+    pub fn header(
+        frame_id: u64,
+        width: usize,
+        height: usize,
+        pixels: &[u16],
+        truth: Option<GroundTruth>,
+    ) -> FrameHeader {
+        FrameHeader {
+            frame_id,
+            t_capture_ns: wire::monotonic_ns(),
+            width_px: width as u32,
+            height_px: height as u32,
+            bit_depth: 16,
+            rig_sample_id: 5000 + 7 * frame_id,
+            has_truth: truth.is_some() as u32,
+            truth: truth.unwrap_or(GroundTruth::IDENTITY),
+            pixel_checksum: wire::frame::pixel_checksum(pixels),
+            ..FrameHeader::default()
+        }
+    }
+
+    /// The next field, waiting (bounded) on the fields event.
+    pub fn next_field(&self) -> FieldCopy {
+        self.try_next_field(PATIENCE).unwrap_or_else(|| {
+            panic!(
+                "no field within {PATIENCE:?}; stderr:\n{}",
+                self.all_stderr()
+            )
+        })
+    }
+
+    pub fn try_next_field(&self, patience: Duration) -> Option<FieldCopy> {
+        let io = self.io.as_ref().unwrap();
+        let deadline = Instant::now() + patience;
+        loop {
+            if let Some(sample) = io.fields.receive().unwrap() {
+                return Some(FieldCopy {
+                    header: *sample.user_header(),
+                    nodes: sample.payload().to_vec(),
+                });
+            }
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return None;
+            }
+            let _ = io
+                .fields
+                .listener()
+                .timed_wait(|_| {}, left.min(Duration::from_millis(200)));
+        }
+    }
+
+    /// Fields until the one of `frame_id` (included).
+    pub fn fields_until(&self, frame_id: u64) -> Vec<FieldCopy> {
+        let mut out = Vec::new();
+        loop {
+            let field = self.next_field();
+            let id = field.header.frame_id;
+            out.push(field);
+            if id == frame_id {
+                return out;
+            }
+            assert!(id < frame_id, "field of frame {id} after {frame_id}");
+        }
+    }
+
+    fn all_stderr(&self) -> String {
+        self.procs
+            .iter()
+            .map(|p| p.stderr())
+            .collect::<Vec<_>>()
+            .join("\n---\n")
+    }
+
+    /// Kills what is left, removes the files and asserts nothing of the instance remains.
+    pub fn finish(mut self) {
+        self.cleanup();
+        let left = self.instance.leftover_files();
+        assert!(left.is_empty(), "left in shared memory: {left:?}");
+    }
+
+    fn cleanup(&mut self) {
+        for proc in &mut self.procs {
+            let _ = proc.child.kill();
+            let _ = proc.child.wait();
+        }
+        self.io = None;
+        self.instance.cleanup_dead_nodes();
+        self.instance.remove_leftover_files();
+        for dir in self.dirs.drain(..) {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
+}
+
+impl Drop for Bench {
+    fn drop(&mut self) {
+        self.cleanup();
+    }
+}
+
+/// Speckle (producer defaults, seed 1) covering the image plus a margin, moved by `motion`,
+/// seen by a 16-bit camera with Gaussian read noise (1 % of full scale) of seed `seed`.
+pub fn render(width: usize, height: usize, motion: &Motion, seed: u64) -> Vec<u16> {
+    let margin_px = 24.0;
+    let speckle = Speckle::new(
+        SpeckleParams::default(),
+        [-margin_px, width as f64 + margin_px],
+        [-margin_px, height as f64 + margin_px],
+    );
+    let mut pattern = vec![0f32; width * height];
+    ExactRenderer {
+        gauss_order: 3,
+        threads: 2,
+    }
+    .render(&speckle, motion, width, &mut pattern);
+    let mut camera = CameraModel::noiseless(16);
+    camera.read_noise_dn = 0.01 * 65535.0;
+    camera.seed = seed;
+    let mut out = vec![0u16; width * height];
+    camera.expose(seed, &pattern, width, &mut out, 2);
+    out
+}
+
+/// An affine motion and the same motion as ground truth for the frame header.
+pub fn affine(
+    f: [[f64; 2]; 2],
+    translation_px: [f64; 2],
+    centre_px: [f64; 2],
+) -> (Motion, GroundTruth) {
+    let motion = Motion::Affine(Affine {
+        f,
+        translation_px,
+        centre_px,
+    });
+    let truth = GroundTruth {
+        deformation_gradient: [f[0][0], f[0][1], f[1][0], f[1][1]],
+        translation_px,
+        centre_px,
+    };
+    (motion, truth)
+}
+
+pub fn translation(u_px: f64, v_px: f64) -> (Motion, GroundTruth) {
+    affine([[1.0, 0.0], [0.0, 1.0]], [u_px, v_px], [0.0, 0.0])
+}
