@@ -22,6 +22,19 @@ struct RefNode {
     status: NodeStatus,
 }
 
+/// Rings of neighbours whose affine fit places a failed node at a reference update.
+const EXTRAPOLATION_RINGS: usize = 2;
+/// Valid nodes an extrapolating fit needs.
+const MIN_EXTRAPOLATION_NODES: usize = 6;
+
+/// An affine fit of total displacements: (u, v) at `origin_px` and the gradient ∇u.
+#[derive(Clone, Copy)]
+struct AffineFit {
+    origin_px: (f64, f64),
+    at_origin_px: (f64, f64),
+    gradient: nalgebra::Matrix2<f64>,
+}
+
 /// CORRELI-GD correlator for images of one size. See the crate documentation.
 pub struct Correlator {
     settings: CorrelatorSettings,
@@ -293,32 +306,27 @@ impl Correlator {
         };
         self.field.global_px = global;
         let global_guess = (global.0 as f64, global.1 as f64);
-        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
-        for (k, guess) in self.guesses.iter_mut().enumerate() {
+        let whole_mesh = if use_previous && self.previous.iter().any(|p| p.is_none()) {
+            self.affine_fit_around(None, 0)
+        } else {
+            None
+        };
+        for k in 0..self.guesses.len() {
             let base = self.ref_nodes[k].base_px;
             // A node without a previous value (it failed or was outside the image) starts from
-            // its neighbours' previous values: the global (U0, V0) can be far from it (a stretch
-            // about the centre has U0 = 0 while its border moves by pixels) and would make it
-            // correlate the wrong area.
+            // what the affine fit of its neighbours' previous values extrapolates to it: the
+            // global (U0, V0) can be far from it (a stretch about the centre has U0 = 0 while
+            // its border moves by pixels), and so can a plain neighbour mean at a border, and
+            // either would make it correlate another area.
             let previous = match (use_previous, self.previous[k]) {
                 (false, _) => None,
                 (true, Some(p)) => Some(p),
-                (true, None) => {
-                    let (i, j) = (k % nx, k / nx);
-                    let (mut su, mut sv, mut count) = (0.0, 0.0, 0.0);
-                    for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
-                        for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
-                            if let Some(p) = self.previous[jj * nx + ii] {
-                                su += p.0;
-                                sv += p.1;
-                                count += 1.0;
-                            }
-                        }
-                    }
-                    (count > 0.0).then(|| (su / count, sv / count))
-                }
+                (true, None) => self
+                    .affine_fit_around(Some(k), EXTRAPOLATION_RINGS)
+                    .or(whole_mesh)
+                    .map(|fit| self.extrapolate(k, fit)),
             };
-            *guess = match previous {
+            self.guesses[k] = match previous {
                 Some(p) => (p.0 - base.0, p.1 - base.1),
                 None => global_guess,
             };
@@ -511,31 +519,24 @@ impl Correlator {
         if !replace || self.field.valid == 0 {
             return;
         }
-        // New base = total displacement; nodes that failed take the mean of valid neighbours.
+        // New base = total displacement. A node that failed (typically one whose followed point
+        // left the image) gets the displacement the affine fit of its valid neighbours
+        // extrapolates to it (within two rings, else over the whole mesh): its followed point
+        // keeps moving with the material, so it stays outside while the material is outside and
+        // comes back where that material is. A neighbour mean would pull it back inside the
+        // image onto another material point, which then correlates as a false "ok".
         let (nx, ny) = (self.mesh.nx, self.mesh.ny);
-        let mean = (self.field.u_mean_px, self.field.v_mean_px);
+        let whole_mesh = self.affine_fit_around(None, 0);
         for k in 0..nx * ny {
             let node = self.field.nodes[k];
             self.scratch_pairs[k] = if node.status == NodeStatus::Ok {
                 (node.u_px, node.v_px)
             } else {
-                let (i, j) = (k % nx, k / nx);
-                let (mut su, mut sv, mut c) = (0.0, 0.0, 0.0);
-                for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
-                    for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
-                        let nb = self.field.nodes[jj * nx + ii];
-                        if nb.status == NodeStatus::Ok {
-                            su += nb.u_px;
-                            sv += nb.v_px;
-                            c += 1.0;
-                        }
-                    }
-                }
-                if c > 0.0 {
-                    (su / c, sv / c)
-                } else {
-                    mean
-                }
+                self.affine_fit_around(Some(k), EXTRAPOLATION_RINGS)
+                    .or(whole_mesh)
+                    .map_or((self.field.u_mean_px, self.field.v_mean_px), |fit| {
+                        self.extrapolate(k, fit)
+                    })
             };
         }
         for (r, &base) in self.ref_nodes.iter_mut().zip(&self.scratch_pairs) {
@@ -543,6 +544,74 @@ impl Correlator {
         }
         self.take_reference(pixels);
         self.field.reference_updated = true;
+    }
+
+    /// Least-squares affine fit of the total displacement of the valid nodes within `rings`
+    /// of node `centre` (all valid nodes when `centre` is None): the origin of the fit, (u, v)
+    /// there, and ∇u; None with fewer than [`MIN_EXTRAPOLATION_NODES`] valid nodes or collinear.
+    fn affine_fit_around(&self, centre: Option<usize>, rings: usize) -> Option<AffineFit> {
+        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
+        let (i_range, j_range, origin) = match centre {
+            Some(k) => {
+                let (i, j) = (k % nx, k / nx);
+                let node = &self.field.nodes[k];
+                (
+                    i.saturating_sub(rings)..=(i + rings).min(nx - 1),
+                    j.saturating_sub(rings)..=(j + rings).min(ny - 1),
+                    (node.x_px, node.y_px),
+                )
+            }
+            None => (
+                0..=nx - 1,
+                0..=ny - 1,
+                (
+                    0.5 * (self.field.nodes[0].x_px + self.field.nodes[nx * ny - 1].x_px),
+                    0.5 * (self.field.nodes[0].y_px + self.field.nodes[nx * ny - 1].y_px),
+                ),
+            ),
+        };
+        let mut sums = AffineSums::default();
+        let mut count = 0;
+        for j in j_range {
+            for i in i_range.clone() {
+                let node = &self.field.nodes[j * nx + i];
+                if node.status == NodeStatus::Ok {
+                    sums.add(
+                        node.x_px - origin.0,
+                        node.y_px - origin.1,
+                        node.u_px,
+                        node.v_px,
+                    );
+                    count += 1;
+                }
+            }
+        }
+        if count < MIN_EXTRAPOLATION_NODES {
+            return None;
+        }
+        sums.fit().map(|(at_origin_px, gradient)| AffineFit {
+            origin_px: origin,
+            at_origin_px,
+            gradient,
+        })
+    }
+
+    /// The displacement an affine fit (from [`Self::affine_fit_around`]) gives at node k.
+    fn extrapolate(
+        &self,
+        k: usize,
+        AffineFit {
+            origin_px: origin,
+            at_origin_px: (u0, v0),
+            gradient: g,
+        }: AffineFit,
+    ) -> (f64, f64) {
+        let node = &self.field.nodes[k];
+        let (dx, dy) = (node.x_px - origin.0, node.y_px - origin.1);
+        (
+            u0 + g[(0, 0)] * dx + g[(0, 1)] * dy,
+            v0 + g[(1, 0)] * dx + g[(1, 1)] * dy,
+        )
     }
 
     /// Sum of the engines' time splits (profiling must be switched on with `set_profiling`).

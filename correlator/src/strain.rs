@@ -48,6 +48,12 @@ impl AffineSums {
 
     /// ∇u = [[du/dx, du/dy], [dv/dx, dv/dy]], or None when the points are fewer than 3 or collinear.
     pub fn gradient(&self) -> Option<Matrix2<f64>> {
+        self.fit().map(|(_, grad)| grad)
+    }
+
+    /// The whole affine fit: (u, v) at dx = dy = 0, and ∇u; None when the points are fewer
+    /// than 3 or collinear.
+    pub fn fit(&self) -> Option<((f64, f64), Matrix2<f64>)> {
         if self.n < 3.0 {
             return None;
         }
@@ -64,7 +70,7 @@ impl AffineSums {
         let inv = a.try_inverse()?;
         let cu = inv * Vector3::new(self.su, self.sxu, self.syu);
         let cv = inv * Vector3::new(self.sv, self.sxv, self.syv);
-        Some(Matrix2::new(cu[1], cu[2], cv[1], cv[2]))
+        Some(((cu[0], cv[0]), Matrix2::new(cu[1], cu[2], cv[1], cv[2])))
     }
 }
 
