@@ -359,3 +359,39 @@ fn idle_timeout_ends_the_process() {
     assert_eq!(number_after(&last, "frames in"), 0, "{last}");
     bench.finish();
 }
+
+/// A new frame sequence (the next test on a new specimen) starts from a new reference: its
+/// first frame becomes reference and origin, and displacements count from it.
+#[test]
+fn a_new_frame_sequence_takes_a_new_reference() {
+    let mut bench = Bench::new("sequence", W * H);
+    let p = bench.spawn_correlator(&["--zoi", "32", "--step", "16", "--threads", "2"]);
+    bench.proc(p).wait_line("correlator: ready");
+    // Sequence 0: reference at rest, then a 0.4 px move.
+    // Sequence 1: starts displaced by 0.4 px (a new reference there), then moves 0.3 px more.
+    let frames = [(0u32, 0.0), (0, 0.4), (1, 0.4), (1, 0.7)];
+    for (id, &(sequence, u)) in frames.iter().enumerate() {
+        let (motion, truth) = translation(u, 0.0);
+        let pixels = render(W, H, &motion, 300 + id as u64);
+        let mut header = Bench::header(id as u64, W, H, &pixels, Some(truth));
+        header.sequence_id = sequence;
+        bench.send_frame(header, &pixels);
+        let field = bench.next_field();
+        let h = field.header;
+        assert_eq!(h.sequence_id, sequence);
+        let (origin, expected_u) = match id {
+            0 | 1 => (0, u),
+            _ => (2, u - 0.4),
+        };
+        assert_eq!(h.origin_frame_id, origin, "frame {id}");
+        assert_eq!(h.reference_frame_id, origin, "frame {id}");
+        assert!(
+            (h.u_mean_px - expected_u).abs() < 0.01,
+            "frame {id}: u {} expected {expected_u}",
+            h.u_mean_px
+        );
+    }
+    let line = bench.proc(p).wait_line("starts frame sequence 1");
+    assert!(line.contains("frame 2"), "{line}");
+    bench.finish();
+}

@@ -19,7 +19,7 @@
 //!   per loaned sample; see `tests/process_allocations.rs`.
 
 use crate::settings::{CorrelatorSettings, StrainMeasure};
-use crate::state::{SavedReference, StateDir, REFERENCE_FROM_FILE};
+use crate::state::{ReferenceIds, SavedReference, StateDir, REFERENCE_FROM_FILE};
 use crate::{Correlator, Field, NodeStatus};
 use hdrhistogram::Histogram;
 use iceoryx2::prelude::*;
@@ -199,7 +199,7 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
         (None, Some(image)) => {
             live.start_from_image(&node, image)?;
             if let (Some(state), Some(correlator)) = (state.as_mut(), live.correlator.as_ref()) {
-                state.save(correlator, REFERENCE_FROM_FILE)?;
+                state.save(correlator, ReferenceIds::FROM_FILE)?;
                 live.summary.state_saves += 1;
             }
             format!(
@@ -299,6 +299,10 @@ struct Live {
     publisher: Option<FieldPublisher>,
     /// Frame id of the reference the next frame is correlated against.
     reference_frame_id: Option<u64>,
+    /// The frame the mesh is defined in, and the frame sequence the reference belongs to
+    /// (None for a reference image file: it holds for every sequence).
+    origin_frame_id: u64,
+    sequence_id: Option<u32>,
     last_frame_id: Option<u64>,
     summary: ProcessSummary,
     /// Correlation time per frame (ns): whole run, and since the last status line.
@@ -318,6 +322,8 @@ impl Live {
             correlator: None,
             publisher: None,
             reference_frame_id: None,
+            origin_frame_id: 0,
+            sequence_id: None,
             last_frame_id: None,
             summary: ProcessSummary::default(),
             run_hist: histogram(),
@@ -348,6 +354,9 @@ impl Live {
         self.open_publisher(node, nx * ny)?;
         self.correlator = Some(correlator);
         self.reference_frame_id = Some(saved.reference_frame_id);
+        self.origin_frame_id = saved.origin_frame_id;
+        self.sequence_id =
+            (saved.reference_frame_id != REFERENCE_FROM_FILE).then_some(saved.sequence_id);
         self.summary.reference_frame_id = self.reference_frame_id;
         self.summary.resumed = true;
         Ok(())
@@ -379,6 +388,8 @@ impl Live {
         self.open_publisher(node, nx * ny)?;
         self.correlator = Some(correlator);
         self.reference_frame_id = Some(REFERENCE_FROM_FILE);
+        self.origin_frame_id = REFERENCE_FROM_FILE;
+        self.sequence_id = None;
         self.summary.reference_frame_id = self.reference_frame_id;
         Ok(())
     }
@@ -420,6 +431,18 @@ impl Live {
         }
         let (w, h) = (header.width_px as usize, header.height_px as usize);
         let mut new_reference = false;
+        // A new frame sequence (the next test, a new specimen) starts from a new reference.
+        if self.reference_frame_id.is_some()
+            && self.sequence_id.is_some_and(|s| s != header.sequence_id)
+        {
+            eprintln!(
+                "correlator: frame {} starts frame sequence {} (was {}): it becomes the new reference",
+                header.frame_id,
+                header.sequence_id,
+                self.sequence_id.unwrap_or(0)
+            );
+            self.reference_frame_id = None;
+        }
         // No correlator yet, or one made for a flat first frame of another size.
         let fits = |c: &Correlator| c.image_size() == (w, h);
         if self.reference_frame_id.is_none() && !self.correlator.as_ref().is_some_and(fits) {
@@ -454,6 +477,8 @@ impl Live {
                     self.open_publisher(node, nx * ny)?;
                 }
                 self.reference_frame_id = Some(header.frame_id);
+                self.origin_frame_id = header.frame_id;
+                self.sequence_id = Some(header.sequence_id);
                 new_reference = true;
                 eprintln!(
                     "correlator: frame {} ({w}x{h} px, {} bit) is the reference; mesh {nx}x{ny} nodes",
@@ -474,6 +499,7 @@ impl Live {
         }
         let correlator = self.correlator.as_mut().expect("made above");
         let reference_frame_id = self.reference_frame_id.expect("set with the correlator");
+        let origin_frame_id = self.origin_frame_id;
         let t = Instant::now();
         correlator.correlate(pixels)?;
         let correlate_ns = t.elapsed().as_nanos() as u64;
@@ -494,7 +520,12 @@ impl Live {
         // holding the reference that field k left behind.
         if new_reference {
             if let Some(state) = state {
-                state.save(correlator, self.reference_frame_id.expect("set"))?;
+                let ids = ReferenceIds {
+                    reference_frame_id: self.reference_frame_id.expect("set"),
+                    origin_frame_id: self.origin_frame_id,
+                    sequence_id: self.sequence_id.unwrap_or(0),
+                };
+                state.save(correlator, ids)?;
             }
         }
         let publisher = self.publisher.as_ref().expect("opened with the correlator");
@@ -508,6 +539,7 @@ impl Live {
                     &header,
                     FieldTimes {
                         reference_frame_id,
+                        origin_frame_id,
                         t_received_ns,
                         correlate_ns,
                         frames_dropped,
@@ -523,6 +555,7 @@ impl Live {
 
 struct FieldTimes {
     reference_frame_id: u64,
+    origin_frame_id: u64,
     t_received_ns: u64,
     correlate_ns: u64,
     frames_dropped: u64,
@@ -581,6 +614,7 @@ fn fill_field(
         strain_measure: wire_measure(settings.strain) as u32,
         frame_id: frame.frame_id,
         reference_frame_id: times.reference_frame_id,
+        origin_frame_id: times.origin_frame_id,
         t_capture_ns: frame.t_capture_ns,
         rig_sample_id: frame.rig_sample_id,
         t_received_ns: times.t_received_ns,
@@ -603,6 +637,8 @@ fn fill_field(
             gauge(g.nominal),
             gauge(g.log),
         ],
+        sequence_id: frame.sequence_id,
+        reserved: 0,
     };
     out.t_published_ns = wire::monotonic_ns();
 }

@@ -7,7 +7,7 @@
 //! | offset | size | content |
 //! |---|---|---|
 //! | 0 | 8 | magic `DICSREF1` |
-//! | 8 | 4 | format version (1) |
+//! | 8 | 4 | format version (2) |
 //! | 12 | 8 | width, height (px, u32 each) |
 //! | 20 | 8 | ZOI, step (px, u32 each) |
 //! | 28 | 16 | ROI x, y, width, height (px, u32 each) |
@@ -15,7 +15,9 @@
 //! | 52 | 20 | reference mode, guess, strain measure, max iterations, strain window (u32 each) |
 //! | 72 | 16 | auto thresholds: displacement fraction, mean score (f64 each; 0 unless auto) |
 //! | 88 | 8 | reference frame id (u64; `u64::MAX` for an image file) |
-//! | 96 | 2 w h | reference pixels, row-major u16 |
+//! | 96 | 8 | origin frame id: the frame the mesh is defined in (u64; `u64::MAX`: an image file) |
+//! | 104 | 8 | sequence id (u32), then 0 (u32) |
+//! | 112 | 2 w h | reference pixels, row-major u16 |
 //! | … | 16 nx ny | per-node base displacement u, v (px, f64 each): total displacement when the reference was taken |
 //! | … | 8 | checksum (u64) of every byte before it |
 //!
@@ -31,8 +33,8 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"DICSREF1";
-const FORMAT_VERSION: u32 = 1;
-const HEADER_BYTES: usize = 96;
+const FORMAT_VERSION: u32 = 2;
+const HEADER_BYTES: usize = 112;
 /// Name of the binary state file inside the state folder.
 pub const STATE_FILE: &str = "reference.state";
 /// Name of the human-readable summary beside it (informative; never read back).
@@ -234,12 +236,34 @@ fn checksum(bytes: &[u8]) -> u64 {
     hash
 }
 
+/// Which frames a saved reference stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ReferenceIds {
+    /// The frame correlated against ([`REFERENCE_FROM_FILE`] for an image file).
+    pub reference_frame_id: u64,
+    /// The frame the mesh is defined in (displacements count from it).
+    pub origin_frame_id: u64,
+    /// The frame sequence (`FrameHeader::sequence_id`) the reference belongs to.
+    pub sequence_id: u32,
+}
+
+impl ReferenceIds {
+    /// A reference read from an image file.
+    pub const FROM_FILE: ReferenceIds = ReferenceIds {
+        reference_frame_id: REFERENCE_FROM_FILE,
+        origin_frame_id: REFERENCE_FROM_FILE,
+        sequence_id: 0,
+    };
+}
+
 /// A reference read back from a state folder.
 #[derive(Clone, Debug)]
 pub struct SavedReference {
     pub width_px: usize,
     pub height_px: usize,
     pub reference_frame_id: u64,
+    pub origin_frame_id: u64,
+    pub sequence_id: u32,
     pub pixels: Vec<u16>,
     pub base_px: Vec<(f64, f64)>,
     layout: Layout,
@@ -334,18 +358,15 @@ impl StateDir {
 
     /// Writes the correlator's current reference with its frame id, atomically, then the
     /// human-readable summary. No allocation after the first call.
-    pub fn save(
-        &mut self,
-        correlator: &Correlator,
-        reference_frame_id: u64,
-    ) -> Result<(), StateError> {
+    pub fn save(&mut self, correlator: &Correlator, ids: ReferenceIds) -> Result<(), StateError> {
+        let reference_frame_id = ids.reference_frame_id;
         let layout = Layout::of(correlator);
         let pixels = correlator
             .reference_pixels()
             .expect("save is called once a reference is set");
         encode(
             &layout,
-            reference_frame_id,
+            ids,
             pixels,
             correlator.reference_base_px(),
             &mut self.bytes,
@@ -385,7 +406,7 @@ fn put_u32(out: &mut Vec<u8>, v: u32) {
 
 fn encode(
     layout: &Layout,
-    reference_frame_id: u64,
+    ids: ReferenceIds,
     pixels: &[u16],
     base_px: impl ExactSizeIterator<Item = (f64, f64)>,
     out: &mut Vec<u8>,
@@ -419,7 +440,10 @@ fn encode(
     for v in layout.auto {
         out.extend_from_slice(&v.to_le_bytes());
     }
-    out.extend_from_slice(&reference_frame_id.to_le_bytes());
+    out.extend_from_slice(&ids.reference_frame_id.to_le_bytes());
+    out.extend_from_slice(&ids.origin_frame_id.to_le_bytes());
+    put_u32(out, ids.sequence_id);
+    put_u32(out, 0);
     debug_assert_eq!(out.len(), HEADER_BYTES);
     for &p in pixels {
         out.extend_from_slice(&p.to_le_bytes());
@@ -464,6 +488,8 @@ fn decode(bytes: &[u8]) -> Result<SavedReference, String> {
         auto: [f64_at(72), f64_at(80)],
     };
     let reference_frame_id = u64_at(88);
+    let origin_frame_id = u64_at(96);
+    let sequence_id = u32_at(104);
     let expected = (layout.width_px as u64 * layout.height_px as u64)
         .checked_mul(2)
         .and_then(|p| p.checked_add(16 * layout.mesh[0] as u64 * layout.mesh[1] as u64))
@@ -500,6 +526,8 @@ fn decode(bytes: &[u8]) -> Result<SavedReference, String> {
         width_px: layout.width_px as usize,
         height_px: layout.height_px as usize,
         reference_frame_id,
+        origin_frame_id,
+        sequence_id,
         pixels,
         base_px,
         layout,
@@ -586,10 +614,16 @@ mod tests {
         correlator.set_reference(&pixels).unwrap();
         let mut state = StateDir::open(&dir).unwrap();
         assert!(state.load().unwrap().is_none());
-        state.save(&correlator, 42).unwrap();
+        let ids = ReferenceIds {
+            reference_frame_id: 42,
+            origin_frame_id: 40,
+            sequence_id: 3,
+        };
+        state.save(&correlator, ids).unwrap();
         let saved = state.load().unwrap().unwrap();
         assert_eq!((saved.width_px, saved.height_px), (w, h));
         assert_eq!(saved.reference_frame_id, 42);
+        assert_eq!((saved.origin_frame_id, saved.sequence_id), (40, 3));
         assert_eq!(saved.pixels, pixels);
         let restored = saved.restore(settings.clone(), state.path()).unwrap();
         assert_eq!(restored.reference_pixels().unwrap(), &pixels[..]);

@@ -166,7 +166,7 @@ pub struct FrameRow {
 
 impl FrameRow {
     /// Builds the row of one field. `rig` is the field's rig sample, `origin_truth` the truth
-    /// of the frame its node positions are measured in (its reference frame), `t0_ns` the
+    /// of the frame its node positions are measured in (its origin frame), `t0_ns` the
     /// run's start and `seen_ns` when the monitor received the field.
     pub fn new(
         header: &FieldHeader,

@@ -116,7 +116,7 @@ impl Recorder {
         let rig = (header.rig_sample_id != wire::NO_RIG_SAMPLE)
             .then(|| self.rigs.get(header.rig_sample_id))
             .flatten();
-        let origin = self.truths.get(header.reference_frame_id);
+        let origin = self.truths.get(header.origin_frame_id);
         let row = FrameRow::new(header, nodes, rig, origin, self.t0_ns, seen_ns);
         if let Some(case) = rig.map(|s| s.load_case as usize).filter(|&c| c < 3) {
             let stretch = row.stretch[0].max(row.stretch[1]);

@@ -119,6 +119,7 @@ impl FrameSource for Replay {
             index,
             truth: None,
             rig_sample_id: None,
+            sequence_id: 0,
         }))
     }
 }

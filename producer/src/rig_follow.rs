@@ -166,6 +166,8 @@ impl Default for RigFollowConfig {
 pub struct RigKinematics {
     /// `RigState::sample_id`.
     pub sample_id: u64,
+    /// `RigState::test_index`: frames of one test form one frame sequence.
+    pub test_index: u32,
     /// In-plane stretches along rig X and Y.
     pub stretch_x: f64,
     pub stretch_y: f64,
@@ -180,6 +182,7 @@ impl RigKinematics {
     pub fn at_rest(sample_id: u64) -> Self {
         RigKinematics {
             sample_id,
+            test_index: 0,
             stretch_x: 1.0,
             stretch_y: 1.0,
             rotation_rad: 0.0,
@@ -192,6 +195,7 @@ impl From<&RigState> for RigKinematics {
     fn from(state: &RigState) -> Self {
         RigKinematics {
             sample_id: state.sample_id,
+            test_index: state.test_index,
             stretch_x: state.specimen_stretch_x,
             stretch_y: state.specimen_stretch_y,
             rotation_rad: state.specimen_rotation_rad,
@@ -205,6 +209,8 @@ impl From<&RigState> for RigKinematics {
 pub struct RigMotion {
     /// The rig sample it comes from.
     pub sample_id: u64,
+    /// The rig's test index (the frame sequence).
+    pub test_index: u32,
     /// The homogeneous map rendered.
     pub motion: Motion,
     /// The same, as the frame header's ground truth.
@@ -305,6 +311,7 @@ impl RigFollower {
         let centre_px = self.centre_px();
         RigMotion {
             sample_id: k.sample_id,
+            test_index: k.test_index,
             motion: Motion::Affine(Affine {
                 f,
                 translation_px,
@@ -365,6 +372,7 @@ impl RigFollower {
                         for &oy in &offsets {
                             let k = RigKinematics {
                                 sample_id: 0,
+                                test_index: 0,
                                 stretch_x: sx,
                                 stretch_y: sy,
                                 rotation_rad: theta,
@@ -467,6 +475,7 @@ impl RigCamera {
             index,
             truth: Some(motion.truth),
             rig_sample_id: Some(motion.sample_id),
+            sequence_id: motion.test_index,
         })
     }
 
@@ -487,6 +496,7 @@ mod tests {
     fn kin(sx: f64, sy: f64, rot_deg: f64, offset_mm: [f64; 2]) -> RigKinematics {
         RigKinematics {
             sample_id: 7,
+            test_index: 0,
             stretch_x: sx,
             stretch_y: sy,
             rotation_rad: rot_deg.to_radians(),

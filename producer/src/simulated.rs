@@ -317,6 +317,7 @@ impl FrameSource for SimulatedCamera {
             index,
             truth: Some(truth),
             rig_sample_id: None,
+            sequence_id: 0,
         }))
     }
 }

@@ -32,6 +32,9 @@ pub struct FrameInfo {
     /// The rig sample (`wire::RigState::sample_id`) the frame was rendered from, for a
     /// rig-driven camera; `None` otherwise.
     pub rig_sample_id: Option<u64>,
+    /// The frame sequence (`FrameHeader::sequence_id`): the rig's test index for rig-driven
+    /// frames, 0 otherwise.
+    pub sequence_id: u32,
 }
 
 /// Frame geometry of a source.

@@ -217,6 +217,7 @@ impl Shell {
                 height_px: dims.height,
                 bit_depth: u32::from(dims.bit_depth),
                 rig_sample_id: info.rig_sample_id.unwrap_or(wire::NO_RIG_SAMPLE),
+                sequence_id: info.sequence_id,
                 pixel_checksum: pixel_checksum(pixels),
                 ..FrameHeader::default()
             };

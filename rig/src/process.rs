@@ -132,6 +132,8 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
     let mut row = String::with_capacity(2048);
 
     let mut campaign = options.campaign.clone();
+    // Index of the campaign test under way, published as `RigState::test_index`.
+    let mut test_index = 0u32;
     let mut rig = Rig::new(options.config.clone(), options.seed)?;
     let mut summary = ProcessSummary::default();
     if let Some(program) = &options.program {
@@ -166,15 +168,18 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
 
         if let Some(campaign) = campaign.as_mut() {
             match campaign.advance(&mut rig) {
-                Ok(CampaignEvent::Started { index, test }) => eprintln!(
-                    "rig: campaign test {}/{}: {:?} to λ {} at {} /s, started at t = {:.1} s",
-                    index + 1,
-                    campaign.tests().len(),
-                    test.test,
-                    test.stretch,
-                    test.rate_per_s,
-                    rig.state().t_s
-                ),
+                Ok(CampaignEvent::Started { index, test }) => {
+                    test_index = index as u32;
+                    eprintln!(
+                        "rig: campaign test {}/{}: {:?} to λ {} at {} /s, started at t = {:.1} s",
+                        index + 1,
+                        campaign.tests().len(),
+                        test.test,
+                        test.stretch,
+                        test.rate_per_s,
+                        rig.state().t_s
+                    )
+                }
                 Ok(CampaignEvent::Busy | CampaignEvent::Done) => {}
                 Err(refusal) => return Err(format!("campaign halted: {refusal}").into()),
             }
@@ -190,7 +195,10 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
                 }
             }
         }
-        publisher.publish(to_wire(&rig, summary.samples_published))?;
+        publisher.publish(RigState {
+            test_index,
+            ..to_wire(&rig, summary.samples_published)
+        })?;
         summary.samples_published += 1;
         if let Some(w) = log.as_mut() {
             if last_flush.elapsed() >= Duration::from_millis(50) {

@@ -74,7 +74,7 @@ impl NodeStatus {
 /// One ZOI of the mesh. Strains are of the measure named in the header.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("dicstream.FieldNode.v1")]
+#[type_name("dicstream.FieldNode.v2")]
 pub struct FieldNode {
     /// ZOI centre in the reference image (px).
     pub x_px: f32,
@@ -95,7 +95,7 @@ pub struct FieldNode {
 /// In-plane strain components (dimensionless).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("dicstream.GaugeStrain.v1")]
+#[type_name("dicstream.GaugeStrain.v2")]
 pub struct GaugeStrain {
     pub exx: f64,
     pub eyy: f64,
@@ -105,14 +105,18 @@ pub struct GaugeStrain {
 /// Header of one field on the `fields` service.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.FieldHeader.v1")]
+#[type_name("dicstream.FieldHeader.v2")]
 pub struct FieldHeader {
     pub layout_version: u32,
     /// The [`StrainMeasure`] code of the node strains.
     pub strain_measure: u32,
-    /// The frame this field was measured on, and its reference frame.
+    /// The frame this field was measured on, and the reference it was correlated against.
     pub frame_id: u64,
     pub reference_frame_id: u64,
+    /// The frame the mesh is defined in: node positions are in its image and displacements
+    /// are counted from it (equal to `reference_frame_id` unless the reference was renewed
+    /// with the mesh followed).
+    pub origin_frame_id: u64,
     /// Copied from the frame: capture time and rig sample (monotonic ns).
     pub t_capture_ns: u64,
     pub rig_sample_id: u64,
@@ -135,6 +139,10 @@ pub struct FieldHeader {
     pub v_mean_px: f64,
     /// Gauge (ROI average) strains in the order of [`StrainMeasure::ALL`].
     pub gauge: [GaugeStrain; 4],
+    /// The frame's `sequence_id`.
+    pub sequence_id: u32,
+    /// Always 0.
+    pub reserved: u32,
 }
 
 impl FieldHeader {
@@ -154,6 +162,7 @@ impl Default for FieldHeader {
             strain_measure: StrainMeasure::Log as u32,
             frame_id: 0,
             reference_frame_id: 0,
+            origin_frame_id: 0,
             t_capture_ns: 0,
             rig_sample_id: crate::NO_RIG_SAMPLE,
             t_received_ns: 0,
@@ -170,6 +179,8 @@ impl Default for FieldHeader {
             u_mean_px: 0.0,
             v_mean_px: 0.0,
             gauge: [GaugeStrain::default(); 4],
+            sequence_id: 0,
+            reserved: 0,
         }
     }
 }

@@ -9,7 +9,7 @@ use iceoryx2::prelude::ZeroCopySend;
 /// comes from the producer library (see `producer::scenario`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.GroundTruth.v1")]
+#[type_name("dicstream.GroundTruth.v2")]
 pub struct GroundTruth {
     /// Deformation gradient, row-major: `[F11, F12, F21, F22]` (dimensionless).
     pub deformation_gradient: [f64; 4],
@@ -41,7 +41,7 @@ impl GroundTruth {
 /// Header of one frame on the `frames` service.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.FrameHeader.v1")]
+#[type_name("dicstream.FrameHeader.v2")]
 pub struct FrameHeader {
     /// Always [`crate::LAYOUT_VERSION`]; checked by every reader.
     pub layout_version: u32,
@@ -62,6 +62,11 @@ pub struct FrameHeader {
     pub truth: GroundTruth,
     /// [`pixel_checksum`] of the payload, so a reader can prove the frame arrived intact.
     pub pixel_checksum: u64,
+    /// Frames of one sequence (one test on one specimen) share it; when it changes, a
+    /// consumer starts afresh (a correlator takes a new reference). 0 for a single sequence.
+    pub sequence_id: u32,
+    /// Always 0 (keeps the layout a multiple of 8 bytes).
+    pub reserved: u32,
 }
 
 impl FrameHeader {
@@ -113,6 +118,8 @@ impl Default for FrameHeader {
             has_truth: 0,
             truth: GroundTruth::IDENTITY,
             pixel_checksum: 0,
+            sequence_id: 0,
+            reserved: 0,
         }
     }
 }

@@ -10,7 +10,7 @@ pub const MAX_RANKED: usize = 8;
 /// One fitted model in the ranking.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.RankedModel.v1")]
+#[type_name("dicstream.RankedModel.v2")]
 pub struct RankedModel {
     /// NUL-padded model name (identifier crate names), see [`crate::text`].
     pub name: [u8; 24],
@@ -21,7 +21,7 @@ pub struct RankedModel {
 /// Header-only sample on `identification` (no payload slice).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.IdentificationReport.v1")]
+#[type_name("dicstream.IdentificationReport.v2")]
 pub struct IdentificationReport {
     pub layout_version: u32,
     /// Points of the load path used, per load case: uniaxial, equibiaxial, pure shear.

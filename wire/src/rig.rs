@@ -11,7 +11,7 @@ pub const AXIS_NAMES: [&str; 3] = ["X", "Y", "Z"];
 /// One servo-hydraulic actuator at one instant.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("dicstream.ActuatorState.v1")]
+#[type_name("dicstream.ActuatorState.v2")]
 pub struct ActuatorState {
     pub position_mm: f64,
     pub command_mm: f64,
@@ -26,7 +26,7 @@ pub struct ActuatorState {
 /// One decimated sample of the rig.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("dicstream.RigState.v1")]
+#[type_name("dicstream.RigState.v2")]
 pub struct RigState {
     pub layout_version: u32,
     /// Program state code (rig crate: idle, running, holding, stopped, tripped).
@@ -52,6 +52,11 @@ pub struct RigState {
     pub load_case: u32,
     /// 1 when the hydraulics are on.
     pub hydraulics_on: u32,
+    /// Which test of the running campaign (from 0; 0 without a campaign): a camera starts a
+    /// new frame sequence when it changes.
+    pub test_index: u32,
+    /// Always 0.
+    pub reserved: u32,
 }
 
 /// What a [`RigCommand`] asks for.
@@ -94,7 +99,7 @@ impl RigCommandKind {
 /// A request on `rig/command`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.RigCommand.v1")]
+#[type_name("dicstream.RigCommand.v2")]
 pub struct RigCommand {
     pub layout_version: u32,
     /// A [`RigCommandKind`] code.
@@ -124,7 +129,7 @@ impl RigCommand {
 /// The answer to a [`RigCommand`]: accepted, or refused with the reason.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.RigReply.v1")]
+#[type_name("dicstream.RigReply.v2")]
 pub struct RigReply {
     pub layout_version: u32,
     pub accepted: u32,
