@@ -70,8 +70,9 @@ pub struct ColourRange {
 }
 
 /// RGB bytes (row-major, 3 per pixel) of the grey image `grey` (`width` px wide), overlaid
-/// inside the mesh with a blue-to-red map of `value` (bilinear between valid nodes, range =
-/// min..max over valid nodes). Returns the range used.
+/// inside the mesh with a blue-to-red map of `value` (bilinear between valid nodes; range =
+/// the 2nd to 98th percentile of the valid nodes' values, so that a few outliers do not flatten
+/// the map; values beyond saturate). Returns the range used.
 pub fn colour_map_rgb(
     grey: &[u16],
     width: usize,
@@ -81,18 +82,20 @@ pub fn colour_map_rgb(
     assert!(width > 0 && grey.len().is_multiple_of(width), "image shape");
     let (w, h) = (width, grey.len() / width);
     let max_grey = grey.iter().copied().max().unwrap_or(1).max(1) as f64;
-    let valid: Vec<f64> = field
+    let mut valid: Vec<f64> = field
         .nodes
         .iter()
         .filter(|n| n.status == NodeStatus::Ok)
         .map(&value)
         .filter(|v| v.is_finite())
         .collect();
-    let (lo, hi) = valid
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
+    valid.sort_by(f64::total_cmp);
+    let quantile = |q: f64| valid[((valid.len() - 1) as f64 * q).round() as usize];
+    let (lo, hi) = if valid.is_empty() {
+        (0.0, 0.0)
+    } else {
+        (quantile(0.02), quantile(0.98))
+    };
     let span = if hi > lo { hi - lo } else { 1.0 };
     let mut rgb = vec![0u8; w * h * 3];
     for (k, &p) in grey.iter().enumerate() {

@@ -30,6 +30,10 @@ pub struct FitOptions {
     pub weights: BTreeMap<LoadCase, f64>,
     /// Extra starting points (full parameter vectors) for the nonlinear search.
     pub extra_starts: Vec<Vec<f64>>,
+    /// Start the nonlinear search from these parameters alone (a refit after a few more
+    /// points: the last solution is next to the new one); the full multi-start search runs
+    /// only if that start fails.
+    pub warm_start: Option<Vec<f64>>,
 }
 
 /// Statistics of one load case.
@@ -211,6 +215,20 @@ pub fn fit_model(model: &Model, curves: &[Curve], options: &FitOptions) -> Resul
                 .map_err(lsq_err)?,
             true,
         )
+    } else if let Some(warm) = options
+        .warm_start
+        .as_ref()
+        .filter(|w| w.len() == n)
+        .and_then(|w| {
+            let start = if linear.iter().any(|&l| l) {
+                problem.solve_linear(w, &linear).ok()?
+            } else {
+                w.clone()
+            };
+            lsq::levenberg_marquardt(&|p: &[f64]| problem.residuals(p), &start, m).ok()
+        })
+    {
+        (warm.params, warm.converged)
     } else {
         let mut candidates: Vec<(f64, Vec<f64>)> = Vec::new();
         let mut last_error = None;

@@ -15,7 +15,7 @@
 //! accepted one of its case by [`OnlineConfig::min_stretch_increment`].
 
 use crate::data::{Curve, LoadCase};
-use crate::fit::{fit_ranked, Fit, FitOptions};
+use crate::fit::{fit_model, Fit, FitOptions};
 use crate::models::Model;
 use std::collections::VecDeque;
 
@@ -125,7 +125,15 @@ pub struct OnlineIdentifier {
     pub counters: OnlineCounters,
     /// The last field accepted (frame id, capture time ns).
     pub last_accepted: Option<(u64, u64)>,
+    /// Per configured model, its last fitted parameters (the next refit's start).
+    warm: Vec<Option<Vec<f64>>>,
+    refits: u64,
+    /// Load cases in the last refit (a new case calls for a full search).
+    fitted_cases: usize,
 }
+
+/// A full multi-start search every this many refits (the others start from the last fit).
+pub const FULL_SEARCH_EVERY: u64 = 16;
 
 fn case_index(case: LoadCase) -> usize {
     LoadCase::ALL
@@ -146,6 +154,9 @@ impl OnlineIdentifier {
             points: [Vec::new(), Vec::new(), Vec::new()],
             counters: OnlineCounters::default(),
             last_accepted: None,
+            warm: vec![None; config.models.len()],
+            refits: 0,
+            fitted_cases: 0,
             config,
         }
     }
@@ -311,14 +322,35 @@ impl OnlineIdentifier {
             .collect()
     }
 
-    /// Refits the configured models on the path so far; `None` before enough points.
-    pub fn refit(&self) -> Option<Vec<Fit>> {
+    /// Refits the configured models on the path so far; `None` before enough points. Each
+    /// model starts from its last solution (a few Levenberg-Marquardt steps after a few more
+    /// points); every [`FULL_SEARCH_EVERY`]th refit, when a case appears, or when the warm
+    /// start fails, the full multi-start search runs instead.
+    pub fn refit(&mut self) -> Option<Vec<Fit>> {
         let total: usize = self.point_counts().iter().sum();
         if total < self.config.min_points_to_fit {
             return None;
         }
         let curves = self.curves();
-        let (fits, _failures) = fit_ranked(&self.config.models, &curves, &FitOptions::default());
+        let cases = curves.len();
+        let full = self.refits.is_multiple_of(FULL_SEARCH_EVERY) || cases != self.fitted_cases;
+        self.refits += 1;
+        self.fitted_cases = cases;
+        let mut fits = Vec::with_capacity(self.config.models.len());
+        for (k, model) in self.config.models.iter().enumerate() {
+            let options = FitOptions {
+                warm_start: if full { None } else { self.warm[k].clone() },
+                ..FitOptions::default()
+            };
+            match fit_model(model, &curves, &options) {
+                Ok(fit) => {
+                    self.warm[k] = Some(fit.params.clone());
+                    fits.push(fit);
+                }
+                Err(_) => self.warm[k] = None,
+            }
+        }
+        fits.sort_by(|a, b| a.aic.total_cmp(&b.aic));
         (!fits.is_empty()).then_some(fits)
     }
 }

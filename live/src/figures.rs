@@ -45,14 +45,15 @@ pub fn identification_figures(
     identifier::plot::write_plots(dir, &curves, &fits, route.as_ref()).map_err(|e| e.to_string())
 }
 
-/// RGB colour map of the last field's exx over the reference image, as PNG at `path`.
+/// RGB colour map of a field's exx over its origin image, as PNG at `path`; returns the
+/// strain range from blue to red.
 pub fn strain_map(
     path: &Path,
     grey: &[u16],
     width: usize,
     field: &correlator::Field,
-) -> Result<(), String> {
-    let (rgb, _range) = correlator::output::colour_map_rgb(grey, width, field, |n| n.exx);
+) -> Result<[f64; 2], String> {
+    let (rgb, range) = correlator::output::colour_map_rgb(grey, width, field, |n| n.exx);
     let height = grey.len() / width;
     let mut bytes = Vec::new();
     image::ImageEncoder::write_image(
@@ -63,7 +64,8 @@ pub fn strain_map(
         image::ExtendedColorType::Rgb8,
     )
     .map_err(|e| format!("{}: {e}", path.display()))?;
-    crate::results::write_atomic(path, &bytes)
+    crate::results::write_atomic(path, &bytes)?;
+    Ok([range.low, range.high])
 }
 
 /// Latency (ms) against log10 of 1/(1 − percentile), the usual HdrHistogram plot.

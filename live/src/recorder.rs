@@ -37,8 +37,11 @@ pub struct Recorder {
     pub last_nodes: Vec<FieldNode>,
     pub last_report: Option<IdentificationReport>,
     pub rig_samples_seen: u64,
-    /// First frame of the run (the correlator's first reference) for the strain map.
-    pub first_frame: Option<(FrameHeader, Vec<u16>)>,
+    /// First frame of the latest frame sequence (the correlator's origin for it).
+    pub sequence_first_frame: Option<(FrameHeader, Vec<u16>)>,
+    /// The most strained field of the latest sequence (largest gauge log strain), for the
+    /// strain map: its header and nodes.
+    pub peak_field: Option<(FieldHeader, Vec<FieldNode>)>,
     /// Largest measured stretch per load case code (1 uniaxial, 2 equibiaxial).
     pub max_stretch: [f64; 3],
     row: String,
@@ -70,7 +73,8 @@ impl Recorder {
             last_nodes: Vec::new(),
             last_report: None,
             rig_samples_seen: 0,
-            first_frame: None,
+            sequence_first_frame: None,
+            peak_field: None,
             max_stretch: [1.0; 3],
             row: String::with_capacity(1024),
             text: String::new(),
@@ -94,8 +98,13 @@ impl Recorder {
         if header.has_truth == 1 {
             self.truths.push(header.frame_id, header.truth);
         }
-        if self.first_frame.is_none() && header.validate(pixels.len()).is_ok() {
-            self.first_frame = Some((*header, pixels.to_vec()));
+        let new_sequence = self
+            .sequence_first_frame
+            .as_ref()
+            .is_none_or(|(first, _)| first.sequence_id != header.sequence_id);
+        if new_sequence && header.validate(pixels.len()).is_ok() {
+            // One copy per sequence (the frame stays in shared memory otherwise).
+            self.sequence_first_frame = Some((*header, pixels.to_vec()));
         }
     }
 
@@ -140,6 +149,21 @@ impl Recorder {
         self.last_field = Some(*header);
         self.last_nodes.clear();
         self.last_nodes.extend_from_slice(nodes);
+        let strain = |h: &FieldHeader| {
+            let g = h.gauge_of(wire::StrainMeasure::Log);
+            g.exx.abs().max(g.eyy.abs())
+        };
+        let is_peak = self.peak_field.as_ref().is_none_or(|(peak, _)| {
+            peak.sequence_id != header.sequence_id || strain(header) > strain(peak)
+        });
+        if is_peak && header.valid_nodes > 0 {
+            let (peak_header, peak_nodes) = self
+                .peak_field
+                .get_or_insert_with(|| (*header, Vec::with_capacity(nodes.len())));
+            *peak_header = *header;
+            peak_nodes.clear();
+            peak_nodes.extend_from_slice(nodes);
+        }
     }
 
     pub fn on_report(&mut self, report: IdentificationReport) {

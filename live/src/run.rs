@@ -67,7 +67,19 @@ pub struct RunReport {
     /// worst node error of the run.
     pub displacement_error_mean_px: Option<f64>,
     pub acceptance: Option<Acceptance>,
+    /// What `strain_map.png` shows.
+    pub strain_map: Option<StrainMapInfo>,
     pub leftover_shm_files: usize,
+}
+
+/// The field drawn in `strain_map.png` (the most strained field of the last test) and the
+/// exx range of its colours.
+#[derive(Clone, Debug, Serialize)]
+pub struct StrainMapInfo {
+    pub frame_id: u64,
+    pub origin_frame_id: u64,
+    pub measure: &'static str,
+    pub exx_blue_to_red: [f64; 2],
 }
 
 /// Seconds a process gets to say it is ready.
@@ -530,17 +542,32 @@ fn finish(
         )
         .map(|_| ()),
     );
-    if let (Some((frame, pixels)), Some(field)) = (&recorder.first_frame, &recorder.last_field) {
-        let field = crate::recorder::to_correlator_field(field, &recorder.last_nodes);
-        keep(
-            "strain_map.png",
-            crate::figures::strain_map(
+    let mut strain_map = None;
+    if let (Some((frame, pixels)), Some((field, nodes))) =
+        (&recorder.sequence_first_frame, &recorder.peak_field)
+    {
+        // The most strained field of the last test over the image its mesh is defined in.
+        if field.origin_frame_id == frame.frame_id {
+            let header = *field;
+            let field = crate::recorder::to_correlator_field(field, nodes);
+            match crate::figures::strain_map(
                 &results.path("strain_map.png"),
                 pixels,
                 frame.width_px as usize,
                 &field,
-            ),
-        );
+            ) {
+                Ok(range) => {
+                    strain_map = Some(StrainMapInfo {
+                        frame_id: header.frame_id,
+                        origin_frame_id: header.origin_frame_id,
+                        measure: wire::StrainMeasure::from_code(header.strain_measure)
+                            .map_or("?", |m| m.name()),
+                        exx_blue_to_red: range,
+                    })
+                }
+                Err(e) => keep("strain_map.png", Err(e)),
+            }
+        }
     }
     let acceptance = recorder.last_report.map(|report| {
         let truth = config.law().expect("validated law");
@@ -578,6 +605,7 @@ fn finish(
         latency_identification_ms: recorder.latency_identification.percentiles(),
         displacement_error_mean_px,
         acceptance,
+        strain_map,
         leftover_shm_files,
     };
     let mut json = serde_json::to_value(&report).map_err(|e| e.to_string())?;
