@@ -87,6 +87,8 @@ const READY_TIMEOUT: Duration = Duration::from_secs(120);
 /// Longest wait for the correlator and identifier to finish the last frames.
 const DRAIN_TIMEOUT: Duration = Duration::from_secs(10);
 const WAIT_SLICE: Duration = Duration::from_millis(200);
+/// Relative margin of the camera's stretch envelope beyond the campaign's largest stretch.
+const STRETCH_MARGIN: f64 = 0.05;
 
 fn fmt_list(values: &[f64]) -> String {
     values
@@ -96,12 +98,14 @@ fn fmt_list(values: &[f64]) -> String {
         .join(",")
 }
 
-/// The command line of each child.
+/// The command line of each child. `first_frame_id` is where the camera's frame ids start
+/// (past the last id seen when a camera is restarted, so ids never go back).
 pub fn child_args(
     role: Role,
     config: &RunConfig,
     instance: &str,
     results: &ResultsDir,
+    first_frame_id: u64,
 ) -> Vec<String> {
     let path = |p: PathBuf| p.to_string_lossy().into_owned();
     let mut args = vec!["--instance".to_string(), instance.to_string()];
@@ -139,13 +143,16 @@ pub fn child_args(
             "--mm-per-px".into(),
             c.mm_per_px.to_string(),
             "--max-stretch".into(),
-            config.max_stretch().to_string(),
+            // The rig overshoots a level by a little: the camera covers a margin beyond it.
+            (config.max_stretch() * (1.0 + STRETCH_MARGIN)).to_string(),
             "--speckle-size-px".into(),
             c.speckle_size_px.to_string(),
             "--seed".into(),
             c.seed.to_string(),
             "--threads".into(),
             c.threads.to_string(),
+            "--first-frame-id".into(),
+            first_frame_id.to_string(),
         ],
         Role::Correlator => vec![
             "--zoi".into(),
@@ -216,9 +223,42 @@ const STOP_ORDER: [Role; 4] = [
     Role::Identifier,
 ];
 
+/// Removes the shared-memory files of earlier default-named runs (`run_<pid>`) whose
+/// supervisor is gone (killed with SIGKILL, or a power cut of the session); returns how many
+/// runs were cleaned.
+pub fn remove_dead_runs() -> usize {
+    let Ok(entries) = std::fs::read_dir(wire::shm::SHM_PATH) else {
+        return 0;
+    };
+    let mut dead: Vec<u32> = entries
+        .flatten()
+        .filter_map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let pid: u32 = name.strip_prefix("run_")?.split('_').next()?.parse().ok()?;
+            let alive = Path::new(&format!("/proc/{pid}")).exists();
+            (!alive).then_some(pid)
+        })
+        .collect();
+    dead.sort_unstable();
+    dead.dedup();
+    for pid in &dead {
+        if let Ok(instance) = wire::Instance::new(&format!("run_{pid}")) {
+            instance.cleanup_dead_nodes();
+            instance.remove_leftover_files();
+        }
+    }
+    dead.len()
+}
+
 pub fn run(options: RunOptions) -> Result<RunReport, String> {
     let config = &options.config;
     config.validate()?;
+    let cleaned = remove_dead_runs();
+    if cleaned > 0 {
+        println!(
+            "run: removed the shared memory of {cleaned} earlier run(s) that did not end cleanly"
+        );
+    }
     let instance_name = options
         .instance
         .clone()
@@ -320,7 +360,7 @@ fn start_children(
     results: &ResultsDir,
 ) -> Result<(), String> {
     for role in start_order() {
-        supervisor.spawn(role, child_args(role, config, instance, results))?;
+        supervisor.spawn(role, child_args(role, config, instance, results, 0))?;
         supervisor.wait_ready(role, READY_TIMEOUT)?;
         println!(
             "run: {} ready (pid {})",
@@ -401,7 +441,16 @@ fn event_loop(
                 };
                 continue;
             }
-            handle_death(exit, supervisor, config, instance, results, state)?;
+            let next_frame_id = recorder.last_frame_id.map_or(0, |id| id + 1);
+            handle_death(
+                exit,
+                supervisor,
+                config,
+                instance,
+                results,
+                next_frame_id,
+                state,
+            )?;
         }
 
         if let Phase::Draining { since, last_frame } = phase {
@@ -449,6 +498,7 @@ fn handle_death(
     config: &RunConfig,
     instance: &str,
     results: &ResultsDir,
+    next_frame_id: u64,
     state: &mut LoopState,
 ) -> Result<(), String> {
     let role = exit.role;
@@ -474,7 +524,8 @@ fn handle_death(
         ));
     }
     *count += 1;
-    let pid = supervisor.restart(role, Some(child_args(role, config, instance, results)))?;
+    let args = child_args(role, config, instance, results, next_frame_id);
+    let pid = supervisor.restart(role, Some(args))?;
     supervisor.wait_ready(role, READY_TIMEOUT)?;
     let note = format!(
         "{} restarted (pid {pid}, restart {} of {}) after: {}",

@@ -22,6 +22,9 @@ pub struct StreamSettings {
     pub fps: Option<f64>,
     /// Stop after this many frames (the source may end earlier).
     pub max_frames: Option<u64>,
+    /// Id of the first frame (ids are consecutive from it): a restarted camera continues the
+    /// numbering of the one it replaces, so consumers see no id going back.
+    pub first_frame_id: u64,
 }
 
 /// What a stream did.
@@ -135,6 +138,7 @@ struct Shell {
     /// When the first frame was sent.
     first_sent: Option<Instant>,
     limit: u64,
+    first_frame_id: u64,
     report: StreamReport,
 }
 
@@ -164,6 +168,7 @@ impl Shell {
             slots: 0,
             first_sent: None,
             limit: settings.max_frames.unwrap_or(u64::MAX),
+            first_frame_id: settings.first_frame_id,
             report: StreamReport::default(),
         })
     }
@@ -202,7 +207,7 @@ impl Shell {
         &mut self,
         render: impl FnOnce(&mut [u16]) -> Result<Option<FrameInfo>, ProducerError>,
     ) -> Result<Option<FrameHeader>, StreamError> {
-        let frame_id = self.report.frames_sent;
+        let frame_id = self.first_frame_id + self.report.frames_sent;
         let dims = self.dims;
         let mut sent_header = FrameHeader::default();
         let outcome = self.publisher.publish(dims.len_px(), |header, pixels| {

@@ -13,12 +13,16 @@ pub struct BenchArgs {
     pub command: BenchCommand,
 }
 
-/// The benchmarks (more will be added, e.g. the whole pipeline).
+/// The benchmarks.
 #[derive(clap::Subcommand, Debug)]
 pub enum BenchCommand {
     /// Correlator throughput on rendered speckle: ZOIs/s and frames/s per thread count, the
     /// time split (FFT, window, peak, shift, other) and a plain 2-D FFT timing for scale.
     Correlate(CorrelateBenchArgs),
+    /// The live bench as processes on this machine: per-frame latency from capture to field
+    /// and to identification, sustained rate, drops, CPU per process; `--fps max` finds the
+    /// highest rate without drops.
+    Pipeline(super::bench_pipeline::PipelineBenchArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -57,6 +61,7 @@ const SHIFT_PX: [f64; 2] = [0.37, -0.21];
 pub fn run(args: BenchArgs) -> Result<()> {
     match args.command {
         BenchCommand::Correlate(args) => correlate(args),
+        BenchCommand::Pipeline(args) => super::bench_pipeline::run(args),
     }
 }
 

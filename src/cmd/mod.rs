@@ -1,6 +1,7 @@
 //! The subcommands of `dicstream`, one module each.
 
 pub mod bench;
+pub mod bench_pipeline;
 pub mod correlate;
 pub mod correlator;
 pub mod identifier;

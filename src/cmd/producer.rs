@@ -50,6 +50,10 @@ pub struct ProducerArgs {
     /// once [default: all] (endlessly with --loop); --follow-rig runs until stopped [default]
     #[arg(long)]
     pub frames: Option<u64>,
+    /// Id of the first frame; ids go on consecutively from it (a restarted camera continues
+    /// the numbering of the one it replaces)
+    #[arg(long, default_value_t = 0)]
+    pub first_frame_id: u64,
     /// Instance name (shared-memory prefix); runs with different names never meet
     #[arg(long, default_value_t = wire::Instance::default_name())]
     pub instance: String,
@@ -72,6 +76,7 @@ pub fn run(args: ProducerArgs) -> anyhow::Result<()> {
     let settings = StreamSettings {
         fps: (args.fps > 0.0).then_some(args.fps),
         max_frames: args.frames,
+        first_frame_id: args.first_frame_id,
     };
     let mut warned_beyond = false;
     let mut on_event = |event: StreamEvent| match event {

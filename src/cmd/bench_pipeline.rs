@@ -1,0 +1,114 @@
+//! `dicstream bench pipeline`: the live bench's per-frame latency, sustained rate, drops and
+//! CPU per process on this machine (see `live::pipeline`).
+
+use anyhow::Result;
+use live::pipeline::{measure, PipelineResult, PipelineSettings};
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug)]
+pub struct PipelineBenchArgs {
+    /// Frame width and height, px.
+    #[arg(long, default_value_t = 1024)]
+    pub width: u32,
+    #[arg(long, default_value_t = 1024)]
+    pub height: u32,
+    /// ZOI side and step, px.
+    #[arg(long, default_value_t = 32)]
+    pub zoi: usize,
+    #[arg(long, default_value_t = 16)]
+    pub step: usize,
+    /// Correlator threads.
+    #[arg(long, default_value_t = 2)]
+    pub threads: usize,
+    /// Frames per second, or `max`: the highest rate without a dropped frame (trials of
+    /// --seconds each at doubling, then bisected, rates).
+    #[arg(long, default_value = "10")]
+    pub fps: String,
+    /// Length of the measured stream per trial (s of wall time).
+    #[arg(long, default_value_t = 60.0)]
+    pub seconds: f64,
+    /// Parent folder of the trials' results folders.
+    #[arg(long, default_value = "results/bench")]
+    pub out: PathBuf,
+    /// Print one JSON object (keys fps_sustained, frames, dropped, latency_ms{field,
+    /// identification}{p50,p90,p99,p999,max}, cpu_cores) instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn describe(r: &PipelineResult) -> String {
+    let l = |name: &str| {
+        r.latency_ms.get(name).map_or(String::new(), |p| {
+            format!(
+                "{name}: p50 {:.1} p90 {:.1} p99 {:.1} p99.9 {:.1} max {:.1} ms",
+                p.p50, p.p90, p.p99, p.p999, p.max
+            )
+        })
+    };
+    let cpu: Vec<String> = r
+        .cpu_cores
+        .iter()
+        .map(|(name, cores)| format!("{name} {:.0} %", 100.0 * cores))
+        .collect();
+    format!(
+        "{:.1} frames/s asked, {:.2} sustained; {} frames, {} dropped\n  latency from capture to {}\n  latency from capture to {}\n  CPU (100 % = one core): {}\n  results: {}",
+        r.fps_requested,
+        r.fps_sustained,
+        r.frames,
+        r.dropped,
+        l("field"),
+        l("identification"),
+        cpu.join(", "),
+        r.results.display()
+    )
+}
+
+pub fn run(args: PipelineBenchArgs) -> Result<()> {
+    let fps = match args.fps.as_str() {
+        "max" => None,
+        text => match text.parse::<f64>() {
+            Ok(f) if f.is_finite() && f > 0.0 => Some(f),
+            _ => anyhow::bail!("--fps {text:?}: expected a positive rate or max"),
+        },
+    };
+    if !(args.seconds.is_finite() && args.seconds >= 5.0) {
+        anyhow::bail!("--seconds {}: expected at least 5 s", args.seconds);
+    }
+    let settings = PipelineSettings {
+        width_px: args.width,
+        height_px: args.height,
+        zoi_px: args.zoi,
+        step_px: args.step,
+        correlator_threads: args.threads,
+        fps,
+        seconds: args.seconds,
+        results_dir: args.out.clone(),
+        exe: std::env::current_exe()?,
+    };
+    let json = args.json;
+    let result = measure(&settings, |trial| {
+        if !json {
+            println!("trial: {}", describe(trial));
+        } else {
+            eprintln!(
+                "trial at {:.1} frames/s: {} dropped",
+                trial.fps_requested, trial.dropped
+            );
+        }
+    })
+    .map_err(anyhow::Error::msg)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&result)?);
+    } else {
+        println!(
+            "bench pipeline, {}x{} px, ZOI {} px, step {} px, {} correlator thread(s):\n  {}",
+            args.width,
+            args.height,
+            args.zoi,
+            args.step,
+            args.threads,
+            describe(&result)
+        );
+    }
+    Ok(())
+}
