@@ -45,6 +45,10 @@ pub struct Proc {
 }
 
 impl Proc {
+    pub fn pid(&self) -> i32 {
+        self.pid
+    }
+
     /// Every stderr line so far, for failure messages.
     pub fn stderr_so_far(&self) -> String {
         self.stderr_log.lock().unwrap().join("\n")
