@@ -75,6 +75,27 @@ fn child_pid(parent: i32, role: &str) -> Option<i32> {
     None
 }
 
+/// Starts `dicstream run` with `config`, results into `out`, on the test's instance; returns
+/// its pid.
+fn start_run(run: &mut Run, config: &Path, out: &Path, extra: &[&str]) -> i32 {
+    let (instance, config_arg, out_arg) = (
+        run.name().to_string(),
+        config.display().to_string(),
+        out.display().to_string(),
+    );
+    let mut args = vec![
+        "run",
+        "--config",
+        &config_arg,
+        "--instance",
+        &instance,
+        "--out",
+        &out_arg,
+    ];
+    args.extend_from_slice(extra);
+    run.spawn("run", &args).pid()
+}
+
 fn kill9(pid: i32) {
     // SAFETY: signalling a process of this test's own tree.
     assert_eq!(
@@ -98,24 +119,7 @@ fn each_process_killed_in_turn_is_reported_restarted_and_the_run_completes() {
     let mut run = Run::new("run_faults");
     let config = config(&run, SHORT_CAMPAIGN);
     let out = results_folder(&run);
-    let (instance, config_arg, out_arg) = (
-        run.name().to_string(),
-        config.display().to_string(),
-        out.display().to_string(),
-    );
-    let bench = run.spawn(
-        "run",
-        &[
-            "run",
-            "--config",
-            &config_arg,
-            "--instance",
-            &instance,
-            "--out",
-            &out_arg,
-        ],
-    );
-    let parent = bench.pid();
+    let parent = start_run(&mut run, &config, &out, &[]);
     let frames_csv = out.join("frames.csv");
     let mut seen = wait_rows(&frames_csv, 0, 15);
     for role in ["correlator", "identifier", "producer", "rig"] {
@@ -180,24 +184,7 @@ fn ctrl_c_stops_every_process_and_keeps_the_results() {
     let mut run = Run::new("run_ctrl_c");
     let config = config(&run, SHORT_CAMPAIGN);
     let out = results_folder(&run);
-    let (instance, config_arg, out_arg) = (
-        run.name().to_string(),
-        config.display().to_string(),
-        out.display().to_string(),
-    );
-    let bench = run.spawn(
-        "run",
-        &[
-            "run",
-            "--config",
-            &config_arg,
-            "--instance",
-            &instance,
-            "--out",
-            &out_arg,
-        ],
-    );
-    let parent = bench.pid();
+    let parent = start_run(&mut run, &config, &out, &[]);
     wait_rows(&out.join("frames.csv"), 0, 10);
     let children: Vec<i32> = ["rig", "producer", "correlator", "identifier"]
         .iter()
@@ -241,24 +228,8 @@ fn a_correlator_slower_than_the_camera_drops_frames_and_counts_them() {
         );
     std::fs::write(&config, text).unwrap();
     let out = results_folder(&run);
-    let (instance, config_arg, out_arg) = (
-        run.name().to_string(),
-        config.display().to_string(),
-        out.display().to_string(),
-    );
-    let (status, stdout, stderr) = run.run_to_end(
-        "run",
-        &[
-            "run",
-            "--config",
-            &config_arg,
-            "--instance",
-            &instance,
-            "--out",
-            &out_arg,
-            "--quiet",
-        ],
-    );
+    start_run(&mut run, &config, &out, &["--quiet"]);
+    let (status, stdout, stderr) = run.child("run").wait();
     assert!(status.success(), "{stdout}\n{stderr}");
     let s = summary(&out);
     let captured = s["frames_captured"].as_u64().unwrap();

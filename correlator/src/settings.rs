@@ -36,6 +36,11 @@ impl StrainMeasure {
             Self::Log => "log",
         }
     }
+
+    /// The measure called `name` (`small`, `green`, `nominal`, `log`).
+    pub fn from_name(name: &str) -> Option<StrainMeasure> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
 }
 
 /// Which image the deformed images are compared with.
@@ -61,6 +66,27 @@ impl ReferenceMode {
         max_displacement_zoi_fraction: 0.25,
         min_mean_score: 0.5,
     };
+
+    /// `fixed`, `incremental` or `auto` (with the default thresholds).
+    pub fn from_name(name: &str) -> Option<ReferenceMode> {
+        match name {
+            "fixed" => Some(ReferenceMode::Fixed),
+            "incremental" => Some(ReferenceMode::Incremental),
+            "auto" => Some(ReferenceMode::AUTO_DEFAULT),
+            _ => None,
+        }
+    }
+}
+
+impl GuessMode {
+    /// `correli` or `predict`.
+    pub fn from_name(name: &str) -> Option<GuessMode> {
+        match name {
+            "correli" => Some(GuessMode::Correli),
+            "predict" => Some(GuessMode::Predict),
+            _ => None,
+        }
+    }
 }
 
 /// Initial guess of each ZOI before its integer FFT correlation.

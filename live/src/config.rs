@@ -258,36 +258,24 @@ impl RunConfig {
     pub fn correlator_settings(&self) -> Result<correlator::CorrelatorSettings, String> {
         use correlator::{GuessMode, ReferenceMode, StrainMeasure};
         let c = &self.correlator;
-        let strain = match c.strain.as_str() {
-            "log" => StrainMeasure::Log,
-            "green" => StrainMeasure::Green,
-            "nominal" => StrainMeasure::Nominal,
-            "small" => StrainMeasure::Small,
-            other => {
-                return Err(format!(
-                    "[correlator] strain = {other:?}: expected log, green, nominal or small"
-                ))
-            }
-        };
-        let reference = match c.reference.as_str() {
-            "fixed" => ReferenceMode::Fixed,
-            "incremental" => ReferenceMode::Incremental,
-            "auto" => ReferenceMode::AUTO_DEFAULT,
-            other => {
-                return Err(format!(
-                    "[correlator] reference = {other:?}: expected fixed, incremental or auto"
-                ))
-            }
-        };
-        let guess = match c.guess.as_str() {
-            "predict" => GuessMode::Predict,
-            "correli" => GuessMode::Correli,
-            other => {
-                return Err(format!(
-                    "[correlator] guess = {other:?}: expected predict or correli"
-                ))
-            }
-        };
+        let strain = StrainMeasure::from_name(&c.strain).ok_or_else(|| {
+            format!(
+                "[correlator] strain = {:?}: expected log, green, nominal or small",
+                c.strain
+            )
+        })?;
+        let reference = ReferenceMode::from_name(&c.reference).ok_or_else(|| {
+            format!(
+                "[correlator] reference = {:?}: expected fixed, incremental or auto",
+                c.reference
+            )
+        })?;
+        let guess = GuessMode::from_name(&c.guess).ok_or_else(|| {
+            format!(
+                "[correlator] guess = {:?}: expected predict or correli",
+                c.guess
+            )
+        })?;
         let settings = correlator::CorrelatorSettings {
             zoi_px: c.zoi_px,
             step_px: c.step_px,

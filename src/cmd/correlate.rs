@@ -35,6 +35,36 @@ pub enum GuessArg {
     Predict,
 }
 
+impl StrainArg {
+    pub fn measure(self) -> StrainMeasure {
+        match self {
+            StrainArg::Log => StrainMeasure::Log,
+            StrainArg::Green => StrainMeasure::Green,
+            StrainArg::Nominal => StrainMeasure::Nominal,
+            StrainArg::Small => StrainMeasure::Small,
+        }
+    }
+}
+
+impl ReferenceArg {
+    pub fn mode(self) -> ReferenceMode {
+        match self {
+            ReferenceArg::Fixed => ReferenceMode::Fixed,
+            ReferenceArg::Incremental => ReferenceMode::Incremental,
+            ReferenceArg::Auto => ReferenceMode::AUTO_DEFAULT,
+        }
+    }
+}
+
+impl GuessArg {
+    pub fn mode(self) -> GuessMode {
+        match self {
+            GuessArg::Correli => GuessMode::Correli,
+            GuessArg::Predict => GuessMode::Predict,
+        }
+    }
+}
+
 #[derive(clap::Args, Debug)]
 pub struct CorrelateArgs {
     /// Reference image (PNG, TIFF or BMP, 8 or 16 bit).
@@ -103,21 +133,9 @@ impl CorrelateArgs {
             zoi_px: self.zoi,
             step_px: self.step,
             roi: self.roi,
-            strain: match self.strain {
-                StrainArg::Log => StrainMeasure::Log,
-                StrainArg::Green => StrainMeasure::Green,
-                StrainArg::Nominal => StrainMeasure::Nominal,
-                StrainArg::Small => StrainMeasure::Small,
-            },
-            reference: match self.reference_mode {
-                ReferenceArg::Fixed => ReferenceMode::Fixed,
-                ReferenceArg::Incremental => ReferenceMode::Incremental,
-                ReferenceArg::Auto => ReferenceMode::AUTO_DEFAULT,
-            },
-            guess: match self.guess {
-                GuessArg::Correli => GuessMode::Correli,
-                GuessArg::Predict => GuessMode::Predict,
-            },
+            strain: self.strain.measure(),
+            reference: self.reference_mode.mode(),
+            guess: self.guess.mode(),
             threads: self.threads,
             max_iterations: self.max_iterations,
             ..CorrelatorSettings::default()

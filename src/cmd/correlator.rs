@@ -4,7 +4,7 @@
 use super::correlate::{parse_roi, GuessArg, ReferenceArg, StrainArg};
 use anyhow::{bail, Context, Result};
 use correlator::process::{run as run_process, ProcessConfig, ReferenceImage};
-use correlator::{CorrelatorSettings, GuessMode, ReferenceMode, Roi, StrainMeasure};
+use correlator::{CorrelatorSettings, Roi};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -58,21 +58,9 @@ impl CorrelatorArgs {
             zoi_px: self.zoi,
             step_px: self.step,
             roi: self.roi,
-            strain: match self.strain {
-                StrainArg::Log => StrainMeasure::Log,
-                StrainArg::Green => StrainMeasure::Green,
-                StrainArg::Nominal => StrainMeasure::Nominal,
-                StrainArg::Small => StrainMeasure::Small,
-            },
-            reference: match self.reference_mode {
-                ReferenceArg::Fixed => ReferenceMode::Fixed,
-                ReferenceArg::Incremental => ReferenceMode::Incremental,
-                ReferenceArg::Auto => ReferenceMode::AUTO_DEFAULT,
-            },
-            guess: match self.guess {
-                GuessArg::Correli => GuessMode::Correli,
-                GuessArg::Predict => GuessMode::Predict,
-            },
+            strain: self.strain.measure(),
+            reference: self.reference_mode.mode(),
+            guess: self.guess.mode(),
             threads: self.threads,
             max_iterations: self.max_iterations,
             ..CorrelatorSettings::default()
