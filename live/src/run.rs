@@ -87,6 +87,8 @@ const READY_TIMEOUT: Duration = Duration::from_secs(120);
 /// Longest wait for the correlator and identifier to finish the last frames.
 const DRAIN_TIMEOUT: Duration = Duration::from_secs(10);
 const WAIT_SLICE: Duration = Duration::from_millis(200);
+/// How often the latency histograms are rewritten during the run.
+const HISTOGRAM_EVERY: Duration = Duration::from_secs(10);
 /// Relative margin of the camera's stretch envelope beyond the campaign's largest stretch.
 const STRETCH_MARGIN: f64 = 0.05;
 
@@ -414,6 +416,7 @@ fn event_loop(
     }
     let status_every = Duration::from_secs_f64(config.run.status_interval_s);
     let mut next_status = Instant::now() + status_every;
+    let mut next_histograms = Instant::now() + HISTOGRAM_EVERY;
     let mut phase = Phase::Running;
     let stop_timeout = Duration::from_secs_f64(config.run.stop_timeout_s);
     loop {
@@ -478,6 +481,12 @@ fn event_loop(
 
         if Instant::now() >= next_status {
             supervisor.sample_cpu();
+            if next_histograms <= Instant::now() {
+                // Kept up to date, so a run killed outright still leaves its latencies (a
+                // write error is reported once at the end, when they are written again).
+                let _ = write_histograms(results, recorder);
+                next_histograms = Instant::now() + HISTOGRAM_EVERY;
+            }
             if status {
                 println!(
                     "{}",
@@ -673,6 +682,18 @@ fn finish(
             .as_bytes(),
     )?;
     Ok(report)
+}
+
+/// `latency.hgrm` (capture to field) and `latency_identification.hgrm`.
+fn write_histograms(results: &ResultsDir, recorder: &Recorder) -> Result<(), String> {
+    write_atomic(
+        &results.path("latency.hgrm"),
+        recorder.latency_field.hgrm().as_bytes(),
+    )?;
+    write_atomic(
+        &results.path("latency_identification.hgrm"),
+        recorder.latency_identification.hgrm().as_bytes(),
+    )
 }
 
 /// Mean of the `disp_error_mean_px` column of `frames.csv`, if any frame has it.

@@ -18,6 +18,9 @@ pub struct RunArgs {
     /// Instance name (shared-memory prefix) [default: run_<pid>].
     #[arg(long)]
     pub instance: Option<String>,
+    /// Also write the kept fields as legacy VTK for ParaView (the configuration's `vtk`).
+    #[arg(long)]
+    pub vtk: bool,
     /// No status line (start and end only).
     #[arg(long)]
     pub quiet: bool,
@@ -36,6 +39,8 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
         }
         None => RunConfig::default(),
     };
+    let mut config = config;
+    config.run.vtk |= args.vtk;
     config
         .validate()
         .map_err(|e| anyhow::anyhow!("configuration refused: {e}"))?;
