@@ -7,6 +7,11 @@
 //!    (bounded: [`ROUTE_PASSES`] passes).
 //! 4. Levenberg-Marquardt refinement of all a_i, b_i against the measured stresses of every load
 //!    case at once (model `lambert-diani-rey`).
+//!
+//! Eqs. 20 and 23 divide the stress by a term that vanishes at λ = 1: the few points within
+//! [`ROUTE_MIN_STRETCH`] of the unstretched state turn load-cell noise into arbitrary (even
+//! negative) f and g values, so steps 1-3 leave them out (the refinement of step 4 uses every
+//! point).
 
 use crate::data::{Curve, LoadCase};
 use crate::law::{InvariantFn, InvariantLaw};
@@ -15,6 +20,22 @@ use nalgebra::{DMatrix, DVector};
 
 /// Passes of the f ↔ g correction.
 pub const ROUTE_PASSES: usize = 5;
+
+/// Smallest stretch whose data enter eqs. 20 and 23.
+pub const ROUTE_MIN_STRETCH: f64 = 1.02;
+
+/// The part of `curve` at or beyond [`ROUTE_MIN_STRETCH`].
+fn route_part(curve: &Curve) -> Curve {
+    let keep: Vec<usize> = (0..curve.stretch.len())
+        .filter(|&i| curve.stretch[i] >= ROUTE_MIN_STRETCH)
+        .collect();
+    Curve {
+        case: curve.case,
+        stretch: keep.iter().map(|&i| curve.stretch[i]).collect(),
+        nominal_stress_mpa: keep.iter().map(|&i| curve.nominal_stress_mpa[i]).collect(),
+        reference_rows_dropped: curve.reference_rows_dropped,
+    }
+}
 
 /// Experimental invariant-derivative points (eq. 20 or 23): (invariant, value in MPa).
 pub type InvariantPoints = Vec<(f64, f64)>;
@@ -162,14 +183,14 @@ pub fn paper_route(
     f_degree: usize,
     g_degree: usize,
 ) -> Result<RouteResult, RouteError> {
-    let uniaxial = curves
-        .iter()
-        .find(|c| c.case == LoadCase::Uniaxial)
-        .ok_or(RouteError::MissingCase(LoadCase::Uniaxial))?;
-    let equibiaxial = curves
-        .iter()
-        .find(|c| c.case == LoadCase::Equibiaxial)
-        .ok_or(RouteError::MissingCase(LoadCase::Equibiaxial))?;
+    let part = |case| {
+        curves
+            .iter()
+            .find(|c| c.case == case)
+            .map(route_part)
+            .ok_or(RouteError::MissingCase(case))
+    };
+    let (uniaxial, equibiaxial) = (&part(LoadCase::Uniaxial)?, &part(LoadCase::Equibiaxial)?);
     let f_points_uncorrected = f_points(uniaxial, None);
     let mut a = fit_log_polynomial(&f_points_uncorrected, f_degree, "f(I1) from eq. 20")?;
     let mut b = Vec::new();

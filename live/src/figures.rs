@@ -41,6 +41,7 @@ pub fn identification_figures(
     }
     let models = identifier::models::parse_model_list(models)?;
     let (fits, _failures) = fit_ranked(&models, &curves, &FitOptions::default());
+    // Without both cases the route cannot run: the f(I1) and g(I2) plots show the fits only.
     let route = identifier::route::paper_route(&curves, 2, 2).ok();
     identifier::plot::write_plots(dir, &curves, &fits, route.as_ref()).map_err(|e| e.to_string())
 }

@@ -68,7 +68,13 @@ pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
         ..FitOptions::default()
     };
     let (fits, failures) = fit_ranked(&models, &curves, &options);
-    let route = paper_route(&curves, 2, 2).ok();
+    let route = match paper_route(&curves, 2, 2) {
+        Ok(route) => Some(route),
+        Err(e) => {
+            eprintln!("paper route (eqs. 20-25) not run: {e}");
+            None
+        }
+    };
 
     if args.json {
         let fits_json: Vec<Value> = fits.iter().map(fit_json).collect();
