@@ -288,6 +288,7 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
         config.campaign_wall_s()?
     );
     let started = Instant::now();
+    let monitor_cpu_at_start_s = crate::children::own_cpu_s();
     let t0_ns = wire::monotonic_ns();
     let mut supervisor = Supervisor::new(&options.exe, &results.logs())?;
     let outcome = {
@@ -333,7 +334,10 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
     state.cpu_s = cpu_s.into_iter().map(|(n, s)| (n.to_string(), s)).collect();
     state
         .cpu_s
-        .insert("monitor".to_string(), crate::children::own_cpu_s());
+        .insert(
+            "monitor".to_string(),
+            crate::children::own_cpu_s() - monitor_cpu_at_start_s,
+        );
     drop(supervisor);
     instance.cleanup_dead_nodes();
     instance.remove_leftover_files();
