@@ -332,12 +332,10 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
     };
     let (result, recorder, mut state, cpu_s) = outcome;
     state.cpu_s = cpu_s.into_iter().map(|(n, s)| (n.to_string(), s)).collect();
-    state
-        .cpu_s
-        .insert(
-            "monitor".to_string(),
-            crate::children::own_cpu_s() - monitor_cpu_at_start_s,
-        );
+    state.cpu_s.insert(
+        "monitor".to_string(),
+        crate::children::own_cpu_s() - monitor_cpu_at_start_s,
+    );
     drop(supervisor);
     instance.cleanup_dead_nodes();
     instance.remove_leftover_files();
