@@ -26,6 +26,25 @@ struct RefNode {
 const EXTRAPOLATION_RINGS: usize = 2;
 /// Valid nodes an extrapolating fit needs.
 const MIN_EXTRAPOLATION_NODES: usize = 6;
+/// A node further than this from the affine fit of its neighbours (within
+/// [`EXTRAPOLATION_RINGS`]) is a false match (px).
+const OUTLIER_PX: f64 = 2.0;
+
+/// Median score of the valid results (0 when none), using `scratch` (no allocation once it
+/// holds every node).
+fn median_ok_score(results: impl Iterator<Item = ZoiResult>, scratch: &mut Vec<f64>) -> f64 {
+    scratch.clear();
+    scratch.extend(
+        results
+            .filter(|r| r.status == NodeStatus::Ok && r.score.is_finite())
+            .map(|r| r.score),
+    );
+    if scratch.is_empty() {
+        return 0.0;
+    }
+    let middle = scratch.len() / 2;
+    *scratch.select_nth_unstable_by(middle, f64::total_cmp).1
+}
 
 /// An affine fit of total displacements: (u, v) at `origin_px` and the gradient ∇u.
 #[derive(Clone, Copy)]
@@ -55,7 +74,15 @@ pub struct Correlator {
     results: Vec<ZoiResult>,
     /// Total displacement of the previous frame, for the predictor (None = no usable value).
     previous: Vec<Option<(f64, f64)>>,
+    /// The same one frame earlier: with `previous`, the node's velocity per frame.
+    previous2: Vec<Option<(f64, f64)>>,
     has_previous: bool,
+    /// Nodes found inconsistent with their neighbours in this frame (scratch).
+    outliers: Vec<bool>,
+    /// Nodes correlated a second time in this frame (scratch, capacity: every node).
+    retry: Vec<usize>,
+    /// Scores of the valid nodes (scratch for their median, capacity: every node).
+    scores: Vec<f64>,
     field: Field,
     scratch_pairs: Vec<(f64, f64)>,
     frames_since_reference: u64,
@@ -102,7 +129,11 @@ impl Correlator {
             guesses: vec![(0.0, 0.0); nodes],
             results: vec![ZoiResult::default(); nodes],
             previous: vec![None; nodes],
+            previous2: vec![None; nodes],
             has_previous: false,
+            outliers: vec![false; nodes],
+            retry: Vec::with_capacity(nodes),
+            scores: Vec::with_capacity(nodes),
             field,
             scratch_pairs: vec![(0.0, 0.0); nodes],
             frames_since_reference: 0,
@@ -157,6 +188,7 @@ impl Correlator {
             };
         }
         self.previous.fill(None);
+        self.previous2.fill(None);
         self.has_previous = false;
         self.take_reference(pixels);
         Ok(())
@@ -224,6 +256,7 @@ impl Correlator {
             };
         }
         self.previous.fill(None);
+        self.previous2.fill(None);
         self.has_previous = false;
         self.take_reference(pixels);
         Ok(())
@@ -320,7 +353,13 @@ impl Correlator {
             // either would make it correlate another area.
             let previous = match (use_previous, self.previous[k]) {
                 (false, _) => None,
-                (true, Some(p)) => Some(p),
+                // A node moving steadily (a ramp) is where its last step takes it: the last
+                // value plus the last change (at a reversal this overshoots by one step, which
+                // the integer search takes back).
+                (true, Some(p)) => Some(match self.previous2[k] {
+                    Some(q) => (2.0 * p.0 - q.0, 2.0 * p.1 - q.1),
+                    None => p,
+                }),
                 (true, None) => self
                     .affine_fit_around(Some(k), EXTRAPOLATION_RINGS)
                     .or(whole_mesh)
@@ -357,13 +396,52 @@ impl Correlator {
                     max_iterations,
                 )
             };
-            // SAFETY: each node is written by exactly one item of the job.
-            unsafe { results.write(k, result) };
+            // SAFETY: each node is written by exactly one item of the job, and only when the
+            // new result is better than what is there (the first pass writes every node).
+            let better = |old: &ZoiResult| {
+                old.status != NodeStatus::Ok
+                    || (result.status == NodeStatus::Ok && result.score > old.score)
+            };
+            if unsafe { better(&results.read(k)) } {
+                unsafe { results.write(k, result) };
+            }
         };
+        // SAFETY: single-threaded here; the pool is not running.
+        for k in 0..self.mesh.len() {
+            unsafe { results.write(k, ZoiResult::default()) };
+        }
         if self.settings.guess == GuessMode::Correli || use_previous {
             self.pool.run(self.mesh.len(), &|engine, k| {
                 correlate_node(engine, k, guesses[k])
             });
+            if use_previous {
+                // A node the velocity guess failed (at a load reversal the guess overshoots by
+                // twice the last step) gets a second try from its last position.
+                // SAFETY (both closures): the pool is not running.
+                let min_score = self.settings.min_relative_score
+                    * median_ok_score(
+                        (0..self.mesh.len()).map(|k| unsafe { results.read(k) }),
+                        &mut self.scores,
+                    );
+                let retry = &mut self.retry;
+                retry.clear();
+                for k in 0..self.mesh.len() {
+                    // SAFETY: the pool is not running.
+                    let result = unsafe { results.read(k) };
+                    let failed = result.status == NodeStatus::NotConverged
+                        || (result.status == NodeStatus::Ok && result.score < min_score);
+                    if failed && self.previous[k].is_some() && self.previous2[k].is_some() {
+                        retry.push(k);
+                    }
+                }
+                let (previous, retry) = (&self.previous, &self.retry);
+                self.pool.run(retry.len(), &|engine, i| {
+                    let k = retry[i];
+                    let p = previous[k].expect("retried nodes have a previous value");
+                    let base = ref_nodes[k].base_px;
+                    correlate_node(engine, k, (p.0 - base.0, p.1 - base.1));
+                });
+            }
             return;
         }
         // Predict without a previous field: grow from the centre node, ring by ring; each node
@@ -421,8 +499,6 @@ impl Correlator {
             }
             self.scratch_pairs[k] = u;
         }
-        let mut valid = 0usize;
-        let (mut su, mut sv) = (0.0, 0.0);
         for k in 0..nx * ny {
             let r = self.ref_nodes[k];
             let result = self.results[k];
@@ -445,11 +521,50 @@ impl Correlator {
             };
             node.iterations = result.iterations;
             node.status = result.status;
-            if ok {
-                valid += 1;
-                su += node.u_px;
-                sv += node.v_px;
+        }
+        let min_score = self.settings.min_relative_score
+            * median_ok_score(self.results.iter().copied(), &mut self.scores);
+        for node in &mut self.field.nodes {
+            if node.status == NodeStatus::Ok && node.score < min_score {
+                node.status = NodeStatus::NotConverged;
+                node.u_px = 0.0;
+                node.v_px = 0.0;
             }
+        }
+        // A node far from what its neighbours say (a false match on other material) is not
+        // trusted: it is marked not converged, so that it neither biases the strains nor moves
+        // the followed mesh onto the wrong material.
+        for k in 0..nx * ny {
+            self.outliers[k] = self.field.nodes[k].status == NodeStatus::Ok
+                && self
+                    .affine_fit(Some(k), EXTRAPOLATION_RINGS, Some(k))
+                    .is_some_and(|fit| {
+                        let (u, v) = self.extrapolate(k, fit);
+                        let node = &self.field.nodes[k];
+                        (node.u_px - u).hypot(node.v_px - v) > OUTLIER_PX
+                    });
+        }
+        for (node, _) in self
+            .field
+            .nodes
+            .iter_mut()
+            .zip(&self.outliers)
+            .filter(|(_, &outlier)| outlier)
+        {
+            node.status = NodeStatus::NotConverged;
+            node.u_px = 0.0;
+            node.v_px = 0.0;
+        }
+        let (mut valid, mut su, mut sv) = (0usize, 0.0, 0.0);
+        for node in self
+            .field
+            .nodes
+            .iter()
+            .filter(|n| n.status == NodeStatus::Ok)
+        {
+            valid += 1;
+            su += node.u_px;
+            sv += node.v_px;
         }
         self.field.valid = valid;
         self.field.u_mean_px = if valid > 0 { su / valid as f64 } else { 0.0 };
@@ -462,6 +577,7 @@ impl Correlator {
             self.settings.strain,
         );
         self.field.gauge = gauge(&self.field.nodes);
+        std::mem::swap(&mut self.previous, &mut self.previous2);
         for (p, node) in self.previous.iter_mut().zip(&self.field.nodes) {
             *p = (node.status == NodeStatus::Ok).then_some((node.u_px, node.v_px));
         }
@@ -550,6 +666,16 @@ impl Correlator {
     /// of node `centre` (all valid nodes when `centre` is None): the origin of the fit, (u, v)
     /// there, and ∇u; None with fewer than [`MIN_EXTRAPOLATION_NODES`] valid nodes or collinear.
     fn affine_fit_around(&self, centre: Option<usize>, rings: usize) -> Option<AffineFit> {
+        self.affine_fit(centre, rings, None)
+    }
+
+    /// [`Self::affine_fit_around`] leaving node `exclude` out.
+    fn affine_fit(
+        &self,
+        centre: Option<usize>,
+        rings: usize,
+        exclude: Option<usize>,
+    ) -> Option<AffineFit> {
         let (nx, ny) = (self.mesh.nx, self.mesh.ny);
         let (i_range, j_range, origin) = match centre {
             Some(k) => {
@@ -575,7 +701,7 @@ impl Correlator {
         for j in j_range {
             for i in i_range.clone() {
                 let node = &self.field.nodes[j * nx + i];
-                if node.status == NodeStatus::Ok {
+                if node.status == NodeStatus::Ok && exclude != Some(j * nx + i) {
                     sums.add(
                         node.x_px - origin.0,
                         node.y_px - origin.1,

@@ -120,6 +120,11 @@ pub struct CorrelatorSettings {
     /// Half-width, in nodes, of the least-squares window of the displacement gradient
     /// (1 = 3x3 nodes).
     pub strain_window_nodes: usize,
+    /// A node whose final correlation score is below this fraction of the frame's median
+    /// score is reported not converged: a false match on other material scores far below the
+    /// nodes around it (a plain threshold would also reject the honest low scores of large
+    /// ZOIs under strain). 0 keeps every node.
+    pub min_relative_score: f64,
 }
 
 impl Default for CorrelatorSettings {
@@ -134,6 +139,7 @@ impl Default for CorrelatorSettings {
             threads: 2,
             max_iterations: 10,
             strain_window_nodes: 1,
+            min_relative_score: 0.7,
         }
     }
 }
@@ -175,6 +181,8 @@ pub enum SettingsError {
         width_px: usize,
         height_px: usize,
     },
+    #[error("minimum relative node score {fraction} is invalid: expected 0 <= fraction < 1")]
+    MinRelativeScore { fraction: f64 },
     #[error("correlate called before set_reference")]
     NoReference,
     #[error("saved reference has {got} node displacements, expected {expected} (one per node of this mesh): it was written with other settings or another image size")]
@@ -230,6 +238,11 @@ impl CorrelatorSettings {
         if !(1..=8).contains(&self.strain_window_nodes) {
             return Err(SettingsError::StrainWindow {
                 nodes: self.strain_window_nodes,
+            });
+        }
+        if !(0.0..1.0).contains(&self.min_relative_score) {
+            return Err(SettingsError::MinRelativeScore {
+                fraction: self.min_relative_score,
             });
         }
         if let ReferenceMode::Auto {
