@@ -428,8 +428,8 @@ impl Correlator {
                 for k in 0..self.mesh.len() {
                     // SAFETY: the pool is not running.
                     let result = unsafe { results.read(k) };
-                    let failed = result.status == NodeStatus::NotConverged
-                        || (result.status == NodeStatus::Ok && result.score < min_score);
+                    // Outside the image too: an overshooting guess can push a border ZOI out.
+                    let failed = result.status != NodeStatus::Ok || result.score < min_score;
                     if failed && self.previous[k].is_some() && self.previous2[k].is_some() {
                         retry.push(k);
                     }
