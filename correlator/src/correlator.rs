@@ -6,7 +6,9 @@ use crate::mesh::Mesh;
 use crate::pool::{Pool, SharedSlice};
 use crate::settings::{CorrelatorSettings, GuessMode, ReferenceMode, Roi, SettingsError};
 use crate::strain::{gauge, node_strains, AffineSums};
-use crate::zoi::{spectrum_len, Image, ReferenceSpectra, TimeSplit, ZoiResult};
+use crate::zoi::{
+    spectrum_len, GradientSensitivity, Image, ReferenceSpectra, TimeSplit, ZoiResult,
+};
 use rustfft::num_complex::Complex32;
 
 /// Per-node state of the current reference image.
@@ -69,6 +71,8 @@ pub struct Correlator {
     plain_spectra: Vec<Complex32>,
     /// Windowed, normalised reference ZOIs (n² per node, spatial).
     windowed_references: Vec<f32>,
+    /// Per node, how its rigid estimate shifts under a displacement gradient.
+    sensitivities: Vec<GradientSensitivity>,
     /// Initial guess per node against the current reference (px).
     guesses: Vec<(f64, f64)>,
     results: Vec<ZoiResult>,
@@ -126,6 +130,7 @@ impl Correlator {
             ref_nodes,
             plain_spectra: vec![zero; nodes * n2],
             windowed_references: vec![0.0; nodes * settings.zoi_px * settings.zoi_px],
+            sensitivities: vec![GradientSensitivity::default(); nodes],
             guesses: vec![(0.0, 0.0); nodes],
             results: vec![ZoiResult::default(); nodes],
             previous: vec![None; nodes],
@@ -291,6 +296,7 @@ impl Correlator {
         let n2 = spectrum_len(n);
         let plain = SharedSlice::new(&mut self.plain_spectra);
         let windowed = SharedSlice::new(&mut self.windowed_references);
+        let sensitivities = SharedSlice::new(&mut self.sensitivities);
         let ref_nodes = SharedSlice::new(&mut self.ref_nodes);
         self.pool.run(self.mesh.len(), &|engine, k| {
             // SAFETY: item k touches only node k's slots.
@@ -300,7 +306,11 @@ impl Correlator {
             }
             let nn = n * n;
             let (p, w) = unsafe { (plain.slice_mut(k * n2, n2), windowed.slice_mut(k * nn, nn)) };
-            if !engine.prepare_reference(image, r.top_left.0, r.top_left.1, p, w) {
+            let mut sensitivity = GradientSensitivity::default();
+            let ok =
+                engine.prepare_reference(image, r.top_left.0, r.top_left.1, p, w, &mut sensitivity);
+            unsafe { sensitivities.write(k, sensitivity) };
+            if !ok {
                 r.status = NodeStatus::LowContrast;
                 unsafe { ref_nodes.write(k, r) };
             }
@@ -486,13 +496,22 @@ impl Correlator {
     /// the followed nodes, then strains and gauge.
     fn assemble(&mut self) {
         let (nx, ny) = (self.mesh.nx, self.mesh.ny);
-        // First-order correction from the ZOI centre to the followed point: u(x + r) ≈ u(x) + ∇u r.
+        // First-order corrections with the local gradient ∇u of the results: the rigid ZOI's
+        // estimate is u(centre) + K vec(∇u) (see `GradientSensitivity`), and the followed
+        // point is off the ZOI centre by r: u(x + r) ≈ u(x) + ∇u r.
+        let correct_gradient = self.settings.gradient_correction;
         for k in 0..nx * ny {
             let r = self.ref_nodes[k];
             let result = self.results[k];
             let mut u = (result.u_px, result.v_px);
-            if result.status == NodeStatus::Ok && (r.offset_px.0 != 0.0 || r.offset_px.1 != 0.0) {
+            if result.status == NodeStatus::Ok {
                 if let Some(g) = self.result_gradient(k) {
+                    if correct_gradient {
+                        let bias = self.sensitivities[k]
+                            .bias_px([[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]);
+                        u.0 -= bias.0;
+                        u.1 -= bias.1;
+                    }
                     u.0 += g[(0, 0)] * r.offset_px.0 + g[(0, 1)] * r.offset_px.1;
                     u.1 += g[(1, 0)] * r.offset_px.0 + g[(1, 1)] * r.offset_px.1;
                 }

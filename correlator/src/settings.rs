@@ -125,6 +125,10 @@ pub struct CorrelatorSettings {
     /// nodes around it (a plain threshold would also reject the honest low scores of large
     /// ZOIs under strain). 0 keeps every node.
     pub min_relative_score: f64,
+    /// Beyond the paper: remove, to first order, the bias of the rigid ZOI under a
+    /// displacement gradient (it reports the motion of a point off its centre, weighted by
+    /// where its speckles are; see `zoi::GradientSensitivity`). Off = CORRELI-GD as published.
+    pub gradient_correction: bool,
 }
 
 impl Default for CorrelatorSettings {
@@ -140,6 +144,7 @@ impl Default for CorrelatorSettings {
             max_iterations: 10,
             strain_window_nodes: 1,
             min_relative_score: 0.7,
+            gradient_correction: true,
         }
     }
 }

@@ -48,6 +48,25 @@ pub struct ReferenceSpectra<'a> {
     pub windowed: &'a [f32],
 }
 
+/// How a ZOI's rigid displacement estimate responds, to first order, to a displacement gradient
+/// G within the ZOI: the estimate is u(centre) + K vec(G), vec(G) = (∂u/∂x, ∂u/∂y, ∂v/∂x,
+/// ∂v/∂y), `k[p]` the row of K for component p. A rigid ZOI weighs its speckles unevenly, so
+/// under strain it reports the motion of a point off its centre; K is that lever, read from
+/// the reference ZOI alone (see [`ZoiEngine::prepare_reference`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GradientSensitivity {
+    pub k: [[f32; 4]; 2],
+}
+
+impl GradientSensitivity {
+    /// The bias K vec(G) (px) for the gradient `g` = [[∂u/∂x, ∂u/∂y], [∂v/∂x, ∂v/∂y]].
+    pub fn bias_px(&self, g: [[f64; 2]; 2]) -> (f64, f64) {
+        let vec_g = [g[0][0], g[0][1], g[1][0], g[1][1]];
+        let row = |r: &[f32; 4]| r.iter().zip(vec_g).map(|(&k, g)| k as f64 * g).sum();
+        (row(&self.k[0]), row(&self.k[1]))
+    }
+}
+
 /// Result of one ZOI: displacement of the ZOI centre (px) against its reference position.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ZoiResult {
@@ -115,6 +134,11 @@ pub struct ZoiEngine {
     n: usize,
     fft: RealFft2d,
     window: Vec<f32>,
+    /// Row scratch of [`Self::gradient_sensitivity`]: ∂f/∂x, ∂f/∂y, w ∂f_w/∂x, w ∂f_w/∂y
+    /// (first and last entries stay 0).
+    gradient_rows: [Vec<f32>; 4],
+    /// x − centre of each column (px).
+    column_offsets: Vec<f32>,
     window_sum: f32,
     /// Zero-mean deformed ZOI (spatial, real).
     g_spatial: Vec<f32>,
@@ -161,6 +185,8 @@ impl ZoiEngine {
             n,
             fft: RealFft2d::new(n),
             window,
+            gradient_rows: std::array::from_fn(|_| vec![0.0; n]),
+            column_offsets: (0..n).map(|x| x as f32 - (n as f32 - 1.0) / 2.0).collect(),
             window_sum,
             g_spatial: vec![0.0; n * n],
             g_spectrum: vec![zero; spectrum_len(n)],
@@ -175,8 +201,9 @@ impl ZoiEngine {
         }
     }
 
-    /// Fills the two reference spectra of the ZOI with top-left (x0, y0) (inside the image).
-    /// Returns false when the ZOI has too little contrast to be correlated.
+    /// Fills the two reference spectra of the ZOI with top-left (x0, y0) (inside the image)
+    /// and its gradient sensitivity. Returns false when the ZOI has too little contrast to be
+    /// correlated.
     pub fn prepare_reference(
         &mut self,
         image: Image,
@@ -184,11 +211,13 @@ impl ZoiEngine {
         y0: usize,
         plain: &mut [Complex32],
         windowed: &mut [f32],
+        sensitivity: &mut GradientSensitivity,
     ) -> bool {
         let n = self.n;
         assert!(image.contains_block(x0 as i64, y0 as i64, n));
         assert_eq!(plain.len(), spectrum_len(n));
         assert_eq!(windowed.len(), n * n);
+        *sensitivity = GradientSensitivity::default();
         let contrast_ok = self.extract_zero_mean(image, x0, y0);
         if !contrast_ok {
             plain.fill(Complex32::new(0.0, 0.0));
@@ -201,10 +230,99 @@ impl ZoiEngine {
         }
         self.fft.forward(&self.windowed, plain);
         let ok = self.window_into(windowed).is_some();
-        if !ok {
+        if ok {
+            *sensitivity = self.gradient_sensitivity(windowed).unwrap_or_default();
+        } else {
             windowed.fill(0.0);
         }
         ok
+    }
+
+    /// The first-order response of the windowed correlation peak to a displacement gradient,
+    /// for the reference ZOI: `g_spatial` holds it zero-mean, `f_w` windowed (w (f − mean_w),
+    /// any scale). At the peak, Σ f_w ∇(w g_d) = 0, g_d the deformed ZOI moved back by the
+    /// estimate d. For g_d(x) = f(x + δ(x)), δ = e − G r (e = d − u(centre), r = x − centre),
+    /// linearising and integrating by parts gives Σ a (∇f · δ) = 0 with
+    /// a = w² ∇f + f w ∇w = w ∇f_w, hence A e = B vec(G) with A = Σ a ∇fᵀ and
+    /// B[p][2q + s] = Σ a_p ∂_q f r_s: K = A⁻¹ B. Central differences on the interior pixels
+    /// (w is 0 on the first row and column and below 1e-6 on the last). None when A is
+    /// singular (no texture).
+    fn gradient_sensitivity(&mut self, f_w: &[f32]) -> Option<GradientSensitivity> {
+        let n = self.n;
+        let f = &self.g_spatial;
+        let centre = (n as f64 - 1.0) / 2.0;
+        let [gx, gy, ax, ay] = &mut self.gradient_rows;
+        // Sums of a_p ∂_q f, index 2p + q: over all pixels (A), times r_x, times r_y.
+        let mut a_sums = [0.0f64; 4];
+        let mut ry_sums = [0.0f64; 4];
+        let mut rx_lanes = [F32x4::zero(); 4];
+        for y in 1..n - 1 {
+            let (row, up, down) = (y * n, (y - 1) * n, (y + 1) * n);
+            for x in 1..n - 1 {
+                let w = self.window[row + x];
+                gx[x] = 0.5 * (f[row + x + 1] - f[row + x - 1]);
+                gy[x] = 0.5 * (f[down + x] - f[up + x]);
+                ax[x] = 0.5 * w * (f_w[row + x + 1] - f_w[row + x - 1]);
+                ay[x] = 0.5 * w * (f_w[down + x] - f_w[up + x]);
+            }
+            let mut row_lanes = [F32x4::zero(); 4];
+            let chunks = ax
+                .as_chunks::<4>()
+                .0
+                .iter()
+                .zip(ay.as_chunks::<4>().0)
+                .zip(gx.as_chunks::<4>().0)
+                .zip(gy.as_chunks::<4>().0)
+                .zip(self.column_offsets.as_chunks::<4>().0);
+            for ((((ax, ay), gx), gy), rx) in chunks {
+                let (ax, ay, gx, gy) = (
+                    F32x4::load(ax),
+                    F32x4::load(ay),
+                    F32x4::load(gx),
+                    F32x4::load(gy),
+                );
+                let rx = F32x4::load(rx);
+                let products = [ax.mul(gx), ax.mul(gy), ay.mul(gx), ay.mul(gy)];
+                for ((row_lane, rx_lane), product) in
+                    row_lanes.iter_mut().zip(&mut rx_lanes).zip(products)
+                {
+                    *row_lane = row_lane.add(product);
+                    *rx_lane = rx_lane.mul_add(product, rx);
+                }
+            }
+            let ry = y as f64 - centre;
+            for ((a, b), lane) in a_sums.iter_mut().zip(&mut ry_sums).zip(row_lanes) {
+                let row_sum = lane.sum() as f64;
+                *a += row_sum;
+                *b += ry * row_sum;
+            }
+        }
+        let a = [[a_sums[0], a_sums[1]], [a_sums[2], a_sums[3]]];
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        let scale = a[0][0].abs() + a[1][1].abs();
+        if !(det.is_finite() && det.abs() > 1e-9 * scale * scale) {
+            return None;
+        }
+        let inverse = [
+            [a[1][1] / det, -a[0][1] / det],
+            [-a[1][0] / det, a[0][0] / det],
+        ];
+        // B[p][2q + s]: s = 0 weighs by r_x, s = 1 by r_y.
+        let b = |p: usize, column: usize| {
+            let (q, s) = (column / 2, column % 2);
+            if s == 0 {
+                rx_lanes[2 * p + q].sum() as f64
+            } else {
+                ry_sums[2 * p + q]
+            }
+        };
+        let mut k = [[0.0f32; 4]; 2];
+        for (p, row) in k.iter_mut().enumerate() {
+            for (column, value) in row.iter_mut().enumerate() {
+                *value = (inverse[p][0] * b(0, column) + inverse[p][1] * b(1, column)) as f32;
+            }
+        }
+        Some(GradientSensitivity { k })
     }
 
     /// Copies the n x n block at (x0, y0) into `g_spatial` minus its mean; false if flat.
@@ -519,6 +637,41 @@ impl ZoiEngine {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A ZOI holding one speckle at r0 from its centre follows that speckle: under a gradient G
+    /// it reports u(centre) + G r0, so K = [[r0x, r0y, 0, 0], [0, 0, r0x, r0y]].
+    #[test]
+    fn a_single_speckle_is_the_lever_of_its_zoi() {
+        let n = 32;
+        let (width, r0) = (48usize, (5.0f64, -3.0f64));
+        let centre = 8.0 + (n as f64 - 1.0) / 2.0;
+        let pixels: Vec<u16> = (0..width * width)
+            .map(|i| {
+                let (x, y) = ((i % width) as f64 - centre, (i / width) as f64 - centre);
+                let d2 = (x - r0.0).powi(2) + (y - r0.1).powi(2);
+                (1000.0 + 30000.0 * (-d2 / (2.0 * 2.0 * 2.0)).exp()) as u16
+            })
+            .collect();
+        let image = Image {
+            pixels: &pixels,
+            width_px: width,
+            height_px: width,
+        };
+        let mut engine = ZoiEngine::new(n);
+        let mut plain = vec![Complex32::new(0.0, 0.0); spectrum_len(n)];
+        let mut windowed = vec![0.0; n * n];
+        let mut sensitivity = GradientSensitivity::default();
+        assert!(engine.prepare_reference(image, 8, 8, &mut plain, &mut windowed, &mut sensitivity));
+        let expected = [[r0.0, r0.1, 0.0, 0.0], [0.0, 0.0, r0.0, r0.1]];
+        for (row, expected_row) in sensitivity.k.iter().zip(expected) {
+            for (&k, e) in row.iter().zip(expected_row) {
+                assert!((k as f64 - e).abs() < 0.1, "{:?}", sensitivity.k);
+            }
+        }
+        // The bias for a 10 % stretch along x is 0.1 r0x along x.
+        let (bx, by) = sensitivity.bias_px([[0.1, 0.0], [0.0, 0.0]]);
+        assert!((bx - 0.5).abs() < 0.01 && by.abs() < 0.01, "{bx} {by}");
+    }
 
     /// The direct 3x3 values are the inverse FFT of G_w conj(F_w) at those shifts, wrapped.
     #[test]

@@ -63,6 +63,8 @@ pub struct CorrelatorSection {
     pub reference: String,
     /// Initial guess: predict or correli.
     pub guess: String,
+    /// First-order correction of the rigid ZOI's bias under a displacement gradient.
+    pub gradient_correction: bool,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -141,6 +143,7 @@ impl Default for CorrelatorSection {
             strain: "log".into(),
             reference: "auto".into(),
             guess: "predict".into(),
+            gradient_correction: true,
         }
     }
 }
@@ -283,6 +286,7 @@ impl RunConfig {
             strain,
             reference,
             guess,
+            gradient_correction: c.gradient_correction,
             ..correlator::CorrelatorSettings::default()
         };
         settings
@@ -450,8 +454,11 @@ impl RunConfig {
              # displacement or the score call for it, mesh followed).\n\
              reference = {:?}\n\
              # Initial guess per ZOI: predict (previous field, neighbours) or correli (paper).\n\
-             guess = {:?}\n",
-            k.zoi_px, k.step_px, k.threads, k.strain, k.reference, k.guess
+             guess = {:?}\n\
+             # Remove, to first order, the rigid ZOI's bias under a displacement gradient\n\
+             # (beyond the paper; false = CORRELI-GD as published).\n\
+             gradient_correction = {}\n",
+            k.zoi_px, k.step_px, k.threads, k.strain, k.reference, k.guess, k.gradient_correction
         );
         let g = &d.rig;
         let _ = writeln!(

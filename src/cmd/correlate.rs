@@ -90,6 +90,10 @@ pub struct CorrelateArgs {
     /// Initial guess per ZOI: the paper's global (U0, V0), or predicted from neighbours/previous field.
     #[arg(long, value_enum, default_value = "predict")]
     pub guess: GuessArg,
+    /// Remove, to first order, the rigid ZOI's bias under a displacement gradient (beyond the
+    /// paper; false = CORRELI-GD as published).
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    pub gradient_correction: bool,
     /// Worker threads.
     #[arg(long, default_value_t = 2)]
     pub threads: usize,
@@ -136,6 +140,7 @@ impl CorrelateArgs {
             strain: self.strain.measure(),
             reference: self.reference_mode.mode(),
             guess: self.guess.mode(),
+            gradient_correction: self.gradient_correction,
             threads: self.threads,
             max_iterations: self.max_iterations,
             ..CorrelatorSettings::default()
@@ -268,6 +273,7 @@ fn settings_json(args: &CorrelateArgs, correlator: &Correlator) -> serde_json::V
         "strain": correlator.settings().strain.name(),
         "reference_mode": format!("{:?}", args.reference_mode).to_lowercase(),
         "guess": format!("{:?}", args.guess).to_lowercase(),
+        "gradient_correction": args.gradient_correction,
         "threads": args.threads,
         "max_iterations": args.max_iterations,
         "strain_window_nodes": correlator.settings().strain_window_nodes,

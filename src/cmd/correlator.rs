@@ -34,6 +34,10 @@ pub struct CorrelatorArgs {
     /// Initial guess per ZOI: the paper's global (U0, V0), or the previous frame's field.
     #[arg(long, value_enum, default_value = "predict")]
     pub guess: GuessArg,
+    /// Remove, to first order, the rigid ZOI's bias under a displacement gradient (beyond the
+    /// paper; false = CORRELI-GD as published).
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    pub gradient_correction: bool,
     /// Worker threads.
     #[arg(long, default_value_t = 2)]
     pub threads: usize,
@@ -61,6 +65,7 @@ impl CorrelatorArgs {
             strain: self.strain.measure(),
             reference: self.reference_mode.mode(),
             guess: self.guess.mode(),
+            gradient_correction: self.gradient_correction,
             threads: self.threads,
             max_iterations: self.max_iterations,
             ..CorrelatorSettings::default()
