@@ -26,6 +26,9 @@ struct RefNode {
 
 /// Rings of neighbours whose affine fit places a failed node at a reference update.
 const EXTRAPOLATION_RINGS: usize = 2;
+/// Rings of never-lost neighbours whose affine fit carries a node whose material is out of
+/// the image (or failed) to the next reference.
+const CARRY_RINGS: usize = 5;
 /// Valid nodes an extrapolating fit needs.
 const MIN_EXTRAPOLATION_NODES: usize = 6;
 /// A node further than this from the affine fit of its neighbours (within
@@ -46,6 +49,14 @@ fn median_ok_score(results: impl Iterator<Item = ZoiResult>, scratch: &mut Vec<f
     }
     let middle = scratch.len() / 2;
     *scratch.select_nth_unstable_by(middle, f64::total_cmp).1
+}
+
+/// Which valid nodes an affine fit may use.
+#[derive(Clone, Copy)]
+enum Support {
+    Valid,
+    /// Only nodes valid in every frame since the reference sequence began.
+    NeverLost,
 }
 
 /// An affine fit of total displacements: (u, v) at `origin_px` and the gradient ∇u.
@@ -83,6 +94,10 @@ pub struct Correlator {
     has_previous: bool,
     /// Nodes found inconsistent with their neighbours in this frame (scratch).
     outliers: Vec<bool>,
+    /// Nodes valid in every frame since the reference sequence began: they measure their own
+    /// material. A node that failed once was carried by an extrapolation since, and may be
+    /// off by that extrapolation's error (it follows whatever material it came back on).
+    never_lost: Vec<bool>,
     /// Nodes correlated a second time in this frame (scratch, capacity: every node).
     retry: Vec<usize>,
     /// Scores of the valid nodes (scratch for their median, capacity: every node).
@@ -137,6 +152,7 @@ impl Correlator {
             previous2: vec![None; nodes],
             has_previous: false,
             outliers: vec![false; nodes],
+            never_lost: vec![true; nodes],
             retry: Vec::with_capacity(nodes),
             scores: Vec::with_capacity(nodes),
             field,
@@ -195,6 +211,7 @@ impl Correlator {
         self.previous.fill(None);
         self.previous2.fill(None);
         self.has_previous = false;
+        self.never_lost.fill(true);
         self.take_reference(pixels);
         Ok(())
     }
@@ -263,6 +280,7 @@ impl Correlator {
         self.previous.fill(None);
         self.previous2.fill(None);
         self.has_previous = false;
+        self.never_lost.fill(true);
         self.take_reference(pixels);
         Ok(())
     }
@@ -556,7 +574,7 @@ impl Correlator {
         for k in 0..nx * ny {
             self.outliers[k] = self.field.nodes[k].status == NodeStatus::Ok
                 && self
-                    .affine_fit(Some(k), EXTRAPOLATION_RINGS, Some(k))
+                    .affine_fit(Some(k), EXTRAPOLATION_RINGS, Some(k), Support::Valid)
                     .is_some_and(|fit| {
                         let (u, v) = self.extrapolate(k, fit);
                         let node = &self.field.nodes[k];
@@ -596,6 +614,9 @@ impl Correlator {
             self.settings.strain,
         );
         self.field.gauge = gauge(&self.field.nodes);
+        for (never_lost, node) in self.never_lost.iter_mut().zip(&self.field.nodes) {
+            *never_lost &= node.status == NodeStatus::Ok;
+        }
         std::mem::swap(&mut self.previous, &mut self.previous2);
         for (p, node) in self.previous.iter_mut().zip(&self.field.nodes) {
             *p = (node.status == NodeStatus::Ok).then_some((node.u_px, node.v_px));
@@ -656,19 +677,25 @@ impl Correlator {
         }
         // New base = total displacement. A node that failed (typically one whose followed point
         // left the image) gets the displacement the affine fit of its valid neighbours
-        // extrapolates to it (within two rings, else over the whole mesh): its followed point
-        // keeps moving with the material, so it stays outside while the material is outside and
-        // comes back where that material is. A neighbour mean would pull it back inside the
-        // image onto another material point, which then correlates as a false "ok".
+        // extrapolates to it: its followed point keeps moving with the material, so it stays
+        // outside while the material is outside and comes back where that material is. A
+        // neighbour mean would pull it back inside the image onto another material point,
+        // which then correlates as a false "ok". The fit uses the never-lost nodes (within
+        // CARRY_RINGS, else the whole mesh): nodes that came back carry their extrapolation
+        // error, and fitting the next ones on them would compound it ring by ring as material
+        // returns (unloading from a large stretch).
         let (nx, ny) = (self.mesh.nx, self.mesh.ny);
-        let whole_mesh = self.affine_fit_around(None, 0);
+        let whole_mesh = self.affine_fit(None, 0, None, Support::NeverLost);
+        let whole_mesh_valid = self.affine_fit_around(None, 0);
         for k in 0..nx * ny {
             let node = self.field.nodes[k];
             self.scratch_pairs[k] = if node.status == NodeStatus::Ok {
                 (node.u_px, node.v_px)
             } else {
-                self.affine_fit_around(Some(k), EXTRAPOLATION_RINGS)
+                self.affine_fit(Some(k), CARRY_RINGS, None, Support::NeverLost)
                     .or(whole_mesh)
+                    .or_else(|| self.affine_fit_around(Some(k), EXTRAPOLATION_RINGS))
+                    .or(whole_mesh_valid)
                     .map_or((self.field.u_mean_px, self.field.v_mean_px), |fit| {
                         self.extrapolate(k, fit)
                     })
@@ -685,15 +712,16 @@ impl Correlator {
     /// of node `centre` (all valid nodes when `centre` is None): the origin of the fit, (u, v)
     /// there, and ∇u; None with fewer than [`MIN_EXTRAPOLATION_NODES`] valid nodes or collinear.
     fn affine_fit_around(&self, centre: Option<usize>, rings: usize) -> Option<AffineFit> {
-        self.affine_fit(centre, rings, None)
+        self.affine_fit(centre, rings, None, Support::Valid)
     }
 
-    /// [`Self::affine_fit_around`] leaving node `exclude` out.
+    /// [`Self::affine_fit_around`] over the nodes of `support`, leaving node `exclude` out.
     fn affine_fit(
         &self,
         centre: Option<usize>,
         rings: usize,
         exclude: Option<usize>,
+        support: Support,
     ) -> Option<AffineFit> {
         let (nx, ny) = (self.mesh.nx, self.mesh.ny);
         let (i_range, j_range, origin) = match centre {
@@ -719,8 +747,13 @@ impl Correlator {
         let mut count = 0;
         for j in j_range {
             for i in i_range.clone() {
-                let node = &self.field.nodes[j * nx + i];
-                if node.status == NodeStatus::Ok && exclude != Some(j * nx + i) {
+                let m = j * nx + i;
+                let node = &self.field.nodes[m];
+                let supported = match support {
+                    Support::Valid => true,
+                    Support::NeverLost => self.never_lost[m],
+                };
+                if node.status == NodeStatus::Ok && supported && exclude != Some(m) {
                     sums.add(
                         node.x_px - origin.0,
                         node.y_px - origin.1,
