@@ -251,7 +251,8 @@ impl Correlator {
     /// Resumes against a saved reference: its pixels and the per-node base displacements read
     /// from [`Correlator::reference_base_px`] (one pair per node, row-major). Afterwards the
     /// correlator is in the state it was right after that reference was taken, except that the
-    /// previous frame's field is unknown (the predictor grows from the centre once).
+    /// previous frame's field is unknown (the predictor grows from the centre once) and every
+    /// node counts as never lost (the saved state does not say which nodes were carried).
     pub fn restore_reference(
         &mut self,
         pixels: &[u16],
