@@ -76,6 +76,9 @@ pub struct Correlator {
     mesh: Mesh,
     pool: Pool,
     global: GlobalCorrelator,
+    /// The global correlator's reference is older than `reference_pixels` (it is renewed
+    /// only when a frame needs the global displacement).
+    global_reference_stale: bool,
     reference_pixels: Vec<u16>,
     has_reference: bool,
     ref_nodes: Vec<RefNode>,
@@ -140,6 +143,7 @@ impl Correlator {
         Ok(Self {
             pool: Pool::new(settings.threads, settings.zoi_px),
             global: GlobalCorrelator::new(roi),
+            global_reference_stale: true,
             reference_pixels: vec![0; width_px * height_px],
             has_reference: false,
             ref_nodes,
@@ -311,7 +315,7 @@ impl Correlator {
                 r.status = NodeStatus::OutsideImage;
             }
         }
-        self.global.set_reference(image);
+        self.global_reference_stale = true;
         let n2 = spectrum_len(n);
         let plain = SharedSlice::new(&mut self.plain_spectra);
         let windowed = SharedSlice::new(&mut self.windowed_references);
@@ -360,14 +364,6 @@ impl Correlator {
         let n2 = spectrum_len(n);
         let max_iterations = self.settings.max_iterations;
         let use_previous = self.settings.guess == GuessMode::Predict && self.has_previous;
-        let needs_global = !use_previous || self.previous.iter().any(|p| p.is_none());
-        let global = if needs_global {
-            self.global.displacement(image)
-        } else {
-            (0, 0)
-        };
-        self.field.global_px = global;
-        let global_guess = (global.0 as f64, global.1 as f64);
         let whole_mesh = if use_previous && self.previous.iter().any(|p| p.is_none()) {
             self.affine_fit_around(None, 0)
         } else {
@@ -394,10 +390,31 @@ impl Correlator {
                     .or(whole_mesh)
                     .map(|fit| self.extrapolate(k, fit)),
             };
-            self.guesses[k] = match previous {
-                Some(p) => (p.0 - base.0, p.1 - base.1),
-                None => global_guess,
-            };
+            // NaN: no prediction, the node starts from the global (U0, V0).
+            self.guesses[k] =
+                previous.map_or((f64::NAN, f64::NAN), |p| (p.0 - base.0, p.1 - base.1));
+        }
+        // The global correlation (two FFTs of up to 512², and one more of the reference after
+        // each reference update) runs only when some node has no prediction: on a followed
+        // mesh the predictions usually cover every node.
+        let needs_global = !use_previous || self.guesses.iter().any(|g| g.0.is_nan());
+        let global = if needs_global {
+            if self.global_reference_stale {
+                self.global.set_reference(Image {
+                    pixels: &self.reference_pixels,
+                    width_px: self.width_px,
+                    height_px: self.height_px,
+                });
+                self.global_reference_stale = false;
+            }
+            self.global.displacement(image)
+        } else {
+            (0, 0)
+        };
+        self.field.global_px = global;
+        let global_guess = (global.0 as f64, global.1 as f64);
+        for guess in self.guesses.iter_mut().filter(|g| g.0.is_nan()) {
+            *guess = global_guess;
         }
         let plain = &self.plain_spectra;
         let windowed = &self.windowed_references;
