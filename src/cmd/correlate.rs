@@ -65,13 +65,10 @@ impl GuessArg {
     }
 }
 
+/// The correlation settings of both `correlate` and `correlator` (their reference-mode flags
+/// differ: `--reference` here, `--reference-mode` live, where `--reference` names a file).
 #[derive(clap::Args, Debug)]
-pub struct CorrelateArgs {
-    /// Reference image (PNG, TIFF or BMP, 8 or 16 bit).
-    pub reference: PathBuf,
-    /// Deformed images, in order.
-    #[arg(required = true)]
-    pub deformed: Vec<PathBuf>,
+pub struct CorrelationArgs {
     /// ZOI side in px, a power of two (2^s).
     #[arg(long, default_value_t = 32)]
     pub zoi: usize,
@@ -81,13 +78,11 @@ pub struct CorrelateArgs {
     /// Region of interest x,y,w,h in px (default: the largest centred 2^p square).
     #[arg(long, value_parser = parse_roi)]
     pub roi: Option<Roi>,
-    /// Strain measure of the per-node strains in the CSV.
+    /// Strain measure of the node strains (the gauge is given in all four).
     #[arg(long, value_enum, default_value = "log")]
     pub strain: StrainArg,
-    /// Reference mode: fixed, incremental (consecutive images) or auto update.
-    #[arg(long = "reference", value_enum, default_value = "fixed")]
-    pub reference_mode: ReferenceArg,
-    /// Initial guess per ZOI: the paper's global (U0, V0), or predicted from neighbours/previous field.
+    /// Initial guess per ZOI: the paper's global (U0, V0), or predicted from the previous
+    /// field or from converged neighbours.
     #[arg(long, value_enum, default_value = "predict")]
     pub guess: GuessArg,
     /// Remove, to first order, the rigid ZOI's bias under a displacement gradient (beyond the
@@ -100,6 +95,37 @@ pub struct CorrelateArgs {
     /// Cap of the sub-pixel iterations per ZOI.
     #[arg(long, default_value_t = 10)]
     pub max_iterations: u32,
+}
+
+impl CorrelationArgs {
+    pub fn settings(&self, reference: ReferenceMode) -> CorrelatorSettings {
+        CorrelatorSettings {
+            zoi_px: self.zoi,
+            step_px: self.step,
+            roi: self.roi,
+            strain: self.strain.measure(),
+            reference,
+            guess: self.guess.mode(),
+            gradient_correction: self.gradient_correction,
+            threads: self.threads,
+            max_iterations: self.max_iterations,
+            ..CorrelatorSettings::default()
+        }
+    }
+}
+
+#[derive(clap::Args, Debug)]
+pub struct CorrelateArgs {
+    /// Reference image (PNG, TIFF or BMP, 8 or 16 bit).
+    pub reference: PathBuf,
+    /// Deformed images, in order.
+    #[arg(required = true)]
+    pub deformed: Vec<PathBuf>,
+    /// Reference mode: fixed, incremental (consecutive images) or auto update.
+    #[arg(long = "reference", value_enum, default_value = "fixed")]
+    pub reference_mode: ReferenceArg,
+    #[command(flatten)]
+    pub correlation: CorrelationArgs,
     /// Output folder (created if missing).
     #[arg(long)]
     pub out: PathBuf,
@@ -133,18 +159,7 @@ pub(crate) fn parse_roi(text: &str) -> Result<Roi, String> {
 
 impl CorrelateArgs {
     fn settings(&self) -> CorrelatorSettings {
-        CorrelatorSettings {
-            zoi_px: self.zoi,
-            step_px: self.step,
-            roi: self.roi,
-            strain: self.strain.measure(),
-            reference: self.reference_mode.mode(),
-            guess: self.guess.mode(),
-            gradient_correction: self.gradient_correction,
-            threads: self.threads,
-            max_iterations: self.max_iterations,
-            ..CorrelatorSettings::default()
-        }
+        self.correlation.settings(self.reference_mode.mode())
     }
 }
 
@@ -266,16 +281,16 @@ fn settings_json(args: &CorrelateArgs, correlator: &Correlator) -> serde_json::V
     let (nx, ny) = correlator.mesh_size();
     serde_json::json!({
         "reference": args.reference.display().to_string(),
-        "zoi": args.zoi,
-        "step": args.step,
+        "zoi": args.correlation.zoi,
+        "step": args.correlation.step,
         "roi": [roi.x_px, roi.y_px, roi.width_px, roi.height_px],
         "mesh": [nx, ny],
         "strain": correlator.settings().strain.name(),
         "reference_mode": format!("{:?}", args.reference_mode).to_lowercase(),
-        "guess": format!("{:?}", args.guess).to_lowercase(),
-        "gradient_correction": args.gradient_correction,
-        "threads": args.threads,
-        "max_iterations": args.max_iterations,
+        "guess": format!("{:?}", args.correlation.guess).to_lowercase(),
+        "gradient_correction": args.correlation.gradient_correction,
+        "threads": args.correlation.threads,
+        "max_iterations": args.correlation.max_iterations,
         "strain_window_nodes": correlator.settings().strain_window_nodes,
     })
 }

@@ -1,10 +1,10 @@
 //! `dicstream correlator`: the live correlation process (subscribes to `frames`, publishes
 //! `fields`, saves its reference to `--state-dir` to survive a restart).
 
-use super::correlate::{parse_roi, GuessArg, ReferenceArg, StrainArg};
+use super::correlate::{CorrelationArgs, ReferenceArg};
 use anyhow::{bail, Context, Result};
 use correlator::process::{run as run_process, ProcessConfig, ReferenceImage};
-use correlator::{CorrelatorSettings, Roi};
+use correlator::CorrelatorSettings;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -16,34 +16,11 @@ pub struct CorrelatorArgs {
     /// Reference image file (PNG, TIFF or BMP); default: the first frame received.
     #[arg(long)]
     pub reference: Option<PathBuf>,
-    /// ZOI side in px, a power of two (2^s).
-    #[arg(long, default_value_t = 32)]
-    pub zoi: usize,
-    /// Distance between ZOI centres in px (1 ..= ZOI).
-    #[arg(long, default_value_t = 16)]
-    pub step: usize,
-    /// Region of interest x,y,w,h in px (default: the largest centred 2^p square).
-    #[arg(long, value_parser = parse_roi)]
-    pub roi: Option<Roi>,
-    /// Strain measure of the node strains (the header carries the gauge in all four).
-    #[arg(long, value_enum, default_value = "log")]
-    pub strain: StrainArg,
     /// Reference mode: fixed, incremental (previous frame) or auto update.
     #[arg(long, value_enum, default_value = "fixed")]
     pub reference_mode: ReferenceArg,
-    /// Initial guess per ZOI: the paper's global (U0, V0), or the previous frame's field.
-    #[arg(long, value_enum, default_value = "predict")]
-    pub guess: GuessArg,
-    /// Remove, to first order, the rigid ZOI's bias under a displacement gradient (beyond the
-    /// paper; false = CORRELI-GD as published).
-    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
-    pub gradient_correction: bool,
-    /// Worker threads.
-    #[arg(long, default_value_t = 2)]
-    pub threads: usize,
-    /// Cap of the sub-pixel iterations per ZOI.
-    #[arg(long, default_value_t = 10)]
-    pub max_iterations: u32,
+    #[command(flatten)]
+    pub correlation: CorrelationArgs,
     /// Folder for the reference and what is needed to resume after a restart (created if
     /// missing); a process started on a folder holding a saved reference resumes against it.
     #[arg(long)]
@@ -58,18 +35,7 @@ pub struct CorrelatorArgs {
 
 impl CorrelatorArgs {
     fn settings(&self) -> CorrelatorSettings {
-        CorrelatorSettings {
-            zoi_px: self.zoi,
-            step_px: self.step,
-            roi: self.roi,
-            strain: self.strain.measure(),
-            reference: self.reference_mode.mode(),
-            guess: self.guess.mode(),
-            gradient_correction: self.gradient_correction,
-            threads: self.threads,
-            max_iterations: self.max_iterations,
-            ..CorrelatorSettings::default()
-        }
+        self.correlation.settings(self.reference_mode.mode())
     }
 }
 
