@@ -17,12 +17,7 @@ const FRAMES: usize = 9;
 fn render(renderer: &FastRenderer, motion: Motion, seed: u64) -> Vec<u16> {
     let mut pattern = vec![0f32; SIZE * SIZE];
     renderer.render(&motion, SIZE, &mut pattern);
-    let mut camera = CameraModel::noiseless(16);
-    camera.read_noise_dn = 0.01 * 65535.0;
-    camera.seed = seed;
-    let mut out = vec![0u16; SIZE * SIZE];
-    camera.expose(seed, &pattern, SIZE, &mut out, 2);
-    out
+    CameraModel::read_noise_only_16bit(0.01, seed).exposed(seed, &pattern, SIZE, 2)
 }
 
 fn median(values: &mut [f64]) -> f64 {

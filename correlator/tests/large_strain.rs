@@ -28,8 +28,6 @@ fn frames() -> Vec<(f64, Vec<u16>)> {
     let extent = [-140.0, SIZE as f64 + 140.0];
     let speckle = Speckle::new(SpeckleParams::default(), extent, extent);
     let renderer = FastRenderer::new(&speckle, extent, extent, 4, 2);
-    let mut camera = CameraModel::noiseless(16);
-    camera.read_noise_dn = 0.005 * 65535.0;
     (0..=LOADING_FRAMES + UNLOADING_FRAMES)
         .map(|k| {
             let stretch = if k <= LOADING_FRAMES {
@@ -40,10 +38,8 @@ fn frames() -> Vec<(f64, Vec<u16>)> {
             };
             let mut pattern = vec![0f32; SIZE * SIZE];
             renderer.render(&uniaxial(stretch), SIZE, &mut pattern);
-            camera.seed = k as u64 + 1;
-            let mut out = vec![0u16; SIZE * SIZE];
-            camera.expose(k as u64, &pattern, SIZE, &mut out, 2);
-            (stretch, out)
+            let camera = CameraModel::read_noise_only_16bit(0.005, k as u64 + 1);
+            (stretch, camera.exposed(k as u64, &pattern, SIZE, 2))
         })
         .collect()
 }

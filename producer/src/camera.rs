@@ -63,6 +63,16 @@ impl CameraModel {
         }
     }
 
+    /// A 16-bit camera whose only noise is Gaussian read noise of `fraction` of full scale,
+    /// seeded: the camera of the accuracy tests and the correlator benchmarks.
+    pub fn read_noise_only_16bit(fraction: f64, seed: u64) -> Self {
+        CameraModel {
+            read_noise_dn: fraction * Self::max_dn_of(16),
+            seed,
+            ..Self::noiseless(16)
+        }
+    }
+
     fn max_dn_of(bit_depth: u8) -> f64 {
         f64::from((1u32 << bit_depth.min(16)) - 1)
     }
@@ -116,6 +126,19 @@ impl CameraModel {
     }
 
     /// Exposes the pattern values `pattern` (rows of `width`) of frame `frame_index` into `out`.
+    /// [`Self::expose`] into a new frame.
+    pub fn exposed(
+        &self,
+        frame_index: u64,
+        pattern: &[f32],
+        width: usize,
+        threads: usize,
+    ) -> Vec<u16> {
+        let mut out = vec![0u16; pattern.len()];
+        self.expose(frame_index, pattern, width, &mut out, threads);
+        out
+    }
+
     pub fn expose(
         &self,
         frame_index: u64,

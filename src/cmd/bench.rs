@@ -74,12 +74,7 @@ fn render(
 ) -> Vec<u16> {
     let mut pattern = vec![0f32; width * height];
     renderer.render(&motion, width, &mut pattern);
-    let mut camera = CameraModel::noiseless(16);
-    camera.read_noise_dn = 0.01 * 65535.0;
-    camera.seed = seed;
-    let mut out = vec![0u16; width * height];
-    camera.expose(seed, &pattern, width, &mut out, 2);
-    out
+    CameraModel::read_noise_only_16bit(0.01, seed).exposed(seed, &pattern, width, 2)
 }
 
 fn median(values: &mut [f64]) -> f64 {

@@ -363,12 +363,7 @@ pub fn render(width: usize, height: usize, motion: &Motion, seed: u64) -> Vec<u1
         threads: 2,
     }
     .render(&speckle, motion, width, &mut pattern);
-    let mut camera = CameraModel::noiseless(16);
-    camera.read_noise_dn = 0.01 * 65535.0;
-    camera.seed = seed;
-    let mut out = vec![0u16; width * height];
-    camera.expose(seed, &pattern, width, &mut out, 2);
-    out
+    CameraModel::read_noise_only_16bit(0.01, seed).exposed(seed, &pattern, width, 2)
 }
 
 /// An affine motion and the same motion as ground truth for the frame header.

@@ -26,12 +26,7 @@ pub fn render(
         threads: 2,
     }
     .render(&speckle, &motion, width, &mut pattern);
-    let mut camera = CameraModel::noiseless(16);
-    camera.read_noise_dn = noise * 65535.0;
-    camera.seed = seed;
-    let mut out = vec![0u16; width * height];
-    camera.expose(seed, &pattern, width, &mut out, 2);
-    out
+    CameraModel::read_noise_only_16bit(noise, seed).exposed(seed, &pattern, width, 2)
 }
 
 pub fn translation(u_px: f64, v_px: f64) -> Motion {
