@@ -219,23 +219,6 @@ fn strain_name(code: u32) -> &'static str {
         .unwrap_or("?")
 }
 
-/// A 64-bit multiply-xorshift checksum over 8-byte words (the tail byte-wise).
-fn checksum(bytes: &[u8]) -> u64 {
-    const K: u64 = 0x9E37_79B9_7F4A_7C15;
-    let mut hash = 0xCBF2_9CE4_8422_2325 ^ bytes.len() as u64;
-    let mut words = bytes.chunks_exact(8);
-    for word in &mut words {
-        let w = u64::from_le_bytes(word.try_into().expect("8 bytes"));
-        hash = (hash ^ w).wrapping_mul(K);
-        hash ^= hash >> 29;
-    }
-    for &b in words.remainder() {
-        hash = (hash ^ b as u64).wrapping_mul(K);
-        hash ^= hash >> 29;
-    }
-    hash
-}
-
 /// Which frames a saved reference stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ReferenceIds {
@@ -452,7 +435,7 @@ fn encode(
         out.extend_from_slice(&u.to_le_bytes());
         out.extend_from_slice(&v.to_le_bytes());
     }
-    let sum = checksum(out);
+    let sum = wire::frame::byte_checksum(out);
     out.extend_from_slice(&sum.to_le_bytes());
     assert_eq!(out.len(), layout.file_bytes());
 }
@@ -505,7 +488,7 @@ fn decode(bytes: &[u8]) -> Result<SavedReference, String> {
         ));
     }
     let body = bytes.len() - 8;
-    if checksum(&bytes[..body]) != u64_at(body) {
+    if wire::frame::byte_checksum(&bytes[..body]) != u64_at(body) {
         return Err("checksum mismatch".into());
     }
     let pixel_end = HEADER_BYTES + 2 * layout.pixels();
