@@ -28,7 +28,7 @@ pub use image_io::{decode_into, read_image, read_shape, Image16, ImageShape};
 pub use image_out::{write_atomic, write_frame, ImageFormatOut};
 pub use motion::{Affine, Bulge, Chirp, Motion};
 pub use natural_sort::natural_cmp;
-pub use render_exact::{gauss_legendre, ExactRenderer};
+pub use render_exact::{exact_test_frame, gauss_legendre, ExactRenderer};
 pub use render_fast::FastRenderer;
 pub use replay::{list_images, Replay, IMAGE_EXTENSIONS};
 pub use rig_follow::{

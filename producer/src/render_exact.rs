@@ -1,9 +1,36 @@
 //! The `exact` renderer: the analytic pattern evaluated at φ⁻¹(x) and integrated over each
 //! camera pixel's area with an n x n Gauss-Legendre rule. Slow; the ground truth.
 
+use crate::camera::CameraModel;
 use crate::motion::Motion;
 use crate::parallel::for_row_bands;
-use crate::speckle::Speckle;
+use crate::speckle::{Speckle, SpeckleParams};
+
+/// The accuracy tests' frame: the default speckle (seed 1) covering the image plus `margin_px`
+/// on every side, moved by `motion`, rendered exactly (Gauss order 3) and exposed by
+/// [`CameraModel::read_noise_only_16bit`] with read noise `noise` (fraction of full scale)
+/// and noise seed `seed`, on 2 threads.
+pub fn exact_test_frame(
+    width: usize,
+    height: usize,
+    margin_px: f64,
+    motion: &Motion,
+    noise: f64,
+    seed: u64,
+) -> Vec<u16> {
+    let speckle = Speckle::new(
+        SpeckleParams::default(),
+        [-margin_px, width as f64 + margin_px],
+        [-margin_px, height as f64 + margin_px],
+    );
+    let mut pattern = vec![0f32; width * height];
+    ExactRenderer {
+        gauss_order: 3,
+        threads: 2,
+    }
+    .render(&speckle, motion, width, &mut pattern);
+    CameraModel::read_noise_only_16bit(noise, seed).exposed(seed, &pattern, width, 2)
+}
 
 /// Largest Gauss-Legendre order supported per axis.
 pub const MAX_GAUSS_ORDER: usize = 6;

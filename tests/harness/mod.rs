@@ -6,7 +6,7 @@
 #![allow(dead_code)]
 
 use producer::motion::Affine;
-use producer::{CameraModel, ExactRenderer, Motion, Speckle, SpeckleParams};
+use producer::Motion;
 use std::io::BufRead;
 use std::path::PathBuf;
 use std::process::{Child, Command, ExitStatus, Stdio};
@@ -351,19 +351,7 @@ impl Drop for Bench {
 /// Speckle (producer defaults, seed 1) covering the image plus a margin, moved by `motion`,
 /// seen by a 16-bit camera with Gaussian read noise (1 % of full scale) of seed `seed`.
 pub fn render(width: usize, height: usize, motion: &Motion, seed: u64) -> Vec<u16> {
-    let margin_px = 24.0;
-    let speckle = Speckle::new(
-        SpeckleParams::default(),
-        [-margin_px, width as f64 + margin_px],
-        [-margin_px, height as f64 + margin_px],
-    );
-    let mut pattern = vec![0f32; width * height];
-    ExactRenderer {
-        gauss_order: 3,
-        threads: 2,
-    }
-    .render(&speckle, motion, width, &mut pattern);
-    CameraModel::read_noise_only_16bit(0.01, seed).exposed(seed, &pattern, width, 2)
+    producer::exact_test_frame(width, height, 24.0, motion, 0.01, seed)
 }
 
 /// An affine motion and the same motion as ground truth for the frame header.

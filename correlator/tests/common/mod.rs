@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use producer::motion::Affine;
-use producer::{CameraModel, ExactRenderer, Motion, Speckle, SpeckleParams};
+use producer::Motion;
 
 /// Renders a speckle (default producer parameters, seed 1) covering the image plus `margin_px`,
 /// moved by `motion`, exposed by a 16-bit camera with Gaussian read noise `noise` (fraction of
@@ -15,18 +15,7 @@ pub fn render(
     noise: f64,
     seed: u64,
 ) -> Vec<u16> {
-    let speckle = Speckle::new(
-        SpeckleParams::default(),
-        [-margin_px, width as f64 + margin_px],
-        [-margin_px, height as f64 + margin_px],
-    );
-    let mut pattern = vec![0f32; width * height];
-    ExactRenderer {
-        gauss_order: 3,
-        threads: 2,
-    }
-    .render(&speckle, &motion, width, &mut pattern);
-    CameraModel::read_noise_only_16bit(noise, seed).exposed(seed, &pattern, width, 2)
+    producer::exact_test_frame(width, height, margin_px, &motion, noise, seed)
 }
 
 pub fn translation(u_px: f64, v_px: f64) -> Motion {
