@@ -1,7 +1,11 @@
 //! The correlator: mesh, reference cache, worker pool, guesses, reference modes, strains.
 
+mod growth;
+
 use crate::field::{Field, Node, NodeStatus};
-use crate::global::GlobalCorrelator;
+use crate::global::{GlobalCorrelator, GlobalMiss};
+use crate::interpolate::Mat2;
+use crate::keypoints::{KeypointMatcher, KeypointSet};
 use crate::mesh::Mesh;
 use crate::pool::{Pool, SharedSlice};
 use crate::settings::{CorrelatorSettings, GuessMode, ReferenceMode, Roi, SettingsError};
@@ -34,6 +38,43 @@ const MIN_EXTRAPOLATION_NODES: usize = 6;
 /// A node further than this from the affine fit of its neighbours (within
 /// [`EXTRAPOLATION_RINGS`]) is a false match (px).
 const OUTLIER_PX: f64 = 2.0;
+
+/// A node to correlate again: its guess (px, against the current reference) and the gradient
+/// to sample its deformed ZOI through.
+#[derive(Clone, Copy, Debug, Default)]
+struct Entry {
+    node: usize,
+    guess_px: (f64, f64),
+    gradient: Mat2,
+}
+
+/// Least-squares gradient of the `ok` results over the 3x3 nodes around k (ZOI centres of an
+/// nx x ny mesh).
+fn result_gradient(
+    results: &[ZoiResult],
+    ref_nodes: &[RefNode],
+    (nx, ny): (usize, usize),
+    k: usize,
+) -> Option<nalgebra::Matrix2<f64>> {
+    let (i, j) = (k % nx, k / nx);
+    let mut sums = AffineSums::default();
+    for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
+        for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
+            let m = jj * nx + ii;
+            if results[m].status != NodeStatus::Ok {
+                continue;
+            }
+            let (a, b) = (ref_nodes[m].top_left, ref_nodes[k].top_left);
+            sums.add(
+                a.0 as f64 - b.0 as f64,
+                a.1 as f64 - b.1 as f64,
+                results[m].u_px,
+                results[m].v_px,
+            );
+        }
+    }
+    sums.gradient()
+}
 
 /// Median score of the valid results (0 when none), using `scratch` (no allocation once it
 /// holds every node).
@@ -108,6 +149,17 @@ pub struct Correlator {
     field: Field,
     scratch_pairs: Vec<(f64, f64)>,
     frames_since_reference: u64,
+    /// The final check of each node's result (ZNCC, see `verify`), 0 when unchecked.
+    zncc: Vec<f64>,
+    /// Nodes to correlate again (growth, keypoints, refinement; capacity: every node).
+    entries: Vec<Entry>,
+    /// Verified neighbours a node had when growth last tried it (it is tried again only
+    /// when it has more).
+    grown_from: Vec<u8>,
+    /// Made on first need (a reference whose cheaper guesses did not verify).
+    keypoint_matcher: Option<KeypointMatcher>,
+    /// The current reference's keypoints, detected on first need.
+    reference_keypoints: Option<KeypointSet>,
 }
 
 impl Correlator {
@@ -162,6 +214,11 @@ impl Correlator {
             field,
             scratch_pairs: vec![(0.0, 0.0); nodes],
             frames_since_reference: 0,
+            zncc: vec![0.0; nodes],
+            entries: Vec::with_capacity(nodes),
+            grown_from: vec![0; nodes],
+            keypoint_matcher: None,
+            reference_keypoints: None,
             settings,
             width_px,
             height_px,
@@ -316,6 +373,7 @@ impl Correlator {
             }
         }
         self.global_reference_stale = true;
+        self.reference_keypoints = None;
         let n2 = spectrum_len(n);
         let plain = SharedSlice::new(&mut self.plain_spectra);
         let windowed = SharedSlice::new(&mut self.windowed_references);
@@ -353,7 +411,12 @@ impl Correlator {
             width_px: self.width_px,
             height_px: self.height_px,
         };
+        self.field.keypoints_used = false;
         self.run_zois(image);
+        self.verify_results(image);
+        if self.settings.guess == GuessMode::Auto {
+            self.improve(image);
+        }
         self.assemble();
         self.update_reference(pixels);
         Ok(&self.field)
@@ -363,7 +426,7 @@ impl Correlator {
         let n = self.settings.zoi_px;
         let n2 = spectrum_len(n);
         let max_iterations = self.settings.max_iterations;
-        let use_previous = self.settings.guess == GuessMode::Predict && self.has_previous;
+        let use_previous = self.settings.guess != GuessMode::Correli && self.has_previous;
         let whole_mesh = if use_previous && self.previous.iter().any(|p| p.is_none()) {
             self.affine_fit_around(None, 0)
         } else {
@@ -407,14 +470,22 @@ impl Correlator {
                 });
                 self.global_reference_stale = false;
             }
-            self.global.displacement(image)
+            match self.global.displacement(image) {
+                Ok(peak) => Some(peak.displacement_px),
+                // Nothing to match: the ZOIs will say where the texture is missing.
+                Err(GlobalMiss::Flat) => Some((0, 0)),
+                Err(GlobalMiss::NotSignificant) => None,
+            }
         } else {
-            (0, 0)
+            None
         };
         self.field.global_px = global;
-        let global_guess = (global.0 as f64, global.1 as f64);
-        for guess in self.guesses.iter_mut().filter(|g| g.0.is_nan()) {
-            *guess = global_guess;
+        // Without a significant peak the nodes keep no guess (NaN: `no_guess`), never a
+        // wrong one.
+        if let Some((u0, v0)) = global {
+            for guess in self.guesses.iter_mut().filter(|g| g.0.is_nan()) {
+                *guess = (u0 as f64, v0 as f64);
+            }
         }
         let plain = &self.plain_spectra;
         let windowed = &self.windowed_references;
@@ -439,6 +510,7 @@ impl Correlator {
                     r.top_left.0,
                     r.top_left.1,
                     guess,
+                    None,
                     max_iterations,
                 )
             };
@@ -456,7 +528,7 @@ impl Correlator {
         for k in 0..self.mesh.len() {
             unsafe { results.write(k, ZoiResult::default()) };
         }
-        if self.settings.guess == GuessMode::Correli || use_previous {
+        if self.settings.guess != GuessMode::Predict || use_previous {
             self.pool.run(self.mesh.len(), &|engine, k| {
                 correlate_node(engine, k, guesses[k])
             });
@@ -543,8 +615,12 @@ impl Correlator {
             if result.status == NodeStatus::Ok {
                 if let Some(g) = self.result_gradient(k) {
                     if correct_gradient {
-                        let bias = self.sensitivities[k]
-                            .bias_px([[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]);
+                        // A warped ZOI is biased only by the gradient beyond its warp.
+                        let w = result.warp_gradient;
+                        let bias = self.sensitivities[k].bias_px([
+                            [g[(0, 0)] - w[0][0], g[(0, 1)] - w[0][1]],
+                            [g[(1, 0)] - w[1][0], g[(1, 1)] - w[1][1]],
+                        ]);
                         u.0 -= bias.0;
                         u.1 -= bias.1;
                     }
@@ -569,25 +645,21 @@ impl Correlator {
             } else {
                 0.0
             };
-            node.score = if result.score.is_finite() {
-                result.score
-            } else {
-                0.0
-            };
+            node.score = self.zncc[k];
             node.iterations = result.iterations;
             node.status = result.status;
         }
         let min_score = self.settings.min_relative_score
             * median_ok_score(self.results.iter().copied(), &mut self.scores);
-        for node in &mut self.field.nodes {
-            if node.status == NodeStatus::Ok && node.score < min_score {
+        for (node, result) in self.field.nodes.iter_mut().zip(&self.results) {
+            if node.status == NodeStatus::Ok && result.score < min_score {
                 node.status = NodeStatus::NotConverged;
                 node.u_px = 0.0;
                 node.v_px = 0.0;
             }
         }
         // A node far from what its neighbours say (a false match on other material) is not
-        // trusted: it is marked not converged, so that it neither biases the strains nor moves
+        // trusted: it is marked inconsistent, so that it neither biases the strains nor moves
         // the followed mesh onto the wrong material.
         for k in 0..nx * ny {
             self.outliers[k] = self.field.nodes[k].status == NodeStatus::Ok
@@ -606,7 +678,7 @@ impl Correlator {
             .zip(&self.outliers)
             .filter(|(_, &outlier)| outlier)
         {
-            node.status = NodeStatus::NotConverged;
+            node.status = NodeStatus::Inconsistent;
             node.u_px = 0.0;
             node.v_px = 0.0;
         }
@@ -644,27 +716,12 @@ impl Correlator {
 
     /// Least-squares gradient of the current results over the 3x3 nodes around k (ZOI centres).
     fn result_gradient(&self, k: usize) -> Option<nalgebra::Matrix2<f64>> {
-        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
-        let (i, j) = (k % nx, k / nx);
-        let n = self.settings.zoi_px;
-        let mut sums = AffineSums::default();
-        for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
-            for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
-                let m = jj * nx + ii;
-                if self.results[m].status != NodeStatus::Ok {
-                    continue;
-                }
-                let (a, b) = (self.ref_nodes[m].top_left, self.ref_nodes[k].top_left);
-                let _ = n;
-                sums.add(
-                    a.0 as f64 - b.0 as f64,
-                    a.1 as f64 - b.1 as f64,
-                    self.results[m].u_px,
-                    self.results[m].v_px,
-                );
-            }
-        }
-        sums.gradient()
+        result_gradient(
+            &self.results,
+            &self.ref_nodes,
+            (self.mesh.nx, self.mesh.ny),
+            k,
+        )
     }
 
     fn update_reference(&mut self, pixels: &[u16]) {

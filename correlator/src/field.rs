@@ -7,22 +7,44 @@ use crate::settings::StrainMeasure;
 pub enum NodeStatus {
     /// Converged: displacement and score are meaningful.
     Ok,
-    /// The integer search did not settle or the sub-pixel iterations hit the cap.
+    /// The integer search did not settle, the sub-pixel iterations hit the cap, or the
+    /// correlation peak is far below the frame's median (a match on other material).
     NotConverged,
     /// The reference or deformed ZOI has (almost) no grey-level variation.
     LowContrast,
     /// The deformed ZOI left the image.
     #[default]
     OutsideImage,
+    /// The final check failed: the reference ZOI against the deformed image sampled through
+    /// the node's displacement and local gradient has a ZNCC below `min_zncc`.
+    LowZncc,
+    /// Further than 2 px from the affine fit of its neighbours.
+    Inconsistent,
+    /// No guess could be trusted for this node (the global correlation peak was not
+    /// significant and no other guess verified), so it was not measured.
+    NoGuess,
 }
 
 impl NodeStatus {
+    pub const ALL: [NodeStatus; 7] = [
+        Self::Ok,
+        Self::NotConverged,
+        Self::LowContrast,
+        Self::OutsideImage,
+        Self::LowZncc,
+        Self::Inconsistent,
+        Self::NoGuess,
+    ];
+
     pub fn word(self) -> &'static str {
         match self {
             Self::Ok => "ok",
             Self::NotConverged => "not_converged",
             Self::LowContrast => "low_contrast",
             Self::OutsideImage => "outside_image",
+            Self::LowZncc => "low_zncc",
+            Self::Inconsistent => "inconsistent",
+            Self::NoGuess => "no_guess",
         }
     }
 }
@@ -67,7 +89,10 @@ pub struct Node {
     pub exx: f64,
     pub eyy: f64,
     pub exy: f64,
-    /// Zero-normalised cross-correlation of the windowed ZOIs at the final position, -1..=1.
+    /// The final check (independent of how the match was found): zero-normalised
+    /// cross-correlation, -1..=1, of the reference ZOI (all its pixels, unwindowed) with the
+    /// deformed image sampled (bilinear) at the node's final displacement and local gradient.
+    /// `ok` needs at least `min_zncc`; 0 where no match was checked.
     pub score: f64,
     /// Sub-pixel Fourier-shift iterations done.
     pub iterations: u32,
@@ -86,8 +111,13 @@ pub struct Field {
     /// Mean u, v over valid nodes (px; 0 when none).
     pub u_mean_px: f64,
     pub v_mean_px: f64,
-    /// Global integer ROI displacement (U0, V0) of this frame against its reference (px).
-    pub global_px: (i64, i64),
+    /// Global integer ROI displacement (U0, V0) of this frame against its reference (px):
+    /// None when it was not needed (every node had a prediction) or its peak was not
+    /// significant.
+    pub global_px: Option<(i64, i64)>,
+    /// The keypoint guess ran on this frame (a new reference whose cheaper guesses did not
+    /// verify).
+    pub keypoints_used: bool,
     /// True when the reference was replaced after this frame (auto and incremental modes).
     pub reference_updated: bool,
 }
@@ -95,5 +125,22 @@ pub struct Field {
 impl Field {
     pub fn node(&self, i: usize, j: usize) -> &Node {
         &self.nodes[j * self.nx + i]
+    }
+
+    /// Nodes with this status.
+    pub fn count(&self, status: NodeStatus) -> usize {
+        self.nodes.iter().filter(|n| n.status == status).count()
+    }
+
+    /// The statuses other than `ok` that occur, with their counts, as `word count, ...`
+    /// (empty when every node is `ok`): why nodes were refused, in one line.
+    pub fn refusals(&self) -> String {
+        NodeStatus::ALL[1..]
+            .iter()
+            .map(|&s| (s, self.count(s)))
+            .filter(|&(_, c)| c > 0)
+            .map(|(s, c)| format!("{} {c}", s.word()))
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 }

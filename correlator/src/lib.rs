@@ -28,6 +28,8 @@ mod correlator;
 mod fft2d;
 pub mod field;
 mod global;
+mod interpolate;
+pub mod keypoints;
 mod mesh;
 pub mod output;
 mod peak;
@@ -39,6 +41,7 @@ mod simd;
 pub mod state;
 pub mod strain;
 pub mod timing;
+mod verify;
 mod window;
 mod zoi;
 
@@ -46,5 +49,6 @@ pub use correlator::Correlator;
 pub use field::{Field, GaugeStrains, Node, NodeStatus, Strain2};
 pub use settings::{
     CorrelatorSettings, GuessMode, ReferenceMode, Roi, SettingsError, StrainMeasure,
+    DEFAULT_MIN_ZNCC,
 };
 pub use zoi::TimeSplit;

@@ -309,6 +309,8 @@ struct Live {
     run_hist: Histogram<u64>,
     window_hist: Histogram<u64>,
     rejects: RateLimit,
+    /// Frames with fewer than half their nodes valid.
+    few_valid: RateLimit,
 }
 
 fn histogram() -> Histogram<u64> {
@@ -329,6 +331,7 @@ impl Live {
             run_hist: histogram(),
             window_hist: histogram(),
             rejects: RateLimit::default(),
+            few_valid: RateLimit::default(),
         }
     }
 
@@ -505,6 +508,15 @@ impl Live {
         let correlate_ns = t.elapsed().as_nanos() as u64;
         let correlator = &*correlator;
         let field = correlator.field();
+        if 2 * field.valid < field.nodes.len() && self.few_valid.allow() {
+            eprintln!(
+                "correlator: warning: frame {}: only {} of {} nodes valid ({})",
+                header.frame_id,
+                field.valid,
+                field.nodes.len(),
+                field.refusals()
+            );
+        }
         // The frame is no longer needed: the correlator copied it if it became the reference.
         drop(sample);
         self.run_hist.saturating_record(correlate_ns);
@@ -567,6 +579,9 @@ fn wire_status(status: NodeStatus) -> wire::NodeStatus {
         NodeStatus::NotConverged => wire::NodeStatus::NotConverged,
         NodeStatus::LowContrast => wire::NodeStatus::LowContrast,
         NodeStatus::OutsideImage => wire::NodeStatus::OutsideImage,
+        NodeStatus::LowZncc => wire::NodeStatus::LowZncc,
+        NodeStatus::Inconsistent => wire::NodeStatus::Inconsistent,
+        NodeStatus::NoGuess => wire::NodeStatus::NoGuess,
     }
 }
 

@@ -79,26 +79,42 @@ impl ReferenceMode {
 }
 
 impl GuessMode {
-    /// `correli` or `predict`.
-    pub fn from_name(name: &str) -> Option<GuessMode> {
-        match name {
-            "correli" => Some(GuessMode::Correli),
-            "predict" => Some(GuessMode::Predict),
-            _ => None,
+    pub const ALL: [GuessMode; 3] = [GuessMode::Auto, GuessMode::Correli, GuessMode::Predict];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            GuessMode::Auto => "auto",
+            GuessMode::Correli => "correli",
+            GuessMode::Predict => "predict",
         }
+    }
+
+    /// `auto`, `correli` or `predict`.
+    pub fn from_name(name: &str) -> Option<GuessMode> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
     }
 }
 
 /// Initial guess of each ZOI before its integer FFT correlation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum GuessMode {
-    /// The paper: every ZOI starts from the global ROI displacement (U0, V0).
-    Correli,
-    /// Beyond the paper: the previous frame's field when there is one, otherwise grow from the
-    /// centre node outwards, each ring starting from its converged inner neighbours.
+    /// The cheapest guess that verifies: the previous frame's field (as `Predict`) or the
+    /// global (U0, V0) when its peak is significant; nodes that fail the final check are
+    /// grown from their verified neighbours (their displacement and gradient, the ZOI warped
+    /// accordingly, best-verified first); when too few nodes verify, keypoints matched over
+    /// the whole image (invariant to rotation and scale) give a local affine guess per node.
     #[default]
+    Auto,
+    /// The paper: every ZOI starts from the global ROI displacement (U0, V0), when its peak
+    /// is significant (otherwise the nodes are `no_guess`).
+    Correli,
+    /// The live path: the previous frame's field when there is one, otherwise grow from the
+    /// centre node outwards, each ring starting from its converged inner neighbours.
     Predict,
 }
+
+/// Default of [`CorrelatorSettings::min_zncc`].
+pub const DEFAULT_MIN_ZNCC: f64 = 0.7;
 
 /// Everything the correlator needs to know before the first frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -125,6 +141,11 @@ pub struct CorrelatorSettings {
     /// nodes around it (a plain threshold would also reject the honest low scores of large
     /// ZOIs under strain). 0 keeps every node.
     pub min_relative_score: f64,
+    /// A node is `ok` only when the ZNCC of its reference ZOI with the deformed image sampled
+    /// at its final displacement and local gradient reaches this (0 < min_zncc < 1). Correct
+    /// matches on speckle score above 0.9 even at 8 bit with visible noise; matches on other
+    /// material score below 0.4.
+    pub min_zncc: f64,
     /// Beyond the paper: remove, to first order, the bias of the rigid ZOI under a
     /// displacement gradient (it reports the motion of a point off its centre, weighted by
     /// where its speckles are; see `zoi::GradientSensitivity`). Off = CORRELI-GD as published.
@@ -139,11 +160,12 @@ impl Default for CorrelatorSettings {
             roi: None,
             strain: StrainMeasure::Log,
             reference: ReferenceMode::Fixed,
-            guess: GuessMode::Predict,
+            guess: GuessMode::Auto,
             threads: 2,
             max_iterations: 10,
             strain_window_nodes: 1,
             min_relative_score: 0.7,
+            min_zncc: DEFAULT_MIN_ZNCC,
             gradient_correction: true,
         }
     }
@@ -188,6 +210,8 @@ pub enum SettingsError {
     },
     #[error("minimum relative node score {fraction} is invalid: expected 0 <= fraction < 1")]
     MinRelativeScore { fraction: f64 },
+    #[error("minimum ZNCC {min_zncc} is invalid: expected 0 < min_zncc < 1")]
+    MinZncc { min_zncc: f64 },
     #[error("correlate called before set_reference")]
     NoReference,
     #[error("saved reference has {got} node displacements, expected {expected} (one per node of this mesh): it was written with other settings or another image size")]
@@ -248,6 +272,11 @@ impl CorrelatorSettings {
         if !(0.0..1.0).contains(&self.min_relative_score) {
             return Err(SettingsError::MinRelativeScore {
                 fraction: self.min_relative_score,
+            });
+        }
+        if !(self.min_zncc > 0.0 && self.min_zncc < 1.0) {
+            return Err(SettingsError::MinZncc {
+                min_zncc: self.min_zncc,
             });
         }
         if let ReferenceMode::Auto {

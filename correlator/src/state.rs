@@ -114,6 +114,7 @@ impl Layout {
             guess: match s.guess {
                 GuessMode::Correli => 0,
                 GuessMode::Predict => 1,
+                GuessMode::Auto => 2,
             },
             strain: match s.strain {
                 StrainMeasure::Small => 0,
@@ -208,6 +209,7 @@ fn guess_name(code: u32) -> &'static str {
     match code {
         0 => "correli",
         1 => "predict",
+        2 => "auto",
         _ => "?",
     }
 }

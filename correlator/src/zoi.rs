@@ -9,6 +9,7 @@
 //! G_w conj(F_w) gives at d, without the forward and inverse transforms.
 
 use crate::field::NodeStatus;
+use crate::interpolate::{apply, bicubic, block_inside, identity_plus, Mat2};
 use crate::peak::quadratic_peak_3x3;
 use crate::real_fft2d::RealFft2d;
 use crate::simd::{dot, F32x4};
@@ -72,9 +73,24 @@ impl GradientSensitivity {
 pub struct ZoiResult {
     pub u_px: f64,
     pub v_px: f64,
+    /// Windowed correlation peak, −1..=1 (how well the match was found; see `verify` for the
+    /// check of the match itself).
     pub score: f64,
     pub iterations: u32,
     pub status: NodeStatus,
+    /// The displacement gradient the deformed ZOI was sampled through (zero: a rigid ZOI cut
+    /// from the pixel grid). The rigid-ZOI bias then only concerns the gradient beyond it.
+    pub warp_gradient: Mat2,
+}
+
+/// A gradient smaller than this (its largest entry times the ZOI half-size, px) is not worth
+/// a warped extraction: the rigid ZOI and the gradient correction handle it.
+pub const MIN_WARP_PX: f64 = 0.25;
+
+/// True when a ZOI of side n under gradient g is worth sampling through the gradient.
+pub fn warp_worth_it(g: Mat2, n: usize) -> bool {
+    let largest = g.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    largest * n as f64 / 2.0 > MIN_WARP_PX
 }
 
 /// Accumulated time split of the engine's work (ns), for the benchmark. Counting is off
@@ -325,6 +341,44 @@ impl ZoiEngine {
         Some(GradientSensitivity { k })
     }
 
+    /// Samples (bicubic) the deformed image through x → x + shift + (a − I)(x − centre) over
+    /// the n x n block centred on `centre` into `g_spatial`, minus its mean. None when a
+    /// sample's 4x4 neighbourhood leaves the image, Some(false) when the samples are flat.
+    fn extract_warped(
+        &mut self,
+        image: Image,
+        centre: (f64, f64),
+        shift: (f64, f64),
+        a: Mat2,
+    ) -> Option<bool> {
+        let n = self.n;
+        if !block_inside(image, centre, shift, a, n, 1.0, 2.0) {
+            return None;
+        }
+        let half = (n as f64 - 1.0) / 2.0;
+        let mut sum = 0.0f64;
+        for (y, row) in self.g_spatial.chunks_exact_mut(n).enumerate() {
+            let start = apply(a, (-half, y as f64 - half));
+            let (mut px, mut py) = (centre.0 + shift.0 + start.0, centre.1 + shift.1 + start.1);
+            let mut row_sum = 0.0f32;
+            for value in row.iter_mut() {
+                *value = bicubic(image, px, py);
+                row_sum += *value;
+                px += a[0][0];
+                py += a[1][0];
+            }
+            sum += row_sum as f64;
+        }
+        let mean = F32x4::splat((sum / (n * n) as f64) as f32);
+        let mut sum_sq = F32x4::zero();
+        for chunk in self.g_spatial.as_chunks_mut::<4>().0 {
+            let g = F32x4::load(chunk).sub(mean);
+            g.store(chunk);
+            sum_sq = sum_sq.mul_add(g, g);
+        }
+        Some((sum_sq.sum() / (n * n) as f32).sqrt() >= MIN_STD_COUNTS)
+    }
+
     /// Copies the n x n block at (x0, y0) into `g_spatial` minus its mean; false if flat.
     fn extract_zero_mean(&mut self, image: Image, x0: usize, y0: usize) -> bool {
         let n = self.n;
@@ -391,7 +445,11 @@ impl ZoiEngine {
     }
 
     /// Correlates the deformed image around the reference ZOI at (x0, y0), starting from the
-    /// guess (px). The returned displacement is total (guess included).
+    /// guess (px). The returned displacement is total (guess included). With a `warp`
+    /// gradient G worth it ([`warp_worth_it`]), the deformed ZOI is sampled (bicubic) through
+    /// x → x + guess + G (x − c) instead of cut from the pixel grid, so that only the residual
+    /// is measured: a ZOI rotated by 170° or stretched by 50 % is correlated against a deformed
+    /// ZOI that looks like it.
     pub fn correlate(
         &mut self,
         reference: &ReferenceSpectra,
@@ -399,6 +457,7 @@ impl ZoiEngine {
         x0: usize,
         y0: usize,
         guess_px: (f64, f64),
+        warp: Option<Mat2>,
         max_iterations: u32,
     ) -> ZoiResult {
         let n = self.n;
@@ -408,31 +467,55 @@ impl ZoiEngine {
             ..ZoiResult::default()
         };
         if !(guess_px.0.is_finite() && guess_px.1.is_finite()) {
+            result.status = NodeStatus::NoGuess;
             return result;
         }
+        let warp =
+            warp.filter(|&g| g.iter().flatten().all(|v| v.is_finite()) && warp_worth_it(g, n));
         // Integer step (paper): one unwindowed FFT correlation, then move the deformed ZOI.
+        // Warped, the move is in the ZOI's own (warped) axes: `origin` is where its centre
+        // lands, relative to the reference centre.
+        let a = warp.map(identity_plus);
         let mut ix = guess_px.0.round() as i64;
         let mut iy = guess_px.1.round() as i64;
+        let mut origin = (ix as f64, iy as f64);
         let mut spectrum_valid = false;
         for pass in 0..2 {
-            // A ZOI at most one pixel past the border is pulled back inside: the sub-pixel
-            // stage accepts a residual of up to one pixel.
-            let max_x = deformed.width_px as i64 - n as i64;
-            let max_y = deformed.height_px as i64 - n as i64;
-            let (gx, gy) = (x0 as i64 + ix, y0 as i64 + iy);
-            let (cx, cy) = (gx.clamp(0, max_x), gy.clamp(0, max_y));
-            if (cx - gx).abs() <= 1 && (cy - gy).abs() <= 1 {
-                ix += cx - gx;
-                iy += cy - gy;
-            }
-            let (gx, gy) = (x0 as i64 + ix, y0 as i64 + iy);
-            if !deformed.contains_block(gx, gy, n) {
-                result.status = NodeStatus::OutsideImage;
-                return result;
-            }
-            if !self.extract_zero_mean(deformed, gx as usize, gy as usize) {
-                result.status = NodeStatus::LowContrast;
-                return result;
+            if let Some(a) = a {
+                let half = (n as f64 - 1.0) / 2.0;
+                let centre = (x0 as f64 + half, y0 as f64 + half);
+                match self.extract_warped(deformed, centre, origin, a) {
+                    None => {
+                        result.status = NodeStatus::OutsideImage;
+                        return result;
+                    }
+                    Some(false) => {
+                        result.status = NodeStatus::LowContrast;
+                        return result;
+                    }
+                    Some(true) => {}
+                }
+            } else {
+                // A ZOI at most one pixel past the border is pulled back inside: the sub-pixel
+                // stage accepts a residual of up to one pixel.
+                let max_x = deformed.width_px as i64 - n as i64;
+                let max_y = deformed.height_px as i64 - n as i64;
+                let (gx, gy) = (x0 as i64 + ix, y0 as i64 + iy);
+                let (cx, cy) = (gx.clamp(0, max_x), gy.clamp(0, max_y));
+                if (cx - gx).abs() <= 1 && (cy - gy).abs() <= 1 {
+                    ix += cx - gx;
+                    iy += cy - gy;
+                }
+                let (gx, gy) = (x0 as i64 + ix, y0 as i64 + iy);
+                if !deformed.contains_block(gx, gy, n) {
+                    result.status = NodeStatus::OutsideImage;
+                    return result;
+                }
+                if !self.extract_zero_mean(deformed, gx as usize, gy as usize) {
+                    result.status = NodeStatus::LowContrast;
+                    return result;
+                }
+                origin = (ix as f64, iy as f64);
             }
             timer.lap(&mut self.split.other_ns);
             if pass == 1 {
@@ -457,6 +540,10 @@ impl ZoiEngine {
             }
             ix += dx;
             iy += dy;
+            if let Some(a) = a {
+                let step = apply(a, (dx as f64, dy as f64));
+                origin = (origin.0 + step.0, origin.1 + step.1);
+            }
         }
         if !spectrum_valid {
             self.fft.forward(&self.g_spatial, &mut self.g_spectrum);
@@ -504,8 +591,11 @@ impl ZoiEngine {
                 break;
             }
         }
-        result.u_px = ix as f64 + best_estimate.0;
-        result.v_px = iy as f64 + best_estimate.1;
+        // The sub-pixel estimate is in the ZOI's axes: a step s there is A s in the image.
+        let step = a.map_or(best_estimate, |a| apply(a, best_estimate));
+        result.u_px = origin.0 + step.0;
+        result.v_px = origin.1 + step.1;
+        result.warp_gradient = warp.unwrap_or_default();
         result.score = best_value.clamp(-1.0, 1.0);
         let drifted = best_estimate.0.abs() > MAX_SUBPIXEL_DRIFT_PX
             || best_estimate.1.abs() > MAX_SUBPIXEL_DRIFT_PX;

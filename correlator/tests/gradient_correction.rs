@@ -8,7 +8,7 @@
 mod common;
 
 use common::{render, stretch};
-use correlator::{Correlator, CorrelatorSettings, NodeStatus, ReferenceMode};
+use correlator::{Correlator, CorrelatorSettings, GuessMode, NodeStatus, ReferenceMode};
 
 const SIZE: usize = 256;
 
@@ -36,10 +36,13 @@ fn node_errors(correlator: &Correlator, ex: f64, ey: f64) -> (f64, f64, usize) {
     ((sum_sq / count as f64).sqrt(), worst, count)
 }
 
+/// The rigid ZOI (guess `predict`): guess `auto` samples the ZOIs of a fresh reference through
+/// the measured gradient, which leaves the correction little to do.
 fn settings(gradient_correction: bool, reference: ReferenceMode) -> CorrelatorSettings {
     CorrelatorSettings {
         gradient_correction,
         reference,
+        guess: GuessMode::Predict,
         ..CorrelatorSettings::default()
     }
 }

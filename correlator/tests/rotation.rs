@@ -1,11 +1,14 @@
-//! Paper section 3.c: 5° rigid rotation, s = 6, δx = 32. Mean infinitesimal strain within 3e-4
-//! of cos 5° − 1; mean Green-Lagrange and logarithmic strains and shear below 2e-4.
+//! Paper section 3.c: 5° rigid rotation, s = 6, δx = 32, on the whole 512² image. Mean
+//! infinitesimal strain within 3e-4 of cos 5° − 1; mean Green-Lagrange and logarithmic strains
+//! and shear below 2e-4; no `ok` node more than 0.5 px off; with the default guess and with the
+//! paper's (whose global (U0, V0) needs the significance test and the smaller centred square
+//! here: on the whole ROI the rotation decorrelates its border).
 
 mod common;
 
-use common::{render, rotation_deg};
+use common::{accuracy, render, rotation_deg};
 use correlator::strain::node_strains;
-use correlator::{Correlator, CorrelatorSettings, GuessMode, NodeStatus, Roi, StrainMeasure};
+use correlator::{Correlator, CorrelatorSettings, GuessMode, NodeStatus, StrainMeasure};
 
 #[test]
 fn five_degree_rotation() {
@@ -14,18 +17,10 @@ fn five_degree_rotation() {
     let reference = render(w, h, 48.0, rotation_deg(0.0, centre), 0.01, 1);
     let deformed = render(w, h, 48.0, rotation_deg(5.0, centre), 0.01, 2);
     let exact_small = 5f64.to_radians().cos() - 1.0;
-    for guess in [GuessMode::Correli, GuessMode::Predict] {
-        // ROI 64 px inside the image borders: the corners move by up to 24 px.
-        let roi = Some(Roi {
-            x_px: 64,
-            y_px: 64,
-            width_px: 384,
-            height_px: 384,
-        });
+    for guess in [GuessMode::Auto, GuessMode::Correli, GuessMode::Predict] {
         let settings = CorrelatorSettings {
             zoi_px: 64,
             step_px: 32,
-            roi,
             guess,
             strain: StrainMeasure::Small,
             ..Default::default()
@@ -50,16 +45,7 @@ fn five_degree_rotation() {
             field.valid,
             field.nodes.len()
         );
-        for status in [
-            NodeStatus::NotConverged,
-            NodeStatus::LowContrast,
-            NodeStatus::OutsideImage,
-        ] {
-            eprintln!(
-                "  {status:?}: {}",
-                field.nodes.iter().filter(|n| n.status == status).count()
-            );
-        }
+        eprintln!("  refused: {}", field.refusals());
         for (measure, exx, eyy, exy) in &means {
             let g = field.gauge.get(*measure);
             eprintln!(
@@ -70,10 +56,20 @@ fn five_degree_rotation() {
                 g.exy
             );
         }
-        if guess == GuessMode::Correli {
-            continue; // reported only: far nodes move by more than the paper's guess allows
+        let (s5, c5) = 5f64.to_radians().sin_cos();
+        let o = accuracy(&field, 64, (w, h), |p| {
+            let d = [p[0] - centre[0], p[1] - centre[1]];
+            [
+                centre[0] + c5 * d[0] - s5 * d[1],
+                centre[1] + s5 * d[0] + c5 * d[1],
+            ]
+        });
+        o.print(&format!("rotation 5°, ZOI 64, step 32, {guess:?}"));
+        assert_eq!(o.false_ok, 0, "{o:?}");
+        if guess == GuessMode::Predict {
+            continue; // reported only: the live path without growth
         }
-        assert_eq!(field.valid, field.nodes.len());
+        assert!(o.valid_fraction() >= 0.95, "{o:?}");
         // The paper's figures are ROI averages (CORRELI-GAUGE): asserted on the gauge. The plain
         // mean of the per-node 3x3 least-squares strains is noisier at the mesh border: looser.
         for (measure, exx, eyy, exy) in means {

@@ -61,8 +61,10 @@ pub struct CorrelatorSection {
     pub strain: String,
     /// Reference: fixed, incremental or auto.
     pub reference: String,
-    /// Initial guess: predict or correli.
+    /// Initial guess: auto, predict or correli.
     pub guess: String,
+    /// A node is ok only when its final ZNCC check reaches this.
+    pub min_zncc: f64,
     /// First-order correction of the rigid ZOI's bias under a displacement gradient.
     pub gradient_correction: bool,
 }
@@ -142,7 +144,8 @@ impl Default for CorrelatorSection {
             threads: 2,
             strain: "log".into(),
             reference: "auto".into(),
-            guess: "predict".into(),
+            guess: "auto".into(),
+            min_zncc: correlator::DEFAULT_MIN_ZNCC,
             gradient_correction: true,
         }
     }
@@ -275,7 +278,7 @@ impl RunConfig {
         })?;
         let guess = GuessMode::from_name(&c.guess).ok_or_else(|| {
             format!(
-                "[correlator] guess = {:?}: expected predict or correli",
+                "[correlator] guess = {:?}: expected auto, predict or correli",
                 c.guess
             )
         })?;
@@ -286,6 +289,7 @@ impl RunConfig {
             strain,
             reference,
             guess,
+            min_zncc: c.min_zncc,
             gradient_correction: c.gradient_correction,
             ..correlator::CorrelatorSettings::default()
         };
@@ -453,12 +457,24 @@ impl RunConfig {
              # Reference: fixed, incremental (consecutive frames) or auto (renewed when the\n\
              # displacement or the score call for it, mesh followed).\n\
              reference = {:?}\n\
-             # Initial guess per ZOI: predict (previous field, neighbours) or correli (paper).\n\
+             # Initial guess per ZOI: auto (previous field or significant global (U0, V0),\n\
+             # failed nodes grown from verified neighbours, keypoints when too few verify),\n\
+             # predict (previous field, neighbours) or correli (paper).\n\
              guess = {:?}\n\
+             # A node is ok only when the ZNCC of its reference ZOI with the frame, sampled at\n\
+             # its displacement and local gradient, reaches this (0 < min_zncc < 1).\n\
+             min_zncc = {}\n\
              # Remove, to first order, the rigid ZOI's bias under a displacement gradient\n\
              # (beyond the paper; false = CORRELI-GD as published).\n\
              gradient_correction = {}\n",
-            k.zoi_px, k.step_px, k.threads, k.strain, k.reference, k.guess, k.gradient_correction
+            k.zoi_px,
+            k.step_px,
+            k.threads,
+            k.strain,
+            k.reference,
+            k.guess,
+            k.min_zncc,
+            k.gradient_correction
         );
         let g = &d.rig;
         let _ = writeln!(

@@ -203,7 +203,10 @@ pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correla
         Some(wire::NodeStatus::Ok) => S::Ok,
         Some(wire::NodeStatus::NotConverged) => S::NotConverged,
         Some(wire::NodeStatus::LowContrast) => S::LowContrast,
-        _ => S::OutsideImage,
+        Some(wire::NodeStatus::LowZncc) => S::LowZncc,
+        Some(wire::NodeStatus::Inconsistent) => S::Inconsistent,
+        Some(wire::NodeStatus::NoGuess) => S::NoGuess,
+        Some(wire::NodeStatus::OutsideImage) | None => S::OutsideImage,
     };
     let nodes: Vec<correlator::Node> = nodes
         .iter()

@@ -169,6 +169,8 @@ pub fn child_args(
             k.reference.clone(),
             "--guess".into(),
             k.guess.clone(),
+            "--min-zncc".into(),
+            k.min_zncc.to_string(),
             "--gradient-correction".into(),
             k.gradient_correction.to_string(),
             "--state-dir".into(),

@@ -2,7 +2,7 @@
 //! per benchmark (`BenchCommand`); `correlate` measures the correlator on rendered speckle.
 
 use anyhow::{bail, Context, Result};
-use correlator::{Correlator, CorrelatorSettings, GuessMode};
+use correlator::{Correlator, CorrelatorSettings};
 use producer::motion::Affine;
 use producer::{CameraModel, FastRenderer, Motion, Speckle, SpeckleParams};
 use std::time::Instant;
@@ -45,8 +45,9 @@ pub struct CorrelateBenchArgs {
     /// Timed frames per thread count (the median is reported).
     #[arg(long, default_value_t = 9)]
     pub frames: usize,
-    /// Initial guess: predict (the live default) or correli (the paper's).
-    #[arg(long, value_enum, default_value = "predict")]
+    /// Initial guess: auto (the default), predict (the live path without growth or
+    /// keypoints) or correli (the paper's).
+    #[arg(long, value_enum, default_value = "auto")]
     pub guess: super::correlate::GuessArg,
     /// Print one JSON object instead of text.
     #[arg(long)]
@@ -102,10 +103,7 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
         bail!("--threads: expected positive thread counts, e.g. 1,2");
     }
     let (w, h) = (args.width, args.height);
-    let guess = match args.guess {
-        super::correlate::GuessArg::Correli => GuessMode::Correli,
-        super::correlate::GuessArg::Predict => GuessMode::Predict,
-    };
+    let guess = args.guess.mode();
     let settings_for = |threads| CorrelatorSettings {
         zoi_px: args.zoi,
         step_px: args.step,

@@ -31,6 +31,7 @@ pub enum ReferenceArg {
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum GuessArg {
+    Auto,
     Correli,
     Predict,
 }
@@ -59,6 +60,7 @@ impl ReferenceArg {
 impl GuessArg {
     pub fn mode(self) -> GuessMode {
         match self {
+            GuessArg::Auto => GuessMode::Auto,
             GuessArg::Correli => GuessMode::Correli,
             GuessArg::Predict => GuessMode::Predict,
         }
@@ -81,10 +83,16 @@ pub struct CorrelationArgs {
     /// Strain measure of the node strains (the gauge is given in all four).
     #[arg(long, value_enum, default_value = "log")]
     pub strain: StrainArg,
-    /// Initial guess per ZOI: the paper's global (U0, V0), or predicted from the previous
-    /// field or from converged neighbours.
-    #[arg(long, value_enum, default_value = "predict")]
+    /// Initial guess per ZOI. auto: the cheapest guess that passes the final check (previous
+    /// field, significant global (U0, V0)), failed nodes grown from verified neighbours,
+    /// keypoints (rotation- and scale-invariant) when too few verify. correli: the paper's
+    /// global (U0, V0). predict: previous field, or grown from the centre.
+    #[arg(long, value_enum, default_value = "auto")]
     pub guess: GuessArg,
+    /// A node is ok only when the ZNCC of its reference ZOI with the deformed image, sampled
+    /// at its displacement and local gradient, reaches this (0 < value < 1).
+    #[arg(long, default_value_t = correlator::DEFAULT_MIN_ZNCC)]
+    pub min_zncc: f64,
     /// Remove, to first order, the rigid ZOI's bias under a displacement gradient (beyond the
     /// paper; false = CORRELI-GD as published).
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
@@ -106,6 +114,7 @@ impl CorrelationArgs {
             strain: self.strain.measure(),
             reference,
             guess: self.guess.mode(),
+            min_zncc: self.min_zncc,
             gradient_correction: self.gradient_correction,
             threads: self.threads,
             max_iterations: self.max_iterations,
@@ -200,6 +209,7 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
     };
     let settings_value = settings_json(&args, &correlator);
     let mut frames = Vec::new();
+    let mut frames_with_valid_nodes = 0usize;
     let mut text = String::new();
     for (i, path) in args.deformed.iter().enumerate() {
         let index = i + 1;
@@ -216,6 +226,20 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
         let t = Instant::now();
         let field = correlator.correlate(&image.pixels)?;
         let elapsed_ms = t.elapsed().as_secs_f64() * 1e3;
+        frames_with_valid_nodes += usize::from(field.valid > 0);
+        if 2 * field.valid < field.nodes.len() {
+            let warning = format!(
+                "warning: {}: only {} of {} nodes valid ({})",
+                path.display(),
+                field.valid,
+                field.nodes.len(),
+                field.refusals()
+            );
+            match &progress {
+                Some(bar) => bar.println(warning),
+                None => eprintln!("{warning}"),
+            }
+        }
         correlator::output::field_csv(field, &mut text);
         write(
             &args.out.join(format!("field_{index:04}.csv")),
@@ -253,6 +277,9 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
             "gauge": gauge_json(&field.gauge),
             "elapsed_ms": elapsed_ms,
             "reference_updated": field.reference_updated,
+            "statuses": status_json(field),
+            "global_px": field.global_px.map(|(u, v)| [u, v]),
+            "keypoints_used": field.keypoints_used,
         }));
         let summary = serde_json::json!({ "frames": frames, "settings": settings_value });
         write(
@@ -267,7 +294,25 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
     if let Some(bar) = progress {
         bar.finish();
     }
+    if frames_with_valid_nodes == 0 {
+        bail!(
+            "no node of any of the {} deformed images passed the final check against {}: \
+             nothing was measured (unrelated or flat images? the fields in {} say why per node)",
+            args.deformed.len(),
+            args.reference.display(),
+            args.out.display()
+        );
+    }
     Ok(())
+}
+
+/// Nodes per status, by status word.
+fn status_json(field: &Field) -> serde_json::Value {
+    correlator::NodeStatus::ALL
+        .iter()
+        .map(|&s| (s.word().to_owned(), field.count(s).into()))
+        .collect::<serde_json::Map<_, _>>()
+        .into()
 }
 
 fn gauge_json(g: &GaugeStrains) -> serde_json::Value {
@@ -289,6 +334,7 @@ fn settings_json(args: &CorrelateArgs, correlator: &Correlator) -> serde_json::V
         "reference_mode": format!("{:?}", args.reference_mode).to_lowercase(),
         "guess": format!("{:?}", args.correlation.guess).to_lowercase(),
         "gradient_correction": args.correlation.gradient_correction,
+        "min_zncc": args.correlation.min_zncc,
         "threads": args.correlation.threads,
         "max_iterations": args.correlation.max_iterations,
         "strain_window_nodes": correlator.settings().strain_window_nodes,

@@ -47,6 +47,12 @@ pub enum NodeStatus {
     NotConverged = 1,
     LowContrast = 2,
     OutsideImage = 3,
+    /// The final ZNCC check failed.
+    LowZncc = 4,
+    /// Far from the affine fit of its neighbours.
+    Inconsistent = 5,
+    /// No trustworthy guess: not measured.
+    NoGuess = 6,
 }
 
 impl NodeStatus {
@@ -56,6 +62,9 @@ impl NodeStatus {
             NodeStatus::NotConverged => "not_converged",
             NodeStatus::LowContrast => "low_contrast",
             NodeStatus::OutsideImage => "outside_image",
+            NodeStatus::LowZncc => "low_zncc",
+            NodeStatus::Inconsistent => "inconsistent",
+            NodeStatus::NoGuess => "no_guess",
         }
     }
 
@@ -65,6 +74,9 @@ impl NodeStatus {
             NodeStatus::NotConverged,
             NodeStatus::LowContrast,
             NodeStatus::OutsideImage,
+            NodeStatus::LowZncc,
+            NodeStatus::Inconsistent,
+            NodeStatus::NoGuess,
         ]
         .into_iter()
         .find(|s| *s as u32 == code)
@@ -85,7 +97,8 @@ pub struct FieldNode {
     pub exx: f32,
     pub eyy: f32,
     pub exy: f32,
-    /// Normalised correlation score in [-1, 1].
+    /// The correlator's final check: ZNCC in [-1, 1] of the reference ZOI against the
+    /// deformed image sampled at the node's displacement and local gradient (0 when unchecked).
     pub score: f32,
     pub iterations: u32,
     /// A [`NodeStatus`] code.
@@ -196,7 +209,8 @@ mod tests {
         }
         assert_eq!(StrainMeasure::from_code(9), None);
         assert_eq!(NodeStatus::from_code(2), Some(NodeStatus::LowContrast));
-        assert_eq!(NodeStatus::from_code(4), None);
+        assert_eq!(NodeStatus::from_code(4), Some(NodeStatus::LowZncc));
+        assert_eq!(NodeStatus::from_code(7), None);
         assert_eq!(StrainMeasure::Log.name(), "log");
     }
 }

@@ -1,6 +1,8 @@
 //! Test images from the producer crate (speckle with exact ground truth), and small helpers.
 #![allow(dead_code)]
 
+pub mod independent;
+
 use producer::motion::Affine;
 use producer::Motion;
 
@@ -58,4 +60,85 @@ pub fn mean_std(values: &[f64]) -> (f64, f64) {
     let mean = values.iter().sum::<f64>() / n;
     let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
     (mean, var.sqrt())
+}
+
+/// An `ok` node further than this from the truth is a false `ok`.
+pub const FALSE_OK_PX: f64 = 0.5;
+
+/// A field against the exact motion.
+#[derive(Debug)]
+pub struct Accuracy {
+    /// Nodes whose deformed ZOI lies in the image, and how many of them are `ok`.
+    pub candidates: usize,
+    pub ok_candidates: usize,
+    /// `ok` nodes in all, their RMS and largest error (px), and how many are > 0.5 px off.
+    pub ok: usize,
+    pub rms_px: f64,
+    pub worst_px: f64,
+    pub false_ok: usize,
+}
+
+impl Accuracy {
+    pub fn valid_fraction(&self) -> f64 {
+        self.ok_candidates as f64 / self.candidates.max(1) as f64
+    }
+
+    /// One line of the table: case, valid fraction, RMS, worst `ok` node, false `ok` count.
+    pub fn print(&self, case: &str) {
+        println!(
+            "| {case:<34} | {:>5.1} % ({}/{}) | {:.4} px | {:.3} px | {} |",
+            100.0 * self.valid_fraction(),
+            self.ok_candidates,
+            self.candidates,
+            self.rms_px,
+            self.worst_px,
+            self.false_ok
+        );
+    }
+}
+
+/// Compares a field with the exact motion `forward` (reference point to deformed point): node
+/// errors, and which nodes could be measured at all (the four corners of their ZOI, moved by
+/// the motion, inside the `size` image).
+pub fn accuracy(
+    field: &correlator::Field,
+    zoi_px: usize,
+    size: (usize, usize),
+    forward: impl Fn([f64; 2]) -> [f64; 2],
+) -> Accuracy {
+    let half = (zoi_px as f64 - 1.0) / 2.0;
+    let inside = |p: [f64; 2]| {
+        p[0] >= 0.0 && p[1] >= 0.0 && p[0] <= size.0 as f64 - 1.0 && p[1] <= size.1 as f64 - 1.0
+    };
+    let (mut candidates, mut ok_candidates, mut ok, mut false_ok) = (0, 0, 0, 0);
+    let (mut sum_sq, mut worst) = (0.0, 0.0f64);
+    for node in &field.nodes {
+        let corners = [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)];
+        let candidate = corners
+            .iter()
+            .all(|(sx, sy)| inside(forward([node.x_px + sx * half, node.y_px + sy * half])));
+        candidates += usize::from(candidate);
+        if node.status != correlator::NodeStatus::Ok {
+            continue;
+        }
+        ok += 1;
+        ok_candidates += usize::from(candidate);
+        let x = forward([node.x_px, node.y_px]);
+        let error = (node.u_px - (x[0] - node.x_px)).hypot(node.v_px - (x[1] - node.y_px));
+        sum_sq += error * error;
+        worst = worst.max(error);
+        false_ok += usize::from(error > FALSE_OK_PX);
+    }
+    Accuracy {
+        candidates,
+        ok_candidates,
+        ok,
+        rms_px: if ok > 0 {
+            (sum_sq / ok as f64).sqrt()
+        } else {
+            f64::NAN
+        },
+        worst_px: worst,
+        false_ok,
+    }
 }

@@ -1,0 +1,314 @@
+//! What happens after the first pass: the final check of every result (all guess modes), and,
+//! with guess `auto`, the cheaper-first rescue of the nodes that fail it:
+//!
+//! 1. **Reliability-guided growth** (as Ncorr does): a node that failed gets a new guess from
+//!    its best-verified neighbour (highest ZNCC), extrapolated with that neighbour's local
+//!    gradient, and its deformed ZOI is sampled through that gradient. Growth goes in waves
+//!    (every failed node next to a verified one, in parallel), each node retried only when it
+//!    has gained verified neighbours, until a wave verifies nothing new.
+//! 2. **Keypoints**, when fewer than half the textured nodes verify after growth (a rotation or
+//!    a strain too large for the global correlation): a local affine guess per node from
+//!    keypoints matched over the whole image (`keypoints`), then growth again.
+//! 3. **Refinement** on a fresh reference (no previous field): every verified node whose
+//!    measured local gradient differs from the one its ZOI was sampled through (by more than
+//!    [`crate::zoi::MIN_WARP_PX`] at the ZOI border) is correlated again through the measured
+//!    gradient, so only a small residual is left to the rigid ZOI.
+//!
+//! Every new result passes the same check before it counts.
+
+use super::{Correlator, Entry};
+use crate::field::NodeStatus;
+use crate::interpolate::Mat2;
+use crate::keypoints::KeypointMatcher;
+use crate::pool::SharedSlice;
+use crate::verify;
+use crate::zoi::{spectrum_len, warp_worth_it, Image, ReferenceSpectra};
+
+/// Keypoints run when fewer than this fraction of the textured nodes verify after growth.
+const KEYPOINTS_BELOW_FRACTION: f64 = 0.5;
+
+fn to_mat2(g: nalgebra::Matrix2<f64>) -> Mat2 {
+    [[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]
+}
+
+fn difference(a: Mat2, b: Mat2) -> Mat2 {
+    [
+        [a[0][0] - b[0][0], a[0][1] - b[0][1]],
+        [a[1][0] - b[1][0], a[1][1] - b[1][1]],
+    ]
+}
+
+impl Correlator {
+    fn reference_image(&self) -> Image<'_> {
+        Image {
+            pixels: &self.reference_pixels,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        }
+    }
+
+    /// The local gradient of node k's neighbourhood of verified results, else the gradient
+    /// its ZOI was sampled through.
+    fn local_gradient(&self, k: usize) -> Mat2 {
+        self.result_gradient(k)
+            .map_or(self.results[k].warp_gradient, to_mat2)
+    }
+
+    /// The final check of every `ok` result: the ZNCC through its displacement and its
+    /// neighbourhood's gradient, or its own warp when that fails (a false neighbour must not
+    /// fail a good node); below `min_zncc` the node is `low_zncc`.
+    pub(super) fn verify_results(&mut self, image: Image) {
+        let n = self.settings.zoi_px;
+        let min_zncc = self.settings.min_zncc;
+        let reference = Image {
+            pixels: &self.reference_pixels,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        };
+        let (results, ref_nodes) = (&self.results, &self.ref_nodes);
+        let mesh = (self.mesh.nx, self.mesh.ny);
+        let zncc = SharedSlice::new(&mut self.zncc);
+        // Results are only read here; the verdicts go to `zncc` and become statuses below.
+        self.pool.run(results.len(), &|_, k| {
+            let result = results[k];
+            let mut score = 0.0;
+            if result.status == NodeStatus::Ok {
+                let gradient = super::result_gradient(results, ref_nodes, mesh, k)
+                    .map_or(result.warp_gradient, to_mat2);
+                let u = (result.u_px, result.v_px);
+                let top_left = ref_nodes[k].top_left;
+                let check = |g: Mat2| verify::zncc(reference, top_left, n, image, u, g);
+                score = check(gradient).unwrap_or(0.0);
+                if score < min_zncc && gradient != result.warp_gradient {
+                    score = score.max(check(result.warp_gradient).unwrap_or(0.0));
+                }
+            }
+            // SAFETY: item k writes only node k's slot.
+            unsafe { zncc.write(k, score) };
+        });
+        for (result, &score) in self.results.iter_mut().zip(&self.zncc) {
+            if result.status == NodeStatus::Ok && score < min_zncc {
+                result.status = NodeStatus::LowZncc;
+            }
+        }
+    }
+
+    /// Guess `auto` after the first pass: growth, keypoints when too few nodes verify, and
+    /// the refinement of a fresh reference (see the module documentation).
+    pub(super) fn improve(&mut self, image: Image) {
+        let fresh = !self.has_previous;
+        self.grow(image);
+        let textured = self
+            .ref_nodes
+            .iter()
+            .filter(|r| r.status == NodeStatus::Ok)
+            .count();
+        let verified = self
+            .results
+            .iter()
+            .filter(|r| r.status == NodeStatus::Ok)
+            .count();
+        if (verified as f64) < KEYPOINTS_BELOW_FRACTION * textured as f64
+            && self.keypoint_pass(image)
+        {
+            self.grow(image);
+        }
+        if fresh {
+            self.refine(image);
+        }
+    }
+
+    /// Reliability-guided growth from the verified nodes (module documentation, step 1).
+    fn grow(&mut self, image: Image) {
+        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
+        self.grown_from.fill(0);
+        loop {
+            self.entries.clear();
+            for k in 0..nx * ny {
+                if self.ref_nodes[k].status != NodeStatus::Ok
+                    || self.results[k].status == NodeStatus::Ok
+                {
+                    continue;
+                }
+                let (i, j) = (k % nx, k / nx);
+                let (mut count, mut best) = (0u8, None::<usize>);
+                for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
+                    for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
+                        let m = jj * nx + ii;
+                        if m != k && self.results[m].status == NodeStatus::Ok {
+                            count += 1;
+                            if best.is_none_or(|b| self.zncc[m] > self.zncc[b]) {
+                                best = Some(m);
+                            }
+                        }
+                    }
+                }
+                let Some(m) = best else { continue };
+                if count <= self.grown_from[k] {
+                    continue;
+                }
+                self.grown_from[k] = count;
+                let g = self.local_gradient(m);
+                let (a, b) = (self.ref_nodes[k].top_left, self.ref_nodes[m].top_left);
+                let (dx, dy) = (a.0 as f64 - b.0 as f64, a.1 as f64 - b.1 as f64);
+                let from = self.results[m];
+                self.entries.push(Entry {
+                    node: k,
+                    guess_px: (
+                        from.u_px + g[0][0] * dx + g[0][1] * dy,
+                        from.v_px + g[1][0] * dx + g[1][1] * dy,
+                    ),
+                    gradient: g,
+                });
+            }
+            if self.entries.is_empty() {
+                return;
+            }
+            if self.correlate_entries(image, false) == 0 {
+                return;
+            }
+        }
+    }
+
+    /// Keypoints matched over the whole image seed every node that has not verified with a
+    /// local affine guess (module documentation, step 2). False when the keypoints gave no
+    /// trustworthy map.
+    fn keypoint_pass(&mut self, image: Image) -> bool {
+        let (w, h) = (self.width_px, self.height_px);
+        let mut matcher = self
+            .keypoint_matcher
+            .take()
+            .unwrap_or_else(|| KeypointMatcher::new(w, h, self.settings.threads));
+        if self.reference_keypoints.is_none() {
+            let roi = self.roi;
+            let region = (roi.x_px, roi.y_px, roi.width_px, roi.height_px);
+            self.reference_keypoints = Some(matcher.detect(self.reference_image(), region));
+        }
+        let deformed = matcher.detect(image, (0, 0, w, h));
+        let guess = self
+            .reference_keypoints
+            .as_ref()
+            .and_then(|reference| matcher.estimate(reference, &deformed));
+        self.keypoint_matcher = Some(matcher);
+        let Some(guess) = guess else {
+            return false;
+        };
+        self.field.keypoints_used = true;
+        let half = (self.settings.zoi_px as f64 - 1.0) / 2.0;
+        self.entries.clear();
+        for k in 0..self.results.len() {
+            if self.ref_nodes[k].status != NodeStatus::Ok
+                || self.results[k].status == NodeStatus::Ok
+            {
+                continue;
+            }
+            let (x0, y0) = self.ref_nodes[k].top_left;
+            let c = [x0 as f64 + half, y0 as f64 + half];
+            let affine = guess.local_affine(c);
+            let moved = affine.apply(c);
+            let a = affine.a;
+            self.entries.push(Entry {
+                node: k,
+                guess_px: (moved[0] - c[0], moved[1] - c[1]),
+                gradient: [[a[0][0] - 1.0, a[0][1]], [a[1][0], a[1][1] - 1.0]],
+            });
+        }
+        self.correlate_entries(image, false);
+        true
+    }
+
+    /// Verified nodes correlated again through their measured local gradient (module
+    /// documentation, step 3).
+    fn refine(&mut self, image: Image) {
+        let n = self.settings.zoi_px;
+        self.entries.clear();
+        for k in 0..self.results.len() {
+            let result = self.results[k];
+            if result.status != NodeStatus::Ok {
+                continue;
+            }
+            let Some(g) = self.result_gradient(k).map(to_mat2) else {
+                continue;
+            };
+            if warp_worth_it(difference(g, result.warp_gradient), n) {
+                self.entries.push(Entry {
+                    node: k,
+                    guess_px: (result.u_px, result.v_px),
+                    gradient: g,
+                });
+            }
+        }
+        self.correlate_entries(image, true);
+    }
+
+    /// Correlates `entries` (each through its gradient), checks each new result with that
+    /// gradient, and keeps it when it verifies and the node had no verified result (or
+    /// `replace_verified`); a node that fails keeps its old result if that one was `ok`, else
+    /// the new failure. Returns how many nodes verified.
+    fn correlate_entries(&mut self, image: Image, replace_verified: bool) -> usize {
+        let n = self.settings.zoi_px;
+        let n2 = spectrum_len(n);
+        let max_iterations = self.settings.max_iterations;
+        let min_zncc = self.settings.min_zncc;
+        let reference = Image {
+            pixels: &self.reference_pixels,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        };
+        let (entries, ref_nodes) = (&self.entries, &self.ref_nodes);
+        let (plain, windowed) = (&self.plain_spectra, &self.windowed_references);
+        let results = SharedSlice::new(&mut self.results);
+        let zncc = SharedSlice::new(&mut self.zncc);
+        let verified = std::sync::atomic::AtomicUsize::new(0);
+        self.pool.run(entries.len(), &|engine, i| {
+            let entry = entries[i];
+            let k = entry.node;
+            let r = ref_nodes[k];
+            let spectra = ReferenceSpectra {
+                plain: &plain[k * n2..(k + 1) * n2],
+                windowed: &windowed[k * n * n..(k + 1) * n * n],
+            };
+            let mut result = engine.correlate(
+                &spectra,
+                image,
+                r.top_left.0,
+                r.top_left.1,
+                entry.guess_px,
+                Some(entry.gradient),
+                max_iterations,
+            );
+            let mut score = 0.0;
+            if result.status == NodeStatus::Ok {
+                score = verify::zncc(
+                    reference,
+                    r.top_left,
+                    n,
+                    image,
+                    (result.u_px, result.v_px),
+                    entry.gradient,
+                )
+                .unwrap_or(0.0);
+                if score < min_zncc {
+                    result.status = NodeStatus::LowZncc;
+                }
+            }
+            // SAFETY: item i touches only node entries[i].node's slots; nodes are distinct.
+            let old = unsafe { results.read(k) };
+            let keep_new = if result.status == NodeStatus::Ok {
+                old.status != NodeStatus::Ok || replace_verified
+            } else {
+                old.status != NodeStatus::Ok
+            };
+            if keep_new {
+                unsafe {
+                    results.write(k, result);
+                    zncc.write(k, score);
+                }
+                if result.status == NodeStatus::Ok && old.status != NodeStatus::Ok {
+                    verified.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                }
+            }
+        });
+        verified.into_inner()
+    }
+}
