@@ -5,7 +5,7 @@
 
 mod harness;
 
-use harness::{render, translation};
+use harness::{render, translation, unrelated_speckle};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -269,7 +269,8 @@ fn bad_inputs_are_clear_errors() {
         ],
         "larger than the ROI",
     );
-    // A flat image: every node low_contrast in the CSV, numbers finite.
+    // A flat image: every node low_contrast in the CSV, numbers finite, a warning naming the
+    // image, and a failure: nothing was measured.
     let flat = dir.0.join("flat.png");
     write_png(&flat, &vec![1000u16; W * H], W, H);
     let output = dicstream(&[
@@ -279,11 +280,13 @@ fn bad_inputs_are_clear_errors() {
         "--out",
         path(&out),
     ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{stderr}");
     assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
+        stderr.contains(&format!("{}: only 0 of", path(&flat))) && stderr.contains("low_contrast"),
+        "{stderr}"
     );
+    assert!(stderr.contains("nothing was measured"), "{stderr}");
     let csv = std::fs::read_to_string(out.join("field_0001.csv")).unwrap();
     for line in csv.lines().skip(1) {
         let row: Vec<&str> = line.split(',').collect();
@@ -295,4 +298,57 @@ fn bad_inputs_are_clear_errors() {
             "{line}"
         );
     }
+}
+
+/// An image of other material: no node may be called ok (the correlation finds a best match
+/// everywhere; the final check refuses it), the run says so and fails. Next to a good image,
+/// the bad one is named and the run succeeds.
+#[test]
+fn unrelated_images_are_refused_and_named() {
+    let dir = TempDir::new("unrelated");
+    let reference = dir.0.join("reference.png");
+    write_png(&reference, &render(W, H, &translation(0.0, 0.0).0, 1), W, H);
+    let unrelated = dir.0.join("unrelated.png");
+    write_png(&unrelated, &unrelated_speckle(W, H, 5), W, H);
+    let good = dir.0.join("good.png");
+    write_png(&good, &render(W, H, &translation(0.4, 0.2).0, 2), W, H);
+    let out = dir.0.join("out");
+    let output = dicstream(&[
+        "correlate",
+        path(&reference),
+        path(&unrelated),
+        "--out",
+        path(&out),
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{stderr}");
+    assert!(stderr.contains("nothing was measured"), "{stderr}");
+    let csv = std::fs::read_to_string(out.join("field_0001.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert!(!rows.is_empty());
+    assert!(rows.iter().all(|row| row[9] != "ok"), "{csv}");
+    let output = dicstream(&[
+        "correlate",
+        path(&reference),
+        path(&good),
+        path(&unrelated),
+        "--out",
+        path(&out),
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(&format!("{}: only 0 of", path(&unrelated))),
+        "{stderr}"
+    );
+    assert!(!stderr.contains(path(&good)), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let frames = summary["frames"].as_array().unwrap();
+    assert_eq!(frames[0]["statuses"]["ok"], frames[0]["nodes"]);
+    assert_eq!(frames[1]["statuses"]["ok"], 0);
 }

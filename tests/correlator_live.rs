@@ -6,7 +6,7 @@
 
 mod harness;
 
-use harness::{affine, number_after, render, translation, Bench, FieldCopy};
+use harness::{affine, number_after, render, translation, unrelated_speckle, Bench, FieldCopy};
 use wire::{FrameHeader, NodeStatus, StrainMeasure};
 
 const W: usize = 256;
@@ -262,7 +262,8 @@ fn a_burst_is_dropped_and_counted_never_queued() {
 /// Bad frames over the wire are logged errors, never a crash: a header whose size disagrees
 /// with its payload, an unknown bit depth, an old layout version, another size than the
 /// reference. A flat first frame is not taken as the reference; a flat frame later gives a
-/// field of low-contrast nodes, no NaN.
+/// field of low-contrast nodes, no NaN; a frame of other material a field with no node ok;
+/// both are warnings.
 #[test]
 fn bad_frames_are_logged_and_skipped() {
     let mut bench = Bench::new("bad_input", W * H);
@@ -308,8 +309,10 @@ fn bad_frames_are_logged_and_skipped() {
         line.contains("128x128 px but the reference is 256x256 px"),
         "{line}"
     );
-    // 6. A flat frame: every node low contrast, nothing NaN.
+    // 6. A flat frame: every node low contrast, nothing NaN, a warning.
     bench.send_frame(Bench::header(106, W, H, &flat, None), &flat);
+    let line = bench.proc(p).wait_line("frame 106: only 0 of");
+    assert!(line.contains("low_contrast"), "{line}");
     let field = bench.next_field();
     assert_eq!(field.header.frame_id, 106);
     assert_eq!(field.header.valid_nodes, 0);
@@ -329,12 +332,24 @@ fn bad_frames_are_logged_and_skipped() {
         .gauge
         .iter()
         .all(|g| g.exx.is_finite() && g.eyy.is_finite() && g.exy.is_finite()));
-    // 7. The process is still measuring.
-    let (moved, truth) = translation(0.4, -0.3);
-    let pixels = render(W, H, &moved, 9);
-    bench.send_frame(Bench::header(107, W, H, &pixels, Some(truth)), &pixels);
+    // 7. A frame of other material: the correlation finds a best match everywhere, the
+    // final check refuses every one; nothing is published as ok.
+    let other = unrelated_speckle(W, H, 10);
+    bench.send_frame(Bench::header(107, W, H, &other, None), &other);
+    bench.proc(p).wait_line("frame 107: only 0 of");
     let field = bench.next_field();
     assert_eq!(field.header.frame_id, 107);
+    assert_eq!(field.header.valid_nodes, 0);
+    assert!(field
+        .nodes
+        .iter()
+        .all(|n| n.status != NodeStatus::Ok as u32));
+    // 8. The process is still measuring.
+    let (moved, truth) = translation(0.4, -0.3);
+    let pixels = render(W, H, &moved, 9);
+    bench.send_frame(Bench::header(108, W, H, &pixels, Some(truth)), &pixels);
+    let field = bench.next_field();
+    assert_eq!(field.header.frame_id, 108);
     let [(mu, _), (mv, _)] = field.error_stats(&truth);
     assert!(mu.abs() < 0.01 && mv.abs() < 0.01);
     let proc = bench.proc(p);
@@ -342,7 +357,7 @@ fn bad_frames_are_logged_and_skipped() {
     assert!(proc.wait_exit().success());
     let last = proc.final_line();
     assert_eq!(number_after(&last, "rejected"), 5, "{last}");
-    assert_eq!(number_after(&last, "correlated"), 3, "{last}");
+    assert_eq!(number_after(&last, "correlated"), 4, "{last}");
     bench.finish();
 }
 

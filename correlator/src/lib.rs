@@ -51,4 +51,4 @@ pub use settings::{
     CorrelatorSettings, GuessMode, ReferenceMode, Roi, SettingsError, StrainMeasure,
     DEFAULT_MIN_ZNCC,
 };
-pub use zoi::TimeSplit;
+pub use zoi::{Image, TimeSplit};

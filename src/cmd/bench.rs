@@ -203,6 +203,7 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
         split = Some((correlator.time_split(), 3 * field_len(&correlator)));
     }
     let (split, profiled_zois) = split.expect("measured above");
+    let keypoints = keypoint_timing(&reference, &deformed, w, h, args.frames);
     let fft = correlator::timing::time_ffts(args.zoi, 2000, 7);
     let two = runs.iter().find(|r| r.threads == 2);
     let standard = (w, h, args.zoi, args.step) == (1024, 1024, 32, 16);
@@ -241,6 +242,11 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
                 "zois_profiled": profiled_zois,
                 "us_per_zoi": total_ns as f64 / 1e3 / profiled_zois as f64,
                 "percent": parts.iter().map(|(name, ns)| (name.to_string(), serde_json::json!(100.0 * *ns as f64 / total_ns.max(1) as f64))).collect::<serde_json::Map<_, _>>(),
+            },
+            "keypoint_guess_2_threads": {
+                "reference_ms": keypoints.reference_ms,
+                "per_frame_ms": keypoints.per_frame_ms,
+                "inliers": keypoints.inliers,
             },
             "fft_2d": {
                 "n": fft.n,
@@ -281,6 +287,16 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
         fft.real_inverse_ns / 1e3,
         n = fft.n
     );
+    println!(
+        "  keypoint guess (2 threads, median of {}): reference keypoints {:.1} ms once per reference, per frame (detect, match, RANSAC) {:.1} ms; {}",
+        args.frames,
+        keypoints.reference_ms,
+        keypoints.per_frame_ms,
+        match keypoints.inliers {
+            Some(n) => format!("{n} inlier matches"),
+            None => "no trustworthy map (unexpected on this pair)".into(),
+        }
+    );
     match (two, standard) {
         (Some(r), true) => {
             let rate = r.nodes as f64 / r.median_s;
@@ -294,6 +310,49 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
         ),
     }
     Ok(())
+}
+
+/// What the keypoint guess costs on the benchmark pair.
+struct KeypointTiming {
+    reference_ms: f64,
+    per_frame_ms: f64,
+    inliers: Option<usize>,
+}
+
+/// Medians over `frames` runs of the keypoint guess on 2 threads: the reference's keypoints
+/// (once per reference) and a frame's (detect, match, RANSAC).
+fn keypoint_timing(
+    reference: &[u16],
+    deformed: &[u16],
+    w: usize,
+    h: usize,
+    frames: usize,
+) -> KeypointTiming {
+    use correlator::keypoints::KeypointMatcher;
+    let image = |pixels| correlator::Image {
+        pixels,
+        width_px: w,
+        height_px: h,
+    };
+    let mut matcher = KeypointMatcher::new(w, h, 2);
+    let mut reference_s = Vec::new();
+    let mut frame_s = Vec::new();
+    let mut inliers = None;
+    for _ in 0..frames {
+        let t = Instant::now();
+        let reference_set = matcher.detect(image(reference), (0, 0, w, h));
+        reference_s.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        let deformed_set = matcher.detect(image(deformed), (0, 0, w, h));
+        let guess = matcher.estimate(&reference_set, &deformed_set);
+        frame_s.push(t.elapsed().as_secs_f64());
+        inliers = guess.map(|g| g.inliers.len());
+    }
+    KeypointTiming {
+        reference_ms: median(&mut reference_s) * 1e3,
+        per_frame_ms: median(&mut frame_s) * 1e3,
+        inliers,
+    }
 }
 
 fn field_len(correlator: &Correlator) -> usize {

@@ -354,6 +354,24 @@ pub fn render(width: usize, height: usize, motion: &Motion, seed: u64) -> Vec<u1
     producer::exact_test_frame(width, height, 24.0, motion, 0.01, seed)
 }
 
+/// A speckle of another pattern (producer defaults but pattern seed 99), unrelated to the
+/// one `render` draws, unmoved, with the same camera.
+pub fn unrelated_speckle(width: usize, height: usize, seed: u64) -> Vec<u16> {
+    let (ex, ey) = ([-8.0, width as f64 + 8.0], [-8.0, height as f64 + 8.0]);
+    let params = producer::SpeckleParams {
+        seed: 99,
+        ..producer::SpeckleParams::default()
+    };
+    let speckle = producer::Speckle::new(params, ex, ey);
+    let mut pattern = vec![0f32; width * height];
+    producer::ExactRenderer {
+        gauss_order: 3,
+        threads: 2,
+    }
+    .render(&speckle, &Motion::IDENTITY, width, &mut pattern);
+    producer::CameraModel::read_noise_only_16bit(0.01, seed).exposed(seed, &pattern, width, 2)
+}
+
 /// An affine motion and the same motion as ground truth for the frame header.
 pub fn affine(
     f: [[f64; 2]; 2],

@@ -6,7 +6,7 @@
 //!    gradient, and its deformed ZOI is sampled through that gradient. Growth goes in waves
 //!    (every failed node next to a verified one, in parallel), each node retried only when it
 //!    has gained verified neighbours, until a wave verifies nothing new.
-//! 2. **Keypoints**, when fewer than half the textured nodes verify after growth (a rotation or
+//! 2. **Keypoints**, when fewer than half the textured nodes in view verify after growth (a rotation or
 //!    a strain too large for the global correlation): a local affine guess per node from
 //!    keypoints matched over the whole image (`keypoints`), then growth again.
 //! 3. **Refinement** on a fresh reference (no previous field): every verified node whose
@@ -24,7 +24,8 @@ use crate::pool::SharedSlice;
 use crate::verify;
 use crate::zoi::{spectrum_len, warp_worth_it, Image, ReferenceSpectra};
 
-/// Keypoints run when fewer than this fraction of the textured nodes verify after growth.
+/// Keypoints run when fewer than this fraction of the nodes that could verify (textured, not
+/// outside the image) do after growth.
 const KEYPOINTS_BELOW_FRACTION: f64 = 0.5;
 
 fn to_mat2(g: nalgebra::Matrix2<f64>) -> Mat2 {
@@ -98,17 +99,16 @@ impl Correlator {
     pub(super) fn improve(&mut self, image: Image) {
         let fresh = !self.has_previous;
         self.grow(image);
-        let textured = self
-            .ref_nodes
-            .iter()
-            .filter(|r| r.status == NodeStatus::Ok)
-            .count();
-        let verified = self
-            .results
-            .iter()
-            .filter(|r| r.status == NodeStatus::Ok)
-            .count();
-        if (verified as f64) < KEYPOINTS_BELOW_FRACTION * textured as f64
+        // Nodes that could have verified: textured in the reference, and not sent out of the
+        // image (material that left the field of view is no failure of the guess).
+        let (mut candidates, mut verified) = (0usize, 0usize);
+        for (r, result) in self.ref_nodes.iter().zip(&self.results) {
+            if r.status == NodeStatus::Ok && result.status != NodeStatus::OutsideImage {
+                candidates += 1;
+                verified += usize::from(result.status == NodeStatus::Ok);
+            }
+        }
+        if (verified as f64) < KEYPOINTS_BELOW_FRACTION * candidates as f64
             && self.keypoint_pass(image)
         {
             self.grow(image);
