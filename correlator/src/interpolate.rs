@@ -81,6 +81,27 @@ pub fn bicubic(image: Image, x: f64, y: f64) -> f32 {
     sum
 }
 
+/// [`bicubic`] anywhere in [0, w − 1] x [0, h − 1]: the 4x4 neighbourhood is clamped into the
+/// image (the border pixels repeated), for ZOIs that touch the border.
+pub fn bicubic_clamped(image: Image, x: f64, y: f64) -> f32 {
+    let (w, h) = (image.width_px as i64, image.height_px as i64);
+    let (fx, fy) = (x.floor(), y.floor());
+    let (ix, iy) = (fx as i64, fy as i64);
+    let wx = keys_weights((x - fx) as f32);
+    let wy = keys_weights((y - fy) as f32);
+    let mut sum = 0.0f32;
+    for (row, &wy) in wy.iter().enumerate() {
+        let yy = (iy + row as i64 - 1).clamp(0, h - 1) as usize;
+        let mut v = 0.0f32;
+        for (col, &wx) in wx.iter().enumerate() {
+            let xx = (ix + col as i64 - 1).clamp(0, w - 1) as usize;
+            v += wx * image.pixels[yy * image.width_px + xx] as f32;
+        }
+        sum += wy * v;
+    }
+    sum
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -103,6 +124,12 @@ mod tests {
             assert!((bicubic(image, x, y) as f64 - ramp(x, y)).abs() < 1e-3);
         }
         assert_eq!(bicubic(image, 3.0, 4.0), pixels[4 * w + 3] as f32);
+        for (x, y) in [(2.25, 3.5), (5.9, 4.1)] {
+            assert_eq!(bicubic_clamped(image, x, y), bicubic(image, x, y));
+        }
+        // At the border, pixels and the samples next to them are still right.
+        assert!((bicubic_clamped(image, 0.0, 0.0) - 100.0).abs() < 1e-3);
+        assert!((bicubic_clamped(image, 11.0, 8.0) as f64 - ramp(11.0, 8.0)).abs() < 1e-3);
     }
 
     #[test]

@@ -9,7 +9,7 @@
 //! G_w conj(F_w) gives at d, without the forward and inverse transforms.
 
 use crate::field::NodeStatus;
-use crate::interpolate::{apply, bicubic, block_inside, identity_plus, Mat2};
+use crate::interpolate::{apply, bicubic, bicubic_clamped, block_inside, identity_plus, Mat2};
 use crate::peak::quadratic_peak_3x3;
 use crate::real_fft2d::RealFft2d;
 use crate::simd::{dot, F32x4};
@@ -343,7 +343,9 @@ impl ZoiEngine {
 
     /// Samples (bicubic) the deformed image through x → x + shift + (a − I)(x − centre) over
     /// the n x n block centred on `centre` into `g_spatial`, minus its mean. None when a
-    /// sample's 4x4 neighbourhood leaves the image, Some(false) when the samples are flat.
+    /// sample is more than a pixel past the border (as the rigid ZOI, which is pulled back
+    /// inside from there), Some(false) when the samples are flat. Near and past the border the
+    /// interpolation repeats the border pixels.
     fn extract_warped(
         &mut self,
         image: Image,
@@ -352,9 +354,13 @@ impl ZoiEngine {
         a: Mat2,
     ) -> Option<bool> {
         let n = self.n;
-        if !block_inside(image, centre, shift, a, n, 1.0, 2.0) {
+        let sample = if block_inside(image, centre, shift, a, n, 1.0, 2.0) {
+            bicubic
+        } else if block_inside(image, centre, shift, a, n, -1.0, -1.0) {
+            bicubic_clamped
+        } else {
             return None;
-        }
+        };
         let half = (n as f64 - 1.0) / 2.0;
         let mut sum = 0.0f64;
         for (y, row) in self.g_spatial.chunks_exact_mut(n).enumerate() {
@@ -362,7 +368,7 @@ impl ZoiEngine {
             let (mut px, mut py) = (centre.0 + shift.0 + start.0, centre.1 + shift.1 + start.1);
             let mut row_sum = 0.0f32;
             for value in row.iter_mut() {
-                *value = bicubic(image, px, py);
+                *value = sample(image, px, py);
                 row_sum += *value;
                 px += a[0][0];
                 py += a[1][0];
@@ -450,6 +456,7 @@ impl ZoiEngine {
     /// x → x + guess + G (x − c) instead of cut from the pixel grid, so that only the residual
     /// is measured: a ZOI rotated by 170° or stretched by 50 % is correlated against a deformed
     /// ZOI that looks like it.
+    #[allow(clippy::too_many_arguments)] // one ZOI's inputs: its data, where, and the guess
     pub fn correlate(
         &mut self,
         reference: &ReferenceSpectra,
