@@ -54,8 +54,11 @@ pub struct CorrelateBenchArgs {
     pub json: bool,
 }
 
-/// Issue 3's speed target: ZOIs per second on two threads at 1024x1024, ZOI 32, step 16.
-const TARGET_ZOIS_PER_S: f64 = 50_000.0;
+/// The speed target: ZOIs per second on two threads at 1024x1024, ZOI 32, step 16 (issue 3
+/// asked for 50,000; issue 10 for keeping at least 150,000 with the final check).
+const TARGET_ZOIS_PER_S: f64 = 150_000.0;
+/// Issue 10's bound on the keypoint guess of a 1024² frame on 2 threads (ms).
+const TARGET_KEYPOINT_MS: f64 = 40.0;
 /// The imposed sub-pixel translation (px): every ZOI does its sub-pixel iterations.
 const SHIFT_PX: [f64; 2] = [0.37, -0.21];
 
@@ -288,10 +291,17 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
         n = fft.n
     );
     println!(
-        "  keypoint guess (2 threads, median of {}): reference keypoints {:.1} ms once per reference, per frame (detect, match, RANSAC) {:.1} ms; {}",
+        "  keypoint guess (2 threads, median of {}): reference keypoints {:.1} ms once per reference, per frame (detect, match, RANSAC) {:.1} ms (target <= {TARGET_KEYPOINT_MS:.0} ms at 1024x1024: {}); {}",
         args.frames,
         keypoints.reference_ms,
         keypoints.per_frame_ms,
+        if !standard {
+            "not measured here"
+        } else if keypoints.per_frame_ms <= TARGET_KEYPOINT_MS {
+            "met"
+        } else {
+            "NOT met"
+        },
         match keypoints.inliers {
             Some(n) => format!("{n} inlier matches"),
             None => "no trustworthy map (unexpected on this pair)".into(),
@@ -301,12 +311,16 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
         (Some(r), true) => {
             let rate = r.nodes as f64 / r.median_s;
             println!(
-                "  target (issue 3): >= {TARGET_ZOIS_PER_S:.0} ZOIs/s on 2 threads: {} ({rate:.0} ZOIs/s)",
-                if rate >= TARGET_ZOIS_PER_S { "met" } else { "NOT met" }
+                "  target: >= {TARGET_ZOIS_PER_S:.0} ZOIs/s on 2 threads: {} ({rate:.0} ZOIs/s)",
+                if rate >= TARGET_ZOIS_PER_S {
+                    "met"
+                } else {
+                    "NOT met"
+                }
             );
         }
         _ => println!(
-            "  target (issue 3) applies to 1024x1024, ZOI 32, step 16 on 2 threads: not measured here"
+            "  target applies to 1024x1024, ZOI 32, step 16 on 2 threads: not measured here"
         ),
     }
     Ok(())
