@@ -35,9 +35,13 @@ const EXTRAPOLATION_RINGS: usize = 2;
 const CARRY_RINGS: usize = 5;
 /// Valid nodes an extrapolating fit needs.
 const MIN_EXTRAPOLATION_NODES: usize = 6;
-/// A node further than this from the affine fit of its neighbours (within
-/// [`EXTRAPOLATION_RINGS`]) is a false match (px).
-const OUTLIER_PX: f64 = 2.0;
+/// A node further from the affine fit of its neighbours (within [`EXTRAPOLATION_RINGS`]) than
+/// [`OUTLIER_SCATTER`] times the frame's median distance, bounded to [`OUTLIER_MIN_PX`,
+/// `OUTLIER_MAX_PX`], is inconsistent: about seven standard deviations of the measurement noise,
+/// never less than the half pixel that makes a wrong value, never more than 2 px.
+const OUTLIER_SCATTER: f64 = 6.0;
+const OUTLIER_MIN_PX: f64 = 0.5;
+const OUTLIER_MAX_PX: f64 = 2.0;
 
 /// A node to correlate again: its guess (px, against the current reference) and the gradient
 /// to sample its deformed ZOI through.
@@ -138,6 +142,8 @@ pub struct Correlator {
     has_previous: bool,
     /// Nodes found inconsistent with their neighbours in this frame (scratch).
     outliers: Vec<bool>,
+    /// Each node's distance to the affine fit of its neighbours (scratch, NaN: no fit).
+    residuals: Vec<f64>,
     /// Nodes valid in every frame since the reference sequence began: they measure their own
     /// material. A node that failed once was carried by an extrapolation since, and may be
     /// off by that extrapolation's error (it follows whatever material it came back on).
@@ -208,6 +214,7 @@ impl Correlator {
             previous2: vec![None; nodes],
             has_previous: false,
             outliers: vec![false; nodes],
+            residuals: vec![0.0; nodes],
             never_lost: vec![true; nodes],
             retry: Vec::with_capacity(nodes),
             scores: Vec::with_capacity(nodes),
@@ -658,18 +665,33 @@ impl Correlator {
                 node.v_px = 0.0;
             }
         }
-        // A node far from what its neighbours say (a false match on other material) is not
-        // trusted: it is marked inconsistent, so that it neither biases the strains nor moves
-        // the followed mesh onto the wrong material.
+        // A node far from what its neighbours say (a false match on other material, or a
+        // noise-driven one) is not trusted: it is marked inconsistent, so that it neither biases
+        // the strains nor moves the followed mesh onto the wrong material.
         for k in 0..nx * ny {
-            self.outliers[k] = self.field.nodes[k].status == NodeStatus::Ok
-                && self
-                    .affine_fit(Some(k), EXTRAPOLATION_RINGS, Some(k), Support::Valid)
-                    .is_some_and(|fit| {
+            self.residuals[k] = if self.field.nodes[k].status == NodeStatus::Ok {
+                self.affine_fit(Some(k), EXTRAPOLATION_RINGS, Some(k), Support::Valid)
+                    .map_or(f64::NAN, |fit| {
                         let (u, v) = self.extrapolate(k, fit);
                         let node = &self.field.nodes[k];
-                        (node.u_px - u).hypot(node.v_px - v) > OUTLIER_PX
-                    });
+                        (node.u_px - u).hypot(node.v_px - v)
+                    })
+            } else {
+                f64::NAN
+            };
+        }
+        self.scores.clear();
+        self.scores
+            .extend(self.residuals.iter().copied().filter(|r| r.is_finite()));
+        let limit_px = if self.scores.is_empty() {
+            OUTLIER_MAX_PX
+        } else {
+            let middle = self.scores.len() / 2;
+            let median = *self.scores.select_nth_unstable_by(middle, f64::total_cmp).1;
+            (OUTLIER_SCATTER * median).clamp(OUTLIER_MIN_PX, OUTLIER_MAX_PX)
+        };
+        for (outlier, &residual) in self.outliers.iter_mut().zip(&self.residuals) {
+            *outlier = residual > limit_px;
         }
         for (node, _) in self
             .field

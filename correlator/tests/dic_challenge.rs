@@ -51,6 +51,8 @@ fn sample5_translation_with_contrast_change() {
                 field.v_mean_px
             );
             assert!(field.valid as f64 > 0.95 * field.nodes.len() as f64);
+            let o = accuracy(field, 32, (w, h), |p| [p[0] + expected, p[1] + expected]);
+            assert_eq!(o.false_ok, 0, "{o:?}");
             assert!(
                 (field.u_mean_px - expected).abs() <= 0.01,
                 "mean u {}",
@@ -108,6 +110,11 @@ fn sample14_l1_chirp_rms() {
         let (mut all, mut slow, mut n_all, mut n_slow) = (0.0, 0.0, 0.0, 0.0);
         for node in field.nodes.iter().filter(|n| n.status == NodeStatus::Ok) {
             let e = node.u_px - interp(node.x_px);
+            assert!(
+                e.hypot(node.v_px) <= common::FALSE_OK_PX,
+                "ZOI {zoi_px}: a node called ok is off by ({e}, {}) px",
+                node.v_px
+            );
             all += e * e;
             n_all += 1.0;
             if node.x_px < w as f64 / 2.0 {

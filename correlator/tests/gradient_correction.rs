@@ -64,6 +64,13 @@ fn correction_removes_the_rigid_zoi_bias_under_strain() {
                  {r:.4} px, worst {worst:.4} px over {count} nodes"
             );
             rms[i] = r;
+            // Without the correction the rigid ZOI's bias is what this test shows.
+            if correct {
+                assert!(
+                    worst <= common::FALSE_OK_PX,
+                    "a node called ok is {worst} px off"
+                );
+            }
         }
         assert!(
             rms[1] < 0.5 * rms[0],
@@ -102,6 +109,13 @@ fn correction_keeps_incremental_errors_from_adding_up() {
              worst {worst:.4} px over {count} nodes"
         );
         rms[i] = r;
+        // Without the correction the rigid ZOI's bias is what this test shows.
+        if correct {
+            assert!(
+                worst <= common::FALSE_OK_PX,
+                "a node called ok is {worst} px off"
+            );
+        }
     }
     assert!(
         rms[1] < 0.5 * rms[0],

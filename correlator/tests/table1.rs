@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{render, stretch};
+use common::{accuracy, render, stretch};
 use correlator::{Correlator, CorrelatorSettings, Field, GuessMode, NodeStatus, StrainMeasure};
 
 fn run(reference: &[u16], deformed: &[u16], zoi_px: usize, guess: GuessMode) -> Field {
@@ -34,6 +34,13 @@ fn table1_equibiaxial_seven_percent() {
     );
     let gauge_error = |zoi_px: usize, guess: GuessMode| {
         let field = run(&reference, &deformed, zoi_px, guess);
+        let o = accuracy(&field, zoi_px, (w, h), |p| {
+            [
+                centre[0] + 1.07 * (p[0] - centre[0]),
+                centre[1] + 1.07 * (p[1] - centre[1]),
+            ]
+        });
+        assert_eq!(o.false_ok, 0, "{guess:?} s = {zoi_px}: {o:?}");
         let g = field.gauge;
         eprintln!(
             "{:8} {} {:4}/{:4}   {:+.4}     {:+.4}     {:+.4}     {:+.4}",
@@ -111,8 +118,18 @@ fn live_predictor_tracks_a_seven_percent_ramp_at_s5() {
                 .count();
             (field.valid, inside, field.gauge.small)
         };
-        let (valid, inside, g) = summary(live.correlate(&deformed).unwrap());
-        let (paper_valid, paper_inside, pg) = summary(paper.correlate(&deformed).unwrap());
+        let forward = |p: [f64; 2]| {
+            [
+                centre[0] + (1.0 + e) * (p[0] - centre[0]),
+                centre[1] + (1.0 + e) * (p[1] - centre[1]),
+            ]
+        };
+        let field = live.correlate(&deformed).unwrap();
+        assert_eq!(accuracy(field, 32, (w, h), forward).false_ok, 0);
+        let (valid, inside, g) = summary(field);
+        let field = paper.correlate(&deformed).unwrap();
+        assert_eq!(accuracy(field, 32, (w, h), forward).false_ok, 0);
+        let (paper_valid, paper_inside, pg) = summary(field);
         eprintln!(
             "{e:.2}     {valid:4}/{inside:4}            {:+.4} {:+.4}  | {paper_valid:4}/{paper_inside:4}                 {:+.4}",
             g.exx, g.eyy, pg.exx

@@ -33,6 +33,12 @@ fn subpixel_translation_sweep() {
             bad.is_empty(),
             "all nodes must converge at shift {shift}: {bad:?}"
         );
+        let worst = field
+            .nodes
+            .iter()
+            .map(|n| (n.u_px - u).hypot(n.v_px - v))
+            .fold(0.0, f64::max);
+        assert!(worst <= common::FALSE_OK_PX, "a node is {worst} px off");
         let eu: Vec<f64> = field.nodes.iter().map(|n| n.u_px - u).collect();
         let ev: Vec<f64> = field.nodes.iter().map(|n| n.v_px - v).collect();
         let iters: Vec<f64> = field.nodes.iter().map(|n| n.iterations as f64).collect();
