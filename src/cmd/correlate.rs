@@ -295,9 +295,15 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
         bar.finish();
     }
     if frames_with_valid_nodes == 0 {
+        let hint = match args.correlation.guess {
+            GuessArg::Auto => "unrelated or flat images?",
+            GuessArg::Correli | GuessArg::Predict => {
+                "unrelated or flat images, or a motion beyond this guess (--guess auto also tries keypoints)?"
+            }
+        };
         bail!(
             "no node of any of the {} deformed images passed the final check against {}: \
-             nothing was measured (unrelated or flat images? the fields in {} say why per node)",
+             nothing was measured ({hint} the fields in {} say why per node)",
             args.deformed.len(),
             args.reference.display(),
             args.out.display()
