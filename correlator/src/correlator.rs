@@ -1,6 +1,7 @@
 //! The correlator: mesh, reference cache, worker pool, guesses, reference modes, strains.
 
 mod growth;
+mod reanchor;
 
 use crate::field::{Field, Node, NodeStatus};
 use crate::global::{GlobalCorrelator, GlobalMiss};
@@ -166,6 +167,14 @@ pub struct Correlator {
     keypoint_matcher: Option<KeypointMatcher>,
     /// The current reference's keypoints, detected on first need.
     reference_keypoints: Option<KeypointSet>,
+    /// The image the mesh was defined in (given to `set_reference`), while known, and whether
+    /// the current reference is still that image (see `reanchor`).
+    origin_pixels: Vec<u16>,
+    origin_known: bool,
+    reference_is_origin: bool,
+    /// Results of the returned nodes measured against the origin (scratch, capacity: every
+    /// node).
+    reanchored: Vec<(ZoiResult, f64)>,
 }
 
 impl Correlator {
@@ -226,6 +235,10 @@ impl Correlator {
             grown_from: vec![0; nodes],
             keypoint_matcher: None,
             reference_keypoints: None,
+            origin_pixels: vec![0; width_px * height_px],
+            origin_known: false,
+            reference_is_origin: true,
+            reanchored: Vec::with_capacity(nodes),
             settings,
             width_px,
             height_px,
@@ -280,6 +293,9 @@ impl Correlator {
         self.previous2.fill(None);
         self.has_previous = false;
         self.never_lost.fill(true);
+        self.origin_pixels.copy_from_slice(pixels);
+        self.origin_known = true;
+        self.reference_is_origin = true;
         self.take_reference(pixels);
         Ok(())
     }
@@ -350,6 +366,13 @@ impl Correlator {
         self.previous2.fill(None);
         self.has_previous = false;
         self.never_lost.fill(true);
+        // The saved state holds the current reference, not the frame the mesh was defined in
+        // (unless they are the same: every base is zero).
+        self.reference_is_origin = base_px.iter().all(|&b| b == (0.0, 0.0));
+        self.origin_known = self.reference_is_origin;
+        if self.origin_known {
+            self.origin_pixels.copy_from_slice(pixels);
+        }
         self.take_reference(pixels);
         Ok(())
     }
@@ -424,7 +447,7 @@ impl Correlator {
         if self.settings.guess == GuessMode::Auto {
             self.improve(image);
         }
-        self.assemble();
+        self.assemble(image);
         self.update_reference(pixels);
         Ok(&self.field)
     }
@@ -609,7 +632,7 @@ impl Correlator {
 
     /// Results (against the current reference, at the ZOI centres) to total displacements at
     /// the followed nodes, then strains and gauge.
-    fn assemble(&mut self) {
+    fn assemble(&mut self, image: Image) {
         let (nx, ny) = (self.mesh.nx, self.mesh.ny);
         // First-order corrections with the local gradient ∇u of the results: the rigid ZOI's
         // estimate is u(centre) + K vec(∇u) (see `GradientSensitivity`), and the followed
@@ -704,6 +727,7 @@ impl Correlator {
             node.u_px = 0.0;
             node.v_px = 0.0;
         }
+        self.reanchor_returned(image);
         let (mut valid, mut su, mut sv) = (0usize, 0.0, 0.0);
         for node in self
             .field
@@ -798,10 +822,16 @@ impl Correlator {
                     })
             };
         }
+        self.bases_from_origin(Image {
+            pixels,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        });
         for (r, &base) in self.ref_nodes.iter_mut().zip(&self.scratch_pairs) {
             r.base_px = base;
         }
         self.take_reference(pixels);
+        self.reference_is_origin = false;
         self.field.reference_updated = true;
     }
 

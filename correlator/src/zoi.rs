@@ -171,6 +171,9 @@ pub struct ZoiEngine {
     corr: Vec<f32>,
     phase_x: Vec<Complex32>,
     phase_y: Vec<Complex32>,
+    /// Spectra of a ZOI that is not in the reference cache ([`Self::correlate_uncached`]).
+    uncached_plain: Vec<Complex32>,
+    uncached_windowed: Vec<f32>,
     pub profile: bool,
     pub split: TimeSplit,
 }
@@ -212,6 +215,8 @@ impl ZoiEngine {
             corr: vec![0.0; n * n],
             phase_x: vec![zero; n],
             phase_y: vec![zero; n],
+            uncached_plain: vec![zero; spectrum_len(n)],
+            uncached_windowed: vec![0.0; n * n],
             profile: false,
             split: TimeSplit::default(),
         }
@@ -611,6 +616,47 @@ impl ZoiEngine {
         } else {
             NodeStatus::NotConverged
         };
+        result
+    }
+
+    /// [`Self::correlate`] for a ZOI of another image than the cached references (a node's
+    /// ZOI in the frame its mesh was defined in): its spectra are prepared in the engine's own
+    /// buffers first. `LowContrast` when that ZOI is flat.
+    #[allow(clippy::too_many_arguments)] // as `correlate`, with the reference image instead
+    pub fn correlate_uncached(
+        &mut self,
+        reference: Image,
+        x0: usize,
+        y0: usize,
+        deformed: Image,
+        guess_px: (f64, f64),
+        warp: Option<Mat2>,
+        max_iterations: u32,
+    ) -> ZoiResult {
+        let mut plain = std::mem::take(&mut self.uncached_plain);
+        let mut windowed = std::mem::take(&mut self.uncached_windowed);
+        let mut sensitivity = GradientSensitivity::default();
+        let result = if self.prepare_reference(
+            reference,
+            x0,
+            y0,
+            &mut plain,
+            &mut windowed,
+            &mut sensitivity,
+        ) {
+            let spectra = ReferenceSpectra {
+                plain: &plain,
+                windowed: &windowed,
+            };
+            self.correlate(&spectra, deformed, x0, y0, guess_px, warp, max_iterations)
+        } else {
+            ZoiResult {
+                status: NodeStatus::LowContrast,
+                ..ZoiResult::default()
+            }
+        };
+        self.uncached_plain = plain;
+        self.uncached_windowed = windowed;
         result
     }
 

@@ -3,7 +3,9 @@
 //! ε times that lever, different from node to node. The first-order gradient correction
 //! (`CorrelatorSettings::gradient_correction`) removes most of it; this measures the node
 //! errors against the exact field with and without it, on a fixed reference (one step) and on
-//! an incremental reference (where the error repeats at every update and adds up).
+//! an incremental reference (where the error would repeat at every update and add up; the
+//! bases measured against the first frame at every update now keep it from adding up with or
+//! without the correction).
 
 mod common;
 
@@ -82,7 +84,7 @@ fn correction_removes_the_rigid_zoi_bias_under_strain() {
 }
 
 #[test]
-fn correction_keeps_incremental_errors_from_adding_up() {
+fn incremental_errors_do_not_add_up() {
     // Uniaxial stretch to 1.3 in 30 steps of 1 %, each frame the reference of the next.
     let steps = 30;
     let frames: Vec<(f64, Vec<u16>)> = (0..=steps)
@@ -109,18 +111,16 @@ fn correction_keeps_incremental_errors_from_adding_up() {
              worst {worst:.4} px over {count} nodes"
         );
         rms[i] = r;
-        // Without the correction the rigid ZOI's bias is what this test shows.
-        if correct {
-            assert!(
-                worst <= common::FALSE_OK_PX,
-                "a node called ok is {worst} px off"
-            );
-        }
+        // Before the bases were measured against the first frame: 0.379 px without the
+        // correction, 0.093 px with it, worst nodes 0.97 and 0.27 px.
+        assert!(
+            r < 0.03,
+            "correction {correct}: RMS {r} px after {steps} updates"
+        );
+        assert!(
+            worst <= common::FALSE_OK_PX,
+            "a node called ok is {worst} px off"
+        );
     }
-    assert!(
-        rms[1] < 0.5 * rms[0],
-        "the correction leaves {} px of {} px",
-        rms[1],
-        rms[0]
-    );
+    assert!(rms[1] <= rms[0], "the correction makes it worse: {rms:?}");
 }

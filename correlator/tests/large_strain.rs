@@ -5,6 +5,8 @@
 //! on their own material (not as false "ok" matches on other material); the gauge strain must
 //! follow the true ln λ to the end.
 
+mod common;
+
 use correlator::{Correlator, CorrelatorSettings, NodeStatus, ReferenceMode};
 use producer::motion::Affine;
 use producer::{CameraModel, FastRenderer, Motion, Speckle, SpeckleParams};
@@ -85,23 +87,22 @@ fn followed_mesh_tracks_uniaxial_stretch_to_2_2() {
         );
         // The stretched material leaves the image: nodes do go out...
         assert!(fewest_valid < correlator.field().nodes.len() / 2);
-        // ...and those left follow their material: no false match on other material (those
-        // are off by a good part of a ZOI). Each reference update adds the node's error under
-        // a small strain step; the gradient correction removes most of the rigid ZOI's part
-        // of it (a bias that would repeat at every update: without it the mean node error
-        // here is 0.53 px), the rest adds up to about 0.1-0.2 px on average over 70 updates.
-        // The worst nodes (2-4 px) are those that come back into the image during the fast
-        // unloading, where a frame is a 10 % strain step and their gradient is one-sided. The
-        // gauge, an affine fit over all nodes, stays within 2e-3 of ln λ.
+        // ...and those left follow their material: no false match on other material, and no
+        // node called ok more than half a pixel off. At every reference update the new bases
+        // are measured against the first frame directly (the ZOI sampled through the local
+        // gradient), so the errors of the intermediate references do not add up (before: a
+        // mean node error of 0.15 px and border nodes 1.7 px off after 70 incremental
+        // updates), and a node whose material comes back into view is measured there again
+        // (before: 2-4 px off, carried by the extrapolation while its material was out).
         let mean_node = node_error_sum / node_count as f64;
         assert!(
-            mean_node < 0.3,
+            mean_node < 0.05,
             "{mode:?}: nodes are off by {mean_node} px on average"
         );
         assert!(
-            worst_node < 5.0,
-            "{mode:?}: a node is off by {worst_node} px"
+            worst_node <= common::FALSE_OK_PX,
+            "{mode:?}: a node called ok is off by {worst_node} px"
         );
-        assert!(worst_strain < 2e-3, "{mode:?}: gauge off by {worst_strain}");
+        assert!(worst_strain < 5e-4, "{mode:?}: gauge off by {worst_strain}");
     }
 }

@@ -1,0 +1,148 @@
+//! Nodes whose material came back into view on a followed mesh. While a node's material was
+//! out of the image (or its match failed), its position was carried by the affine
+//! extrapolation of its neighbours, reference update after reference update; when the material
+//! returns, the node measures whatever material its carried position landed on, so its total
+//! displacement carries the extrapolation's error (up to 2 px after a large stretch and a fast
+//! unloading), and the final check against the current reference cannot see it: that match is
+//! right. Such a node is measured again against the frame its mesh was defined in (the origin):
+//! its own ZOI there, correlated with the frame through the total displacement and the gradient
+//! of its never-lost neighbours, then checked with the same final check. A node that verifies
+//! gets that total displacement (and its base is corrected, so it counts as never lost again); a
+//! node that does not is `low_zncc`, never a wrong `ok`. Without the origin image (a correlator
+//! restored from a saved reference) the returned nodes stay as measured.
+
+use super::{Correlator, Entry, Support, CARRY_RINGS, EXTRAPOLATION_RINGS};
+use crate::field::NodeStatus;
+use crate::interpolate::Mat2;
+use crate::pool::SharedSlice;
+use crate::verify;
+use crate::zoi::{Image, ZoiResult};
+
+impl Correlator {
+    /// Measures the returned nodes against the origin (see the module documentation).
+    pub(super) fn reanchor_returned(&mut self, image: Image) {
+        if !self.origin_known || self.reference_is_origin {
+            return;
+        }
+        let whole_mesh = self.affine_fit(None, 0, None, Support::NeverLost);
+        self.entries.clear();
+        for k in 0..self.field.nodes.len() {
+            let node = self.field.nodes[k];
+            if node.status != NodeStatus::Ok || self.never_lost[k] {
+                continue;
+            }
+            let gradient: Mat2 = self
+                .affine_fit(Some(k), CARRY_RINGS, Some(k), Support::NeverLost)
+                .or(whole_mesh)
+                .map_or([[0.0; 2]; 2], |fit| {
+                    let g = fit.gradient;
+                    [[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]
+                });
+            self.entries.push(Entry {
+                node: k,
+                guess_px: (node.u_px, node.v_px),
+                gradient,
+            });
+        }
+        self.measure_against_origin(image);
+        for (entry, &(result, score)) in self.entries.iter().zip(&self.reanchored) {
+            let k = entry.node;
+            let node = &mut self.field.nodes[k];
+            if result.status == NodeStatus::Ok && score >= self.settings.min_zncc {
+                let correction = (result.u_px - node.u_px, result.v_px - node.v_px);
+                node.u_px = result.u_px;
+                node.v_px = result.v_px;
+                node.score = score;
+                let base = &mut self.ref_nodes[k].base_px;
+                base.0 += correction.0;
+                base.1 += correction.1;
+                self.never_lost[k] = true;
+            } else {
+                node.status = NodeStatus::LowZncc;
+                node.score = score;
+                node.u_px = 0.0;
+                node.v_px = 0.0;
+            }
+        }
+    }
+
+    /// At a reference update, the new bases (`scratch_pairs`, the nodes' total displacements)
+    /// of the `ok` nodes are measured against the origin directly, where that verifies: the
+    /// errors of the measurements against intermediate references then do not add up from
+    /// reference to reference (a border node of an incremental reference drifted by 1.7 px
+    /// over 70 updates without this).
+    pub(super) fn bases_from_origin(&mut self, image: Image) {
+        if !self.origin_known || self.reference_is_origin {
+            return;
+        }
+        self.entries.clear();
+        for k in 0..self.field.nodes.len() {
+            if self.field.nodes[k].status != NodeStatus::Ok {
+                continue;
+            }
+            let gradient: Mat2 = self
+                .affine_fit(Some(k), EXTRAPOLATION_RINGS, None, Support::Valid)
+                .map_or([[0.0; 2]; 2], |fit| {
+                    let g = fit.gradient;
+                    [[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]
+                });
+            self.entries.push(Entry {
+                node: k,
+                guess_px: self.scratch_pairs[k],
+                gradient,
+            });
+        }
+        self.measure_against_origin(image);
+        for (entry, &(result, score)) in self.entries.iter().zip(&self.reanchored) {
+            if result.status == NodeStatus::Ok && score >= self.settings.min_zncc {
+                self.scratch_pairs[entry.node] = (result.u_px, result.v_px);
+            }
+        }
+    }
+
+    /// Each of `entries` (node, total displacement, gradient) measured against the origin:
+    /// its ZOI there correlated with `image` through the gradient, and the final check; the
+    /// results and their ZNCC go to `reanchored`, in the order of `entries`.
+    fn measure_against_origin(&mut self, image: Image) {
+        let n = self.settings.zoi_px;
+        let max_iterations = self.settings.max_iterations;
+        let origin = Image {
+            pixels: &self.origin_pixels,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        };
+        self.reanchored.clear();
+        self.reanchored
+            .resize(self.entries.len(), (ZoiResult::default(), 0.0));
+        let (entries, top_left) = (&self.entries, &self.mesh.top_left);
+        let out = SharedSlice::new(&mut self.reanchored);
+        self.pool.run(entries.len(), &|engine, i| {
+            let entry = entries[i];
+            let (x0, y0) = top_left[entry.node];
+            let result = engine.correlate_uncached(
+                origin,
+                x0,
+                y0,
+                image,
+                entry.guess_px,
+                Some(entry.gradient),
+                max_iterations,
+            );
+            let score = if result.status == NodeStatus::Ok {
+                verify::zncc(
+                    origin,
+                    (x0, y0),
+                    n,
+                    image,
+                    (result.u_px, result.v_px),
+                    entry.gradient,
+                )
+                .unwrap_or(0.0)
+            } else {
+                0.0
+            };
+            // SAFETY: item i writes only slot i.
+            unsafe { out.write(i, (result, score)) };
+        });
+    }
+}
