@@ -172,6 +172,9 @@ pub struct Correlator {
     origin_pixels: Vec<u16>,
     origin_known: bool,
     reference_is_origin: bool,
+    /// Counts the origins this correlator has had (the state folder rewrites its copy when it
+    /// changes).
+    origin_generation: u64,
     /// Results of the returned nodes measured against the origin (scratch, capacity: every
     /// node).
     reanchored: Vec<(ZoiResult, f64)>,
@@ -238,6 +241,7 @@ impl Correlator {
             origin_pixels: vec![0; width_px * height_px],
             origin_known: false,
             reference_is_origin: true,
+            origin_generation: 0,
             reanchored: Vec::with_capacity(nodes),
             settings,
             width_px,
@@ -296,6 +300,7 @@ impl Correlator {
         self.origin_pixels.copy_from_slice(pixels);
         self.origin_known = true;
         self.reference_is_origin = true;
+        self.origin_generation += 1;
         self.take_reference(pixels);
         Ok(())
     }
@@ -372,8 +377,31 @@ impl Correlator {
         self.origin_known = self.reference_is_origin;
         if self.origin_known {
             self.origin_pixels.copy_from_slice(pixels);
+            self.origin_generation += 1;
         }
         self.take_reference(pixels);
+        Ok(())
+    }
+
+    /// The frame the mesh is defined in (the image given to `set_reference`), while this
+    /// correlator knows it: a correlator restored from a saved reference knows it only when
+    /// that reference is the origin or [`Correlator::restore_origin`] gave it back.
+    pub fn origin_pixels(&self) -> Option<&[u16]> {
+        self.origin_known.then_some(self.origin_pixels.as_slice())
+    }
+
+    /// Changes whenever the origin changes (a new `set_reference`).
+    pub fn origin_generation(&self) -> u64 {
+        self.origin_generation
+    }
+
+    /// Gives a restored correlator back the frame its mesh is defined in (saved beside the
+    /// reference), so that its bases are measured against it again at reference updates.
+    pub fn restore_origin(&mut self, pixels: &[u16]) -> Result<(), SettingsError> {
+        self.check_size("origin", pixels)?;
+        self.origin_pixels.copy_from_slice(pixels);
+        self.origin_known = true;
+        self.origin_generation += 1;
         Ok(())
     }
 

@@ -21,10 +21,17 @@
 //! | … | 16 nx ny | per-node base displacement u, v (px, f64 each): total displacement when the reference was taken |
 //! | … | 8 | checksum (u64) of every byte before it |
 //!
+//! The frame the mesh is defined in goes to `origin.state` beside it when it changes (see
+//! [`origin`]).
+//!
 //! Encoding reuses one buffer, and opening, writing and renaming short paths does not allocate,
 //! so saving on every frame (incremental mode) keeps the live loop allocation-free. Written
 //! files survive a killed process (the rename is atomic); they are not fsynced, so a power cut
 //! may lose the last reference change.
+
+mod origin;
+
+pub use origin::ORIGIN_FILE;
 
 use crate::settings::{CorrelatorSettings, GuessMode, ReferenceMode, SettingsError, StrainMeasure};
 use crate::Correlator;
@@ -251,6 +258,9 @@ pub struct SavedReference {
     pub sequence_id: u32,
     pub pixels: Vec<u16>,
     pub base_px: Vec<(f64, f64)>,
+    /// The frame the mesh is defined in, when `origin.state` holds it (same origin frame id
+    /// and size).
+    pub origin_pixels: Option<Vec<u16>>,
     layout: Layout,
 }
 
@@ -275,6 +285,11 @@ impl SavedReference {
         correlator
             .restore_reference(&self.pixels, &self.base_px)
             .map_err(StateError::Settings)?;
+        if let Some(origin) = &self.origin_pixels {
+            correlator
+                .restore_origin(origin)
+                .map_err(StateError::Settings)?;
+        }
         Ok(correlator)
     }
 }
@@ -290,6 +305,11 @@ pub struct StateDir {
     bytes: Vec<u8>,
     summary: String,
     pub saves: u64,
+    origin_path: PathBuf,
+    origin_temp: PathBuf,
+    origin_bytes: Vec<u8>,
+    /// `Correlator::origin_generation` of the origin last written.
+    saved_origin: Option<u64>,
 }
 
 impl StateDir {
@@ -309,6 +329,10 @@ impl StateDir {
             bytes: Vec::new(),
             summary: String::with_capacity(4096),
             saves: 0,
+            origin_path: dir.join(ORIGIN_FILE),
+            origin_temp: dir.join(format!(".{ORIGIN_FILE}.tmp{pid}")),
+            origin_bytes: Vec::new(),
+            saved_origin: None,
         })
     }
 
@@ -333,12 +357,34 @@ impl StateDir {
                 })
             }
         };
-        decode(&bytes)
-            .map(Some)
-            .map_err(|detail| StateError::Corrupt {
-                path: self.path.clone(),
-                detail,
-            })
+        let mut saved = decode(&bytes).map_err(|detail| StateError::Corrupt {
+            path: self.path.clone(),
+            detail,
+        })?;
+        saved.origin_pixels = self.load_origin(&saved)?;
+        Ok(Some(saved))
+    }
+
+    /// The origin of `saved` from `origin.state`, None when the file is missing or holds
+    /// another origin.
+    fn load_origin(&self, saved: &SavedReference) -> Result<Option<Vec<u16>>, StateError> {
+        let bytes = match std::fs::read(&self.origin_path) {
+            Ok(bytes) => bytes,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => {
+                return Err(StateError::Io {
+                    path: self.origin_path.clone(),
+                    detail: format!("cannot read: {e}"),
+                })
+            }
+        };
+        let origin = origin::decode(&bytes).map_err(|detail| StateError::Corrupt {
+            path: self.origin_path.clone(),
+            detail,
+        })?;
+        let same = origin.origin_frame_id == saved.origin_frame_id
+            && (origin.width_px, origin.height_px) == (saved.width_px, saved.height_px);
+        Ok(same.then_some(origin.pixels))
     }
 
     /// Writes the correlator's current reference with its frame id, atomically, then the
@@ -349,6 +395,20 @@ impl StateDir {
         let pixels = correlator
             .reference_pixels()
             .expect("save is called once a reference is set");
+        // The origin first: a reference state on disk never names an origin that is not.
+        if let Some(origin) = correlator.origin_pixels() {
+            let generation = correlator.origin_generation();
+            if self.saved_origin != Some(generation) {
+                origin::encode(
+                    correlator.image_size(),
+                    ids.origin_frame_id,
+                    origin,
+                    &mut self.origin_bytes,
+                );
+                write_atomically(&self.origin_temp, &self.origin_path, &self.origin_bytes)?;
+                self.saved_origin = Some(generation);
+            }
+        }
         encode(
             &layout,
             ids,
@@ -515,6 +575,7 @@ fn decode(bytes: &[u8]) -> Result<SavedReference, String> {
         sequence_id,
         pixels,
         base_px,
+        origin_pixels: None,
         layout,
     })
 }
@@ -610,8 +671,20 @@ mod tests {
         assert_eq!(saved.reference_frame_id, 42);
         assert_eq!((saved.origin_frame_id, saved.sequence_id), (40, 3));
         assert_eq!(saved.pixels, pixels);
+        assert_eq!(saved.origin_pixels.as_deref(), Some(&pixels[..]));
         let restored = saved.restore(settings.clone(), state.path()).unwrap();
         assert_eq!(restored.reference_pixels().unwrap(), &pixels[..]);
+        assert_eq!(restored.origin_pixels(), Some(&pixels[..]));
+        // An origin file of another origin frame is no origin for this reference.
+        let other = ReferenceIds {
+            origin_frame_id: 7,
+            ..ids
+        };
+        let mut other_dir = StateDir::open(&dir.join("other")).unwrap();
+        other_dir.save(&correlator, other).unwrap();
+        std::fs::copy(dir.join("other").join(ORIGIN_FILE), dir.join(ORIGIN_FILE)).unwrap();
+        assert_eq!(state.load().unwrap().unwrap().origin_pixels, None);
+        std::fs::remove_dir_all(dir.join("other")).unwrap();
         let summary = std::fs::read_to_string(dir.join(SUMMARY_FILE)).unwrap();
         assert!(summary.contains("\"reference_frame_id\": 42"), "{summary}");
         assert!(

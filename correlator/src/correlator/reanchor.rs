@@ -9,7 +9,8 @@
 //! of its never-lost neighbours, then checked with the same final check. A node that verifies
 //! gets that total displacement (and its base is corrected, so it counts as never lost again); a
 //! node that does not is `low_zncc`, never a wrong `ok`. Without the origin image (a correlator
-//! restored from a saved reference) the returned nodes stay as measured.
+//! restored from a saved reference whose `origin.state` is missing) the returned nodes stay as
+//! measured.
 
 use super::{Correlator, Entry, Support, CARRY_RINGS, EXTRAPOLATION_RINGS};
 use crate::field::NodeStatus;
