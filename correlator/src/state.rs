@@ -347,15 +347,8 @@ impl StateDir {
 
     /// The saved reference, or None when the folder holds none yet.
     pub fn load(&self) -> Result<Option<SavedReference>, StateError> {
-        let bytes = match std::fs::read(&self.path) {
-            Ok(bytes) => bytes,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(e) => {
-                return Err(StateError::Io {
-                    path: self.path.clone(),
-                    detail: format!("cannot read: {e}"),
-                })
-            }
+        let Some(bytes) = read_if_present(&self.path)? else {
+            return Ok(None);
         };
         let mut saved = decode(&bytes).map_err(|detail| StateError::Corrupt {
             path: self.path.clone(),
@@ -368,15 +361,8 @@ impl StateDir {
     /// The origin of `saved` from `origin.state`, None when the file is missing or holds
     /// another origin.
     fn load_origin(&self, saved: &SavedReference) -> Result<Option<Vec<u16>>, StateError> {
-        let bytes = match std::fs::read(&self.origin_path) {
-            Ok(bytes) => bytes,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(e) => {
-                return Err(StateError::Io {
-                    path: self.origin_path.clone(),
-                    detail: format!("cannot read: {e}"),
-                })
-            }
+        let Some(bytes) = read_if_present(&self.origin_path)? else {
+            return Ok(None);
         };
         let origin = origin::decode(&bytes).map_err(|detail| StateError::Corrupt {
             path: self.origin_path.clone(),
@@ -431,6 +417,18 @@ impl StateDir {
         )?;
         self.saves += 1;
         Ok(())
+    }
+}
+
+/// The file's bytes, None when it does not exist.
+fn read_if_present(path: &Path) -> Result<Option<Vec<u8>>, StateError> {
+    match std::fs::read(path) {
+        Ok(bytes) => Ok(Some(bytes)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(StateError::Io {
+            path: path.to_path_buf(),
+            detail: format!("cannot read: {e}"),
+        }),
     }
 }
 
