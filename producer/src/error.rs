@@ -21,6 +21,18 @@ pub enum ProducerError {
         /// What went wrong, from the decoder.
         reason: String,
     },
+    /// An image file declares a side beyond the largest frame (refused before any pixel is
+    /// decoded or allocated).
+    #[error("image {path} declares {width}x{height} px, more than the largest frame side of {max_side_px} px: refused before decoding")]
+    ImageTooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Declared size, px.
+        width: u32,
+        height: u32,
+        /// The largest frame side, px.
+        max_side_px: u32,
+    },
     /// An image has a pixel type replay does not support.
     #[error("unsupported pixel type in {path}: {found}; expected 8- or 16-bit grayscale (or colour, converted to luma)")]
     PixelType {

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use image::{ColorType, ImageDecoder, ImageReader};
 
 use crate::error::ProducerError;
+use crate::simulated::MAX_SIDE_PX;
 
 /// A grayscale image with its pixels widened to `u16`, row-major, `pixels[y * width + x]`.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -68,6 +69,8 @@ fn decode_error(path: &Path, error: impl std::fmt::Display) -> ProducerError {
     }
 }
 
+/// Opens the decoder and reads the header; refuses a declared size beyond
+/// [`MAX_SIDE_PX`] at once (a kilobyte file may declare gigapixels).
 fn open_decoder(path: &Path) -> Result<impl ImageDecoder, ProducerError> {
     let io_error = |source| ProducerError::Io {
         path: path.to_path_buf(),
@@ -75,7 +78,17 @@ fn open_decoder(path: &Path) -> Result<impl ImageDecoder, ProducerError> {
     };
     let reader = ImageReader::open(path).map_err(io_error)?;
     let reader = reader.with_guessed_format().map_err(io_error)?;
-    reader.into_decoder().map_err(|e| decode_error(path, e))
+    let decoder = reader.into_decoder().map_err(|e| decode_error(path, e))?;
+    let (width, height) = decoder.dimensions();
+    if width > MAX_SIDE_PX || height > MAX_SIDE_PX {
+        return Err(ProducerError::ImageTooLarge {
+            path: path.to_path_buf(),
+            width,
+            height,
+            max_side_px: MAX_SIDE_PX,
+        });
+    }
+    Ok(decoder)
 }
 
 fn bit_depth_of(path: &Path, color: ColorType) -> Result<u8, ProducerError> {

@@ -150,7 +150,7 @@ pub struct SimulatedCamera {
 
 /// Pattern margin beyond the reach of the motion, px.
 const EXTRA_MARGIN_PX: f64 = 8.0;
-/// Largest frame side, px.
+/// Largest frame side, px, of every frame: simulated, replayed or read by `correlate`.
 pub const MAX_SIDE_PX: u32 = 16_384;
 
 impl SimulatedCamera {

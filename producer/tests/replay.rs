@@ -224,3 +224,66 @@ fn looping_replay_starts_again_and_keeps_counting() {
     assert_eq!(replay.frames_total(), Some(2));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A PNG of a few dozen bytes that declares `width` x `height` px of 8-bit grey (signature,
+/// IHDR, an empty IDAT, IEND; CRCs computed here).
+fn png_header_only(width: u32, height: u32) -> Vec<u8> {
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut crc = 0xFFFF_FFFFu32;
+        for &b in bytes {
+            crc ^= u32::from(b);
+            for _ in 0..8 {
+                crc = if crc & 1 == 1 {
+                    (crc >> 1) ^ 0xEDB8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        !crc
+    }
+    let mut out = vec![0x89, b'P', b'N', b'G', 0x0D, 0x0A, 0x1A, 0x0A];
+    let mut chunk = |kind: &[u8; 4], data: &[u8]| {
+        out.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        out.extend_from_slice(&body);
+        out.extend_from_slice(&crc32(&body).to_be_bytes());
+    };
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&width.to_be_bytes());
+    ihdr.extend_from_slice(&height.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 0, 0, 0, 0]); // 8 bit, grey, deflate, no filter, no interlace
+    chunk(b"IHDR", &ihdr);
+    chunk(b"IDAT", &[]);
+    chunk(b"IEND", &[]);
+    out
+}
+
+/// A tiny file declaring 100000 x 100000 px is refused from its header, naming the file and
+/// the limit, before anything the size of the declared image is allocated.
+#[test]
+fn a_gigapixel_header_is_refused_at_once() {
+    let dir = temp_dir("gigapixel");
+    let path = dir.join("huge.png");
+    std::fs::write(&path, png_header_only(100_000, 100_000)).unwrap();
+    let error = read_image(&path).unwrap_err();
+    assert!(
+        matches!(error, ProducerError::ImageTooLarge { width: 100_000, .. }),
+        "{error:?}"
+    );
+    let text = error.to_string();
+    assert!(
+        text.contains("huge.png") && text.contains("16384"),
+        "{text}"
+    );
+    // A header within the limit is still read (and then fails on its missing data, not on
+    // its size).
+    std::fs::write(&path, png_header_only(64, 48)).unwrap();
+    let error = read_image(&path).unwrap_err();
+    assert!(
+        !matches!(error, ProducerError::ImageTooLarge { .. }),
+        "{error:?}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
