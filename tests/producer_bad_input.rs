@@ -110,6 +110,36 @@ fn unknown_scenario_lists_the_known_ones() {
     }
 }
 
+/// A frame side of 0 or 3 px is an error naming it, not a panic (it was: rc 101).
+#[test]
+fn a_frame_side_out_of_range_is_refused() {
+    let mut run = Run::new("bad_side");
+    let instance = run.name().to_string();
+    let out = std::env::temp_dir().join(format!("bad_side_{}", std::process::id()));
+    let out = out.to_str().unwrap().to_string();
+    for args in [
+        vec!["synth", "--width", "0", "--frames", "1", "--out", &out],
+        vec![
+            "producer",
+            "--height",
+            "3",
+            "--frames",
+            "1",
+            "--instance",
+            &instance,
+        ],
+    ] {
+        let (status, _, stderr) = run.run_to_end("producer", &args);
+        assert_eq!(status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(
+            stderr.contains("expected a frame side in [8, 16384] px"),
+            "{stderr}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 /// The frame service must fit in `/dev/shm`: a size that does not is refused at start, before
 /// the camera is built (no "ready"), with the free and needed space. The size is chosen from
 /// the machine's actual free space.

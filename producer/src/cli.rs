@@ -91,8 +91,9 @@ impl SimArgs {
         spec
     }
 
-    /// The parsed scenario.
+    /// The parsed scenario (for a frame size within the limits).
     pub fn scenario(&self) -> Result<Scenario, ProducerError> {
+        crate::simulated::check_frame_size(self.width, self.height)?;
         Scenario::parse(&self.scenario_spec(), self.width, self.height)
     }
 

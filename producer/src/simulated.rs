@@ -153,6 +153,20 @@ const EXTRA_MARGIN_PX: f64 = 8.0;
 /// Largest frame side, px, of every frame: simulated, replayed or read by `correlate`.
 pub const MAX_SIDE_PX: u32 = 16_384;
 
+/// Refuses a simulated frame side outside [8, [`MAX_SIDE_PX`]] px, naming it.
+pub fn check_frame_size(width: u32, height: u32) -> Result<(), ProducerError> {
+    for (name, side) in [("width", width), ("height", height)] {
+        if !(8..=MAX_SIDE_PX).contains(&side) {
+            return Err(ProducerError::InvalidParameter {
+                name: name.to_owned(),
+                value: side.to_string(),
+                expected: format!("a frame side in [8, {MAX_SIDE_PX}] px"),
+            });
+        }
+    }
+    Ok(())
+}
+
 impl SimulatedCamera {
     /// Builds the pattern (and the fast texture) for the motions `motions` may produce.
     pub fn new(
@@ -183,15 +197,7 @@ impl SimulatedCamera {
         reach_px: f64,
         motions: Option<Box<dyn MotionSource>>,
     ) -> Result<Self, ProducerError> {
-        for (name, side) in [("width", config.width), ("height", config.height)] {
-            if !(8..=MAX_SIDE_PX).contains(&side) {
-                return Err(ProducerError::InvalidParameter {
-                    name: name.to_owned(),
-                    value: side.to_string(),
-                    expected: format!("a frame side in [8, {MAX_SIDE_PX}] px"),
-                });
-            }
-        }
+        check_frame_size(config.width, config.height)?;
         config.speckle.validate()?;
         config.camera.validate()?;
         if !(config.oversample.is_multiple_of(2) && (2..=8).contains(&config.oversample)) {
