@@ -67,6 +67,18 @@ pub enum ProducerError {
         /// The folder or glob given.
         path: PathBuf,
     },
+    /// An image file's size is not the frame buffer's (a file rewritten with another size).
+    #[error("image {path} is {found_width}x{found_height} px, the frame buffer holds {expected_px} pixels")]
+    ImageSize {
+        /// The file.
+        path: PathBuf,
+        /// Its shape.
+        found_width: u32,
+        found_height: u32,
+        found_bit_depth: u8,
+        /// Length of the buffer, pixels.
+        expected_px: usize,
+    },
     /// The caller's output buffer has the wrong length.
     #[error("frame buffer holds {found_px} pixels, expected {expected_px} (width x height)")]
     BufferSize {

@@ -131,9 +131,12 @@ pub fn decode_into(
         bit_depth,
     };
     if out.len() != shape.len_px() {
-        return Err(ProducerError::BufferSize {
-            found_px: out.len(),
-            expected_px: shape.len_px(),
+        return Err(ProducerError::ImageSize {
+            path: path.to_path_buf(),
+            found_width: width,
+            found_height: height,
+            found_bit_depth: bit_depth,
+            expected_px: out.len(),
         });
     }
     if color == ColorType::L8 || color == ColorType::L16 {

@@ -99,7 +99,21 @@ impl FrameSource for Replay {
         let Some(file) = self.files.get(self.next_index) else {
             return Ok(None);
         };
-        let read = decode_into(file, &mut self.scratch, out)?;
+        let read = match decode_into(file, &mut self.scratch, out) {
+            // A file rewritten with another size since the list was read: the same message
+            // as any other frame of another shape.
+            Err(ProducerError::ImageSize {
+                found_width,
+                found_height,
+                found_bit_depth,
+                ..
+            }) => ImageShape {
+                width: found_width,
+                height: found_height,
+                bit_depth: found_bit_depth,
+            },
+            other => other?,
+        };
         if read != self.shape {
             return Err(ProducerError::FrameMismatch {
                 path: file.clone(),

@@ -162,6 +162,25 @@ fn truncated_file_names_the_file() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A file rewritten with another size while the replay runs: named, with the size it has and
+/// the one expected (the message was "frame buffer holds 4096 pixels, expected 2304").
+#[test]
+fn a_file_rewritten_with_another_size_is_named() {
+    let dir = temp_dir("rewritten");
+    write_gray8(&dir.join("a1.png"), 64, 64, 0);
+    write_gray8(&dir.join("a2.png"), 64, 64, 1);
+    let mut replay = Replay::open(&dir).unwrap();
+    let mut out = vec![0u16; replay.dims().len_px()];
+    replay.next_frame(&mut out).expect("first frame is fine");
+    write_gray8(&dir.join("a2.png"), 48, 48, 1);
+    let error = message(replay.next_frame(&mut out).unwrap_err());
+    assert!(
+        error.contains("a2.png") && error.contains("48x48") && error.contains("64x64"),
+        "{error}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn missing_file_names_the_file() {
     let error = message(read_image("/nonexistent/frame.png").unwrap_err());
