@@ -90,6 +90,38 @@ pub struct InPlaneStress {
     pub stretch3: f64,
 }
 
+/// Why coefficients do not make a law ([`InvariantLaw::exp_poly`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum LawError {
+    /// The coefficients of `which` (f or g) are empty or not finite.
+    Coefficients {
+        which: &'static str,
+        coefficients: Vec<f64>,
+    },
+    /// The law's small-strain Young's modulus is not positive.
+    Stiffness { young_mpa: f64 },
+}
+
+impl std::fmt::Display for LawError {
+    fn fmt(&self, out: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LawError::Coefficients {
+                which,
+                coefficients,
+            } => write!(
+                out,
+                "{which} coefficients {coefficients:?}: expected one or more finite numbers"
+            ),
+            LawError::Stiffness { young_mpa } => write!(
+                out,
+                "the law has a small-strain Young's modulus of {young_mpa} MPa: expected a positive stiffness"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for LawError {}
+
 /// The invariant-based law: ∂W/∂I1 = f(I1), ∂W/∂I2 = g(I2).
 #[derive(Clone, Debug, PartialEq)]
 pub struct InvariantLaw {
@@ -105,6 +137,29 @@ impl InvariantLaw {
             f: InvariantFn::ExpPoly(vec![-1.27, -2.52e-2, 1.40e-3]),
             g: InvariantFn::ExpPoly(vec![-1.02, -3.92e-3, -5.30e-4]),
         }
+    }
+
+    /// The law ln f = Σ a_i (I1 − 3)^i, ln g = Σ b_i (I2 − 3)^i from its coefficients, checked:
+    /// each list non-empty and finite, and a positive small-strain stiffness. The error says
+    /// which part is wrong (`f`, `g`, or the stiffness) for the caller to name its own input.
+    pub fn exp_poly(a: &[f64], b: &[f64]) -> Result<InvariantLaw, LawError> {
+        for (which, coefficients) in [("f", a), ("g", b)] {
+            if coefficients.is_empty() || coefficients.iter().any(|c| !c.is_finite()) {
+                return Err(LawError::Coefficients {
+                    which,
+                    coefficients: coefficients.to_vec(),
+                });
+            }
+        }
+        let law = InvariantLaw {
+            f: InvariantFn::ExpPoly(a.to_vec()),
+            g: InvariantFn::ExpPoly(b.to_vec()),
+        };
+        let young_mpa = law.small_strain_young_modulus_mpa();
+        if !(young_mpa.is_finite() && young_mpa > 0.0) {
+            return Err(LawError::Stiffness { young_mpa });
+        }
+        Ok(law)
     }
 
     /// Small-strain Young's modulus E = 6 (f(3) + g(3)), MPa.
@@ -191,6 +246,26 @@ pub fn force_n(cauchy_stress_mpa: f64, current_section_mm2: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn coefficients_are_checked() {
+        let smactane = InvariantLaw::smactane();
+        let (a, b) = (smactane.f.coefficients(), smactane.g.coefficients());
+        assert_eq!(InvariantLaw::exp_poly(a, b), Ok(smactane.clone()));
+        assert!(matches!(
+            InvariantLaw::exp_poly(&[f64::NAN, 1.0], b),
+            Err(LawError::Coefficients { which: "f", .. })
+        ));
+        assert!(matches!(
+            InvariantLaw::exp_poly(a, &[]),
+            Err(LawError::Coefficients { which: "g", .. })
+        ));
+        // ln f = 800: f overflows to infinity, no stiffness.
+        assert!(matches!(
+            InvariantLaw::exp_poly(&[800.0], b),
+            Err(LawError::Stiffness { .. })
+        ));
+    }
 
     #[test]
     fn small_strain_limit_gives_young_modulus() {

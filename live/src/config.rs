@@ -230,29 +230,16 @@ impl RunConfig {
 
     /// The specimen material.
     pub fn law(&self) -> Result<identifier::law::InvariantLaw, String> {
-        use identifier::law::{InvariantFn, InvariantLaw};
-        for (name, coefficients) in [
-            ("law_f", &self.specimen.law_f),
-            ("law_g", &self.specimen.law_g),
-        ] {
-            if coefficients.is_empty() || coefficients.iter().any(|c| !c.is_finite()) {
-                return Err(format!(
-                    "[specimen] {name} = {coefficients:?}: expected one or more finite numbers"
-                ));
-            }
-        }
-        let law = InvariantLaw {
-            f: InvariantFn::ExpPoly(self.specimen.law_f.clone()),
-            g: InvariantFn::ExpPoly(self.specimen.law_g.clone()),
-        };
-        let young_mpa = law.small_strain_young_modulus_mpa();
-        if !(young_mpa.is_finite() && young_mpa > 0.0) {
-            return Err(format!(
-                "[specimen] the law has a small-strain Young's modulus of {young_mpa} MPa: \
-                 expected a positive stiffness"
-            ));
-        }
-        Ok(law)
+        use identifier::law::{InvariantLaw, LawError};
+        InvariantLaw::exp_poly(&self.specimen.law_f, &self.specimen.law_g).map_err(|e| match e {
+            LawError::Coefficients {
+                which,
+                coefficients,
+            } => format!(
+                "[specimen] law_{which} = {coefficients:?}: expected one or more finite numbers"
+            ),
+            LawError::Stiffness { .. } => format!("[specimen] {e}"),
+        })
     }
 
     /// Largest stretch any test reaches: the camera's pattern must cover it.

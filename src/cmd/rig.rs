@@ -68,13 +68,25 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
     };
     let campaign = match (campaign, &args.law_f, &args.law_g) {
         (Some(c), f, g) if f.is_some() || g.is_some() => {
-            let mut law = identifier::law::InvariantLaw::smactane();
-            if let Some(a) = f {
-                law.f = identifier::law::InvariantFn::ExpPoly(a.clone());
-            }
-            if let Some(b) = g {
-                law.g = identifier::law::InvariantFn::ExpPoly(b.clone());
-            }
+            let smactane = identifier::law::InvariantLaw::smactane();
+            let a = f
+                .clone()
+                .unwrap_or_else(|| smactane.f.coefficients().to_vec());
+            let b = g
+                .clone()
+                .unwrap_or_else(|| smactane.g.coefficients().to_vec());
+            // The same refusals as a run's [specimen].
+            let law = identifier::law::InvariantLaw::exp_poly(&a, &b).map_err(|e| match e {
+                identifier::law::LawError::Coefficients {
+                    which,
+                    coefficients,
+                } => anyhow::anyhow!(
+                    "--law-{which} {coefficients:?}: expected one or more finite numbers"
+                ),
+                identifier::law::LawError::Stiffness { .. } => {
+                    anyhow::anyhow!("--law-f/--law-g: {e}")
+                }
+            })?;
             Some(c.with_law(law))
         }
         (None, Some(_), _) | (None, _, Some(_)) => {
