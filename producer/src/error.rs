@@ -6,12 +6,14 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum ProducerError {
     /// A file could not be opened or read.
-    #[error("cannot read {path}: {source}")]
+    /// The reason is part of the message, not a separate cause, so that an error chain
+    /// (`{:#}`) does not say it twice.
+    #[error("cannot read {path}: {reason}")]
     Io {
         /// The file or folder.
         path: PathBuf,
         /// The underlying error.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// A file is not a decodable image (not an image, truncated, unsupported format).
     #[error("cannot decode image {path}: {reason}")]

@@ -72,9 +72,9 @@ fn decode_error(path: &Path, error: impl std::fmt::Display) -> ProducerError {
 /// Opens the decoder and reads the header; refuses a declared size beyond
 /// [`MAX_SIDE_PX`] at once (a kilobyte file may declare gigapixels).
 fn open_decoder(path: &Path) -> Result<impl ImageDecoder, ProducerError> {
-    let io_error = |source| ProducerError::Io {
+    let io_error = |reason| ProducerError::Io {
         path: path.to_path_buf(),
-        source,
+        reason,
     };
     let reader = ImageReader::open(path).map_err(io_error)?;
     let reader = reader.with_guessed_format().map_err(io_error)?;

@@ -37,9 +37,9 @@ impl ImageFormatOut {
 
 /// Writes `bytes` to `path` atomically (temporary sibling, then rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ProducerError> {
-    let io = |source| ProducerError::Io {
+    let io = |reason| ProducerError::Io {
         path: path.to_path_buf(),
-        source,
+        reason,
     };
     let name = path.file_name().and_then(|n| n.to_str()).ok_or_else(|| {
         ProducerError::InvalidParameter {

@@ -156,13 +156,13 @@ pub fn list_images(source: &Path) -> Result<Vec<PathBuf>, ProducerError> {
     };
     let entries = std::fs::read_dir(&dir).map_err(|e| ProducerError::Io {
         path: dir.clone(),
-        source: e,
+        reason: e,
     })?;
     let mut files = Vec::new();
     for entry in entries {
         let entry = entry.map_err(|e| ProducerError::Io {
             path: dir.clone(),
-            source: e,
+            reason: e,
         })?;
         let path = entry.path();
         if !path.is_file() {

@@ -40,6 +40,20 @@ pub fn run(args: IdentifierArgs) -> anyhow::Result<()> {
         Some(s) => anyhow::bail!("--idle-timeout-s must be a positive number of seconds, got {s}"),
         None => None,
     };
+    // The fits are written at the end (and every second): a folder that is not there is
+    // refused now, not after the whole test.
+    let folder = args
+        .output
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    if !folder.is_dir() {
+        anyhow::bail!(
+            "--output {}: the folder {} does not exist",
+            args.output.display(),
+            folder.display()
+        );
+    }
     let config = ProcessConfig {
         instance: args.instance,
         output_json: args.output.clone(),

@@ -100,7 +100,10 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| anyhow::anyhow!("program {}: {e}", path.display()))?;
             let base = path.parent().map(PathBuf::from).unwrap_or_default();
-            Some(Program::from_toml(&text, &base).map_err(anyhow::Error::msg)?)
+            Some(
+                Program::from_toml(&text, &base)
+                    .map_err(|e| anyhow::anyhow!("program {}: {e}", path.display()))?,
+            )
         }
         (None, Some(name)) => {
             let test = BuiltinTest::parse(name).ok_or_else(|| {

@@ -1,0 +1,107 @@
+//! Bad command-line input refused at start with a message naming it (issue 11's smaller
+//! defects): `rig` refuses what a run's configuration refuses (a law whose coefficients are not
+//! finite used to publish NaN positions and never finish) and names a broken program file;
+//! `identifier` refuses an output folder that does not exist before it runs (it failed at the
+//! end without the path); a missing replay folder is said once, not twice.
+
+use std::process::{Command, Output};
+
+fn dicstream(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_dicstream"))
+        .args(args)
+        .output()
+        .expect("run dicstream")
+}
+
+fn instance() -> String {
+    format!("cli_refusals_{}", std::process::id())
+}
+
+/// Exit status 1, the message holds every needle, nothing started.
+fn refused(args: &[&str], needles: &[&str]) -> String {
+    let output = dicstream(args);
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert_eq!(output.status.code(), Some(1), "{args:?}: {stderr}");
+    for needle in needles {
+        assert!(stderr.contains(needle), "{needle:?} not in {stderr}");
+    }
+    assert!(!stderr.contains(": ready"), "{stderr}");
+    stderr
+}
+
+#[test]
+fn a_broken_program_file_is_named() {
+    let path = std::env::temp_dir().join(format!("cli_refusals_{}.toml", std::process::id()));
+    std::fs::write(&path, "bad toml [").unwrap();
+    let p = path.to_str().unwrap();
+    refused(
+        &["rig", "--program", p, "--instance", &instance()],
+        &[&format!("program {p}"), "TOML parse error"],
+    );
+    let _ = std::fs::remove_file(&path);
+}
+
+#[test]
+fn a_missing_output_folder_is_refused_at_start() {
+    refused(
+        &[
+            "identifier",
+            "--output",
+            "/nonexistent_dicstream/out.json",
+            "--instance",
+            &instance(),
+        ],
+        &["/nonexistent_dicstream/out.json", "does not exist"],
+    );
+}
+
+#[test]
+fn a_missing_replay_folder_is_said_once() {
+    let stderr = refused(
+        &[
+            "producer",
+            "--replay",
+            "/nonexistent_dicstream",
+            "--instance",
+            &instance(),
+        ],
+        &["cannot read /nonexistent_dicstream"],
+    );
+    assert_eq!(
+        stderr.matches("No such file or directory").count(),
+        1,
+        "{stderr}"
+    );
+}
+
+#[test]
+fn a_law_that_is_not_finite_is_refused_at_start() {
+    for (flag, value, needle) in [
+        ("--law-f", "nan,1", "--law-f [NaN, 1.0]"),
+        ("--law-g", "1,inf", "--law-g [1.0, inf]"),
+    ] {
+        let output = Command::new(env!("CARGO_BIN_EXE_dicstream"))
+            .args([
+                "rig",
+                "--test",
+                "campaign",
+                flag,
+                value,
+                "--speed",
+                "max",
+                "--exit-when-done",
+                "--instance",
+                &format!("rig_cli_{}", std::process::id()),
+            ])
+            .output()
+            .expect("run dicstream");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains(needle), "{stderr}");
+        assert!(
+            stderr.contains("expected one or more finite numbers"),
+            "{stderr}"
+        );
+        assert!(!stderr.contains("rig: ready"), "{stderr}");
+    }
+}
