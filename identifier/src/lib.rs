@@ -16,7 +16,8 @@
 pub mod data;
 pub mod fit;
 pub mod journal;
-pub mod law;
+/// The law lives in its own crate (`material`), shared with the rig; re-exported here.
+pub use material as law;
 pub mod lsq;
 pub mod models;
 pub mod online;

@@ -11,7 +11,7 @@ use crate::refusal::Refusal;
 use crate::rig::{Rig, RigCommand};
 use crate::snapshot::ProgramStatus;
 use crate::specimen::SpecimenConfig;
-use identifier::law::InvariantLaw;
+use material::InvariantLaw;
 
 /// One test of a campaign: a built-in test to a stretch at a stretch rate.
 #[derive(Clone, Copy, Debug, PartialEq)]

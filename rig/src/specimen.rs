@@ -1,7 +1,7 @@
 //! The specimen between the grips: an incompressible hyperelastic rubber sheet whose law is
-//! `identifier::law::InvariantLaw` (Smactane™ by default, paper Tables 3 and 4). This module
+//! `material::InvariantLaw` (Smactane™ by default, paper Tables 3 and 4). This module
 //! only maps grip displacements to homogeneous stretches and stretches to grip forces; the law
-//! itself lives in the identifier crate (one place per concept).
+//! itself lives in the `material` crate (one place per concept).
 //!
 //! Geometry (mm): the gauge region is `gauge_length_mm` along X (between the X grips) by
 //! `width_mm` along Y, `thickness_mm` thick. In equibiaxial tension (cruciform, X and Y pairs)
@@ -22,7 +22,7 @@
 use crate::hydraulics::ACTUATOR_COUNT;
 use crate::ids::Axis;
 use crate::snapshot::SpecimenKinematics;
-use identifier::law::InvariantLaw;
+use material::InvariantLaw;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Loading {

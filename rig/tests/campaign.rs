@@ -3,7 +3,7 @@
 //! with the other axes as the load case says, the specimen change happens only unloaded, and
 //! the forces follow the specimen law of the mounted specimen.
 
-use identifier::law::InvariantLaw;
+use material::InvariantLaw;
 use rig::{Campaign, CampaignEvent, Loading, ProgramStatus, Rig, RigCommand, RigConfig};
 
 #[test]

@@ -1,8 +1,8 @@
 //! Equibiaxial ramp to λ = 2 at 1e-3 /s in centroid displacement control, in simulated time
 //! (1000 s at 5 kHz = 5 M steps): centre drift of each axis, elongation following error, and
-//! grip forces against eq. (19) evaluated directly with the identifier's law.
+//! grip forces against eq. (19) evaluated directly with the law (`material`).
 
-use identifier::law::InvariantLaw;
+use material::InvariantLaw;
 use rig::{Axis, Program, ProgramStatus, Rig, RigCommand, RigConfig};
 
 const PROGRAM: &str = r#"
