@@ -81,20 +81,40 @@ fn result_gradient(
     sums.gradient()
 }
 
-/// Median score of the valid results (0 when none), using `scratch` (no allocation once it
-/// holds every node).
-fn median_ok_score(results: impl Iterator<Item = ZoiResult>, scratch: &mut Vec<f64>) -> f64 {
+/// Median of the finite `values`, using `scratch` (no allocation once it holds every node);
+/// None when there are none.
+fn median(values: impl Iterator<Item = f64>, scratch: &mut Vec<f64>) -> Option<f64> {
     scratch.clear();
-    scratch.extend(
-        results
-            .filter(|r| r.status == NodeStatus::Ok && r.score.is_finite())
-            .map(|r| r.score),
-    );
+    scratch.extend(values.filter(|v| v.is_finite()));
     if scratch.is_empty() {
-        return 0.0;
+        return None;
     }
     let middle = scratch.len() / 2;
-    *scratch.select_nth_unstable_by(middle, f64::total_cmp).1
+    Some(*scratch.select_nth_unstable_by(middle, f64::total_cmp).1)
+}
+
+/// Median score of the valid results (0 when none).
+fn median_ok_score(results: impl Iterator<Item = ZoiResult>, scratch: &mut Vec<f64>) -> f64 {
+    median(
+        results
+            .filter(|r| r.status == NodeStatus::Ok)
+            .map(|r| r.score),
+        scratch,
+    )
+    .unwrap_or(0.0)
+}
+
+/// a − b.
+fn difference(a: Mat2, b: Mat2) -> Mat2 {
+    [
+        [a[0][0] - b[0][0], a[0][1] - b[0][1]],
+        [a[1][0] - b[1][0], a[1][1] - b[1][1]],
+    ]
+}
+
+/// A nalgebra gradient as the row-major matrix of the warps.
+fn to_mat2(g: nalgebra::Matrix2<f64>) -> Mat2 {
+    [[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]
 }
 
 /// Which valid nodes an affine fit may use.
@@ -674,11 +694,8 @@ impl Correlator {
                 if let Some(g) = self.result_gradient(k) {
                     if correct_gradient {
                         // A warped ZOI is biased only by the gradient beyond its warp.
-                        let w = result.warp_gradient;
-                        let bias = self.sensitivities[k].bias_px([
-                            [g[(0, 0)] - w[0][0], g[(0, 1)] - w[0][1]],
-                            [g[(1, 0)] - w[1][0], g[(1, 1)] - w[1][1]],
-                        ]);
+                        let bias = self.sensitivities[k]
+                            .bias_px(difference(to_mat2(g), result.warp_gradient));
                         u.0 -= bias.0;
                         u.1 -= bias.1;
                     }
@@ -731,16 +748,10 @@ impl Correlator {
                 f64::NAN
             };
         }
-        self.scores.clear();
-        self.scores
-            .extend(self.residuals.iter().copied().filter(|r| r.is_finite()));
-        let limit_px = if self.scores.is_empty() {
-            OUTLIER_MAX_PX
-        } else {
-            let middle = self.scores.len() / 2;
-            let median = *self.scores.select_nth_unstable_by(middle, f64::total_cmp).1;
-            (OUTLIER_SCATTER * median).clamp(OUTLIER_MIN_PX, OUTLIER_MAX_PX)
-        };
+        let limit_px = median(self.residuals.iter().copied(), &mut self.scores)
+            .map_or(OUTLIER_MAX_PX, |m| {
+                (OUTLIER_SCATTER * m).clamp(OUTLIER_MIN_PX, OUTLIER_MAX_PX)
+            });
         for (outlier, &residual) in self.outliers.iter_mut().zip(&self.residuals) {
             *outlier = residual > limit_px;
         }

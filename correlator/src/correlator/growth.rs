@@ -16,7 +16,7 @@
 //!
 //! Every new result passes the same check before it counts.
 
-use super::{Correlator, Entry};
+use super::{difference, to_mat2, Correlator, Entry};
 use crate::field::NodeStatus;
 use crate::interpolate::Mat2;
 use crate::keypoints::KeypointMatcher;
@@ -27,17 +27,6 @@ use crate::zoi::{spectrum_len, warp_worth_it, Image, ReferenceSpectra};
 /// Keypoints run when fewer than this fraction of the nodes that could verify (textured, not
 /// outside the image) do after growth.
 const KEYPOINTS_BELOW_FRACTION: f64 = 0.5;
-
-fn to_mat2(g: nalgebra::Matrix2<f64>) -> Mat2 {
-    [[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]
-}
-
-fn difference(a: Mat2, b: Mat2) -> Mat2 {
-    [
-        [a[0][0] - b[0][0], a[0][1] - b[0][1]],
-        [a[1][0] - b[1][0], a[1][1] - b[1][1]],
-    ]
-}
 
 impl Correlator {
     fn reference_image(&self) -> Image<'_> {

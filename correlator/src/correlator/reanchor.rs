@@ -12,7 +12,7 @@
 //! restored from a saved reference whose `origin.state` is missing) the returned nodes stay as
 //! measured.
 
-use super::{Correlator, Entry, Support, CARRY_RINGS, EXTRAPOLATION_RINGS};
+use super::{to_mat2, Correlator, Entry, Support, CARRY_RINGS, EXTRAPOLATION_RINGS};
 use crate::field::NodeStatus;
 use crate::interpolate::Mat2;
 use crate::pool::SharedSlice;
@@ -35,10 +35,7 @@ impl Correlator {
             let gradient: Mat2 = self
                 .affine_fit(Some(k), CARRY_RINGS, Some(k), Support::NeverLost)
                 .or(whole_mesh)
-                .map_or([[0.0; 2]; 2], |fit| {
-                    let g = fit.gradient;
-                    [[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]
-                });
+                .map_or([[0.0; 2]; 2], |fit| to_mat2(fit.gradient));
             self.entries.push(Entry {
                 node: k,
                 guess_px: (node.u_px, node.v_px),
@@ -83,10 +80,7 @@ impl Correlator {
             }
             let gradient: Mat2 = self
                 .affine_fit(Some(k), EXTRAPOLATION_RINGS, None, Support::Valid)
-                .map_or([[0.0; 2]; 2], |fit| {
-                    let g = fit.gradient;
-                    [[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]
-                });
+                .map_or([[0.0; 2]; 2], |fit| to_mat2(fit.gradient));
             self.entries.push(Entry {
                 node: k,
                 guess_px: self.scratch_pairs[k],
