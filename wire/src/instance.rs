@@ -26,6 +26,12 @@ pub enum InstanceError {
         free_bytes: u64,
         path: String,
     },
+    /// The role already has a process on this instance.
+    Owned {
+        instance: String,
+        role: String,
+        pid: Option<u32>,
+    },
     Io(String),
 }
 
@@ -52,6 +58,19 @@ impl std::fmt::Display for InstanceError {
                  (mount -o remount,size=... {path})",
                 *free_bytes as f64 / 1048576.0,
                 *needed_bytes as f64 / 1048576.0
+            ),
+            InstanceError::Owned {
+                instance,
+                role,
+                pid,
+            } => write!(
+                f,
+                "instance {instance} already has a {role} ({}): stop it, or use another \
+                 --instance",
+                match pid {
+                    Some(pid) => format!("pid {pid}"),
+                    None => "pid unknown".into(),
+                }
             ),
             InstanceError::Io(detail) => write!(f, "{detail}"),
         }
@@ -139,18 +158,26 @@ impl Instance {
         let node = NodeBuilder::new()
             .name(&node_name)
             .config(&self.config)
-            // The processes handle SIGINT/SIGTERM themselves through WaitSet and `node.wait`.
-            .signal_handling_mode(SignalHandlingMode::HandleTerminationRequests)
+            // Signals are handled by `crate::signals` (installed first thing in `main`).
+            .signal_handling_mode(SignalHandlingMode::Disabled)
             .create::<ipc::Service>()
             .map_err(|e| node_error(format!("{e:?}")))?;
-        // iceoryx2 installs its SIGINT/SIGTERM handler lazily, on the first termination check:
-        // do it now, so a signal between here and the process's first wait is not fatal. The
-        // check consumes a request that was already recorded: raise it again, now handled.
-        if node.wait(std::time::Duration::ZERO).is_err() {
-            // SAFETY: raise(3) with a valid signal number; the handler is installed.
-            unsafe { libc::raise(libc::SIGTERM) };
-        }
         Ok((node, removed))
+    }
+
+    /// Claims `role` on this instance for as long as the returned [`crate::owner::Owner`]
+    /// lives: a second process of the role is refused, naming the first one's pid.
+    pub fn claim(&self, role: &str) -> Result<crate::owner::Owner, InstanceError> {
+        crate::owner::claim(&self.name, role).map_err(|e| match e {
+            crate::owner::ClaimError::Owned { pid } => InstanceError::Owned {
+                instance: self.name.clone(),
+                role: role.to_string(),
+                pid,
+            },
+            crate::owner::ClaimError::Io { path, error } => {
+                InstanceError::Io(format!("cannot claim {}: {error}", path.display()))
+            }
+        })
     }
 
     /// Removes the stale resources of this instance's nodes whose process died (e.g. SIGKILL).

@@ -8,14 +8,18 @@
 //! origin at the centre of the top-left pixel; u, v are Lagrangian displacements in pixels.
 
 pub mod clock;
+pub mod exit;
 pub mod field;
+pub mod files;
 pub mod frame;
 pub mod identification;
 pub mod instance;
+pub mod owner;
 pub mod pubsub;
 pub mod rig;
 pub mod services;
 pub mod shm;
+pub mod signals;
 pub mod text;
 
 pub use clock::monotonic_ns;

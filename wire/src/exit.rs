@@ -1,0 +1,71 @@
+//! Exit codes with a meaning between processes: `dicstream run` reads them to tell a death it
+//! should restart from one it must not (a restart would fail the same way, or start a test
+//! over). Codes from sysexits(3).
+
+/// A results file could not be written (a full disk, a removed folder): the run stops.
+pub const OUTPUT_FAILED: u8 = 74;
+/// The rig could not resume its test safely from its journal: it unloaded and stopped.
+pub const CANNOT_RESUME: u8 = 75;
+
+/// An error that sets the process's exit code (the binary's `main` looks for it, and for a
+/// [`crate::files::FileError`], in the error's chain).
+#[derive(Debug)]
+pub struct ExitWith {
+    pub code: u8,
+    pub message: String,
+}
+
+impl std::fmt::Display for ExitWith {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for ExitWith {}
+
+/// The exit code an error asks for: an [`ExitWith`]'s, or [`OUTPUT_FAILED`] for a file that
+/// could not be written.
+/// The error's sources are looked at too.
+pub fn code_of(error: &(dyn std::error::Error + 'static)) -> Option<u8> {
+    let mut next = Some(error);
+    while let Some(error) = next {
+        if let Some(exit) = error.downcast_ref::<ExitWith>() {
+            return Some(exit.code);
+        }
+        if error.downcast_ref::<crate::files::FileError>().is_some() {
+            return Some(OUTPUT_FAILED);
+        }
+        next = error.source();
+    }
+    None
+}
+
+/// `error` with a context, keeping the exit code it asks for (1 if none).
+pub fn in_context(context: &str, error: &(dyn std::error::Error + 'static)) -> ExitWith {
+    ExitWith {
+        code: code_of(error).unwrap_or(1),
+        message: format!("{context}: {error}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_error_keeps_its_code_through_a_context() {
+        let file_error = crate::files::FileError {
+            path: "rig.csv".into(),
+            what: "write",
+            source: std::io::Error::from_raw_os_error(libc::ENOSPC),
+        };
+        let boxed: Box<dyn std::error::Error + Send + Sync> = Box::new(file_error);
+        let exit = in_context("rig process", &*boxed);
+        assert_eq!(exit.code, OUTPUT_FAILED);
+        assert!(exit
+            .message
+            .starts_with("rig process: cannot write rig.csv"));
+        let other: Box<dyn std::error::Error + Send + Sync> = "no".into();
+        assert_eq!(in_context("rig", &*other).code, 1);
+    }
+}
