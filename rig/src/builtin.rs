@@ -21,6 +21,14 @@ impl BuiltinTest {
         }
     }
 
+    /// As the command line names it.
+    pub fn name(self) -> &'static str {
+        match self {
+            BuiltinTest::Uniaxial => "uniaxial",
+            BuiltinTest::Equibiaxial => "equibiaxial",
+        }
+    }
+
     /// The specimen of the test: a 100 × 20 × 2 mm strip in uniaxial tension along X, the
     /// default 100 × 100 × 2 mm cruciform centre in equibiaxial tension.
     pub fn specimen(self) -> SpecimenConfig {
@@ -43,11 +51,15 @@ impl BuiltinTest {
     pub fn program(self, rate_per_s: f64, stretch: f64) -> Result<Program, String> {
         if !(rate_per_s.is_finite() && rate_per_s > 0.0) {
             return Err(format!(
-                "--rate {rate_per_s}: expected a positive stretch rate (/s)"
+                "--rate {}: expected a positive stretch rate (/s)",
+                crate::refusal::number(rate_per_s)
             ));
         }
         if !(stretch.is_finite() && stretch > 1.0 && stretch <= 8.0) {
-            return Err(format!("--stretch {stretch}: expected a stretch in (1, 8]"));
+            return Err(format!(
+                "--stretch {}: expected a stretch in (1, 8]",
+                crate::refusal::number(stretch)
+            ));
         }
         let geometry = self.specimen().geometry;
         let axes: &[(Axis, f64)] = match self {
@@ -59,7 +71,7 @@ impl BuiltinTest {
         };
         let centroid = AxisControl::Centroid(ControlMode::Displacement);
         let program = Program {
-            name: format!("{self:?} to λ {stretch} at {rate_per_s} /s").to_lowercase(),
+            name: format!("{} to λ {stretch} at {rate_per_s} /s", self.name()),
             stop: StopTransition::RampToZero,
             stop_rate_per_s: 10.0 * rate_per_s * geometry.gauge_length_mm,
             setup: axes.iter().map(|&(axis, _)| (axis, centroid)).collect(),

@@ -180,9 +180,9 @@ impl Campaign {
         for (k, test) in self.tests.iter().enumerate() {
             let describe = || {
                 format!(
-                    "campaign test {} ({:?} to λ {} at {} /s)",
+                    "campaign test {} ({} to λ {} at {} /s)",
                     k + 1,
-                    test.test,
+                    test.test.name(),
                     test.stretch,
                     test.rate_per_s
                 )

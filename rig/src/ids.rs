@@ -75,6 +75,19 @@ pub enum Channel {
     Centre(Axis),
 }
 
+/// As a program file names it: `x+`, `x.elongation`, `y.centre`.
+impl std::fmt::Display for Channel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Channel::Actuator(id) => f.write_str(&id.name().to_ascii_lowercase()),
+            Channel::Elongation(axis) => {
+                write!(f, "{}.elongation", axis.name().to_ascii_lowercase())
+            }
+            Channel::Centre(axis) => write!(f, "{}.centre", axis.name().to_ascii_lowercase()),
+        }
+    }
+}
+
 impl Channel {
     /// Parse "x+", "x-", "x.elongation", "y.centre" (case-insensitive).
     pub fn parse(text: &str) -> Option<Channel> {

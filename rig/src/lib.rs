@@ -10,6 +10,7 @@ pub mod config;
 pub mod control;
 pub mod hydraulics;
 pub mod ids;
+pub mod journal;
 pub mod limits;
 pub mod log;
 pub mod params;
@@ -18,6 +19,7 @@ pub mod process;
 pub mod program;
 pub mod refusal;
 pub mod rig;
+pub mod session;
 pub mod snapshot;
 pub mod specimen;
 

@@ -9,14 +9,15 @@ use crate::codes;
 use crate::config::RigConfig;
 use crate::control::{AxisControl, ControlMode};
 use crate::ids::{ActuatorId, Axis};
+use crate::journal::Journal;
 use crate::limits::LimitKind;
 use crate::program::{Program, StopTransition};
 use crate::rig::{Rig, RigCommand};
-use crate::snapshot::ProgramStatus;
+use crate::session::{PeriodEvent, Session};
 use iceoryx2::prelude::*;
-use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+use wire::files::RowFile;
 use wire::rig::{RigCommandKind, RigReply, RigState};
 
 type BoxError = Box<dyn std::error::Error + Send + Sync>;
@@ -66,6 +67,9 @@ pub struct ProcessOptions {
     pub duration_s: Option<f64>,
     /// Stop once the program has finished or stopped.
     pub exit_when_done: bool,
+    /// Folder of the resume journal (`rig.journal`): written as the rig runs, and followed by
+    /// a restarted rig of the same settings, which goes on where it was.
+    pub state_dir: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -98,7 +102,31 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
     if let Some(campaign) = &options.campaign {
         campaign.check_against(&options.config)?;
     }
+    let settings = settings_fingerprint(&options);
+    let mut session = Session::new(
+        &options.config,
+        options.seed,
+        options.program.as_ref(),
+        options.campaign.clone(),
+        publish_every,
+        log_every,
+    )?;
+    // Resume where a journal says an earlier rig of these settings had got to (before
+    // anything is published: the replay takes a fraction of a second).
+    let journal_path = options
+        .state_dir
+        .as_ref()
+        .map(|dir| dir.join(crate::journal::FILE_NAME));
+    if let Some(dir) = &options.state_dir {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    let resumed = match &journal_path {
+        Some(path) => resume(&mut session, path, settings)?,
+        None => None,
+    };
     let instance = wire::Instance::new(&options.instance)?;
+    let _owner = instance.claim("rig")?;
     let (node, removed) = instance.create_node("rig")?;
     if removed > 0 {
         eprintln!(
@@ -118,39 +146,46 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
         .create()
         .map_err(|e| format!("server {}: {e:?}", wire::services::RIG_COMMAND))?;
 
-    eprintln!("rig: ready (instance {})", instance.name());
-    let mut log = match &options.log_path {
-        Some(path) => {
-            let file =
-                std::fs::File::create(path).map_err(|e| format!("log {}: {e}", path.display()))?;
-            let mut w = std::io::BufWriter::new(file);
-            writeln!(w, "{}", crate::log::csv_header())?;
-            Some(w)
-        }
-        None => None,
-    };
-    let mut row = String::with_capacity(2048);
-
-    let mut campaign = options.campaign.clone();
-    // Index of the campaign test under way, published as `RigState::test_index`.
-    let mut test_index = 0u32;
-    let mut rig = Rig::new(options.config.clone(), options.seed)?;
     let mut summary = ProcessSummary::default();
-    if let Some(program) = &options.program {
-        rig.command(RigCommand::StartProgram(Box::new(program.clone())))
-            .map_err(|e| format!("program refused: {e}"))?;
-    }
+    // The log grows by whole rows; a resumed rig goes on after the rows its journal names.
+    let mut log = match (&options.log_path, &resumed) {
+        (Some(path), Some(journal)) => {
+            summary.rows_logged = journal.rows_logged;
+            Some(RowFile::resume(
+                path,
+                &crate::log::csv_header(),
+                journal.log_bytes,
+            )?)
+        }
+        (Some(path), None) => Some(RowFile::create(path, &crate::log::csv_header())?),
+        (None, _) => None,
+    };
+    eprintln!(
+        "rig: ready (instance {}){}",
+        instance.name(),
+        match &resumed {
+            Some(_) => format!(
+                "; resumed at t = {:.3} s, test {} of the campaign",
+                session.rig.state().t_s,
+                session.test_index + 1
+            ),
+            None => String::new(),
+        }
+    );
+    let mut rows = String::with_capacity(4096);
+    summary.samples_published = session.periods;
     let started = Instant::now();
-    let mut paced_from = (started, 0.0f64);
+    let mut paced_from = (started, session.rig.state().t_s);
     let mut last_flush = started;
     let mut was_max = false;
+    let mut stopped_by = None;
     loop {
         // Commands, between publication periods.
         while let Some(active) = server
             .receive()
             .map_err(|e| format!("rig/command receive: {e:?}"))?
         {
-            let reply = match handle(&mut rig, &active, &options) {
+            let reply = match handle(&mut session.rig, &active, &options) {
                 Ok(()) => {
                     summary.commands_accepted += 1;
                     RigReply::accepted()
@@ -166,100 +201,149 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
                 .map_err(|e| format!("rig/command reply: {e:?}"))?;
         }
 
-        if let Some(campaign) = campaign.as_mut() {
-            match campaign.advance(&mut rig) {
-                Ok(CampaignEvent::Started { index, test }) => {
-                    test_index = index as u32;
-                    eprintln!(
-                        "rig: campaign test {}/{}: {:?} to λ {} at {} /s, started at t = {:.1} s",
-                        index + 1,
-                        campaign.tests().len(),
-                        test.test,
-                        test.stretch,
-                        test.rate_per_s,
-                        rig.state().t_s
-                    )
-                }
-                Ok(CampaignEvent::Busy | CampaignEvent::Done) => {}
-                Err(refusal) => return Err(format!("campaign halted: {refusal}").into()),
-            }
-        }
-        for _ in 0..publish_every {
-            rig.step();
-            if let Some(w) = log.as_mut() {
-                if rig.state().step.is_multiple_of(log_every) {
-                    row.clear();
-                    crate::log::write_csv_row(rig.state(), &mut row);
-                    w.write_all(row.as_bytes())?;
-                    summary.rows_logged += 1;
-                }
-            }
+        let event = session.period(log.is_some().then_some(&mut rows))?;
+        if let PeriodEvent::TestStarted(CampaignEvent::Started { index, test }) = event {
+            eprintln!(
+                "rig: campaign test {}/{}: {} to λ {} at {} /s, started at t = {:.1} s",
+                index + 1,
+                session.campaign.as_ref().map_or(0, |c| c.tests().len()),
+                test.test.name(),
+                test.stretch,
+                test.rate_per_s,
+                session.rig.state().t_s
+            )
         }
         publisher.publish(RigState {
-            test_index,
-            ..to_wire(&rig, summary.samples_published)
+            test_index: session.test_index,
+            ..to_wire(&session.rig, summary.samples_published)
         })?;
         summary.samples_published += 1;
-        if let Some(w) = log.as_mut() {
-            if last_flush.elapsed() >= Duration::from_millis(50) {
-                w.flush()?;
-                last_flush = Instant::now();
+        let done = options.exit_when_done && session.done(options.program.is_some());
+        let ending = done
+            || options
+                .duration_s
+                .is_some_and(|d| session.rig.state().t_s >= d);
+        if last_flush.elapsed() >= Duration::from_millis(50) || ending {
+            // Whole rows, then the journal that names them.
+            if let Some(log) = log.as_mut() {
+                log.append(&rows)?;
+                summary.rows_logged += rows.matches('\n').count() as u64;
+                rows.clear();
             }
+            if let Some(path) = &journal_path {
+                let journal = session.journal(
+                    settings,
+                    summary.rows_logged,
+                    log.as_ref().map_or(0, RowFile::len_bytes),
+                    summary.commands_accepted,
+                );
+                wire::files::write_atomic(path, journal.to_text().as_bytes())?;
+            }
+            last_flush = Instant::now();
         }
-
-        let s = rig.state();
-        let program_active = matches!(s.program, ProgramStatus::Running | ProgramStatus::Held);
-        if options.duration_s.is_some_and(|d| s.t_s >= d) {
+        if ending {
             break;
         }
-        if options.exit_when_done {
-            let done = match &campaign {
-                Some(c) => c.is_done(&rig),
-                None => !program_active && options.program.is_some(),
-            };
-            if done {
-                break;
-            }
-        }
         // Pacing: the wall clock follows simulated time / factor.
+        let t_s = session.rig.state().t_s;
         let factor = match options.speed {
             Speed::Realtime => Some(1.0),
             Speed::Factor(f) => Some(f),
-            Speed::Max if program_active || campaign.as_ref().is_some_and(|c| !c.is_done(&rig)) => {
-                None
-            }
+            Speed::Max if session.program_active() || !session.done(true) => None,
             Speed::Max => Some(1.0),
         };
         match factor {
-            None => {
-                was_max = true;
-                // Check for termination requests every ~1000 periods without sleeping.
-                if summary.samples_published.is_multiple_of(1000)
-                    && node.wait(Duration::ZERO).is_err()
-                {
-                    break;
-                }
-            }
+            None => was_max = true,
             Some(f) => {
                 if was_max {
-                    paced_from = (Instant::now(), s.t_s);
+                    paced_from = (Instant::now(), t_s);
                     was_max = false;
                 }
-                let target = Duration::from_secs_f64(((s.t_s - paced_from.1) / f).max(0.0));
+                let target = Duration::from_secs_f64(((t_s - paced_from.1) / f).max(0.0));
                 let ahead = target.saturating_sub(paced_from.0.elapsed());
-                if node.wait(ahead).is_err() {
-                    break;
-                }
+                // Returns early on a signal; only a termination request stops the rig (a
+                // SIGCONT after SIGSTOP just goes on pacing).
+                let _ = node.wait(ahead);
             }
         }
+        if let Some(signal) = wire::signals::requested() {
+            stopped_by = Some(signal);
+            break;
+        }
     }
-    if let Some(w) = log.as_mut() {
-        w.flush()?;
+    if let Some(log) = log.as_mut() {
+        log.append(&rows)?;
+        summary.rows_logged += rows.matches('\n').count() as u64;
     }
-    summary.simulated_s = rig.state().t_s;
+    summary.simulated_s = session.rig.state().t_s;
     summary.wall_s = started.elapsed().as_secs_f64();
-    summary.limits_tripped = rig.state().limits_tripped;
+    summary.limits_tripped = session.rig.state().limits_tripped;
+    if let Some(signal) = stopped_by {
+        if options.exit_when_done && !session.done(options.program.is_some()) {
+            // Not "done": a supervisor must not read this stop as the end of the campaign.
+            return Err(format!(
+                "stopped by {} at t = {:.3} s, before the {} finished{}",
+                wire::signals::name(signal),
+                summary.simulated_s,
+                if session.campaign.is_some() {
+                    "campaign"
+                } else {
+                    "program"
+                },
+                match &journal_path {
+                    Some(path) => format!(" (a restart resumes from {})", path.display()),
+                    None => String::new(),
+                }
+            )
+            .into());
+        }
+    }
     Ok(summary)
+}
+
+/// The settings that make the simulation what it is, as a fingerprint (not the instance, the
+/// log's path, the pacing or the stop conditions).
+fn settings_fingerprint(options: &ProcessOptions) -> u64 {
+    crate::journal::fingerprint(&format!(
+        "{:?}|{}|{:?}|{:?}|{}|{}|{}|{}",
+        options.config,
+        options.seed,
+        options.program,
+        options.campaign,
+        options.test_rate_per_s,
+        options.test_stretch,
+        options.publish_hz,
+        options.log_hz
+    ))
+}
+
+/// Brings `session` to where the journal at `path` says (None: no journal, a fresh start).
+/// A journal that cannot be followed safely leaves the machine unloaded and stopped: the
+/// error asks for exit code [`wire::exit::CANNOT_RESUME`].
+fn resume(session: &mut Session, path: &Path, settings: u64) -> Result<Option<Journal>, BoxError> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(format!("cannot read {}: {e}", path.display()).into()),
+    };
+    let refuse = |why: String| -> BoxError {
+        Box::new(wire::exit::ExitWith {
+            code: wire::exit::CANNOT_RESUME,
+            message: format!(
+                "cannot resume from {}: {why}; the specimen is left unloaded and the rig stopped",
+                path.display()
+            ),
+        })
+    };
+    let journal = Journal::parse(&text).map_err(|e| refuse(format!("unreadable journal: {e}")))?;
+    if journal.settings != settings {
+        return Err(refuse(
+            "it was written by a rig with other settings (campaign, material, seed or rates)"
+                .into(),
+        ));
+    }
+    session.resume(&journal).map_err(refuse)?;
+    Ok(Some(journal))
 }
 
 /// A `wire::RigCommand` to a core command, refused with a reason when malformed or refused.
@@ -315,7 +399,12 @@ fn handle(
                 let mounted = rig.specimen().map(|s| s.config().loading);
                 if mounted != Some(test.specimen().loading) {
                     return Err(format!(
-                        "built-in test {test:?} needs its specimen; mounted: {mounted:?}"
+                        "built-in test {} needs its specimen; mounted: {}",
+                        test.name(),
+                        match mounted {
+                            Some(loading) => format!("a {} specimen", loading.name()),
+                            None => "none".into(),
+                        }
                     ));
                 }
                 test.program(options.test_rate_per_s, options.test_stretch)?

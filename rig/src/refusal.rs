@@ -43,11 +43,13 @@ impl fmt::Display for Refusal {
             } => {
                 write!(
                     f,
-                    "{what} {value} on {channel:?} is beyond the limit {limit}"
+                    "{what} {} on {channel} is beyond the limit {}",
+                    number(*value),
+                    number(*limit)
                 )
             }
             Refusal::ChannelInactive { channel } => {
-                write!(f, "{channel:?} is not driven in the present control mode")
+                write!(f, "{channel} is not driven in the present control mode")
             }
             Refusal::HydraulicsOff => write!(f, "hydraulics are off"),
             Refusal::EmergencyStopLatched => {
@@ -67,3 +69,14 @@ impl fmt::Display for Refusal {
 }
 
 impl std::error::Error for Refusal {}
+
+/// A number as a person reads it: plain when moderate, in exponent form when huge or tiny
+/// (1e300, not three hundred digits).
+pub fn number(value: f64) -> String {
+    let magnitude = value.abs();
+    if value == 0.0 || (1e-4..1e7).contains(&magnitude) {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
+    }
+}

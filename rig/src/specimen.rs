@@ -32,6 +32,18 @@ pub enum Loading {
     Equibiaxial,
 }
 
+impl Loading {
+    /// `uniaxial along x`, `equibiaxial`.
+    pub fn name(self) -> String {
+        match self {
+            Loading::Uniaxial(axis) => {
+                format!("uniaxial (along {})", axis.name().to_ascii_lowercase())
+            }
+            Loading::Equibiaxial => "equibiaxial".into(),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpecimenGeometry {
     pub gauge_length_mm: f64,

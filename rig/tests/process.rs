@@ -39,6 +39,7 @@ fn state_is_published_and_commands_are_answered() {
         log_hz: 100.0,
         duration_s: Some(15.0),
         exit_when_done: false,
+        state_dir: None,
     };
     let rig_thread = std::thread::spawn(move || run(options).unwrap());
 

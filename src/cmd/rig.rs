@@ -56,6 +56,11 @@ pub struct RigArgs {
     /// Stop once the started program has finished (or was stopped).
     #[arg(long)]
     pub exit_when_done: bool,
+    /// Folder of the resume journal: a rig restarted with the same settings and folder goes
+    /// on where it was (same time, test and position; its --log continued), or refuses to
+    /// start (exit code 75) if it cannot do so exactly. Created if missing.
+    #[arg(long)]
+    pub state_dir: Option<PathBuf>,
 }
 
 pub fn run(args: RigArgs) -> anyhow::Result<()> {
@@ -131,8 +136,9 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         log_hz: args.log_hz,
         duration_s: args.duration_s,
         exit_when_done: args.exit_when_done,
+        state_dir: args.state_dir.clone(),
     };
-    let summary = run_process(options).map_err(|e| anyhow::anyhow!("rig process: {e}"))?;
+    let summary = run_process(options).map_err(|e| wire::exit::in_context("rig process", &*e))?;
     eprintln!(
         "rig: {:.1} s simulated in {:.1} s wall ({:.0}x), {} samples published, {} log rows, \
          commands {} accepted / {} refused, limits tripped {:#x}",

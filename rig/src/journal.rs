@@ -1,0 +1,154 @@
+//! The rig's resume journal: where a run of the rig had got to, so that a restarted rig goes
+//! on with the same test instead of starting the campaign over. The simulation is
+//! deterministic (seeded noise, simulated time), so the journal holds a position, not a state:
+//! how many publication periods were run, and what the machine looked like then (time, step,
+//! actuator positions, bit for bit) to check that a replay of as many periods reached the very
+//! same state. It also says how much of the log (`rig.csv`) was written whole, and carries a
+//! fingerprint of the settings (a folder written with other settings is refused), and the
+//! count of commands accepted over `rig/command` (those are not replayed: a rig that took
+//! commands cannot resume). Pure: text in, text out; the shell writes it atomically.
+
+use crate::snapshot::RigSnapshot;
+
+/// Where the rig had got to.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Journal {
+    /// Fingerprint of the settings that make the simulation what it is.
+    pub settings: u64,
+    /// Publication periods run (also the next `rig/state` sample id).
+    pub periods: u64,
+    /// Control steps run.
+    pub step: u64,
+    pub t_s: f64,
+    /// Actuator positions (mm), compared bit for bit after a replay.
+    pub positions_mm: Vec<f64>,
+    /// Rows in the log and its length in bytes, all whole.
+    pub rows_logged: u64,
+    pub log_bytes: u64,
+    /// Commands accepted over `rig/command` so far.
+    pub commands_accepted: u64,
+}
+
+/// The journal's file name in a state folder.
+pub const FILE_NAME: &str = "rig.journal";
+
+impl Journal {
+    /// The positions of `snapshot` as the journal keeps them.
+    pub fn positions_of(snapshot: &RigSnapshot) -> Vec<f64> {
+        snapshot.actuators.iter().map(|a| a.position_mm).collect()
+    }
+
+    pub fn to_text(&self) -> String {
+        let bits = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{:016x}", x.to_bits()))
+                .collect::<Vec<_>>()
+                .join(",")
+        };
+        format!(
+            "# dicstream rig resume journal\nsettings = {:016x}\nperiods = {}\nstep = {}\n\
+             t_s_bits = {:016x}\npositions_mm_bits = {}\nrows_logged = {}\nlog_bytes = {}\n\
+             commands_accepted = {}\n",
+            self.settings,
+            self.periods,
+            self.step,
+            self.t_s.to_bits(),
+            bits(&self.positions_mm),
+            self.rows_logged,
+            self.log_bytes,
+            self.commands_accepted
+        )
+    }
+
+    pub fn parse(text: &str) -> Result<Journal, String> {
+        let value = |key: &str| -> Result<&str, String> {
+            text.lines()
+                .filter_map(|l| l.split_once('='))
+                .find(|(k, _)| k.trim() == key)
+                .map(|(_, v)| v.trim())
+                .ok_or_else(|| format!("no {key}"))
+        };
+        let int = |v: &str, key: &str| {
+            v.parse::<u64>()
+                .map_err(|_| format!("{key} = {v:?} is not a count"))
+        };
+        let hex = |v: &str, key: &str| {
+            u64::from_str_radix(v, 16).map_err(|_| format!("{key} = {v:?} is not hexadecimal"))
+        };
+        let positions = value("positions_mm_bits")?
+            .split(',')
+            .filter(|s| !s.is_empty())
+            .map(|s| hex(s, "positions_mm_bits").map(f64::from_bits))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Journal {
+            settings: hex(value("settings")?, "settings")?,
+            periods: int(value("periods")?, "periods")?,
+            step: int(value("step")?, "step")?,
+            t_s: f64::from_bits(hex(value("t_s_bits")?, "t_s_bits")?),
+            positions_mm: positions,
+            rows_logged: int(value("rows_logged")?, "rows_logged")?,
+            log_bytes: int(value("log_bytes")?, "log_bytes")?,
+            commands_accepted: int(value("commands_accepted")?, "commands_accepted")?,
+        })
+    }
+
+    /// Why a replay that reached `snapshot` after `self.periods` periods is not where the
+    /// journal says the rig was (None: it is, bit for bit).
+    pub fn mismatch(&self, snapshot: &RigSnapshot) -> Option<String> {
+        if snapshot.step != self.step || snapshot.t_s.to_bits() != self.t_s.to_bits() {
+            return Some(format!(
+                "the replay reached step {} (t = {} s), the journal says step {} (t = {} s)",
+                snapshot.step, snapshot.t_s, self.step, self.t_s
+            ));
+        }
+        let replayed = Journal::positions_of(snapshot);
+        if replayed.len() != self.positions_mm.len()
+            || replayed
+                .iter()
+                .zip(&self.positions_mm)
+                .any(|(a, b)| a.to_bits() != b.to_bits())
+        {
+            return Some(format!(
+                "the replay's actuator positions {replayed:?} mm differ from the journal's {:?} mm",
+                self.positions_mm
+            ));
+        }
+        None
+    }
+}
+
+/// A fingerprint of settings given as text (their debug form): FNV-1a, stable across runs
+/// and builds.
+pub fn fingerprint(settings: &str) -> u64 {
+    settings.bytes().fold(0xcbf29ce484222325u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x100000001b3)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_journal_reads_back_bit_for_bit() {
+        let journal = Journal {
+            settings: fingerprint("a"),
+            periods: 1234,
+            step: 12340,
+            t_s: 2.468,
+            positions_mm: vec![0.1 + 0.2, -1e-300, 3.0, f64::MIN_POSITIVE],
+            rows_logged: 50,
+            log_bytes: 12345,
+            commands_accepted: 0,
+        };
+        let back = Journal::parse(&journal.to_text()).unwrap();
+        assert_eq!(back, journal);
+        assert_ne!(fingerprint("a"), fingerprint("b"));
+        assert!(Journal::parse("periods = x").is_err());
+        assert!(
+            Journal::parse(&journal.to_text().replace("step = 12340\n", ""))
+                .unwrap_err()
+                .contains("no step")
+        );
+    }
+}
