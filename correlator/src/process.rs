@@ -23,7 +23,6 @@ use crate::state::{ReferenceIds, SavedReference, StateDir, REFERENCE_FROM_FILE};
 use crate::{Correlator, Field, NodeStatus};
 use hdrhistogram::Histogram;
 use iceoryx2::prelude::*;
-use iceoryx2::waitset::WaitSetRunResult;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use wire::pubsub::{SlicePublisher, SliceSubscriber};
@@ -76,19 +75,19 @@ impl ProcessConfig {
 /// Why the process stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum StopReason {
-    /// SIGINT or SIGTERM.
+    /// SIGINT, SIGTERM or SIGHUP (the signal number).
+    Signal(i32),
     #[default]
-    Signal,
     MaxFrames,
     IdleTimeout,
 }
 
 impl StopReason {
-    pub fn describe(self) -> &'static str {
+    pub fn describe(self) -> String {
         match self {
-            StopReason::Signal => "SIGINT/SIGTERM",
-            StopReason::MaxFrames => "--max-frames reached",
-            StopReason::IdleTimeout => "idle timeout",
+            StopReason::Signal(signal) => wire::signals::name(signal),
+            StopReason::MaxFrames => "--max-frames reached".into(),
+            StopReason::IdleTimeout => "idle timeout".into(),
         }
     }
 }
@@ -158,6 +157,7 @@ const REJECT_LOG_BURST: u64 = 5;
 pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
     config.settings.validate()?;
     let instance = Instance::new(&config.instance)?;
+    let _owner = instance.claim("correlator")?;
     let mut state = match &config.state_dir {
         Some(dir) => Some(StateDir::open(dir)?),
         None => None,
@@ -175,7 +175,7 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
     }
     let frames: SliceSubscriber<u16, FrameHeader> =
         SliceSubscriber::create(&node, &services::FRAMES)?;
-    let waitset = WaitSetBuilder::new().create::<ipc::Service>()?;
+    let waitset = wire::signals::waitset()?;
     let frames_guard = waitset.attach_notification(frames.listener())?;
 
     let mut live = Live::new(&config);
@@ -235,7 +235,8 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
         if let Some(idle) = config.idle_timeout {
             timeout = timeout.min(idle.saturating_sub(last_activity.elapsed()));
         }
-        let result = waitset.wait_and_process_once_with_timeout(
+        // An early wake-up (a signal, SIGCONT after SIGSTOP) only ends the wait.
+        waitset.wait_and_process_once_with_timeout(
             |id| {
                 if id.has_event_from(&frames_guard) {
                     frames.clear_events();
@@ -245,11 +246,8 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
             timeout,
         )?;
         live.summary.wakeups += 1;
-        if matches!(
-            result,
-            WaitSetRunResult::Interrupt | WaitSetRunResult::TerminationRequest
-        ) {
-            live.summary.stop = StopReason::Signal;
+        if let Some(signal) = wire::signals::requested() {
+            live.summary.stop = StopReason::Signal(signal);
             break;
         }
         // Drain: keep only the newest sample, release the others at once.

@@ -36,7 +36,6 @@ pub use origin::ORIGIN_FILE;
 use crate::settings::{CorrelatorSettings, GuessMode, ReferenceMode, SettingsError, StrainMeasure};
 use crate::Correlator;
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"DICSREF1";
@@ -52,10 +51,21 @@ pub const REFERENCE_FROM_FILE: u64 = u64::MAX;
 /// Why a state folder could not be used.
 #[derive(Debug)]
 pub enum StateError {
-    Io { path: PathBuf, detail: String },
-    Corrupt { path: PathBuf, detail: String },
-    Mismatch { path: PathBuf, detail: String },
+    Io {
+        path: PathBuf,
+        detail: String,
+    },
+    Corrupt {
+        path: PathBuf,
+        detail: String,
+    },
+    Mismatch {
+        path: PathBuf,
+        detail: String,
+    },
     Settings(SettingsError),
+    /// A state file could not be written (a full disk, say).
+    Write(wire::files::FileError),
 }
 
 impl std::fmt::Display for StateError {
@@ -73,11 +83,19 @@ impl std::fmt::Display for StateError {
                 path.display()
             ),
             StateError::Settings(e) => write!(f, "saved reference refused: {e}"),
+            StateError::Write(e) => write!(f, "{e}"),
         }
     }
 }
 
-impl std::error::Error for StateError {}
+impl std::error::Error for StateError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            StateError::Write(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
 /// The settings and size a state file was written for, as stored in its header.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -298,15 +316,15 @@ impl SavedReference {
 pub struct StateDir {
     dir: PathBuf,
     path: PathBuf,
-    temp: PathBuf,
-    summary_path: PathBuf,
-    summary_temp: PathBuf,
+    /// The same paths, written atomically (temporary siblings named once).
+    file: wire::files::AtomicFile,
+    summary_file: wire::files::AtomicFile,
+    origin_file: wire::files::AtomicFile,
     /// Reused encoding buffers (sized on the first save).
     bytes: Vec<u8>,
     summary: String,
     pub saves: u64,
     origin_path: PathBuf,
-    origin_temp: PathBuf,
     origin_bytes: Vec<u8>,
     /// `Correlator::origin_generation` of the origin last written.
     saved_origin: Option<u64>,
@@ -319,18 +337,16 @@ impl StateDir {
             path: dir.to_path_buf(),
             detail: format!("cannot create the state folder: {e}"),
         })?;
-        let pid = std::process::id();
         Ok(StateDir {
             dir: dir.to_path_buf(),
             path: dir.join(STATE_FILE),
-            temp: dir.join(format!(".{STATE_FILE}.tmp{pid}")),
-            summary_path: dir.join(SUMMARY_FILE),
-            summary_temp: dir.join(format!(".{SUMMARY_FILE}.tmp{pid}")),
+            file: wire::files::AtomicFile::new(&dir.join(STATE_FILE)),
+            summary_file: wire::files::AtomicFile::new(&dir.join(SUMMARY_FILE)),
+            origin_file: wire::files::AtomicFile::new(&dir.join(ORIGIN_FILE)),
             bytes: Vec::new(),
             summary: String::with_capacity(4096),
             saves: 0,
             origin_path: dir.join(ORIGIN_FILE),
-            origin_temp: dir.join(format!(".{ORIGIN_FILE}.tmp{pid}")),
             origin_bytes: Vec::new(),
             saved_origin: None,
         })
@@ -391,7 +407,7 @@ impl StateDir {
                     origin,
                     &mut self.origin_bytes,
                 );
-                write_atomically(&self.origin_temp, &self.origin_path, &self.origin_bytes)?;
+                self.origin_file.write(&self.origin_bytes).map_err(StateError::Write)?;
                 self.saved_origin = Some(generation);
             }
         }
@@ -402,7 +418,7 @@ impl StateDir {
             correlator.reference_base_px(),
             &mut self.bytes,
         );
-        write_atomically(&self.temp, &self.path, &self.bytes)?;
+        self.file.write(&self.bytes).map_err(StateError::Write)?;
         self.summary.clear();
         summary_json(
             &layout,
@@ -410,11 +426,9 @@ impl StateDir {
             self.saves + 1,
             &mut self.summary,
         );
-        write_atomically(
-            &self.summary_temp,
-            &self.summary_path,
-            self.summary.as_bytes(),
-        )?;
+        self.summary_file
+            .write(self.summary.as_bytes())
+            .map_err(StateError::Write)?;
         self.saves += 1;
         Ok(())
     }
@@ -432,16 +446,6 @@ fn read_if_present(path: &Path) -> Result<Option<Vec<u8>>, StateError> {
     }
 }
 
-fn write_atomically(temp: &Path, path: &Path, bytes: &[u8]) -> Result<(), StateError> {
-    let io = |what: &str, e: std::io::Error| StateError::Io {
-        path: path.to_path_buf(),
-        detail: format!("cannot {what}: {e}"),
-    };
-    let mut file = std::fs::File::create(temp).map_err(|e| io("create the temporary file", e))?;
-    file.write_all(bytes).map_err(|e| io("write", e))?;
-    drop(file);
-    std::fs::rename(temp, path).map_err(|e| io("rename the temporary file", e))
-}
 
 fn put_u32(out: &mut Vec<u8>, v: u32) {
     out.extend_from_slice(&v.to_le_bytes());

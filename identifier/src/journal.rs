@@ -6,8 +6,8 @@
 //! one of `uniaxial`, `equibiaxial`, `pure_shear`.
 
 use crate::data::LoadCase;
-use std::io::{BufRead, Write};
-use std::path::{Path, PathBuf};
+use std::io::BufRead;
+use std::path::Path;
 
 pub const HEADER: &str = "case,stretch,nominal_stress_mpa,frame_id";
 
@@ -77,32 +77,21 @@ fn parse_row(row: &str) -> Option<JournalPoint> {
     })
 }
 
-/// Appends points to a journal, flushing each one.
+/// Appends points to a journal, each row whole ([`wire::files::RowFile`]: a row a full disk
+/// tore is cut back off, and a torn last row left by a kill is cut before appending).
 pub struct JournalWriter {
-    path: PathBuf,
-    file: std::fs::File,
+    rows: wire::files::RowFile,
 }
 
 impl JournalWriter {
     /// Opens `path` for appending, writing the header if the file is new or empty.
-    pub fn open(path: &Path) -> Result<JournalWriter, String> {
-        let error = |e: std::io::Error| format!("journal {}: {e}", path.display());
-        let mut file = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .map_err(error)?;
-        if file.metadata().map_err(error)?.len() == 0 {
-            writeln!(file, "{HEADER}").map_err(error)?;
-        }
+    pub fn open(path: &Path) -> Result<JournalWriter, wire::files::FileError> {
         Ok(JournalWriter {
-            path: path.to_path_buf(),
-            file,
+            rows: wire::files::RowFile::append_to(path, HEADER)?,
         })
     }
 
-    pub fn append(&mut self, point: &JournalPoint) -> Result<(), String> {
-        // One write call per line: a kill leaves at most one torn last line.
+    pub fn append(&mut self, point: &JournalPoint) -> Result<(), wire::files::FileError> {
         let line = format!(
             "{},{},{},{}\n",
             point.case.name(),
@@ -110,9 +99,7 @@ impl JournalWriter {
             point.nominal_stress_mpa,
             point.frame_id
         );
-        self.file
-            .write_all(line.as_bytes())
-            .map_err(|e| format!("journal {}: {e}", self.path.display()))
+        self.rows.append(&line)
     }
 }
 

@@ -94,73 +94,87 @@ pub fn chart(
     }
     let pad = 0.05 * (y1 - y0).max(1e-9);
     let text = text_available();
-    let root = BitMapBackend::new(path, SIZE_PX).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut builder = ChartBuilder::on(&root);
-    builder.margin(20);
-    if text {
-        builder
-            .caption(title, ("sans-serif", 24))
-            .x_label_area_size(45)
-            .y_label_area_size(70);
-    }
-    let mut chart = builder
-        .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
-        .map_err(|e| err(&e))?;
-    if text {
-        chart
-            .configure_mesh()
-            .x_desc(x_desc)
-            .y_desc(y_desc)
-            .draw()
-            .map_err(|e| err(&e))?;
-    } else {
-        let area = chart.plotting_area();
-        area.draw(&Rectangle::new(
-            [(x0, y0 - pad), (x1, y1 + pad)],
-            BLACK.stroke_width(1),
-        ))
-        .map_err(|e| err(&e))?;
-    }
-    for (k, s) in series.iter().enumerate() {
-        let color = if s.markers {
-            BLACK
-        } else {
-            PALETTE[k % PALETTE.len()]
-        };
-        let pts: Vec<(f64, f64)> = s
-            .points
-            .iter()
-            .copied()
-            .filter(|p| p.0.is_finite() && p.1.is_finite())
-            .collect();
-        let drawn = if s.markers {
-            chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))
-                .map_err(|e| err(&e))?
-        } else {
-            chart
-                .draw_series(LineSeries::new(pts, color.stroke_width(2)))
-                .map_err(|e| err(&e))?
-        };
+    // Drawn in memory, then encoded and written atomically: a full disk leaves no partial or
+    // empty PNG.
+    let mut rgb = vec![0u8; SIZE_PX.0 as usize * SIZE_PX.1 as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, SIZE_PX).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(&e))?;
+        let mut builder = ChartBuilder::on(&root);
+        builder.margin(20);
         if text {
-            drawn.label(s.label.clone()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
-            });
+            builder
+                .caption(title, ("sans-serif", 24))
+                .x_label_area_size(45)
+                .y_label_area_size(70);
         }
-    }
-    if text {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 16))
-            .draw()
+        let mut chart = builder
+            .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
             .map_err(|e| err(&e))?;
+        if text {
+            chart
+                .configure_mesh()
+                .x_desc(x_desc)
+                .y_desc(y_desc)
+                .draw()
+                .map_err(|e| err(&e))?;
+        } else {
+            let area = chart.plotting_area();
+            area.draw(&Rectangle::new(
+                [(x0, y0 - pad), (x1, y1 + pad)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(|e| err(&e))?;
+        }
+        for (k, s) in series.iter().enumerate() {
+            let color = if s.markers {
+                BLACK
+            } else {
+                PALETTE[k % PALETTE.len()]
+            };
+            let pts: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .copied()
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+                .collect();
+            let drawn = if s.markers {
+                chart
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                    .map_err(|e| err(&e))?
+            } else {
+                chart
+                    .draw_series(LineSeries::new(pts, color.stroke_width(2)))
+                    .map_err(|e| err(&e))?
+            };
+            if text {
+                drawn.label(s.label.clone()).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+                });
+            }
+        }
+        if text {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 16))
+                .draw()
+                .map_err(|e| err(&e))?;
+        }
+        root.present().map_err(|e| err(&e))?;
     }
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
+    let mut png = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut png),
+        &rgb,
+        SIZE_PX.0,
+        SIZE_PX.1,
+        image::ExtendedColorType::Rgb8,
+    )
+    .map_err(|e| PlotError(format!("{}: cannot encode the PNG: {e}", path.display())))?;
+    wire::files::write_atomic(path, &png).map_err(|e| PlotError(e.to_string()))
 }
 
 fn sample(from: f64, to: f64) -> impl Iterator<Item = f64> {

@@ -6,7 +6,6 @@ use crate::models::Model;
 use crate::online::{FieldOutcome, FieldSample, OnlineConfig, OnlineIdentifier, RigSample};
 use crate::report::{fit_json, write_atomically};
 use iceoryx2::prelude::*;
-use iceoryx2::waitset::WaitSetRunResult;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use wire::identification::{RankedModel, MAX_COEFFICIENTS, MAX_RANKED};
@@ -125,6 +124,7 @@ pub fn build_report(
 /// Runs the process until a termination signal, `max_fields`, or the idle timeout.
 pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
     let instance = Instance::new(&config.instance)?;
+    let _owner = instance.claim("identifier")?;
     let (node, cleaned) = instance.create_node("identifier")?;
     if cleaned > 0 {
         eprintln!(
@@ -137,7 +137,7 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
     let rig: ValueSubscriber<RigState> = ValueSubscriber::create(&node, &services::RIG_STATE)?;
     let publisher: ValuePublisher<IdentificationReport> =
         ValuePublisher::create(&node, &services::IDENTIFICATION)?;
-    let waitset = WaitSetBuilder::new().create::<ipc::Service>()?;
+    let waitset = wire::signals::waitset()?;
     eprintln!("identifier: ready (instance {})", instance.name());
     let fields_guard = waitset.attach_notification(fields.listener())?;
     let rig_guard = waitset.attach_notification(rig.listener())?;
@@ -169,7 +169,7 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
     loop {
         let mut stop = false;
         let mut accepted_any = false;
-        let result = waitset.wait_and_process_once_with_timeout(
+        waitset.wait_and_process_once_with_timeout(
             |id| {
                 let mut step = || -> Result<(), BoxError> {
                     if id.has_event_from(&rig_guard) {
@@ -196,7 +196,7 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
                                 })?;
                             }
                         }
-                        Ok::<(), String>(())
+                        Ok::<(), wire::files::FileError>(())
                     };
                     while let Some(state) = rig.receive()? {
                         summary.rig_samples_received += 1;
@@ -224,9 +224,9 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
         if let Some(e) = failure.take() {
             return Err(e);
         }
-        match result {
-            WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt => stop = true,
-            _ => {}
+        // An early wake-up (a signal, SIGCONT after SIGSTOP) is not a request to stop.
+        if wire::signals::requested().is_some() {
+            stop = true;
         }
         if accepted_any {
             last_activity = Instant::now();

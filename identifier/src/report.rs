@@ -51,16 +51,6 @@ pub fn fit_json(fit: &Fit) -> Value {
 
 /// Writes `text` to `path` atomically (temporary file in the same folder, then rename). The
 /// error names the path.
-pub fn write_atomically(path: &std::path::Path, text: &str) -> std::io::Result<()> {
-    let named = |e: std::io::Error| {
-        std::io::Error::new(e.kind(), format!("cannot write {}: {e}", path.display()))
-    };
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = std::path::PathBuf::from(tmp);
-    std::fs::write(&tmp, text).map_err(named)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        named(e)
-    })
+pub fn write_atomically(path: &std::path::Path, text: &str) -> Result<(), wire::files::FileError> {
+    wire::files::write_atomic(path, text.as_bytes())
 }

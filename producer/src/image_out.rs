@@ -37,20 +37,17 @@ impl ImageFormatOut {
 
 /// Writes `bytes` to `path` atomically (temporary sibling, then rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ProducerError> {
-    let io = |reason| ProducerError::Io {
-        path: path.to_path_buf(),
-        reason,
-    };
-    let name = path.file_name().and_then(|n| n.to_str()).ok_or_else(|| {
-        ProducerError::InvalidParameter {
+    if path.file_name().is_none() {
+        return Err(ProducerError::InvalidParameter {
             name: "output path".to_owned(),
             value: path.display().to_string(),
             expected: "a file path".to_owned(),
-        }
-    })?;
-    let temp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
-    std::fs::write(&temp, bytes).map_err(io)?;
-    std::fs::rename(&temp, path).map_err(io)
+        });
+    }
+    wire::files::write_atomic(path, bytes).map_err(|e| ProducerError::Io {
+        path: e.path,
+        reason: e.source,
+    })
 }
 
 /// Encodes a `width` x `height` frame of `bit_depth` bits in `format` and writes it atomically.

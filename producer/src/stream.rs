@@ -9,11 +9,13 @@
 
 use crate::{FrameDims, FrameInfo, FrameSource, NextMotion, ProducerError, RigCamera};
 use iceoryx2::prelude::*;
-use iceoryx2::waitset::WaitSetRunResult;
 use std::time::{Duration, Instant};
 use wire::frame::pixel_checksum;
 use wire::pubsub::{SlicePublisher, ValueSubscriber};
 use wire::{services, FrameHeader, GroundTruth, Instance, InstanceError, RigState};
+
+/// Longest sleep while waiting for the first rig sample (a signal is seen within it).
+const RIG_WAIT_SLICE: Duration = Duration::from_millis(200);
 
 /// How to stream.
 #[derive(Debug, Clone)]
@@ -43,7 +45,7 @@ pub struct StreamReport {
     pub rig_samples_received: u64,
     /// The rig sample of the last frame sent (following the rig only).
     pub last_rig_sample_id: Option<u64>,
-    /// True when a termination signal (SIGINT, SIGTERM) ended the stream.
+    /// True when a termination signal (SIGINT, SIGTERM, SIGHUP) ended the stream.
     pub interrupted: bool,
 }
 
@@ -128,6 +130,8 @@ pub fn check_shm_for_frames(width_px: u32, height_px: u32) -> Result<(), Instanc
 
 /// The part both loops share: node, publisher, pacing, header stamping, the report.
 struct Shell {
+    /// The camera's claim on the instance (one producer per instance).
+    _owner: wire::owner::Owner,
     node: Node<ipc::Service>,
     publisher: SlicePublisher<u16, FrameHeader>,
     dims: FrameDims,
@@ -150,6 +154,7 @@ impl Shell {
         on_event: &mut dyn FnMut(StreamEvent),
     ) -> Result<Shell, StreamError> {
         check_shm_for_frames(dims.width, dims.height)?;
+        let owner = instance.claim("producer")?;
         let (node, dead_nodes_cleaned) = instance.create_node("producer")?;
         let publisher = SlicePublisher::create(&node, &services::FRAMES, dims.len_px())?;
         on_event(StreamEvent::Ready {
@@ -157,6 +162,7 @@ impl Shell {
             dead_nodes_cleaned,
         });
         Ok(Shell {
+            _owner: owner,
             node,
             publisher,
             dims,
@@ -183,19 +189,25 @@ impl Shell {
         self.slots = 0;
     }
 
-    /// Sleeps until the next frame slot is due (`node.wait` returns early on a signal; a late
-    /// slot only checks for one). False when a termination signal arrived.
+    /// Sleeps until the next frame slot is due (`node.wait` returns early on a signal, and a
+    /// wake-up that is not a termination request sleeps again). False when a termination signal
+    /// arrived.
     fn wait_for_slot(&mut self) -> bool {
-        let pause = match self.period {
-            Some(period) => {
-                let due = self.start + period.mul_f64(self.slots as f64);
-                due.saturating_duration_since(Instant::now())
+        let due = self
+            .period
+            .map(|period| self.start + period.mul_f64(self.slots as f64));
+        loop {
+            if wire::signals::requested().is_some() {
+                self.report.interrupted = true;
+                return false;
             }
-            None => Duration::ZERO,
-        };
-        if self.node.wait(pause).is_err() {
-            self.report.interrupted = true;
-            return false;
+            let pause = due.map_or(Duration::ZERO, |due| {
+                due.saturating_duration_since(Instant::now())
+            });
+            if pause.is_zero() {
+                break;
+            }
+            let _ = self.node.wait(pause);
         }
         self.slots += 1;
         true
@@ -306,23 +318,21 @@ pub fn stream_following_rig(
     drain(camera, &mut shell.report)?;
     if camera.follower().latest().is_none() {
         on_event(StreamEvent::WaitingForRig);
-        let waitset = WaitSetBuilder::new()
-            .create::<ipc::Service>()
-            .map_err(|e| wait_error(&e))?;
+        let waitset = wire::signals::waitset().map_err(|e| wait_error(&e))?;
         let _guard = waitset
             .attach_notification(rig.listener())
             .map_err(|e| wait_error(&e))?;
         while camera.follower().latest().is_none() {
-            // Wakes on a rig/state event or a signal; the callback only notes the wake-up.
-            let result = waitset
-                .wait_and_process_once(|_| CallbackProgression::Continue)
+            // Wakes on a rig/state event or a signal (bounded, so a signal that lands just
+            // before the wait is seen too); the callback only notes the wake-up.
+            waitset
+                .wait_and_process_once_with_timeout(
+                    |_| CallbackProgression::Continue,
+                    RIG_WAIT_SLICE,
+                )
                 .map_err(|e| wait_error(&e))?;
             drain(camera, &mut shell.report)?;
-            if matches!(
-                result,
-                WaitSetRunResult::Interrupt | WaitSetRunResult::TerminationRequest
-            ) && camera.follower().latest().is_none()
-            {
+            if wire::signals::requested().is_some() && camera.follower().latest().is_none() {
                 shell.report.interrupted = true;
                 return Ok(shell.finish());
             }

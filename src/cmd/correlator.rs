@@ -66,7 +66,8 @@ pub fn run(args: CorrelatorArgs) -> Result<()> {
         idle_timeout,
         ..ProcessConfig::new(&args.instance, settings)
     };
-    let summary = run_process(config).map_err(|e| anyhow::anyhow!("correlator process: {e}"))?;
+    let summary =
+        run_process(config).map_err(|e| wire::exit::in_context("correlator process", &*e))?;
     eprintln!("{}", summary.final_line());
     Ok(())
 }

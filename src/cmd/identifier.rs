@@ -65,7 +65,8 @@ pub fn run(args: IdentifierArgs) -> anyhow::Result<()> {
             ..OnlineConfig::default()
         },
     };
-    let summary = run_process(config).map_err(|e| anyhow::anyhow!("identifier process: {e}"))?;
+    let summary =
+        run_process(config).map_err(|e| wire::exit::in_context("identifier process", &*e))?;
     eprintln!(
         "identifier: {} fields, {} rig samples, {} reports; points uniaxial/equibiaxial/pure shear = {:?}; best {}; wrote {}",
         summary.fields_received,

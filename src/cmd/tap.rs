@@ -15,7 +15,6 @@ use anyhow::Context;
 use hdrhistogram::Histogram;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
-use iceoryx2::waitset::WaitSetRunResult;
 use serde_json::{json, Value};
 use wire::frame::pixel_checksum;
 use wire::pubsub::{SliceSubscriber, ValueSubscriber};
@@ -614,9 +613,8 @@ pub fn run(args: TapArgs) -> anyhow::Result<()> {
         );
     }
     let tap = Tap::open(&node, kind)?;
-    let waitset = WaitSetBuilder::new()
-        .create::<ipc::Service>()
-        .map_err(|e| anyhow::anyhow!("creating the WaitSet: {e:?}"))?;
+    let waitset =
+        wire::signals::waitset().map_err(|e| anyhow::anyhow!("creating the WaitSet: {e:?}"))?;
     let sample_guard = waitset
         .attach_notification(tap.listener())
         .map_err(|e| anyhow::anyhow!("attaching {} to the WaitSet: {e:?}", kind.name()))?;
@@ -660,7 +658,7 @@ pub fn run(args: TapArgs) -> anyhow::Result<()> {
             None => Duration::MAX,
         };
         let (mut sample_ready, mut tick) = (false, false);
-        let result = waitset
+        waitset
             .wait_and_process_once_with_timeout(
                 |id| {
                     sample_ready |= id.has_event_from(&sample_guard);
@@ -678,10 +676,8 @@ pub fn run(args: TapArgs) -> anyhow::Result<()> {
         if tick {
             print_window(&mut stats, &mut window_started);
         }
-        if matches!(
-            result,
-            WaitSetRunResult::Interrupt | WaitSetRunResult::TerminationRequest
-        ) {
+        // The 1 s tick bounds the wait, so a request is seen within a second.
+        if wire::signals::requested().is_some() {
             break "signal";
         }
     };
