@@ -37,26 +37,53 @@ enum Command {
     Tap(cmd::tap::TapArgs),
 }
 
+/// The termination signals are handled from the moment the program is loaded, before the
+/// Rust runtime and `main` (a signal in the first millisecond is then a request to stop).
+#[used]
+#[link_section = ".init_array"]
+static INSTALL_SIGNAL_HANDLERS_AT_LOAD: extern "C" fn() = {
+    extern "C" fn install() {
+        // `main` installs them again and reports an error.
+        let _ = wire::signals::install();
+    }
+    install
+};
+
+/// A subcommand that succeeds or fails (exit code 0, or one chosen by its error).
+fn ok(result: anyhow::Result<()>) -> anyhow::Result<std::process::ExitCode> {
+    result.map(|()| std::process::ExitCode::SUCCESS)
+}
+
 fn main() -> std::process::ExitCode {
+    // First, so that SIGINT/SIGTERM/SIGHUP in the first milliseconds is a request to stop like
+    // any other, never a default-action kill that leaves shared memory behind.
+    if let Err(e) = wire::signals::install() {
+        eprintln!("dicstream: error: cannot install the signal handlers: {e}");
+        return std::process::ExitCode::FAILURE;
+    }
     let cli = Cli::parse();
-    let result: anyhow::Result<()> = match cli.command {
+    // `run` chooses its exit code (see live::run::exit_code); the others succeed or fail.
+    let result: anyhow::Result<std::process::ExitCode> = match cli.command {
         // One arm per subcommand.
-        Command::Bench(args) => cmd::bench::run(args),
-        Command::Correlate(args) => cmd::correlate::run(args),
-        Command::Correlator(args) => cmd::correlator::run(args),
-        Command::Identify(args) => cmd::identify::run(args),
-        Command::Identifier(args) => cmd::identifier::run(args),
-        Command::Producer(args) => cmd::producer::run(args),
-        Command::Rig(args) => cmd::rig::run(args),
+        Command::Bench(args) => ok(cmd::bench::run(args)),
+        Command::Correlate(args) => ok(cmd::correlate::run(args)),
+        Command::Correlator(args) => ok(cmd::correlator::run(args)),
+        Command::Identify(args) => ok(cmd::identify::run(args)),
+        Command::Identifier(args) => ok(cmd::identifier::run(args)),
+        Command::Producer(args) => ok(cmd::producer::run(args)),
+        Command::Rig(args) => ok(cmd::rig::run(args)),
         Command::Run(args) => cmd::run::run(args),
-        Command::Synth(args) => cmd::synth::run(args),
-        Command::Tap(args) => cmd::tap::run(args),
+        Command::Synth(args) => ok(cmd::synth::run(args)),
+        Command::Tap(args) => ok(cmd::tap::run(args)),
     };
     match result {
-        Ok(()) => std::process::ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(error) => {
             eprintln!("dicstream: error: {error:#}");
-            std::process::ExitCode::FAILURE
+            // A code with a meaning for `dicstream run` (a results file that could not be
+            // written, a rig that could not resume), else 1.
+            let code = error.chain().find_map(wire::exit::code_of).unwrap_or(1);
+            std::process::ExitCode::from(code)
         }
     }
 }

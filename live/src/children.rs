@@ -73,6 +73,8 @@ pub struct Exit {
     /// `exit status 0`, `exit status 1`, `killed by signal 9 (SIGKILL)`.
     pub how: String,
     pub success: bool,
+    /// The exit code, if it exited (not killed by a signal).
+    pub code: Option<i32>,
     /// The last lines it printed, oldest first.
     pub last_lines: Vec<String>,
 }
@@ -104,6 +106,9 @@ pub struct Supervisor {
     exe: PathBuf,
     log_dir: PathBuf,
     children: Vec<Managed>,
+    /// Exits noticed but not yet handed out by [`Supervisor::take_exits`]: an exit noticed
+    /// while waiting for another child is kept, never lost.
+    exited: Vec<Exit>,
     tx: Sender<Event>,
     rx: Receiver<Event>,
 }
@@ -118,6 +123,7 @@ impl Supervisor {
             exe: exe.to_path_buf(),
             log_dir: log_dir.to_path_buf(),
             children: Vec::new(),
+            exited: Vec::new(),
             tx,
             rx,
         })
@@ -259,18 +265,25 @@ impl Supervisor {
         self.pid(role).is_some()
     }
 
-    /// Waits (bounded) until `role` says it is ready; an exit or the timeout is an error with
-    /// the process's last lines.
-    pub fn wait_ready(&mut self, role: Role, timeout: Duration) -> Result<(), String> {
+    /// Waits (bounded) until `role` says it is ready: Ok(true). Ok(false) when a termination
+    /// signal arrived first. Its exit or the timeout is an error with the process's last lines;
+    /// exits of other children seen meanwhile stay queued for [`Supervisor::take_exits`].
+    pub fn wait_ready(&mut self, role: Role, timeout: Duration) -> Result<bool, String> {
         let deadline = Instant::now() + timeout;
         loop {
             if self.is_ready(role) {
-                return Ok(());
+                return Ok(true);
             }
-            if let Some(exit) = self.reap().into_iter().find(|e| e.role == role) {
+            if wire::signals::requested().is_some() {
+                return Ok(false);
+            }
+            self.reap();
+            if let Some(at) = self.exited.iter().position(|e| e.role == role) {
+                let exit = self.exited.remove(at);
                 return Err(format!(
-                    "{} stopped before it was ready ({}):\n  {}",
+                    "{} (pid {}) stopped before it was ready ({}):\n  {}",
                     role.name(),
+                    exit.pid,
                     exit.how,
                     exit.last_lines.join("\n  ")
                 ));
@@ -315,8 +328,15 @@ impl Supervisor {
             .map_or(0.0, |m| m.cpu_s_ended + m.cpu_s_current)
     }
 
-    /// Children that have ended since the last call.
-    pub fn reap(&mut self) -> Vec<Exit> {
+    /// Children that have ended since the last call, in the order they were noticed
+    /// (including those noticed while waiting for a child to be ready).
+    pub fn take_exits(&mut self) -> Vec<Exit> {
+        self.reap();
+        std::mem::take(&mut self.exited)
+    }
+
+    /// Notices the children that have ended and queues their exits.
+    fn reap(&mut self) {
         self.drain_lines();
         let mut exits = Vec::new();
         for managed in &mut self.children {
@@ -329,6 +349,7 @@ impl Supervisor {
                     pid: child.id(),
                     how: describe_status(status),
                     success: status.success(),
+                    code: status.code(),
                     last_lines: managed.last_lines.iter().cloned().collect(),
                 });
                 managed.child = None;
@@ -343,7 +364,30 @@ impl Supervisor {
                 exit.last_lines = m.last_lines.iter().cloned().collect();
             }
         }
-        exits
+        self.exited.extend(exits);
+    }
+
+    /// Kills `role` at once (SIGKILL works on a stopped process too) and queues its exit,
+    /// described as `why`. False if it was not running.
+    pub fn kill(&mut self, role: Role, why: &str) -> bool {
+        let Some(managed) = self.children.iter_mut().find(|m| m.role == role) else {
+            return false;
+        };
+        let Some(mut child) = managed.child.take() else {
+            return false;
+        };
+        let _ = child.kill();
+        let _ = child.wait();
+        let exit = Exit {
+            role,
+            pid: child.id(),
+            how: format!("{why}; killed by the supervisor (SIGKILL)"),
+            success: false,
+            code: None,
+            last_lines: managed.last_lines.iter().cloned().collect(),
+        };
+        self.exited.push(exit);
+        true
     }
 
     /// Starts `role` again with the arguments of its last start, or `args` if given.
@@ -404,6 +448,18 @@ pub fn process_cpu_s(pid: u32) -> Option<f64> {
     (ticks > 0.0).then(|| (utime + stime) / ticks)
 }
 
+/// Whether process `pid` is stopped (state `T`, e.g. by SIGSTOP or Ctrl-Z), from
+/// `/proc/<pid>/stat`.
+pub fn process_stopped(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .ok()
+        .and_then(|stat| {
+            let rest = &stat[stat.rfind(')')? + 2..];
+            rest.split_whitespace().next().map(|state| state == "T")
+        })
+        .unwrap_or(false)
+}
+
 /// CPU time of this process so far (s).
 pub fn own_cpu_s() -> f64 {
     process_cpu_s(std::process::id()).unwrap_or(0.0)
@@ -435,6 +491,22 @@ mod tests {
         assert!(x != 1);
         assert!(own_cpu_s() > before);
         assert!(process_cpu_s(u32::MAX).is_none());
+    }
+
+    #[test]
+    fn a_stopped_process_reads_as_stopped() {
+        let mut child = Command::new("sleep").arg("30").spawn().unwrap();
+        let pid = child.id();
+        assert!(!process_stopped(pid));
+        // SAFETY: signalling our own unreaped child.
+        unsafe { libc::kill(pid as libc::pid_t, libc::SIGSTOP) };
+        let deadline = Instant::now() + Duration::from_secs(5);
+        while !process_stopped(pid) && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        assert!(process_stopped(pid));
+        child.kill().unwrap();
+        child.wait().unwrap();
     }
 
     #[test]

@@ -34,6 +34,9 @@ pub struct RunSection {
     pub status_interval_s: f64,
     /// Seconds a process gets to stop after SIGTERM before SIGKILL.
     pub stop_timeout_s: f64,
+    /// Seconds after which a process that is stopped (SIGSTOP) or publishes nothing while its
+    /// input comes is stale: reported, killed and handled like a death.
+    pub stale_after_s: f64,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -117,6 +120,7 @@ impl Default for RunSection {
             vtk: false,
             status_interval_s: 1.0,
             stop_timeout_s: 5.0,
+            stale_after_s: 5.0,
         }
     }
 }
@@ -309,6 +313,7 @@ impl RunConfig {
         for (name, v) in [
             ("status_interval_s", r.status_interval_s),
             ("stop_timeout_s", r.stop_timeout_s),
+            ("stale_after_s", r.stale_after_s),
         ] {
             if !(v.is_finite() && v > 0.0 && v <= 3600.0) {
                 return Err(format!("[run] {name} = {v}: expected (0, 3600] s"));
@@ -401,14 +406,17 @@ impl RunConfig {
              # Keep the field of every Nth correlated frame (fields/field_<frame>.csv, and .vtk).\n\
              fields_every = {}\nvtk = {}\n\
              # Seconds between two status lines, and given to a process to stop before SIGKILL.\n\
-             status_interval_s = {:?}\nstop_timeout_s = {:?}\n",
+             status_interval_s = {:?}\nstop_timeout_s = {:?}\n\
+             # Seconds after which a stopped (SIGSTOP) or silent process is killed as hung.\n\
+             stale_after_s = {:?}\n",
             d.run.results_dir,
             d.run.restart,
             d.run.max_restarts,
             d.run.fields_every,
             d.run.vtk,
             d.run.status_interval_s,
-            d.run.stop_timeout_s
+            d.run.stop_timeout_s,
+            d.run.stale_after_s
         );
         let c = &d.camera;
         let _ = writeln!(

@@ -37,6 +37,10 @@ pub struct Recorder {
     pub last_nodes: Vec<FieldNode>,
     pub last_report: Option<IdentificationReport>,
     pub rig_samples_seen: u64,
+    /// Frames the correlators that have ended skipped (their last `frames_dropped`), and the
+    /// running one's so far: a restarted correlator counts from 0.
+    pub frames_dropped_by_ended_correlators: u64,
+    pub frames_dropped_by_correlator: u64,
     /// First frame of the latest frame sequence (the correlator's origin for it).
     pub sequence_first_frame: Option<(FrameHeader, Vec<u16>)>,
     /// The most strained field of the latest sequence (largest gauge log strain), for the
@@ -73,6 +77,8 @@ impl Recorder {
             last_nodes: Vec::new(),
             last_report: None,
             rig_samples_seen: 0,
+            frames_dropped_by_ended_correlators: 0,
+            frames_dropped_by_correlator: 0,
             sequence_first_frame: None,
             peak_field: None,
             max_stretch: [1.0; 3],
@@ -120,6 +126,7 @@ impl Recorder {
     /// A field: its `frames.csv` row, its files every Nth frame, its latency.
     pub fn on_field(&mut self, header: &FieldHeader, nodes: &[FieldNode], seen_ns: u64) {
         self.fields_seen += 1;
+        self.frames_dropped_by_correlator = header.frames_dropped;
         self.latency_field
             .record_ns(header.t_published_ns.saturating_sub(header.t_capture_ns));
         let rig = (header.rig_sample_id != wire::NO_RIG_SAMPLE)
@@ -164,6 +171,17 @@ impl Recorder {
             peak_nodes.clear();
             peak_nodes.extend_from_slice(nodes);
         }
+    }
+
+    /// The correlator has ended: its skipped frames are kept, the next one counts from 0.
+    pub fn correlator_ended(&mut self) {
+        self.frames_dropped_by_ended_correlators +=
+            std::mem::take(&mut self.frames_dropped_by_correlator);
+    }
+
+    /// Frames skipped by every correlator of the run (behind the camera, they took the newest).
+    pub fn frames_dropped_by_correlators(&self) -> u64 {
+        self.frames_dropped_by_ended_correlators + self.frames_dropped_by_correlator
     }
 
     pub fn on_report(&mut self, report: IdentificationReport) {

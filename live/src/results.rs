@@ -2,7 +2,6 @@
 //! written (appended and flushed per row, or whole files atomically: temporary sibling, then
 //! rename), so a run killed at any moment keeps everything it had.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Paths of one run's results.
@@ -31,15 +30,35 @@ impl ResultsDir {
         Err(format!("{}: too many runs this second", parent.display()))
     }
 
-    /// Uses `root` (created if missing; its files are overwritten).
+    /// Uses `root` (created if missing; its files are overwritten, and the resume state of
+    /// an earlier run there is removed: this run's children start afresh, and only their own
+    /// restarts resume).
     pub fn at(root: &Path) -> Result<ResultsDir, String> {
         for dir in [root.to_path_buf(), root.join("fields"), root.join("logs")] {
             std::fs::create_dir_all(&dir)
                 .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
         }
-        Ok(ResultsDir {
+        let results = ResultsDir {
             root: root.to_path_buf(),
-        })
+        };
+        for state in [results.rig_state(), results.correlator_state()] {
+            match std::fs::remove_dir_all(&state) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(format!("cannot remove {}: {e}", state.display()))
+                }
+                _ => {}
+            }
+        }
+        match std::fs::remove_file(results.journal()) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(format!(
+                    "cannot remove {}: {e}",
+                    results.journal().display()
+                ))
+            }
+            _ => {}
+        }
+        Ok(results)
     }
 
     pub fn path(&self, name: &str) -> PathBuf {
@@ -64,6 +83,9 @@ impl ResultsDir {
     pub fn correlator_state(&self) -> PathBuf {
         self.path("correlator_state")
     }
+    pub fn rig_state(&self) -> PathBuf {
+        self.path("rig_state")
+    }
     pub fn fields(&self) -> PathBuf {
         self.path("fields")
     }
@@ -75,38 +97,27 @@ impl ResultsDir {
     }
 }
 
-/// Writes `bytes` to `path` atomically (temporary sibling, then rename).
+/// Writes `bytes` to `path` atomically ([`wire::files::write_atomic`]; the error names the
+/// file).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, bytes)
-        .and_then(|_| std::fs::rename(&tmp, path))
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+    wire::files::write_atomic(path, bytes).map_err(|e| e.to_string())
 }
 
-/// A CSV file written row by row, each row flushed to the file at once (one write call).
+/// A CSV file written row by row, each row whole ([`wire::files::RowFile`]).
 pub struct CsvAppender {
-    path: PathBuf,
-    file: std::fs::File,
+    rows: wire::files::RowFile,
 }
 
 impl CsvAppender {
     pub fn create(path: &Path, header: &str) -> Result<CsvAppender, String> {
-        let mut file = std::fs::File::create(path)
-            .map_err(|e| format!("cannot create {}: {e}", path.display()))?;
-        writeln!(file, "{header}").map_err(|e| format!("{}: {e}", path.display()))?;
         Ok(CsvAppender {
-            path: path.to_path_buf(),
-            file,
+            rows: wire::files::RowFile::create(path, header).map_err(|e| e.to_string())?,
         })
     }
 
-    /// Appends `line` (which ends with a newline).
+    /// Appends `line` (which ends with a newline), whole or not at all.
     pub fn append(&mut self, line: &str) -> Result<(), String> {
-        self.file
-            .write_all(line.as_bytes())
-            .map_err(|e| format!("{}: {e}", self.path.display()))
+        self.rows.append(line).map_err(|e| e.to_string())
     }
 }
 

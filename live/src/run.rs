@@ -9,11 +9,11 @@ use crate::acceptance::{accept, Acceptance};
 use crate::children::{Exit, Role, Supervisor};
 use crate::config::RunConfig;
 use crate::latency::Percentiles;
+use crate::liveness::{Counts, Liveness};
 use crate::recorder::{Recorder, RecorderSettings};
 use crate::results::{write_atomic, ResultsDir};
 use crate::subscriptions::Subscriptions;
 use iceoryx2::prelude::*;
-use iceoryx2::waitset::WaitSetRunResult;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -36,12 +36,27 @@ pub struct RunOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Ending {
-    /// The campaign ran to its end.
+    /// The campaign ran to its end (`failure` then names what makes its results doubtful,
+    /// if anything: acceptance not passed, frames lost to a fault, nothing identified).
     Completed,
-    /// Ctrl-C or SIGTERM.
+    /// SIGINT, SIGTERM or SIGHUP (`failure` names it).
     Interrupted,
-    /// A process died and could not be restarted.
+    /// A process died and could not be kept alive, a results file could not be written, or
+    /// the bench could not start.
     Failed,
+}
+
+/// Exit codes of `dicstream run`, also written in `summary.json`.
+pub mod exit_code {
+    /// Completed, and the results are trustworthy.
+    pub const PASSED: u8 = 0;
+    /// Failed (see [`super::Ending::Failed`]).
+    pub const FAILED: u8 = 1;
+    /// Completed, but the acceptance was not passed, frames were lost to a fault, or nothing
+    /// was identified.
+    pub const DOUBTFUL: u8 = 2;
+    /// Interrupted by signal N: 128 + N, as a shell reports it.
+    pub const SIGNAL_BASE: u8 = 128;
 }
 
 /// What the run did, also written as `summary.json`.
@@ -54,7 +69,14 @@ pub struct RunReport {
     pub wall_s: f64,
     pub frames_captured: u64,
     pub fields: u64,
-    pub frames_dropped_by_correlator: u64,
+    /// Frames captured that have no field: skipped by a correlator that fell behind, lost while
+    /// it was dead or stopped, or still on their way when the run stopped.
+    pub frames_not_correlated: u64,
+    /// Of those, the frames lost while a process was dead or stale (not skipped by a running
+    /// correlator): a fault cost them.
+    pub frames_lost_to_faults: u64,
+    /// Every death and stale process of the run, as noticed.
+    pub faults: Vec<String>,
     pub identification_reports: u64,
     pub restarts: Vec<String>,
     /// CPU seconds used per process (user + system, all threads), and as a share of one core
@@ -70,6 +92,8 @@ pub struct RunReport {
     /// What `strain_map.png` shows.
     pub strain_map: Option<StrainMapInfo>,
     pub leftover_shm_files: usize,
+    /// The exit code of `dicstream run` (see [`exit_code`]).
+    pub exit_code: u8,
 }
 
 /// The field drawn in `strain_map.png` (the most strained field of the last test) and the
@@ -130,6 +154,8 @@ pub fn child_args(
             g.log_hz.to_string(),
             "--seed".into(),
             g.seed.to_string(),
+            "--state-dir".into(),
+            path(results.rig_state()),
             "--exit-when-done".into(),
         ],
         Role::Producer => vec![
@@ -270,6 +296,8 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
         .clone()
         .unwrap_or_else(|| format!("run_{}", std::process::id()));
     let instance = wire::Instance::new(&instance_name).map_err(|e| e.to_string())?;
+    // Before anything is written or started: a second run on this instance is refused.
+    let _owner = instance.claim("run").map_err(|e| e.to_string())?;
     wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes(config)?)
         .map_err(|e| e.to_string())?;
     let results = match &options.results {
@@ -307,9 +335,10 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
             t0_ns,
         )?;
         let mut state = LoopState::default();
-        let result =
-            start_children(&mut supervisor, config, &instance_name, &results).and_then(|()| {
-                event_loop(
+        let result = start_children(&mut supervisor, config, &instance_name, &results).and_then(
+            |all_ready| match all_ready {
+                false => Ok(Ending::Interrupted),
+                true => event_loop(
                     &subscriptions,
                     &mut recorder,
                     &mut supervisor,
@@ -319,8 +348,9 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
                     options.status,
                     started,
                     &mut state,
-                )
-            });
+                ),
+            },
+        );
         supervisor.sample_cpu();
         let cpu_s = Role::ALL.map(|role| (role.name(), supervisor.cpu_seconds(role)));
         let stopped = supervisor.stop_all(
@@ -336,6 +366,7 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
     };
     let (result, recorder, mut state, cpu_s) = outcome;
     state.cpu_s = cpu_s.into_iter().map(|(n, s)| (n.to_string(), s)).collect();
+    state.signal = wire::signals::requested();
     state.cpu_s.insert(
         "monitor".to_string(),
         crate::children::own_cpu_s() - monitor_cpu_at_start_s,
@@ -361,22 +392,31 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
     )
 }
 
+/// Starts every child, each waited for until ready. False when a termination signal came
+/// first (the children started so far are stopped by the caller).
 fn start_children(
     supervisor: &mut Supervisor,
     config: &RunConfig,
     instance: &str,
     results: &ResultsDir,
-) -> Result<(), String> {
+) -> Result<bool, String> {
     for role in start_order() {
+        if wire::signals::requested().is_some() {
+            return Ok(false);
+        }
         supervisor.spawn(role, child_args(role, config, instance, results, 0))?;
-        supervisor.wait_ready(role, READY_TIMEOUT)?;
+        if !supervisor.wait_ready(role, READY_TIMEOUT)? {
+            return Ok(false);
+        }
         println!(
             "run: {} ready (pid {})",
             role.name(),
             supervisor.pid(role).unwrap_or(0)
         );
     }
-    Ok(())
+    // An exit while a later child was starting is kept by the supervisor: handled first thing
+    // by the event loop.
+    Ok(true)
 }
 
 /// What the loop learnt that the end of the run reports.
@@ -384,6 +424,10 @@ fn start_children(
 struct LoopState {
     restarts: Vec<String>,
     restart_counts: [u32; 4],
+    /// Deaths and stale processes, as noticed (`<role> <how>`).
+    faults: Vec<String>,
+    /// The termination signal that interrupted the run.
+    signal: Option<i32>,
     /// CPU seconds per process (children by role, and this monitor).
     cpu_s: std::collections::BTreeMap<String, f64>,
 }
@@ -395,6 +439,25 @@ enum Phase {
         since: Instant,
         last_frame: Option<u64>,
     },
+}
+
+/// How the loop ends when a termination signal has arrived.
+fn interrupted(signal: i32) -> Ending {
+    println!(
+        "run: {} received, stopping the processes",
+        wire::signals::name(signal)
+    );
+    Ending::Interrupted
+}
+
+/// The samples seen so far per service, for the liveness watch.
+fn counts(recorder: &Recorder) -> Counts {
+    Counts {
+        rig_states: recorder.rig_samples_seen,
+        frames: recorder.frames_seen,
+        fields: recorder.fields_seen,
+        reports: recorder.latency_identification.count(),
+    }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -409,9 +472,7 @@ fn event_loop(
     started: Instant,
     state: &mut LoopState,
 ) -> Result<Ending, String> {
-    let waitset = WaitSetBuilder::new()
-        .create::<ipc::Service>()
-        .map_err(|e| format!("monitor WaitSet: {e:?}"))?;
+    let waitset = wire::signals::waitset().map_err(|e| format!("monitor WaitSet: {e:?}"))?;
     let mut guards = Vec::new();
     for listener in subscriptions.listeners() {
         guards.push(
@@ -425,20 +486,39 @@ fn event_loop(
     let mut next_histograms = Instant::now() + HISTOGRAM_EVERY;
     let mut phase = Phase::Running;
     let stop_timeout = Duration::from_secs_f64(config.run.stop_timeout_s);
+    let mut liveness = Liveness::new(Duration::from_secs_f64(config.run.stale_after_s));
+    for role in Role::ALL {
+        liveness.reset(role, &counts(recorder), Instant::now());
+    }
     loop {
-        let woke = waitset
+        // Woken by a sample, a signal, or SIGCONT after this monitor was stopped (Ctrl-Z, fg):
+        // only a termination request stops the run.
+        waitset
             .wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, WAIT_SLICE)
             .map_err(|e| format!("monitor WaitSet: {e:?}"))?;
-        if matches!(
-            woke,
-            WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt
-        ) {
-            println!("run: interrupted, stopping the processes");
-            return Ok(Ending::Interrupted);
+        if let Some(signal) = wire::signals::requested() {
+            return Ok(interrupted(signal));
         }
         subscriptions.drain(recorder)?;
+        if let Some(error) = &recorder.write_error {
+            return Err(format!(
+                "{error}; the run stops (every earlier row is whole)"
+            ));
+        }
 
-        for exit in supervisor.reap() {
+        if matches!(phase, Phase::Running) {
+            let stopped = |role| {
+                supervisor
+                    .pid(role)
+                    .is_some_and(crate::children::process_stopped)
+            };
+            for (role, why) in liveness.check(&counts(recorder), stopped, Instant::now()) {
+                // Handled below like a death (reported, restarted if configured).
+                supervisor.kill(role, &format!("stale: {why}"));
+            }
+        }
+
+        for exit in supervisor.take_exits() {
             let campaign_done = exit.role == Role::Rig && exit.success;
             if campaign_done && matches!(phase, Phase::Running) {
                 println!("run: campaign finished; stopping the camera, finishing the last frames");
@@ -450,6 +530,14 @@ fn event_loop(
                 };
                 continue;
             }
+            if matches!(phase, Phase::Draining { .. }) && exit.role == Role::Producer {
+                // Stopped on purpose above.
+                continue;
+            }
+            subscriptions.drain(recorder)?;
+            if exit.role == Role::Correlator {
+                recorder.correlator_ended();
+            }
             let next_frame_id = recorder.last_frame_id.map_or(0, |id| id + 1);
             handle_death(
                 exit,
@@ -460,6 +548,13 @@ fn event_loop(
                 next_frame_id,
                 state,
             )?;
+            if let Some(signal) = wire::signals::requested() {
+                return Ok(interrupted(signal));
+            }
+            // The restarted child is watched afresh (the others too: the restart paused them).
+            for role in Role::ALL {
+                liveness.reset(role, &counts(recorder), Instant::now());
+            }
         }
 
         if let Phase::Draining { since, last_frame } = phase {
@@ -529,6 +624,18 @@ fn handle_death(
         }
     );
     eprintln!("run: {report}");
+    state.faults.push(format!("{} {}", role.name(), exit.how));
+    // A child that could not write its results (a full disk) or refused to resume is not
+    // restarted: it would fail the same way, or start its test over.
+    match exit.code {
+        Some(code) if code == i32::from(wire::exit::OUTPUT_FAILED) => {
+            return Err(format!("{report}\n(a results file could not be written)"));
+        }
+        Some(code) if code == i32::from(wire::exit::CANNOT_RESUME) => {
+            return Err(format!("{report}\n(it could not resume its test safely)"));
+        }
+        _ => {}
+    }
     let count = &mut state.restart_counts[role as usize];
     if !config.run.restart || *count >= config.run.max_restarts {
         return Err(format!(
@@ -541,7 +648,9 @@ fn handle_death(
     *count += 1;
     let args = child_args(role, config, instance, results, next_frame_id);
     let pid = supervisor.restart(role, Some(args))?;
-    supervisor.wait_ready(role, READY_TIMEOUT)?;
+    if !supervisor.wait_ready(role, READY_TIMEOUT)? {
+        return Ok(());
+    }
     let note = format!(
         "{} restarted (pid {pid}, restart {} of {}) after: {}",
         role.name(),
@@ -649,6 +758,32 @@ fn finish(
     });
     let displacement_error_mean_px = mean_displacement_error(&results.frames_csv());
     let wall_s = started.elapsed().as_secs_f64();
+    let frames_captured = recorder.last_frame_id.map_or(0, |id| id + 1);
+    let frames_not_correlated = frames_captured.saturating_sub(recorder.fields_seen);
+    // Frames no correlator skipped yet none measured: lost while one was dead or stale.
+    let frames_lost_to_faults = if state.faults.is_empty() {
+        0
+    } else {
+        frames_not_correlated.saturating_sub(recorder.frames_dropped_by_correlators())
+    };
+    let (mut failure, mut exit_code) = verdict(
+        ending,
+        failure,
+        acceptance.as_ref(),
+        frames_lost_to_faults,
+        &state,
+    );
+    let mut ending = ending;
+    if !notes.is_empty() && ending != Ending::Interrupted {
+        // Results that could not be written (a full disk): the run did not deliver them.
+        let missing = format!("results not written: {}", notes.join("; "));
+        failure = Some(match failure {
+            Some(f) if ending == Ending::Failed => format!("{f}; {missing}"),
+            _ => missing,
+        });
+        ending = Ending::Failed;
+        exit_code = exit_code::FAILED;
+    }
     let cpu_cores = state
         .cpu_s
         .iter()
@@ -660,9 +795,11 @@ fn finish(
         ending,
         failure,
         wall_s,
-        frames_captured: recorder.last_frame_id.map_or(0, |id| id + 1),
+        frames_captured,
         fields: recorder.fields_seen,
-        frames_dropped_by_correlator: recorder.last_field.map_or(0, |f| f.frames_dropped),
+        frames_not_correlated,
+        frames_lost_to_faults,
+        faults: state.faults,
         identification_reports: recorder.latency_identification.count(),
         restarts: state.restarts,
         cpu_s: state.cpu_s,
@@ -673,6 +810,7 @@ fn finish(
         acceptance,
         strain_map,
         leftover_shm_files,
+        exit_code,
     };
     let mut json = serde_json::to_value(&report).map_err(|e| e.to_string())?;
     if !notes.is_empty() {
@@ -688,6 +826,47 @@ fn finish(
             .as_bytes(),
     )?;
     Ok(report)
+}
+
+/// What makes the results doubtful or the run failed, and the exit code of `dicstream run`.
+fn verdict(
+    ending: Ending,
+    failure: Option<String>,
+    acceptance: Option<&Acceptance>,
+    frames_lost_to_faults: u64,
+    state: &LoopState,
+) -> (Option<String>, u8) {
+    match ending {
+        Ending::Failed => (failure, exit_code::FAILED),
+        Ending::Interrupted => {
+            let signal = state.signal.unwrap_or(libc::SIGINT);
+            (
+                Some(format!("interrupted by {}", wire::signals::name(signal))),
+                exit_code::SIGNAL_BASE.saturating_add(signal as u8),
+            )
+        }
+        Ending::Completed => {
+            let mut doubts = Vec::new();
+            match acceptance {
+                None => doubts.push("nothing was identified".to_string()),
+                Some(a) if !a.passed => doubts.push(format!(
+                    "the identified law did not pass the acceptance (tolerance {:.0} %)",
+                    100.0 * a.tolerance
+                )),
+                Some(_) => {}
+            }
+            if frames_lost_to_faults > 0 {
+                doubts.push(format!(
+                    "{frames_lost_to_faults} frame(s) were lost to faults ({})",
+                    state.faults.join("; ")
+                ));
+            }
+            match doubts.is_empty() {
+                true => (None, exit_code::PASSED),
+                false => (Some(doubts.join("; ")), exit_code::DOUBTFUL),
+            }
+        }
+    }
 }
 
 /// `latency.hgrm` (capture to field) and `latency_identification.hgrm`.

@@ -26,10 +26,10 @@ pub struct RunArgs {
     pub quiet: bool,
 }
 
-pub fn run(args: RunArgs) -> anyhow::Result<()> {
+pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
     if args.print_config {
         print!("{}", RunConfig::commented_defaults());
-        return Ok(());
+        return Ok(std::process::ExitCode::SUCCESS);
     }
     let config = match &args.config {
         Some(path) => {
@@ -55,13 +55,15 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
     })
     .map_err(anyhow::Error::msg)?;
     println!(
-        "run: {:?} after {:.1} s: {} frames captured, {} correlated, {} dropped by the correlator; \
-         latency capture to field p50 {:.0} ms p99 {:.0} ms, to identification p50 {:.0} ms",
+        "run: {:?} after {:.1} s: {} frames captured, {} correlated, {} not correlated ({} lost \
+         to faults); latency capture to field p50 {:.0} ms p99 {:.0} ms, to identification p50 \
+         {:.0} ms",
         report.ending,
         report.wall_s,
         report.frames_captured,
         report.fields,
-        report.frames_dropped_by_correlator,
+        report.frames_not_correlated,
+        report.frames_lost_to_faults,
         report.latency_field_ms.p50,
         report.latency_field_ms.p99,
         report.latency_identification_ms.p50,
@@ -99,11 +101,19 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
             report.leftover_shm_files, report.instance
         );
     }
+    let failure = report.failure.as_deref().unwrap_or("unknown");
     match report.ending {
-        Ending::Completed | Ending::Interrupted => Ok(()),
-        Ending::Failed => anyhow::bail!(
-            "the run failed: {}",
-            report.failure.as_deref().unwrap_or("unknown")
-        ),
+        Ending::Completed if report.exit_code == live::run::exit_code::PASSED => {}
+        Ending::Completed => eprintln!("run: completed, but the results are doubtful: {failure}"),
+        Ending::Interrupted => eprintln!("run: {failure}"),
+        Ending::Failed => eprintln!("run: failed: {failure}"),
     }
+    if report.exit_code != live::run::exit_code::PASSED {
+        eprintln!(
+            "run: exit code {} (see `ending` and `failure` in {})",
+            report.exit_code,
+            report.results.join("summary.json").display()
+        );
+    }
+    Ok(std::process::ExitCode::from(report.exit_code))
 }

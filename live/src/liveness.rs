@@ -1,0 +1,202 @@
+//! Which child has stopped responding. A child is stale when it has been stopped (process
+//! state `T`: SIGSTOP, a debugger) for the stale time, or when it has published nothing for
+//! that long while its input kept coming (the rig always publishes; the camera publishes when
+//! rig states come; the correlator when frames come). The identifier publishes only when a
+//! new point is accepted, so only its stopped state is watched. Pure: the run feeds it the
+//! counts of samples seen per service and the children's stopped states.
+
+use crate::children::Role;
+use std::time::{Duration, Instant};
+
+/// Samples seen so far on each service of the run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counts {
+    pub rig_states: u64,
+    pub frames: u64,
+    pub fields: u64,
+    pub reports: u64,
+}
+
+impl Counts {
+    /// What `role` publishes, and what it is fed (None: it publishes on its own clock;
+    /// the identifier's output is not watched, see the module's text).
+    fn of(&self, role: Role) -> Option<(u64, Option<u64>)> {
+        match role {
+            Role::Rig => Some((self.rig_states, None)),
+            Role::Producer => Some((self.frames, Some(self.rig_states))),
+            Role::Correlator => Some((self.fields, Some(self.frames))),
+            Role::Identifier => None,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Watch {
+    output: u64,
+    /// When the output last changed (or the watch started).
+    output_since: Instant,
+    /// The input count when the output last changed.
+    input_then: Option<u64>,
+    stopped_since: Option<Instant>,
+}
+
+pub struct Liveness {
+    stale_after: Duration,
+    watches: [Option<Watch>; 4],
+}
+
+impl Liveness {
+    pub fn new(stale_after: Duration) -> Liveness {
+        Liveness {
+            stale_after,
+            watches: [None; 4],
+        }
+    }
+
+    /// Starts (or starts again, after a restart) watching `role` from `now`.
+    pub fn reset(&mut self, role: Role, counts: &Counts, now: Instant) {
+        let (output, input) = counts.of(role).unwrap_or((0, None));
+        self.watches[role as usize] = Some(Watch {
+            output,
+            output_since: now,
+            input_then: input,
+            stopped_since: None,
+        });
+    }
+
+    /// Takes in the counts and which children are stopped; returns the stale ones with why.
+    pub fn check(
+        &mut self,
+        counts: &Counts,
+        stopped: impl Fn(Role) -> bool,
+        now: Instant,
+    ) -> Vec<(Role, String)> {
+        let mut stale = Vec::new();
+        for role in Role::ALL {
+            let Some(watch) = self.watches[role as usize].as_mut() else {
+                continue;
+            };
+            watch.stopped_since = match (stopped(role), watch.stopped_since) {
+                (true, None) => Some(now),
+                (true, since) => since,
+                (false, _) => None,
+            };
+            if let Some(since) = watch.stopped_since {
+                if now.duration_since(since) >= self.stale_after {
+                    stale.push((
+                        role,
+                        format!(
+                            "stopped (process state T, e.g. SIGSTOP) for {:.1} s",
+                            now.duration_since(since).as_secs_f64()
+                        ),
+                    ));
+                    continue;
+                }
+            }
+            let Some((output, input)) = counts.of(role) else {
+                continue;
+            };
+            if output != watch.output {
+                watch.output = output;
+                watch.output_since = now;
+                watch.input_then = input;
+                continue;
+            }
+            let fed = match (input, watch.input_then) {
+                (Some(now_in), Some(then_in)) => now_in > then_in,
+                _ => true,
+            };
+            let silent = now.duration_since(watch.output_since);
+            if fed && silent >= self.stale_after {
+                stale.push((
+                    role,
+                    format!(
+                        "published nothing for {:.1} s{}",
+                        silent.as_secs_f64(),
+                        if input.is_some() {
+                            " while its input kept coming"
+                        } else {
+                            ""
+                        }
+                    ),
+                ));
+            }
+        }
+        stale
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const STALE: Duration = Duration::from_secs(5);
+
+    fn watching_all(counts: &Counts, t0: Instant) -> Liveness {
+        let mut liveness = Liveness::new(STALE);
+        for role in Role::ALL {
+            liveness.reset(role, counts, t0);
+        }
+        liveness
+    }
+
+    #[test]
+    fn a_silent_rig_is_stale_after_the_stale_time_only() {
+        let t0 = Instant::now();
+        let counts = Counts::default();
+        let mut liveness = watching_all(&counts, t0);
+        assert!(liveness
+            .check(&counts, |_| false, t0 + Duration::from_secs(4))
+            .is_empty());
+        let stale = liveness.check(&counts, |_| false, t0 + Duration::from_secs(6));
+        assert_eq!(stale.len(), 1);
+        assert_eq!(stale[0].0, Role::Rig);
+    }
+
+    #[test]
+    fn a_correlator_without_frames_is_not_stale_but_one_fed_and_silent_is() {
+        let t0 = Instant::now();
+        let mut counts = Counts::default();
+        let mut liveness = watching_all(&counts, t0);
+        // The rig and the camera publish; no frame reaches... the correlator publishes nothing.
+        let mut t = t0;
+        for step in 1..=10u64 {
+            t = t0 + Duration::from_secs(step);
+            counts.rig_states += 100;
+            counts.frames += 10;
+            let stale = liveness.check(&counts, |_| false, t);
+            if step < 5 {
+                assert!(stale.is_empty(), "{stale:?}");
+            } else {
+                assert_eq!(
+                    stale.iter().map(|s| s.0).collect::<Vec<_>>(),
+                    [Role::Correlator]
+                );
+            }
+        }
+        // No frames either: an idle correlator is not stale.
+        let mut quiet = watching_all(&counts, t);
+        counts.rig_states += 100;
+        let stale = quiet.check(&counts, |_| false, t + Duration::from_secs(10));
+        assert!(!stale.iter().any(|s| s.0 == Role::Correlator), "{stale:?}");
+    }
+
+    #[test]
+    fn a_stopped_identifier_is_stale_and_a_continued_one_is_not() {
+        let t0 = Instant::now();
+        let counts = Counts::default();
+        let mut liveness = Liveness::new(STALE);
+        liveness.reset(Role::Identifier, &counts, t0);
+        let stopped = |role: Role| role == Role::Identifier;
+        assert!(liveness.check(&counts, stopped, t0).is_empty());
+        assert!(liveness
+            .check(&counts, |_| false, t0 + Duration::from_secs(3))
+            .is_empty());
+        assert!(liveness
+            .check(&counts, stopped, t0 + Duration::from_secs(4))
+            .is_empty());
+        let stale = liveness.check(&counts, stopped, t0 + Duration::from_secs(10));
+        assert_eq!(stale.len(), 1);
+        assert!(stale[0].1.contains("stopped"), "{}", stale[0].1);
+    }
+}
