@@ -105,3 +105,42 @@ fn a_law_that_is_not_finite_is_refused_at_start() {
         assert!(!stderr.contains("rig: ready"), "{stderr}");
     }
 }
+
+/// A program beyond the stroke is refused before the rig says it is ready, with the channel as
+/// a program names it and the number readable (not 300 digits, not a Rust debug name).
+#[test]
+fn a_stroke_beyond_the_limit_is_refused_before_ready_and_readable() {
+    let path = std::env::temp_dir().join(format!("cli_stroke_{}.toml", std::process::id()));
+    std::fs::write(
+        &path,
+        "[[setup]]\naxis = \"x\"\ncontrol = \"centroid_displacement\"\n[[channel]]\n\
+         target = \"x.elongation\"\nsegments = [{ kind = \"ramp\", to = 1e300, rate_per_s = 1.0 }]\n",
+    )
+    .unwrap();
+    let stderr = refused(
+        &[
+            "rig",
+            "--program",
+            path.to_str().unwrap(),
+            "--instance",
+            &instance(),
+        ],
+        &["stroke", "5e299", "on x.elongation", "beyond the limit 120"],
+    );
+    assert!(!stderr.contains("Elongation("), "{stderr}");
+    assert!(stderr.len() < 300, "{stderr}");
+    let stderr = refused(
+        &[
+            "rig",
+            "--test",
+            "uniaxial",
+            "--stretch",
+            "1e300",
+            "--instance",
+            &instance(),
+        ],
+        &["--stretch 1e300"],
+    );
+    assert!(stderr.len() < 200, "{stderr}");
+    let _ = std::fs::remove_file(&path);
+}

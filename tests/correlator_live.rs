@@ -89,7 +89,7 @@ fn live_translation_matches_the_truth() {
     let status = proc.wait_exit();
     assert!(status.success(), "exit status {status:?}");
     let last = proc.final_line();
-    assert!(last.contains("SIGINT/SIGTERM"), "{last}");
+    assert!(last.contains("stopped (SIGINT)"), "{last}");
     assert_eq!(number_after(&last, "correlated"), 6, "{last}");
     assert_eq!(number_after(&last, "dropped"), 0, "{last}");
     bench.finish();

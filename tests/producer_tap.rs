@@ -433,3 +433,43 @@ fn follow_rig_skips_and_counts_states_beyond_the_envelope_with_one_warning() {
     assert!(status.success(), "rig: {stderr}");
     assert_clean_shutdown_left_nothing(&run);
 }
+
+/// A second camera on an instance that has one is refused at start, naming the first one's
+/// pid (two used to publish interleaved frames); once the first has ended, a new one starts.
+#[test]
+fn a_second_producer_on_an_instance_is_refused_naming_the_first() {
+    let mut run = Run::new("two_producers");
+    let instance = run.name().to_string();
+    let args = [
+        "producer",
+        "--instance",
+        &instance,
+        "--width",
+        SIDE,
+        "--height",
+        SIDE,
+        "--fps",
+        FPS,
+        "--frames",
+        "1000000",
+        "--threads",
+        "1",
+    ];
+    let first = run.spawn("first", &args);
+    first.wait_for_stderr("ready line", |l| l.contains("producer: ready"));
+    let first_pid = first.pid();
+    let (status, _, stderr) = run.run_to_end("second", &args);
+    assert_eq!(status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains(&format!("already has a producer (pid {first_pid})")),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("producer: ready"), "{stderr}");
+    run.child("first").signal(libc::SIGKILL);
+    run.child("first").wait();
+    let third = run.spawn("third", &args);
+    third.wait_for_stderr("ready line", |l| l.contains("producer: ready"));
+    third.signal(libc::SIGTERM);
+    let (status, _, stderr) = run.child("third").wait();
+    assert!(status.success(), "{stderr}");
+}

@@ -7,6 +7,8 @@
 
 #![allow(dead_code)]
 
+pub mod bench_run;
+
 use std::io::{BufRead, BufReader, Read};
 use std::path::PathBuf;
 use std::process::{Command, ExitStatus, Stdio};
