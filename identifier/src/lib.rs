@@ -14,6 +14,7 @@
 //! - [`online`]: pairing strains with rig forces, accumulating the load path, refitting (no IPC).
 //! - [`process`]: the live `identifier` process shell over iceoryx2 (`wire` services).
 //! - [`report`]: JSON of fits, atomic file writes.
+//! - [`subsample`]: the documented limit on fitted points and the load-path-preserving subsample.
 
 pub mod data;
 pub mod fit;
@@ -30,3 +31,4 @@ pub mod report;
 pub mod residuals;
 pub mod route;
 pub mod stability;
+pub mod subsample;
