@@ -2,33 +2,15 @@
 //! and a finite-difference Jacobian, the code before it): same fits on Treloar's data, same
 //! normal equations; and the same bits whatever the thread count.
 
-use identifier::data::{read_curve_csv, Curve, LoadCase};
+mod common;
+
+use common::treloar;
+use identifier::data::{Curve, LoadCase};
 use identifier::fit::{fit_model, FitOptions, JacobianPath};
 use identifier::lsq::{LeastSquares, ResidualVector};
 use identifier::models::Model;
 use identifier::residuals::PointSet;
 use nalgebra::{DMatrix, DVector};
-use std::path::Path;
-
-const DATA_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/treloar1944");
-
-fn treloar() -> Option<Vec<Curve>> {
-    let dir = Path::new(DATA_DIR);
-    if !dir.exists() {
-        eprintln!("SKIPPED: Treloar data not found at {DATA_DIR}");
-        return None;
-    }
-    Some(
-        [
-            ("uniaxial.csv", LoadCase::Uniaxial),
-            ("equibiaxial.csv", LoadCase::Equibiaxial),
-            ("pure_shear.csv", LoadCase::PureShear),
-        ]
-        .iter()
-        .map(|(f, c)| read_curve_csv(&dir.join(f), *c).expect("Treloar CSV reads"))
-        .collect(),
-    )
-}
 
 fn options(jacobian: JacobianPath, threads: usize) -> FitOptions {
     FitOptions {
