@@ -56,10 +56,11 @@ pub struct IdentifyArgs {
     /// JSON; RMS and R² are still over every point).
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_FIT_POINTS as u64, value_parser = clap::value_parser!(u64).range(2..))]
     pub max_fit_points: u64,
-    /// Threads sharing the points of each fit evaluation (default: the available cores); the
-    /// results do not depend on it.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
-    pub threads: Option<u64>,
+    /// Threads sharing the points of each fit evaluation; the results do not depend on it.
+    /// Default 1: on a shared two-core machine more threads (spawned per evaluation) measured
+    /// slower, not faster.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    pub threads: u64,
 }
 
 pub fn run(args: IdentifyArgs) -> anyhow::Result<()> {
@@ -95,10 +96,7 @@ pub fn run_with(
         bail!("no data: give at least one of --uniaxial, --biaxial, --pure-shear");
     }
     let models = parse_model_list(&args.model).map_err(anyhow::Error::msg)?;
-    let threads = match args.threads {
-        Some(n) => n as usize,
-        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-    };
+    let threads = usize::try_from(args.threads).unwrap_or(1);
     let options = FitOptions {
         residual: match args.residual {
             ResidualArg::Absolute => ResidualKind::Absolute,
@@ -358,7 +356,7 @@ mod tests {
                 json,
                 plot: None,
                 max_fit_points,
-                threads: Some(2),
+                threads: 2,
             }
         }
     }
