@@ -8,6 +8,7 @@
 use crate::data::{Curve, LoadCase};
 use crate::lsq::{self, LsqError};
 use crate::models::Model;
+use crate::residuals::PointSet;
 use crate::stability::{drucker_stability, StabilityRange};
 use nalgebra::{DMatrix, DVector};
 use std::collections::BTreeMap;
@@ -22,6 +23,18 @@ pub enum ResidualKind {
     Relative,
 }
 
+/// How the Jacobian of the residuals is obtained.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum JacobianPath {
+    /// Analytic gradients, normal equations accumulated point by point ([`crate::residuals`]).
+    #[default]
+    Analytic,
+    /// The straightforward reference: residual vectors and a central finite-difference
+    /// Jacobian (n + 1 evaluations of every residual per iteration). Slow; kept to check the
+    /// analytic path against.
+    FiniteDifference,
+}
+
 /// Fit options.
 #[derive(Clone, Debug, Default)]
 pub struct FitOptions {
@@ -34,6 +47,19 @@ pub struct FitOptions {
     /// points: the last solution is next to the new one); the full multi-start search runs
     /// only if that start fails.
     pub warm_start: Option<Vec<f64>>,
+    /// Threads sharing the points of each evaluation (0 or 1: the calling thread alone). The
+    /// result does not depend on it.
+    pub threads: usize,
+    pub jacobian: JacobianPath,
+}
+
+/// Where a fit is, for a progress display.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FitStage {
+    /// Solving the linear parameters at start `start` (1-based) of `starts`.
+    Screening { start: usize, starts: usize },
+    /// Levenberg-Marquardt from the `start`th best start of `starts`.
+    Refining { start: usize, starts: usize },
 }
 
 /// Statistics of one load case.
@@ -109,44 +135,92 @@ impl std::fmt::Display for FitError {
 impl std::error::Error for FitError {}
 
 struct Problem<'a> {
-    model: &'a Model,
-    points: Vec<(LoadCase, f64, f64)>,
-    /// sqrt(w_c) / scale_i per point.
-    factors: Vec<f64>,
+    set: PointSet<'a>,
+    path: JacobianPath,
 }
 
 impl Problem<'_> {
     fn residuals(&self, p: &[f64]) -> Option<DVector<f64>> {
-        let mut r = DVector::zeros(self.points.len());
-        for (k, &(case, stretch, stress)) in self.points.iter().enumerate() {
-            let model = self.model.nominal_stress_mpa(p, case, stretch)?;
-            r[k] = (model - stress) * self.factors[k];
+        self.set.residuals(p)
+    }
+
+    /// Σ r², `None` where a residual is undefined or not finite.
+    fn cost(&mut self, p: &[f64]) -> Option<f64> {
+        match self.path {
+            JacobianPath::Analytic => lsq::LeastSquares::cost(&mut self.set, p),
+            JacobianPath::FiniteDifference => self
+                .residuals(p)
+                .filter(|r| r.iter().all(|v| v.is_finite()))
+                .map(|r| r.norm_squared()),
         }
-        Some(r)
+    }
+
+    fn levenberg_marquardt(&mut self, start: &[f64]) -> Result<lsq::LmResult, LsqError> {
+        match self.path {
+            JacobianPath::Analytic => lsq::minimise(&mut self.set, start),
+            JacobianPath::FiniteDifference => {
+                let m = self.set.len();
+                lsq::levenberg_marquardt(&|p: &[f64]| self.residuals(p), start, m)
+            }
+        }
+    }
+
+    fn jacobian(&self, p: &[f64]) -> DMatrix<f64> {
+        match self.path {
+            JacobianPath::Analytic => self.set.jacobian(p),
+            JacobianPath::FiniteDifference => {
+                lsq::numeric_jacobian(&|q: &[f64]| self.residuals(q), p, self.set.len())
+            }
+        }
     }
 
     /// Solves the linear parameters with the nonlinear ones of `p` fixed; returns the full vector.
-    fn solve_linear(&self, p: &[f64], linear: &[bool]) -> Result<Vec<f64>, LsqError> {
+    fn solve_linear(&mut self, p: &[f64], linear: &[bool]) -> Result<Vec<f64>, LsqError> {
+        self.solve_linear_with_cost(p, linear).map(|(p, _)| p)
+    }
+
+    /// [`Problem::solve_linear`] and the cost there (`None` if not finite). The analytic path
+    /// takes it from the linear system (r = design x − rhs: the stress is linear in those
+    /// parameters and their values do not change the model's domain), not from the model.
+    fn solve_linear_with_cost(
+        &mut self,
+        p: &[f64],
+        linear: &[bool],
+    ) -> Result<(Vec<f64>, Option<f64>), LsqError> {
         let lin_idx: Vec<usize> = (0..p.len()).filter(|&i| linear[i]).collect();
-        let m = self.points.len();
         let mut base = p.to_vec();
         for &i in &lin_idx {
             base[i] = 0.0;
         }
-        let r0 = self.residuals(&base).ok_or(LsqError::NonFiniteStart)?;
-        let mut design = DMatrix::zeros(m, lin_idx.len());
-        for (col, &i) in lin_idx.iter().enumerate() {
-            let mut q = base.clone();
-            q[i] = 1.0;
-            let r1 = self.residuals(&q).ok_or(LsqError::NonFiniteStart)?;
-            design.set_column(col, &(r1 - &r0));
-        }
-        let x = lsq::linear_least_squares(&design, &(-r0))?;
+        let (design, rhs) = match self.path {
+            JacobianPath::Analytic => self
+                .set
+                .linear_system(&base, linear)
+                .ok_or(LsqError::NonFiniteStart)?,
+            JacobianPath::FiniteDifference => {
+                let r0 = self.residuals(&base).ok_or(LsqError::NonFiniteStart)?;
+                let mut design = DMatrix::zeros(self.set.len(), lin_idx.len());
+                for (col, &i) in lin_idx.iter().enumerate() {
+                    let mut q = base.clone();
+                    q[i] = 1.0;
+                    let r1 = self.residuals(&q).ok_or(LsqError::NonFiniteStart)?;
+                    design.set_column(col, &(r1 - &r0));
+                }
+                (design, -r0)
+            }
+        };
+        let x = lsq::linear_least_squares(&design, &rhs)?;
         let mut out = base;
         for (col, &i) in lin_idx.iter().enumerate() {
             out[i] = x[col];
         }
-        Ok(out)
+        let cost = match self.path {
+            JacobianPath::Analytic => {
+                Some((design * x - rhs).norm_squared()).filter(|c| c.is_finite())
+            }
+            JacobianPath::FiniteDifference => self.cost(&out),
+        };
+        Ok((out, cost))
     }
 }
 
@@ -155,12 +229,21 @@ pub const LM_STARTS_REFINED: usize = 6;
 
 /// Fits `model` to `curves`.
 pub fn fit_model(model: &Model, curves: &[Curve], options: &FitOptions) -> Result<Fit, FitError> {
+    fit_model_with_progress(model, curves, options, &mut |_| {})
+}
+
+/// [`fit_model`], telling `progress` where it is (at every start of the nonlinear search).
+pub fn fit_model_with_progress(
+    model: &Model,
+    curves: &[Curve],
+    options: &FitOptions,
+    progress: &mut dyn FnMut(FitStage),
+) -> Result<Fit, FitError> {
     let name = model.name();
     if curves.iter().all(|c| c.is_empty()) {
         return Err(FitError::NoData);
     }
     let mut points = Vec::new();
-    let mut factors = Vec::new();
     for curve in curves {
         let weight = options.weights.get(&curve.case).copied().unwrap_or(1.0);
         if !(weight.is_finite() && weight > 0.0) {
@@ -182,8 +265,7 @@ pub fn fit_model(model: &Model, curves: &[Curve], options: &FitOptions) -> Resul
                     stress.abs()
                 }
             };
-            points.push((curve.case, stretch, stress));
-            factors.push(weight.sqrt() / scale);
+            points.push((curve.case, stretch, stress, weight.sqrt() / scale));
         }
     }
     let m = points.len();
@@ -197,10 +279,9 @@ pub fn fit_model(model: &Model, curves: &[Curve], options: &FitOptions) -> Resul
             },
         });
     }
-    let problem = Problem {
-        model,
-        points,
-        factors,
+    let mut problem = Problem {
+        set: PointSet::new(model, &points, options.threads),
+        path: options.jacobian,
     };
     let linear = model.linear_params();
     let lsq_err = |error| FitError::Lsq {
@@ -225,17 +306,23 @@ pub fn fit_model(model: &Model, curves: &[Curve], options: &FitOptions) -> Resul
             } else {
                 w.clone()
             };
-            lsq::levenberg_marquardt(&|p: &[f64]| problem.residuals(p), &start, m).ok()
+            problem.levenberg_marquardt(&start).ok()
         })
     {
         (warm.params, warm.converged)
     } else {
         let mut candidates: Vec<(f64, Vec<f64>)> = Vec::new();
         let mut last_error = None;
-        let starts = nonlinear_starts(model, curves)
+        let starts: Vec<Vec<f64>> = nonlinear_starts(model, curves)
             .into_iter()
-            .chain(options.extra_starts.iter().cloned());
-        for start in starts {
+            .chain(options.extra_starts.iter().cloned())
+            .collect();
+        let start_count = starts.len();
+        for (k, start) in starts.into_iter().enumerate() {
+            progress(FitStage::Screening {
+                start: k + 1,
+                starts: start_count,
+            });
             assert_eq!(
                 start.len(),
                 n,
@@ -243,19 +330,14 @@ pub fn fit_model(model: &Model, curves: &[Curve], options: &FitOptions) -> Resul
             );
             let has_linear = linear.iter().any(|&l| l);
             let full = if has_linear {
-                problem.solve_linear(&start, &linear)
+                problem.solve_linear_with_cost(&start, &linear)
             } else {
-                Ok(start)
+                let cost = problem.cost(&start);
+                Ok((start, cost))
             };
             match full {
-                Ok(p) => {
-                    if let Some(r) = problem
-                        .residuals(&p)
-                        .filter(|r| r.iter().all(|v| v.is_finite()))
-                    {
-                        candidates.push((r.norm_squared(), p));
-                    }
-                }
+                Ok((p, Some(cost))) => candidates.push((cost, p)),
+                Ok((_, None)) => {}
                 Err(e) => last_error = Some(e),
             }
         }
@@ -269,8 +351,13 @@ pub fn fit_model(model: &Model, curves: &[Curve], options: &FitOptions) -> Resul
         }
         candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut best: Option<lsq::LmResult> = None;
-        for (_, start) in candidates.iter().take(LM_STARTS_REFINED) {
-            let res = lsq::levenberg_marquardt(&|p: &[f64]| problem.residuals(p), start, m);
+        let refined = candidates.len().min(LM_STARTS_REFINED);
+        for (k, (_, start)) in candidates.iter().take(refined).enumerate() {
+            progress(FitStage::Refining {
+                start: k + 1,
+                starts: refined,
+            });
+            let res = problem.levenberg_marquardt(start);
             if let Ok(res) = res {
                 if best.as_ref().is_none_or(|b| res.cost < b.cost) {
                     best = Some(res);
@@ -287,7 +374,7 @@ pub fn fit_model(model: &Model, curves: &[Curve], options: &FitOptions) -> Resul
         model: name.clone(),
     })?;
     let objective = r.norm_squared();
-    let jac = lsq::numeric_jacobian(&|p: &[f64]| problem.residuals(p), &params, m);
+    let jac = problem.jacobian(&params);
     let variance = objective / (m - n) as f64;
     let stderr = match lsq::inverse_normal_matrix(&jac) {
         Some(cov) => (0..n)
@@ -390,10 +477,24 @@ pub fn fit_ranked(
     curves: &[Curve],
     options: &FitOptions,
 ) -> (Vec<Fit>, Vec<(Model, FitError)>) {
+    fit_ranked_with_progress(models, curves, options, &mut |_, _| {})
+}
+
+/// [`fit_ranked`], telling `progress` which model (index into `models`) is where.
+pub fn fit_ranked_with_progress(
+    models: &[Model],
+    curves: &[Curve],
+    options: &FitOptions,
+    progress: &mut dyn FnMut(usize, Option<FitStage>),
+) -> (Vec<Fit>, Vec<(Model, FitError)>) {
     let mut fits = Vec::new();
     let mut failures = Vec::new();
-    for model in models {
-        match fit_model(model, curves, options) {
+    for (index, model) in models.iter().enumerate() {
+        progress(index, None);
+        let result = fit_model_with_progress(model, curves, options, &mut |stage| {
+            progress(index, Some(stage))
+        });
+        match result {
             Ok(fit) => fits.push(fit),
             Err(e) => failures.push((model.clone(), e)),
         }

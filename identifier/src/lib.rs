@@ -4,7 +4,9 @@
 //! - [`law`]: the invariant-based law W(I1, I2) with f(I1), g(I2) (eqs 18-25), Smactane™ default.
 //! - [`data`]: load cases, kinematics, stresses from forces, the CSV reader.
 //! - [`models`]: the catalogue of potentials (Table 2 and the usual others).
+//! - [`gradient`]: analytic gradients of the nominal stress with respect to the parameters.
 //! - [`lsq`]: linear least squares and a bounded Levenberg-Marquardt (nalgebra).
+//! - [`residuals`]: the fit's residuals, cost and normal equations in one pass (blocked, threaded).
 //! - [`fit`]: fitting a model to any combination of load cases, statistics, ranking by AIC.
 //! - [`stability`]: Drucker stability along the load paths.
 //! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
@@ -12,9 +14,11 @@
 //! - [`online`]: pairing strains with rig forces, accumulating the load path, refitting (no IPC).
 //! - [`process`]: the live `identifier` process shell over iceoryx2 (`wire` services).
 //! - [`report`]: JSON of fits, atomic file writes.
+//! - [`subsample`]: the documented limit on fitted points and the load-path-preserving subsample.
 
 pub mod data;
 pub mod fit;
+pub mod gradient;
 pub mod journal;
 /// The law lives in its own crate (`material`), shared with the rig; re-exported here.
 pub use material as law;
@@ -24,5 +28,7 @@ pub mod online;
 pub mod plot;
 pub mod process;
 pub mod report;
+pub mod residuals;
 pub mod route;
 pub mod stability;
+pub mod subsample;

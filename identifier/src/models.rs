@@ -292,16 +292,15 @@ impl Model {
         (stress[0].is_finite() && stress[1].is_finite()).then_some(stress)
     }
 
-    /// Nominal stress along the loaded direction of a load case, MPa.
+    /// Nominal stress along the loaded direction of a load case, MPa (σ1/λ1, computed by
+    /// [`Model::nominal_stress_at`]; `None` outside the model's domain).
     pub fn nominal_stress_mpa(
         &self,
         p: &[f64],
         case: crate::data::LoadCase,
         stretch: f64,
     ) -> Option<f64> {
-        let (l1, l2) = case.in_plane_stretches(stretch);
-        self.in_plane_cauchy_stress_mpa(p, l1, l2)
-            .map(|s| s[0] / l1)
+        self.nominal_stress_at(p, &crate::gradient::Kinematics::of(case, stretch), None)
     }
 }
 

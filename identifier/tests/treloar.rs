@@ -1,30 +1,11 @@
 //! Treloar (1944): every model on uniaxial + equibiaxial + pure shear; Ogden reference check.
 
-use identifier::data::{read_curve_csv, Curve, LoadCase};
+mod common;
+
+use common::treloar;
+use identifier::data::LoadCase;
 use identifier::fit::{evaluate, fit_model, fit_ranked, FitOptions};
 use identifier::models::Model;
-use std::path::Path;
-
-const DATA_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/treloar1944");
-
-fn treloar() -> Option<Vec<Curve>> {
-    let dir = Path::new(DATA_DIR);
-    if !dir.exists() {
-        eprintln!("SKIPPED: Treloar data not found at {DATA_DIR}");
-        return None;
-    }
-    let files = [
-        ("uniaxial.csv", LoadCase::Uniaxial),
-        ("equibiaxial.csv", LoadCase::Equibiaxial),
-        ("pure_shear.csv", LoadCase::PureShear),
-    ];
-    Some(
-        files
-            .iter()
-            .map(|(f, c)| read_curve_csv(&dir.join(f), *c).expect("Treloar CSV reads"))
-            .collect(),
-    )
-}
 
 const OGDEN_REFERENCE: [f64; 6] = [0.63, 0.0012, -0.01, 1.3, 5.0, -2.0];
 
