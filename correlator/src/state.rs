@@ -407,7 +407,9 @@ impl StateDir {
                     origin,
                     &mut self.origin_bytes,
                 );
-                self.origin_file.write(&self.origin_bytes).map_err(StateError::Write)?;
+                self.origin_file
+                    .write(&self.origin_bytes)
+                    .map_err(StateError::Write)?;
                 self.saved_origin = Some(generation);
             }
         }
@@ -445,7 +447,6 @@ fn read_if_present(path: &Path) -> Result<Option<Vec<u8>>, StateError> {
         }),
     }
 }
-
 
 fn put_u32(out: &mut Vec<u8>, v: u32) {
     out.extend_from_slice(&v.to_le_bytes());
