@@ -25,7 +25,7 @@ fn ctrl_c_stops_every_process_and_keeps_the_results() {
     let (status, stdout, stderr) = run.child("run").wait();
     // Exit 128 + SIGINT, as a shell reports an interrupted command.
     assert_eq!(status.code(), Some(130), "{stdout}\n{stderr}");
-    assert!(stdout.contains("SIGINT received"), "{stdout}");
+    assert!(stderr.contains("SIGINT received"), "{stderr}");
     assert_eq!(summary(&out)["ending"], "interrupted");
     assert_eq!(summary(&out)["exit_code"], 130);
     for pid in children {
@@ -122,4 +122,36 @@ fn bad_configurations_are_refused_at_start_with_the_key_named() {
         assert!(stderr.contains(expected), "{toml}: {stderr}");
         assert!(!out.exists(), "a refused run made its results folder");
     }
+}
+
+/// `bench pipeline --json` prints the JSON alone on stdout (the run's own lines go to stderr).
+#[test]
+fn bench_pipeline_json_is_json_alone() {
+    let mut run = Run::new("pipeline_json");
+    let out = run.dir.join("bench").display().to_string();
+    let (status, stdout, stderr) = run.run_to_end(
+        "bench",
+        &[
+            "bench",
+            "pipeline",
+            "--width",
+            "256",
+            "--height",
+            "256",
+            "--fps",
+            "10",
+            "--seconds",
+            "5",
+            "--threads",
+            "1",
+            "--out",
+            &out,
+            "--json",
+        ],
+    );
+    assert!(status.success(), "{stderr}");
+    let json: serde_json::Value = serde_json::from_str(stdout.trim())
+        .unwrap_or_else(|e| panic!("stdout is not JSON alone ({e}):\n{stdout}"));
+    assert!(json["frames"].as_u64().is_some_and(|f| f > 0), "{json}");
+    assert!(stderr.contains("run: results in"), "{stderr}");
 }

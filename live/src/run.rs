@@ -287,7 +287,7 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
     config.validate()?;
     let cleaned = remove_dead_runs();
     if cleaned > 0 {
-        println!(
+        eprintln!(
             "run: removed the shared memory of {cleaned} earlier run(s) that did not end cleanly"
         );
     }
@@ -313,7 +313,7 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
         )
         .as_bytes(),
     )?;
-    println!(
+    eprintln!(
         "run: results in {}, instance {instance_name}, campaign {} (about {:.0} s)",
         results.root.display(),
         config.campaign_spec(),
@@ -408,7 +408,7 @@ fn start_children(
         if !supervisor.wait_ready(role, READY_TIMEOUT)? {
             return Ok(false);
         }
-        println!(
+        eprintln!(
             "run: {} ready (pid {})",
             role.name(),
             supervisor.pid(role).unwrap_or(0)
@@ -443,7 +443,7 @@ enum Phase {
 
 /// How the loop ends when a termination signal has arrived.
 fn interrupted(signal: i32) -> Ending {
-    println!(
+    eprintln!(
         "run: {} received, stopping the processes",
         wire::signals::name(signal)
     );
@@ -521,7 +521,7 @@ fn event_loop(
         for exit in supervisor.take_exits() {
             let campaign_done = exit.role == Role::Rig && exit.success;
             if campaign_done && matches!(phase, Phase::Running) {
-                println!("run: campaign finished; stopping the camera, finishing the last frames");
+                eprintln!("run: campaign finished; stopping the camera, finishing the last frames");
                 supervisor.stop(Role::Producer, stop_timeout);
                 subscriptions.drain(recorder)?;
                 phase = Phase::Draining {
@@ -658,7 +658,7 @@ fn handle_death(
         config.run.max_restarts,
         exit.how
     );
-    println!("run: {note}");
+    eprintln!("run: {note}");
     state.restarts.push(note);
     Ok(())
 }
