@@ -43,6 +43,26 @@ pub enum Model {
 
 /// Default Rivlin terms when none are given: C10, C01, C20, C11.
 pub const DEFAULT_RIVLIN_TERMS: [(u32, u32); 4] = [(1, 0), (0, 1), (2, 0), (1, 1)];
+/// The Rivlin terms (ij of C_ij) of the 3-, 5- and 9-constant Mooney-Rivlin forms of FE codes
+/// (`mooney-rivlin:3|5|9`; `mooney-rivlin:2` is [`Model::Mooney`]).
+pub const MOONEY_RIVLIN_TERMS: [(usize, &[(u32, u32)]); 3] = [
+    (3, &[(1, 0), (0, 1), (1, 1)]),
+    (5, &[(1, 0), (0, 1), (2, 0), (1, 1), (0, 2)]),
+    (
+        9,
+        &[
+            (1, 0),
+            (0, 1),
+            (2, 0),
+            (1, 1),
+            (0, 2),
+            (3, 0),
+            (2, 1),
+            (1, 2),
+            (0, 3),
+        ],
+    ),
+];
 /// Highest Ogden term count accepted.
 pub const MAX_OGDEN_TERMS: usize = 6;
 
@@ -84,7 +104,17 @@ impl Model {
         };
         match head.as_str() {
             "neo-hookean" | "neohookean" | "neo_hookean" => no_arg(Model::NeoHookean),
-            "mooney" | "mooney-rivlin" => no_arg(Model::Mooney),
+            "mooney" | "mooney-rivlin" => match arg.as_deref() {
+                None | Some("2") => Ok(Model::Mooney),
+                // The Mooney-Rivlin forms of FE codes, by their count of constants.
+                Some(n) => MOONEY_RIVLIN_TERMS
+                    .iter()
+                    .find(|(count, _)| count.to_string() == n.trim())
+                    .map(|(_, terms)| Model::Rivlin(terms.to_vec()))
+                    .ok_or_else(|| {
+                        format!("model `{name}`: Mooney-Rivlin takes 2, 3, 5 or 9 constants")
+                    }),
+            },
             "isihara" => no_arg(Model::Isihara),
             "rivlin-saunders" | "rivlin_saunders" => no_arg(Model::RivlinSaunders),
             "gent-thomas" | "gent_thomas" => no_arg(Model::GentThomas),
@@ -132,7 +162,8 @@ impl Model {
                 }
             }
             _ => Err(format!(
-                "unknown model `{name}`; expected one of neo-hookean, mooney, rivlin[:ij,..], isihara, \
+                "unknown model `{name}`; expected one of neo-hookean, mooney (= mooney-rivlin:2), \
+                 mooney-rivlin:3|5|9, rivlin[:ij,..], isihara, \
                  rivlin-saunders, gent-thomas, biderman, hart-smith, alexander, yeoh, ogden[:N], gent, \
                  arruda-boyce, lambert-diani-rey[:NF,NG], or all"
             )),
@@ -380,6 +411,17 @@ mod tests {
             assert_eq!(Model::parse(&m.name()).unwrap(), m);
         }
         let list = parse_model_list("mooney,rivlin:10,01,11,ogden:2,ldr:3,1").unwrap();
+        assert_eq!(Model::parse("mooney-rivlin:2").unwrap(), Model::Mooney);
+        assert_eq!(
+            Model::parse("Mooney-Rivlin:3").unwrap(),
+            Model::Rivlin(vec![(1, 0), (0, 1), (1, 1)])
+        );
+        assert!(
+            matches!(Model::parse("mooney-rivlin:9").unwrap(), Model::Rivlin(t) if t.len() == 9)
+        );
+        assert!(Model::parse("mooney-rivlin:4")
+            .unwrap_err()
+            .contains("2, 3, 5 or 9"));
         assert_eq!(list.len(), 4);
         assert_eq!(list[1], Model::Rivlin(vec![(1, 0), (0, 1), (1, 1)]));
         assert_eq!(
