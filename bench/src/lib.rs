@@ -1,1 +1,3 @@
 //! Shared helpers for the dicstream benchmarks.
+
+#![forbid(unsafe_code)]

@@ -16,6 +16,8 @@
 //! - [`report`]: JSON of fits, atomic file writes.
 //! - [`subsample`]: the documented limit on fitted points and the load-path-preserving subsample.
 
+#![forbid(unsafe_code)]
+
 pub mod data;
 pub mod fit;
 pub mod gradient;

@@ -8,6 +8,8 @@
 //! The material is incompressible: λ1 λ2 λ3 = 1. Cauchy stress (eqs 16-17), principal axes:
 //! σ_i = 2 f λ_i² − 2 g λ_i⁻² − p, with p fixed by the free surface σ3 = 0.
 
+#![forbid(unsafe_code)]
+
 /// One of the two invariant derivatives f(I1) or g(I2).
 #[derive(Clone, Debug, PartialEq)]
 pub enum InvariantFn {

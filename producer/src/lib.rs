@@ -3,6 +3,8 @@
 //! Pure library, no IPC, except the thin streaming shell (`stream`), which publishes what a
 //! [`FrameSource`] (scenario, replay) or the rig-driven [`RigCamera`] renders.
 
+#![forbid(unsafe_code)]
+
 pub mod camera;
 mod cli;
 mod error;

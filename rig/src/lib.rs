@@ -2,6 +2,8 @@
 //! shared power station, PIDF control with centroid mode, programs, limits and a hyperelastic
 //! specimen. A deterministic library stepped in simulated time; the process shell is separate.
 
+#![forbid(unsafe_code)]
+
 pub mod actuator;
 pub mod builtin;
 pub mod campaign;
