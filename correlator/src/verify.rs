@@ -82,7 +82,8 @@ pub fn zncc(
         sfg += sums[4] as f64;
     }
     let count = count as f64;
-    let side = n.div_ceil(stride) - first / stride;
+    // Samples per side: first, first + stride, ... below n (any n, not only 2^s).
+    let side = (n - first).div_ceil(stride);
     if count < MIN_INSIDE_FRACTION * (side * side) as f64 {
         return None;
     }
