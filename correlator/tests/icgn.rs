@@ -8,14 +8,11 @@
 
 mod common;
 
-use common::{accuracy, mean_std, render, shared_data, stretch, translation};
+use common::{
+    accuracy, command_columns, load, mean_std, render, shared_data, stretch, translation,
+};
 use correlator::settings::Method;
 use correlator::{Correlator, CorrelatorSettings, Field, NodeStatus, ReferenceMode, Roi};
-
-fn load(path: std::path::PathBuf) -> (Vec<u16>, usize, usize) {
-    let image = producer::read_image(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    (image.pixels, image.width as usize, image.height as usize)
-}
 
 fn settings(method: Method, zoi_px: usize, step_px: usize) -> CorrelatorSettings {
     CorrelatorSettings {
@@ -79,15 +76,7 @@ fn sample14_chirp_rms_at_33_px() {
     let Some(data) = shared_data() else { return };
     let dir = data.join("dic-challenge/sample14");
     let (reference, w, h) = load(dir.join("Sample14 Reference.tif"));
-    let command = std::fs::read_to_string(dir.join("command.csv")).unwrap();
-    let columns: Vec<Vec<f64>> = command
-        .lines()
-        .map(|line| {
-            line.split(',')
-                .map(|v| v.trim().parse::<f64>().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
+    let columns = command_columns(dir.join("command.csv"));
     assert_eq!(columns.len(), w, "command.csv rows");
     println!("| sample 14 RMS(u - command), 150 <= x <= 1900 | L1 | L3 | L5 |");
     let mut worst = 0.0f64;
@@ -97,11 +86,7 @@ fn sample14_chirp_rms_at_33_px() {
         for (variant, column) in [("L1", 1), ("L3", 3), ("L5", 5)] {
             let (deformed, _, _) = load(dir.join(format!("Sample14 {variant} Amp0.1b.tif")));
             let u_command: Vec<f64> = columns.iter().map(|c| c[column]).collect();
-            let interp = |x: f64| {
-                let i = (x.floor() as usize).min(w - 2);
-                let t = x - i as f64;
-                u_command[i] * (1.0 - t) + u_command[i + 1] * t
-            };
+            let interp = |x: f64| common::linear(&u_command, x);
             let s = CorrelatorSettings {
                 roi: Some(Roi {
                     x_px: 0,

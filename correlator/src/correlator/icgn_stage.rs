@@ -180,15 +180,8 @@ impl Correlator {
             let guess = Warp::affine(entry.guess_px, entry.gradient);
             let outcome = icgn::solve(&subset, order, coefficients, guess, max_iterations);
             timer.lap(&mut engine.split.iterations_ns);
-            let (u, v) = outcome.warp.displacement();
-            let mut result = ZoiResult {
-                u_px: u,
-                v_px: v,
-                score: outcome.zncc,
-                iterations: outcome.iterations,
-                status: outcome.status,
-                warp_gradient: outcome.warp.gradient(),
-            };
+            let mut result = zoi_result(&outcome);
+            let (u, v) = (result.u_px, result.v_px);
             let mut score = 0.0;
             if result.status == NodeStatus::Ok {
                 // Through the node's own gradient, or the guess's (smoother than a noisy
@@ -262,14 +255,20 @@ impl OriginIcgn<'_> {
             Warp::affine(guess_px, gradient),
             self.max_iterations,
         );
-        let (u, v) = outcome.warp.displacement();
-        ZoiResult {
-            u_px: u,
-            v_px: v,
-            score: outcome.zncc,
-            iterations: outcome.iterations,
-            status: outcome.status,
-            warp_gradient: outcome.warp.gradient(),
-        }
+        zoi_result(&outcome)
+    }
+}
+
+/// IC-GN's outcome as a node result: the displacement of the subset centre, the ZNCC of the
+/// last samples as the score, and the shape function's gradient as the node's gradient.
+fn zoi_result(outcome: &icgn::Outcome) -> ZoiResult {
+    let (u, v) = outcome.warp.displacement();
+    ZoiResult {
+        u_px: u,
+        v_px: v,
+        score: outcome.zncc,
+        iterations: outcome.iterations,
+        status: outcome.status,
+        warp_gradient: outcome.warp.gradient(),
     }
 }

@@ -60,6 +60,39 @@ struct Sums {
     jg: [f64; 12],
 }
 
+/// One row's sums, in f32: Σ g', Σ g'², Σ f̂ g', Σ ∂f̂/∂x g' times 1, dx, dx² and the same
+/// with ∂f̂/∂y (the dx² sums for the second order only).
+#[derive(Default)]
+struct RowSums {
+    g: f32,
+    gg: f32,
+    fg: f32,
+    x: f32,
+    xd: f32,
+    xdd: f32,
+    y: f32,
+    yd: f32,
+    ydd: f32,
+}
+
+impl RowSums {
+    #[inline(always)]
+    fn add<const SECOND: bool>(&mut self, f: f32, fx: f32, fy: f32, g: f32, dx: f32) {
+        let (fx, fy) = (fx * g, fy * g);
+        self.g += g;
+        self.gg += g * g;
+        self.fg += f * g;
+        self.x += fx;
+        self.xd += fx * dx;
+        self.y += fy;
+        self.yd += fy * dx;
+        if SECOND {
+            self.xdd += fx * dx * dx;
+            self.ydd += fy * dx * dx;
+        }
+    }
+}
+
 /// The deformed image's value at (x, y) (B-spline), None outside [0, w − 1] x [0, h − 1].
 #[inline(always)]
 fn sample(c: &Coefficients, x: f64, y: f64) -> Option<f32> {
@@ -97,10 +130,7 @@ fn evaluate(
         let dy = j as f64 - half;
         let row = j * n..(j + 1) * n;
         let (f_row, gx_row, gy_row) = (&values[row.clone()], &gx[row.clone()], &gy[row]);
-        // Per row, in f32: Σ g', Σ g'², Σ f̂ g', Σ ∂f̂/∂x g' (times 1, dx, dx²), the same in y.
-        let (mut sg, mut sgg, mut sfg) = (0.0f32, 0.0f32, 0.0f32);
-        let (mut ax, mut axd, mut axdd) = (0.0f32, 0.0f32, 0.0f32);
-        let (mut ay, mut ayd, mut aydd) = (0.0f32, 0.0f32, 0.0f32);
+        let mut r = RowSums::default();
         match order {
             Order::First => {
                 // Affine: the samples of a row are evenly spaced.
@@ -111,73 +141,48 @@ fn evaluate(
                 let (step_x, step_y) = (1.0 + p[1], p[7]);
                 for i in 0..n {
                     let g = sample(coefficients, x, y)? - mean;
-                    let dx = i as f32 - half as f32;
-                    let (fx, fy) = (gx_row[i] * g, gy_row[i] * g);
-                    sg += g;
-                    sgg += g * g;
-                    sfg += f_row[i] * g;
-                    ax += fx;
-                    axd += fx * dx;
-                    ay += fy;
-                    ayd += fy * dx;
+                    r.add::<false>(f_row[i], gx_row[i], gy_row[i], g, i as f32 - half as f32);
                     x += step_x;
                     y += step_y;
                 }
             }
             Order::Second => {
                 for i in 0..n {
-                    let dxf = i as f64 - half;
-                    let (wx, wy) = warp.apply(dxf, dy);
+                    let dx = i as f64 - half;
+                    let (wx, wy) = warp.apply(dx, dy);
                     let g = sample(coefficients, cx + wx, cy + wy)? - mean;
-                    let dx = dxf as f32;
-                    let (fx, fy) = (gx_row[i] * g, gy_row[i] * g);
-                    sg += g;
-                    sgg += g * g;
-                    sfg += f_row[i] * g;
-                    ax += fx;
-                    axd += fx * dx;
-                    axdd += fx * dx * dx;
-                    ay += fy;
-                    ayd += fy * dx;
-                    aydd += fy * dx * dx;
+                    r.add::<true>(f_row[i], gx_row[i], gy_row[i], g, dx as f32);
                 }
             }
         }
-        sums.g += sg as f64;
-        sums.gg += sgg as f64;
-        sums.fg += sfg as f64;
+        sums.g += r.g as f64;
+        sums.gg += r.gg as f64;
+        sums.fg += r.fg as f64;
         let (ax, axd, axdd, ay, ayd, aydd) = (
-            ax as f64,
-            axd as f64,
-            axdd as f64,
-            ay as f64,
-            ayd as f64,
-            aydd as f64,
+            r.x as f64,
+            r.xd as f64,
+            r.xdd as f64,
+            r.y as f64,
+            r.yd as f64,
+            r.ydd as f64,
         );
         // Σ J g' in the order of `subset::steepest_descent`.
-        let jg = &mut sums.jg;
-        match order {
-            Order::First => {
-                jg[0] += ax;
-                jg[1] += axd;
-                jg[2] += dy * ax;
-                jg[3] += ay;
-                jg[4] += ayd;
-                jg[5] += dy * ay;
-            }
-            Order::Second => {
-                jg[0] += ax;
-                jg[1] += axd;
-                jg[2] += dy * ax;
-                jg[3] += 0.5 * axdd;
-                jg[4] += dy * axd;
-                jg[5] += 0.5 * dy * dy * ax;
-                jg[6] += ay;
-                jg[7] += ayd;
-                jg[8] += dy * ay;
-                jg[9] += 0.5 * aydd;
-                jg[10] += dy * ayd;
-                jg[11] += 0.5 * dy * dy * ay;
+        // Per gradient component: the first-order terms (1, dx, dy) and the second-order ones
+        // (dx²/2, dx dy, dy²/2).
+        let first = |a: f64, ad: f64| [a, ad, dy * a];
+        let second = |a: f64, ad: f64, add: f64| [0.5 * add, dy * ad, 0.5 * dy * dy * a];
+        let terms: &[[f64; 3]] = match order {
+            Order::First => &[first(ax, axd), first(ay, ayd)],
+            Order::Second => &[
+                first(ax, axd),
+                second(ax, axd, axdd),
+                first(ay, ayd),
+                second(ay, ayd, aydd),
+            ],
+        };
+        for (jg, term) in sums.jg.chunks_exact_mut(3).zip(terms) {
+            for (j, t) in jg.iter_mut().zip(term) {
+                *j += t;
             }
         }
     }
@@ -252,11 +257,7 @@ mod tests {
     use super::*;
     use crate::zoi::Image;
 
-    fn texture(x: f64, y: f64) -> f64 {
-        20000.0
-            + 8000.0 * (0.9 * x + 0.3 * y).sin() * (0.5 * y - 0.2 * x).cos()
-            + 5000.0 * (0.37 * x * x / 40.0 + 0.61 * y).sin()
-    }
+    use crate::verify::tests::texture;
 
     /// A deformed image of the analytic texture under a known affine map: IC-GN recovers the
     /// displacement and gradient at the subset centre from a guess 0.6 px away and no gradient,
