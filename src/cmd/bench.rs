@@ -43,7 +43,7 @@ pub struct CorrelateBenchArgs {
     pub zoi: usize,
     /// Correlate these two image files (reference, deformed) instead of rendered speckle, over
     /// the whole image (e.g. DIC Challenge sample 14).
-    #[arg(long, value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_delimiter = ',')]
     pub images: Option<Vec<std::path::PathBuf>>,
     /// Distance between ZOI centres in px.
     #[arg(long, default_value_t = 16)]
@@ -119,6 +119,9 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
     let t = Instant::now();
     let (reference, deformed, w, h, source) = match &args.images {
         Some(files) => {
+            if files.len() != 2 {
+                bail!("--images: expected two files, REF,DEF (got {})", files.len());
+            }
             let reference = super::correlate::load(&files[0])?;
             let deformed = super::correlate::load(&files[1])?;
             if (reference.width, reference.height) != (deformed.width, deformed.height) {
