@@ -120,7 +120,10 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
     let (reference, deformed, w, h, source) = match &args.images {
         Some(files) => {
             if files.len() != 2 {
-                bail!("--images: expected two files, REF,DEF (got {})", files.len());
+                bail!(
+                    "--images: expected two files, REF,DEF (got {})",
+                    files.len()
+                );
             }
             let reference = super::correlate::load(&files[0])?;
             let deformed = super::correlate::load(&files[1])?;
