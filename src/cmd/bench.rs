@@ -464,8 +464,17 @@ fn field_len(correlator: &Correlator) -> usize {
 }
 
 fn print_run(r: &ThreadRun) {
+    // Image files carry no truth: no mean error then.
+    let error = if r.error_px[0].is_finite() {
+        format!(
+            "mean error u {:+.4} v {:+.4} px",
+            r.error_px[0], r.error_px[1]
+        )
+    } else {
+        "no truth for image files".to_owned()
+    };
     println!(
-        "  {} thread(s): {:8.0} ZOIs/s, {:6.2} frames/s, {:7.2} ms/frame (min {:.2}, max {:.2}); {} ZOIs, {} valid, {:.2} iterations/ZOI, mean error u {:+.4} v {:+.4} px; set_reference {:.1} ms",
+        "  {} thread(s): {:8.0} ZOIs/s, {:6.2} frames/s, {:7.2} ms/frame (min {:.2}, max {:.2}); {} ZOIs, {} valid, {:.2} iterations/ZOI, {error}; set_reference {:.1} ms",
         r.threads,
         r.nodes as f64 / r.median_s,
         1.0 / r.median_s,
@@ -475,8 +484,6 @@ fn print_run(r: &ThreadRun) {
         r.nodes,
         r.valid,
         r.mean_iterations,
-        r.error_px[0],
-        r.error_px[1],
         r.set_reference_ms
     );
 }
