@@ -154,6 +154,67 @@ fn fields_and_summary_follow_the_contract() {
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
 
+/// `--method icgn1` takes an odd subset (the summary says which method ran, nodes sit on
+/// pixels); `--method correli` refuses it and points to IC-GN.
+#[test]
+fn method_icgn1_takes_any_subset_size() {
+    let dir = TempDir::new("method");
+    let (u, v) = (0.41, -0.27);
+    let reference = dir.0.join("ref.png");
+    let deformed = dir.0.join("def.png");
+    write_png(&reference, &render(W, H, &translation(0.0, 0.0).0, 1), W, H);
+    write_png(&deformed, &render(W, H, &translation(u, v).0, 2), W, H);
+    let out = dir.0.join("out");
+    let run = |method: &str| {
+        dicstream(&[
+            "correlate",
+            path(&reference),
+            path(&deformed),
+            "--method",
+            method,
+            "--zoi",
+            "33",
+            "--out",
+            path(&out),
+        ])
+    };
+    let output = run("icgn1");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["settings"]["method"], "icgn1");
+    assert_eq!(summary["settings"]["zoi"], 33);
+    let frame = &summary["frames"][0];
+    assert_eq!(frame["nodes"], frame["valid"]);
+    assert!(
+        (frame["u_mean"].as_f64().unwrap() - u).abs() < 0.01,
+        "{frame}"
+    );
+    assert!(
+        (frame["v_mean"].as_f64().unwrap() - v).abs() < 0.01,
+        "{frame}"
+    );
+    let csv = std::fs::read_to_string(out.join("field_0001.csv")).unwrap();
+    let x: f64 = csv
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(x.fract(), 0.0, "an odd subset is centred on a pixel: {x}");
+    let output = run("correli");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success());
+    assert!(
+        stderr.contains("not a power of two") && stderr.contains("--method icgn1"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn bad_inputs_are_clear_errors() {
     let dir = TempDir::new("bad");

@@ -1,16 +1,19 @@
 //! The correlator: mesh, reference cache, worker pool, guesses, reference modes, strains.
 
 mod growth;
+mod icgn_stage;
 mod reanchor;
 
 use crate::field::{Field, Node, NodeStatus};
 use crate::global::{GlobalCorrelator, GlobalMiss};
-use crate::interpolate::Mat2;
+use crate::icgn::bspline::Coefficients;
+use crate::icgn::subset::SubsetStats;
+use crate::interpolate::{identity_plus, Mat2};
 use crate::keypoints::{KeypointMatcher, KeypointSet};
 use crate::mesh::Mesh;
 use crate::pool::{Pool, SharedSlice};
 use crate::settings::{CorrelatorSettings, GuessMode, ReferenceMode, Roi, SettingsError};
-use crate::strain::{gauge, node_strains, AffineSums};
+use crate::strain::{gauge, node_strains_and_gradients, strains_from_gradients, AffineSums};
 use crate::zoi::{
     spectrum_len, GradientSensitivity, Image, ReferenceSpectra, TimeSplit, ZoiResult,
 };
@@ -25,6 +28,8 @@ struct RefNode {
     offset_px: (f64, f64),
     /// Total displacement of the node when the current reference was taken (px).
     base_px: (f64, f64),
+    /// Total displacement gradient of the node then (against the origin).
+    base_gradient: Mat2,
     /// Ok, or why this node cannot be correlated against this reference.
     status: NodeStatus,
 }
@@ -117,6 +122,19 @@ fn to_mat2(g: nalgebra::Matrix2<f64>) -> Mat2 {
     [[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]
 }
 
+/// (I + a)(I + b) − I: the total gradient of a gradient `a` measured against a reference
+/// whose own gradient was `b`.
+fn compose_gradients(a: Mat2, b: Mat2) -> Mat2 {
+    let (fa, fb) = (identity_plus(a), identity_plus(b));
+    let mut out = [[0.0; 2]; 2];
+    for (r, row) in out.iter_mut().enumerate() {
+        for (c, value) in row.iter_mut().enumerate() {
+            *value = fa[r][0] * fb[0][c] + fa[r][1] * fb[1][c] - if r == c { 1.0 } else { 0.0 };
+        }
+    }
+    out
+}
+
 /// Which valid nodes an affine fit may use.
 #[derive(Clone, Copy)]
 enum Support {
@@ -139,6 +157,25 @@ pub struct Correlator {
     width_px: usize,
     height_px: usize,
     roi: Roi,
+    /// Side of the FFT ZOIs (the guess for IC-GN) and their offset inside the node's ZOI or
+    /// subset ((zoi − fft) / 2 px, both axes).
+    fft_px: usize,
+    fft_pad_px: usize,
+    /// IC-GN: the B-spline coefficients of the image being correlated (the reference's while
+    /// a reference is prepared), made in `new`.
+    coefficients: Option<Coefficients>,
+    /// IC-GN: the B-spline coefficients of the origin (the frame the mesh was defined in),
+    /// while it is known, for the measurements against it (`reanchor`).
+    origin_coefficients: Option<Coefficients>,
+    /// IC-GN: per node, the reference subset's f̂, ∂f̂/∂x, ∂f̂/∂y (3 n² values) and constants.
+    subset_planes: Vec<f32>,
+    subset_stats: Vec<SubsetStats>,
+    /// IC-GN: each node's gradient against the current reference in the last frame (the next
+    /// frame's guess), None when unknown.
+    previous_gradient: Vec<Option<Mat2>>,
+    /// The prefilter's time, for the time split (profiling only).
+    profiling: bool,
+    coefficients_ns: u64,
     mesh: Mesh,
     pool: Pool,
     global: GlobalCorrelator,
@@ -211,12 +248,20 @@ impl Correlator {
         let roi = settings.resolve_roi(width_px, height_px)?;
         let mesh = Mesh::new(roi, settings.zoi_px, settings.step_px);
         let nodes = mesh.len();
-        let n2 = spectrum_len(settings.zoi_px);
+        let fft_px = settings.fft_zoi_px();
+        let n2 = spectrum_len(fft_px);
+        let icgn = settings.method.is_icgn();
+        let subset_values = if icgn {
+            crate::icgn::subset::PLANES * settings.zoi_px * settings.zoi_px
+        } else {
+            0
+        };
         let zero = Complex32::new(0.0, 0.0);
         let mut field = Field {
             nx: mesh.nx,
             ny: mesh.ny,
             nodes: vec![Node::default(); nodes],
+            gradients: vec![[[0.0; 2]; 2]; nodes],
             ..Field::default()
         };
         for (k, node) in field.nodes.iter_mut().enumerate() {
@@ -231,14 +276,23 @@ impl Correlator {
             })
             .collect();
         Ok(Self {
-            pool: Pool::new(settings.threads, settings.zoi_px),
+            pool: Pool::new(settings.threads, fft_px, subset_values),
+            fft_px,
+            fft_pad_px: (settings.zoi_px - fft_px) / 2,
+            coefficients: icgn.then(|| Coefficients::new(width_px, height_px)),
+            origin_coefficients: icgn.then(|| Coefficients::new(width_px, height_px)),
+            subset_planes: vec![0.0; nodes * subset_values],
+            subset_stats: vec![SubsetStats::default(); if icgn { nodes } else { 0 }],
+            previous_gradient: vec![None; nodes],
+            profiling: false,
+            coefficients_ns: 0,
             global: GlobalCorrelator::new(roi),
             global_reference_stale: true,
             reference_pixels: vec![0; width_px * height_px],
             has_reference: false,
             ref_nodes,
             plain_spectra: vec![zero; nodes * n2],
-            windowed_references: vec![0.0; nodes * settings.zoi_px * settings.zoi_px],
+            windowed_references: vec![0.0; nodes * fft_px * fft_px],
             sensitivities: vec![GradientSensitivity::default(); nodes],
             guesses: vec![(0.0, 0.0); nodes],
             results: vec![ZoiResult::default(); nodes],
@@ -321,7 +375,8 @@ impl Correlator {
         self.origin_known = true;
         self.reference_is_origin = true;
         self.origin_generation += 1;
-        self.take_reference(pixels);
+        self.take_reference(pixels, false);
+        self.origin_coefficients_from_reference();
         Ok(())
     }
 
@@ -399,7 +454,14 @@ impl Correlator {
             self.origin_pixels.copy_from_slice(pixels);
             self.origin_generation += 1;
         }
-        self.take_reference(pixels);
+        // The gradient at each base: the least-squares fit of the saved bases around it.
+        for k in 0..self.ref_nodes.len() {
+            self.ref_nodes[k].base_gradient = self.base_fit_gradient(k);
+        }
+        self.take_reference(pixels, false);
+        if self.reference_is_origin {
+            self.origin_coefficients_from_reference();
+        }
         Ok(())
     }
 
@@ -422,14 +484,38 @@ impl Correlator {
         self.origin_pixels.copy_from_slice(pixels);
         self.origin_known = true;
         self.origin_generation += 1;
+        if let Some(mut origin) = self.origin_coefficients.take() {
+            self.prefilter_into(&mut origin, pixels);
+            self.origin_coefficients = Some(origin);
+        }
         Ok(())
     }
 
-    /// Copies the pixels as the current reference and prepares the spectra of every node at its
-    /// followed position (`ref_nodes[k].base_px` must be set).
-    fn take_reference(&mut self, pixels: &[u16]) {
+    /// Least-squares gradient of the bases of the nodes around k (3x3), zero when none.
+    fn base_fit_gradient(&self, k: usize) -> Mat2 {
+        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
+        let (i, j) = (k % nx, k / nx);
+        let mut sums = AffineSums::default();
+        for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
+            for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
+                let m = jj * nx + ii;
+                let (a, b) = (&self.field.nodes[m], &self.field.nodes[k]);
+                let base = self.ref_nodes[m].base_px;
+                sums.add(a.x_px - b.x_px, a.y_px - b.y_px, base.0, base.1);
+            }
+        }
+        sums.gradient().map_or([[0.0; 2]; 2], to_mat2)
+    }
+
+    /// Copies the pixels as the current reference and prepares the spectra (and IC-GN subsets)
+    /// of every node at its followed position (`ref_nodes[k].base_px` must be set).
+    /// `coefficients_hold_pixels`: the B-spline coefficients are already those of `pixels`
+    /// (the frame just correlated becomes the reference).
+    fn take_reference(&mut self, pixels: &[u16], coefficients_hold_pixels: bool) {
         self.reference_pixels.copy_from_slice(pixels);
+        self.previous_gradient.fill(None);
         let n = self.settings.zoi_px;
+        let (fft, pad) = (self.fft_px, self.fft_pad_px);
         let half = (n as f64 - 1.0) / 2.0;
         let image = Image {
             pixels: &self.reference_pixels,
@@ -452,7 +538,7 @@ impl Correlator {
         }
         self.global_reference_stale = true;
         self.reference_keypoints = None;
-        let n2 = spectrum_len(n);
+        let n2 = spectrum_len(fft);
         let plain = SharedSlice::new(&mut self.plain_spectra);
         let windowed = SharedSlice::new(&mut self.windowed_references);
         let sensitivities = SharedSlice::new(&mut self.sensitivities);
@@ -463,17 +549,23 @@ impl Correlator {
             if r.status != NodeStatus::Ok {
                 return;
             }
-            let nn = n * n;
+            let nn = fft * fft;
             let (p, w) = unsafe { (plain.slice_mut(k * n2, n2), windowed.slice_mut(k * nn, nn)) };
             let mut sensitivity = GradientSensitivity::default();
-            let ok =
-                engine.prepare_reference(image, r.top_left.0, r.top_left.1, p, w, &mut sensitivity);
+            let (x0, y0) = (r.top_left.0 + pad, r.top_left.1 + pad);
+            let ok = engine.prepare_reference(image, x0, y0, p, w, &mut sensitivity);
             unsafe { sensitivities.write(k, sensitivity) };
             if !ok {
                 r.status = NodeStatus::LowContrast;
                 unsafe { ref_nodes.write(k, r) };
             }
         });
+        if self.settings.method.is_icgn() {
+            if !coefficients_hold_pixels {
+                self.prefilter(pixels);
+            }
+            self.prepare_subsets();
+        }
         self.has_reference = true;
         self.frames_since_reference = 0;
     }
@@ -490,10 +582,17 @@ impl Correlator {
             height_px: self.height_px,
         };
         self.field.keypoints_used = false;
+        let icgn = self.settings.method.is_icgn();
+        if icgn {
+            self.prefilter(pixels);
+        }
         self.run_zois(image);
         self.verify_results(image);
         if self.settings.guess == GuessMode::Auto {
             self.improve(image);
+        }
+        if icgn {
+            self.refine_icgn(image);
         }
         self.assemble(image);
         self.update_reference(pixels);
@@ -501,7 +600,7 @@ impl Correlator {
     }
 
     fn run_zois(&mut self, image: Image) {
-        let n = self.settings.zoi_px;
+        let (n, pad) = (self.fft_px, self.fft_pad_px);
         let n2 = spectrum_len(n);
         let max_iterations = self.settings.max_iterations;
         let use_previous = self.settings.guess != GuessMode::Correli && self.has_previous;
@@ -569,6 +668,14 @@ impl Correlator {
         let windowed = &self.windowed_references;
         let ref_nodes = &self.ref_nodes;
         let guesses = &self.guesses;
+        // IC-GN with the previous field: the FFT ZOI is sampled through the node's last
+        // gradient.
+        let no_warps = [None];
+        let warps: &[Option<Mat2>] = if use_previous {
+            &self.previous_gradient
+        } else {
+            &no_warps
+        };
         let results = SharedSlice::new(&mut self.results);
         let correlate_node = |engine: &mut crate::zoi::ZoiEngine, k: usize, guess: (f64, f64)| {
             let r = ref_nodes[k];
@@ -585,10 +692,10 @@ impl Correlator {
                 engine.correlate(
                     &spectra,
                     image,
-                    r.top_left.0,
-                    r.top_left.1,
+                    r.top_left.0 + pad,
+                    r.top_left.1 + pad,
                     guess,
-                    None,
+                    warps.get(k).copied().flatten(),
                     max_iterations,
                 )
             };
@@ -685,13 +792,22 @@ impl Correlator {
         // First-order corrections with the local gradient ∇u of the results: the rigid ZOI's
         // estimate is u(centre) + K vec(∇u) (see `GradientSensitivity`), and the followed
         // point is off the ZOI centre by r: u(x + r) ≈ u(x) + ∇u r.
-        let correct_gradient = self.settings.gradient_correction;
+        // IC-GN measures the subset centre through its own gradient: no rigid-ZOI bias, and
+        // its own gradient carries the followed point.
+        let icgn = self.settings.method.is_icgn();
+        let correct_gradient = self.settings.gradient_correction && !icgn;
         for k in 0..nx * ny {
             let r = self.ref_nodes[k];
             let result = self.results[k];
             let mut u = (result.u_px, result.v_px);
             if result.status == NodeStatus::Ok {
-                if let Some(g) = self.result_gradient(k) {
+                let gradient = if icgn {
+                    let g = result.warp_gradient;
+                    Some(nalgebra::Matrix2::new(g[0][0], g[0][1], g[1][0], g[1][1]))
+                } else {
+                    self.result_gradient(k)
+                };
+                if let Some(g) = gradient {
                     if correct_gradient {
                         // A warped ZOI is biased only by the gradient beyond its warp.
                         let bias = self.sensitivities[k]
@@ -781,13 +897,31 @@ impl Correlator {
         self.field.valid = valid;
         self.field.u_mean_px = if valid > 0 { su / valid as f64 } else { 0.0 };
         self.field.v_mean_px = if valid > 0 { sv / valid as f64 } else { 0.0 };
-        node_strains(
-            &mut self.field.nodes,
-            nx,
-            ny,
-            self.settings.strain_window_nodes,
-            self.settings.strain,
-        );
+        if icgn {
+            for k in 0..nx * ny {
+                self.field.gradients[k] = if self.field.nodes[k].status == NodeStatus::Ok {
+                    compose_gradients(
+                        self.results[k].warp_gradient,
+                        self.ref_nodes[k].base_gradient,
+                    )
+                } else {
+                    [[0.0; 2]; 2]
+                };
+            }
+            strains_from_gradients(
+                &mut self.field.nodes,
+                &self.field.gradients,
+                self.settings.strain,
+            );
+        } else {
+            node_strains_and_gradients(
+                &mut self.field.nodes,
+                (nx, ny),
+                self.settings.strain_window_nodes,
+                self.settings.strain,
+                &mut self.field.gradients,
+            );
+        }
         self.field.gauge = gauge(&self.field.nodes);
         for (never_lost, node) in self.never_lost.iter_mut().zip(&self.field.nodes) {
             *never_lost &= node.status == NodeStatus::Ok;
@@ -795,6 +929,16 @@ impl Correlator {
         std::mem::swap(&mut self.previous, &mut self.previous2);
         for (p, node) in self.previous.iter_mut().zip(&self.field.nodes) {
             *p = (node.status == NodeStatus::Ok).then_some((node.u_px, node.v_px));
+        }
+        if icgn {
+            for ((g, node), result) in self
+                .previous_gradient
+                .iter_mut()
+                .zip(&self.field.nodes)
+                .zip(&self.results)
+            {
+                *g = (node.status == NodeStatus::Ok).then_some(result.warp_gradient);
+            }
         }
         self.has_previous = true;
     }
@@ -869,7 +1013,14 @@ impl Correlator {
         for (r, &base) in self.ref_nodes.iter_mut().zip(&self.scratch_pairs) {
             r.base_px = base;
         }
-        self.take_reference(pixels);
+        for k in 0..nx * ny {
+            self.ref_nodes[k].base_gradient = if self.field.nodes[k].status == NodeStatus::Ok {
+                self.field.gradients[k]
+            } else {
+                self.base_fit_gradient(k)
+            };
+        }
+        self.take_reference(pixels, self.settings.method.is_icgn());
         self.reference_is_origin = false;
         self.field.reference_updated = true;
     }
@@ -960,20 +1111,20 @@ impl Correlator {
 
     /// Sum of the engines' time splits (profiling must be switched on with `set_profiling`).
     pub fn time_split(&self) -> TimeSplit {
-        let mut total = TimeSplit::default();
+        let mut total = TimeSplit {
+            coefficients_ns: self.coefficients_ns,
+            ..TimeSplit::default()
+        };
         for i in 0..self.pool.threads() {
-            let s = self.pool.engine(i).split;
-            total.fft_ns += s.fft_ns;
-            total.window_ns += s.window_ns;
-            total.peak_ns += s.peak_ns;
-            total.shift_ns += s.shift_ns;
-            total.other_ns += s.other_ns;
+            total.add(&self.pool.engine(i).split);
         }
         total
     }
 
     /// Switches the per-engine time split on or off and resets it (benchmark only: reads the clock in the hot loop).
     pub fn set_profiling(&mut self, on: bool) {
+        self.profiling = on;
+        self.coefficients_ns = 0;
         for i in 0..self.pool.threads() {
             let mut engine = self.pool.engine(i);
             engine.profile = on;

@@ -120,6 +120,12 @@ pub struct Field {
     pub keypoints_used: bool,
     /// True when the reference was replaced after this frame (auto and incremental modes).
     pub reference_updated: bool,
+    /// Each node's total displacement gradient [[∂u/∂X, ∂u/∂Y], [∂v/∂X, ∂v/∂Y]] against the
+    /// frame the mesh was defined in, the one its strains come from: IC-GN's own shape function
+    /// (composed with the gradient at the current reference's base) for the IC-GN methods, the
+    /// least-squares gradient of the neighbouring nodes for `correli`; zero where the node is
+    /// not `ok`. The gauge is always the least-squares fit over all valid nodes.
+    pub gradients: Vec<[[f64; 2]; 2]>,
 }
 
 impl Field {

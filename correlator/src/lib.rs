@@ -28,6 +28,7 @@ mod correlator;
 mod fft2d;
 pub mod field;
 mod global;
+mod icgn;
 mod interpolate;
 pub mod keypoints;
 mod mesh;
@@ -48,7 +49,7 @@ mod zoi;
 pub use correlator::Correlator;
 pub use field::{Field, GaugeStrains, Node, NodeStatus, Strain2};
 pub use settings::{
-    CorrelatorSettings, GuessMode, ReferenceMode, Roi, SettingsError, StrainMeasure,
+    CorrelatorSettings, GuessMode, Method, ReferenceMode, Roi, SettingsError, StrainMeasure,
     DEFAULT_MIN_ZNCC,
 };
 pub use zoi::{Image, TimeSplit};

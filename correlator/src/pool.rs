@@ -43,10 +43,16 @@ pub struct Pool {
 }
 
 impl Pool {
-    pub fn new(threads: usize, zoi_px: usize) -> Self {
+    /// `threads` workers with an engine for ZOIs of `zoi_px` and `subset_scratch` values of
+    /// IC-GN scratch each.
+    pub fn new(threads: usize, zoi_px: usize, subset_scratch: usize) -> Self {
         assert!(threads >= 1);
         let engines = (0..threads)
-            .map(|_| Mutex::new(ZoiEngine::new(zoi_px)))
+            .map(|_| {
+                let mut engine = ZoiEngine::new(zoi_px);
+                engine.subset_scratch = vec![0.0; subset_scratch];
+                Mutex::new(engine)
+            })
             .collect();
         let shared = Arc::new(Shared {
             state: Mutex::new(State {
@@ -216,6 +222,13 @@ impl<T: Copy> SharedSlice<T> {
 }
 
 impl<T> SharedSlice<T> {
+    /// The first element, for items that split the slice in ways `slice_mut` cannot say
+    /// (strided columns).
+    #[inline]
+    pub fn as_mut_ptr(&self) -> *mut T {
+        self.ptr
+    }
+
     /// # Safety
     /// No other item of the running job may access `start..start + len`.
     #[inline]

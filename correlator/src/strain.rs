@@ -116,6 +116,46 @@ fn lagrangian(f: &Matrix2<f64>, m: f64) -> Matrix2<f64> {
     q * d * q.transpose()
 }
 
+/// Least-squares gradient of the valid nodes in the (2h+1) x (2h+1) window around node (i, j)
+/// (None when that node is not valid or the fit is impossible).
+fn window_gradient(
+    nodes: &[Node],
+    (nx, ny): (usize, usize),
+    half_window: usize,
+    (i, j): (usize, usize),
+) -> Option<Matrix2<f64>> {
+    let centre = nodes[j * nx + i];
+    if centre.status != NodeStatus::Ok {
+        return None;
+    }
+    let mut sums = AffineSums::default();
+    let (j0, j1) = (j.saturating_sub(half_window), (j + half_window).min(ny - 1));
+    let (i0, i1) = (i.saturating_sub(half_window), (i + half_window).min(nx - 1));
+    for jj in j0..=j1 {
+        for ii in i0..=i1 {
+            let node = &nodes[jj * nx + ii];
+            if node.status == NodeStatus::Ok {
+                sums.add(
+                    node.x_px - centre.x_px,
+                    node.y_px - centre.y_px,
+                    node.u_px,
+                    node.v_px,
+                );
+            }
+        }
+    }
+    sums.gradient()
+}
+
+fn set_strain(node: &mut Node, gradient: Option<Matrix2<f64>>, measure: StrainMeasure) {
+    let strain = gradient
+        .and_then(|g| strain_from_gradient(&g, measure))
+        .unwrap_or_default();
+    node.exx = strain.exx;
+    node.eyy = strain.eyy;
+    node.exy = strain.exy;
+}
+
 /// Fills exx, eyy, exy of every node from a least-squares gradient over the
 /// (2h+1) x (2h+1) window of valid nodes around it (zeros where the fit is impossible).
 pub fn node_strains(
@@ -126,36 +166,44 @@ pub fn node_strains(
     measure: StrainMeasure,
 ) {
     assert_eq!(nodes.len(), nx * ny);
-    for j in 0..ny {
-        for i in 0..nx {
-            let centre = nodes[j * nx + i];
-            let mut sums = AffineSums::default();
-            if centre.status == NodeStatus::Ok {
-                let (j0, j1) = (j.saturating_sub(half_window), (j + half_window).min(ny - 1));
-                let (i0, i1) = (i.saturating_sub(half_window), (i + half_window).min(nx - 1));
-                for jj in j0..=j1 {
-                    for ii in i0..=i1 {
-                        let node = &nodes[jj * nx + ii];
-                        if node.status == NodeStatus::Ok {
-                            sums.add(
-                                node.x_px - centre.x_px,
-                                node.y_px - centre.y_px,
-                                node.u_px,
-                                node.v_px,
-                            );
-                        }
-                    }
-                }
-            }
-            let strain = sums
-                .gradient()
-                .and_then(|g| strain_from_gradient(&g, measure))
-                .unwrap_or_default();
-            let node = &mut nodes[j * nx + i];
-            node.exx = strain.exx;
-            node.eyy = strain.eyy;
-            node.exy = strain.exy;
-        }
+    for k in 0..nx * ny {
+        let g = window_gradient(nodes, (nx, ny), half_window, (k % nx, k / nx));
+        set_strain(&mut nodes[k], g, measure);
+    }
+}
+
+/// [`node_strains`], also writing each node's least-squares gradient ([[∂u/∂x, ∂u/∂y],
+/// [∂v/∂x, ∂v/∂y]], zero where there is none) into `gradients`.
+pub fn node_strains_and_gradients(
+    nodes: &mut [Node],
+    (nx, ny): (usize, usize),
+    half_window: usize,
+    measure: StrainMeasure,
+    gradients: &mut [[[f64; 2]; 2]],
+) {
+    assert_eq!(nodes.len(), nx * ny);
+    assert_eq!(gradients.len(), nx * ny);
+    for k in 0..nx * ny {
+        let g = window_gradient(nodes, (nx, ny), half_window, (k % nx, k / nx));
+        gradients[k] = g.map_or([[0.0; 2]; 2], |g| {
+            [[g[(0, 0)], g[(0, 1)]], [g[(1, 0)], g[(1, 1)]]]
+        });
+        set_strain(&mut nodes[k], g, measure);
+    }
+}
+
+/// Fills exx, eyy, exy of every valid node from its own displacement gradient (IC-GN's),
+/// zeros elsewhere.
+pub fn strains_from_gradients(
+    nodes: &mut [Node],
+    gradients: &[[[f64; 2]; 2]],
+    measure: StrainMeasure,
+) {
+    assert_eq!(nodes.len(), gradients.len());
+    for (node, g) in nodes.iter_mut().zip(gradients) {
+        let gradient = (node.status == NodeStatus::Ok)
+            .then(|| Matrix2::new(g[0][0], g[0][1], g[1][0], g[1][1]));
+        set_strain(node, gradient, measure);
     }
 }
 

@@ -82,7 +82,8 @@ pub fn zncc(
         sfg += sums[4] as f64;
     }
     let count = count as f64;
-    let side = n.div_ceil(stride) - first / stride;
+    // Samples per side: first, first + stride, ... below n (any n, not only 2^s).
+    let side = (n - first).div_ceil(stride);
     if count < MIN_INSIDE_FRACTION * (side * side) as f64 {
         return None;
     }
@@ -98,10 +99,11 @@ pub fn zncc(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn texture(x: f64, y: f64) -> f64 {
+    /// A smooth analytic texture with speckle-like detail (also IC-GN's test image).
+    pub(crate) fn texture(x: f64, y: f64) -> f64 {
         20000.0
             + 8000.0 * (0.9 * x + 0.3 * y).sin() * (0.5 * y - 0.2 * x).cos()
             + 5000.0 * (0.37 * x * x / 40.0 + 0.61 * y).sin()

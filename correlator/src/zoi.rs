@@ -98,6 +98,9 @@ pub fn warp_worth_it(g: Mat2, n: usize) -> bool {
 /// `fft_ns`: the integer step's transforms; `window_ns`: windowing and normalisation;
 /// `peak_ns`: the 3x3 windowed correlation values (direct sums) and the quadratic fit;
 /// `shift_ns`: the Fourier shift (phase ramp and inverse transform); `other_ns`: extraction.
+/// IC-GN adds `coefficients_ns` (the frame's B-spline prefilter, counted on the calling
+/// thread over the whole pool's run), `iterations_ns` (the Gauss-Newton iterations) and
+/// `check_ns` (the final ZNCC checks, every method).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TimeSplit {
     pub fft_ns: u64,
@@ -105,6 +108,23 @@ pub struct TimeSplit {
     pub peak_ns: u64,
     pub shift_ns: u64,
     pub other_ns: u64,
+    pub coefficients_ns: u64,
+    pub iterations_ns: u64,
+    pub check_ns: u64,
+}
+
+impl TimeSplit {
+    /// Adds another split (engines of several threads) to this one.
+    pub fn add(&mut self, other: &TimeSplit) {
+        self.fft_ns += other.fft_ns;
+        self.window_ns += other.window_ns;
+        self.peak_ns += other.peak_ns;
+        self.shift_ns += other.shift_ns;
+        self.other_ns += other.other_ns;
+        self.coefficients_ns += other.coefficients_ns;
+        self.iterations_ns += other.iterations_ns;
+        self.check_ns += other.check_ns;
+    }
 }
 
 /// Length of the cached half spectrum of one ZOI of side n.
@@ -176,17 +196,21 @@ pub struct ZoiEngine {
     uncached_windowed: Vec<f32>,
     pub profile: bool,
     pub split: TimeSplit,
+    /// IC-GN: room for one reference subset prepared on the fly (a node's subset in the
+    /// origin frame), empty for CORRELI-GD.
+    pub subset_scratch: Vec<f32>,
 }
 
-struct Timer(Option<std::time::Instant>);
+/// Laps of the time split: reads the clock only when profiling is on.
+pub(crate) struct Timer(Option<std::time::Instant>);
 
 impl Timer {
     #[inline]
-    fn start(on: bool) -> Self {
+    pub(crate) fn start(on: bool) -> Self {
         Timer(on.then(std::time::Instant::now))
     }
     #[inline]
-    fn lap(&mut self, into: &mut u64) {
+    pub(crate) fn lap(&mut self, into: &mut u64) {
         if let Some(t) = self.0.as_mut() {
             let now = std::time::Instant::now();
             *into += (now - *t).as_nanos() as u64;
@@ -219,6 +243,7 @@ impl ZoiEngine {
             uncached_windowed: vec![0.0; n * n],
             profile: false,
             split: TimeSplit::default(),
+            subset_scratch: Vec::new(),
         }
     }
 

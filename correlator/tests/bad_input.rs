@@ -3,7 +3,7 @@
 mod common;
 
 use common::{render, translation};
-use correlator::{Correlator, CorrelatorSettings, NodeStatus, Roi, SettingsError};
+use correlator::{Correlator, CorrelatorSettings, Method, NodeStatus, Roi, SettingsError};
 
 fn settings(zoi_px: usize, step_px: usize) -> CorrelatorSettings {
     CorrelatorSettings {
@@ -15,7 +15,11 @@ fn settings(zoi_px: usize, step_px: usize) -> CorrelatorSettings {
 
 #[test]
 fn zoi_not_power_of_two_suggests_nearest() {
-    let error = Correlator::new(settings(30, 16), 256, 256).err().unwrap();
+    let correli = CorrelatorSettings {
+        method: Method::Correli,
+        ..settings(30, 16)
+    };
+    let error = Correlator::new(correli, 256, 256).err().unwrap();
     assert_eq!(
         error,
         SettingsError::ZoiNotPowerOfTwo {
@@ -24,6 +28,15 @@ fn zoi_not_power_of_two_suggests_nearest() {
         }
     );
     assert!(error.to_string().contains("use 32 px"), "{error}");
+    // IC-GN takes any size from 9 px.
+    let icgn = |zoi_px, step_px| CorrelatorSettings {
+        method: Method::Icgn1,
+        ..settings(zoi_px, step_px)
+    };
+    assert!(Correlator::new(icgn(30, 16), 256, 256).is_ok());
+    let error = Correlator::new(icgn(7, 4), 256, 256).err().unwrap();
+    assert_eq!(error, SettingsError::SubsetOutOfRange { zoi_px: 7 });
+    assert!(error.to_string().contains("9 to 256"), "{error}");
 }
 
 #[test]

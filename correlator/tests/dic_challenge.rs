@@ -2,13 +2,8 @@
 
 mod common;
 
-use common::{accuracy, shared_data};
+use common::{accuracy, command_columns, load, shared_data};
 use correlator::{Correlator, CorrelatorSettings, GuessMode, NodeStatus};
-
-fn load(path: std::path::PathBuf) -> (Vec<u16>, usize, usize) {
-    let image = producer::read_image(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    (image.pixels, image.width as usize, image.height as usize)
-}
 
 #[test]
 fn sample5_translation_with_contrast_change() {
@@ -102,11 +97,7 @@ fn sample14_l1_chirp_rms() {
         let mut correlator = Correlator::new(settings, w, h).unwrap();
         correlator.set_reference(&reference).unwrap();
         let field = correlator.correlate(&deformed).unwrap();
-        let interp = |x: f64| {
-            let i = (x.floor() as usize).min(w - 2);
-            let t = x - i as f64;
-            u_command[i] * (1.0 - t) + u_command[i + 1] * t
-        };
+        let interp = |x: f64| common::linear(&u_command, x);
         let (mut all, mut slow, mut n_all, mut n_slow) = (0.0, 0.0, 0.0, 0.0);
         for node in field.nodes.iter().filter(|n| n.status == NodeStatus::Ok) {
             let e = node.u_px - interp(node.x_px);
@@ -142,15 +133,7 @@ fn sample14_smaller_zones_follow_the_fast_end() {
     let Some(data) = shared_data() else { return };
     let dir = data.join("dic-challenge/sample14");
     let (reference, w, h) = load(dir.join("Sample14 Reference.tif"));
-    let command = std::fs::read_to_string(dir.join("command.csv")).unwrap();
-    let columns: Vec<Vec<f64>> = command
-        .lines()
-        .map(|line| {
-            line.split(',')
-                .map(|v| v.trim().parse::<f64>().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
+    let columns = command_columns(dir.join("command.csv"));
     assert_eq!(columns.len(), w, "command.csv rows");
     let (slow, fast) = ((0.0, 700.0), (1400.0, w as f64));
     eprintln!("variant ZOI  node RMS slow/fast (px)   column-averaged RMS slow/fast (px)");
@@ -158,11 +141,7 @@ fn sample14_smaller_zones_follow_the_fast_end() {
     for (variant, column) in [("L1", 1), ("L3", 3), ("L5", 5)] {
         let (deformed, _, _) = load(dir.join(format!("Sample14 {variant} Amp0.1b.tif")));
         let u_command: Vec<f64> = columns.iter().map(|c| c[column]).collect();
-        let interp = |x: f64| {
-            let i = (x.floor() as usize).min(w - 2);
-            let t = x - i as f64;
-            u_command[i] * (1.0 - t) + u_command[i + 1] * t
-        };
+        let interp = |x: f64| common::linear(&u_command, x);
         for zoi_px in [16, 32, 64] {
             let settings = CorrelatorSettings {
                 zoi_px,

@@ -42,6 +42,7 @@ fn node_errors(correlator: &Correlator, ex: f64, ey: f64) -> (f64, f64, usize) {
 /// the measured gradient, which leaves the correction little to do.
 fn settings(gradient_correction: bool, reference: ReferenceMode) -> CorrelatorSettings {
     CorrelatorSettings {
+        method: correlator::Method::Correli,
         gradient_correction,
         reference,
         guess: GuessMode::Predict,

@@ -1,10 +1,10 @@
 //! No allocation per frame in steady state: a counting global allocator watches `correlate`
-//! after a warm-up frame, for every reference and guess mode, on 2 threads.
+//! after a warm-up frame, for every method, reference and guess mode, on 2 threads.
 
 mod common;
 
 use common::{render, translation};
-use correlator::{Correlator, CorrelatorSettings, GuessMode, ReferenceMode};
+use correlator::{Correlator, CorrelatorSettings, GuessMode, Method, ReferenceMode};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -50,9 +50,20 @@ fn steady_state_allocates_nothing() {
         (ReferenceMode::Incremental, GuessMode::Predict),
         (ReferenceMode::AUTO_DEFAULT, GuessMode::Predict),
     ];
-    for (reference, guess) in modes {
+    let cases = modes
+        .into_iter()
+        .map(|(r, g)| (Method::Correli, 32, r, g))
+        .chain(modes.into_iter().map(|(r, g)| (Method::Icgn1, 33, r, g)))
+        .chain([(
+            Method::Icgn2,
+            24,
+            ReferenceMode::AUTO_DEFAULT,
+            GuessMode::Predict,
+        )]);
+    for (method, zoi_px, reference, guess) in cases {
         let settings = CorrelatorSettings {
-            zoi_px: 32,
+            method,
+            zoi_px,
             step_px: 16,
             reference,
             guess,
@@ -71,7 +82,7 @@ fn steady_state_allocates_nothing() {
         assert!(valid > 0);
         assert_eq!(
             allocated, 0,
-            "{reference:?} {guess:?}: {allocated} allocations in 3 frames"
+            "{method:?} {reference:?} {guess:?}: {allocated} allocations in 3 frames"
         );
     }
 }

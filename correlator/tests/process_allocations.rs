@@ -11,7 +11,7 @@ mod common;
 
 use common::{render, translation};
 use correlator::process::{run, ProcessConfig};
-use correlator::{CorrelatorSettings, ReferenceMode};
+use correlator::{CorrelatorSettings, Method, ReferenceMode};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -70,6 +70,7 @@ const WARM_UP: u64 = 4;
 
 fn steady_state_allocations(
     label: &str,
+    method: Method,
     reference: ReferenceMode,
     with_state: bool,
 ) -> (usize, u64) {
@@ -84,6 +85,7 @@ fn steady_state_allocations(
     let mut config = ProcessConfig::new(
         &name,
         CorrelatorSettings {
+            method,
             reference,
             threads: 2,
             ..CorrelatorSettings::default()
@@ -178,11 +180,22 @@ fn steady_state_allocations(
 
 #[test]
 fn the_shell_allocates_nothing_per_frame_but_the_waitset() {
-    for (label, reference, with_state) in [
-        ("fixed", ReferenceMode::Fixed, false),
-        ("incremental_state", ReferenceMode::Incremental, true),
+    for (label, method, reference, with_state) in [
+        ("fixed", Method::Correli, ReferenceMode::Fixed, false),
+        (
+            "incremental_state",
+            Method::Correli,
+            ReferenceMode::Incremental,
+            true,
+        ),
+        (
+            "icgn1_incremental_state",
+            Method::Icgn1,
+            ReferenceMode::Incremental,
+            true,
+        ),
     ] {
-        let (allocations, frames) = steady_state_allocations(label, reference, with_state);
+        let (allocations, frames) = steady_state_allocations(label, method, reference, with_state);
         eprintln!(
             "{label}: {allocations} allocations on the shell thread in {frames} frames ({:.1} per frame)",
             allocations as f64 / frames as f64

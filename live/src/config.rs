@@ -57,6 +57,8 @@ pub struct CameraSection {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CorrelatorSection {
+    /// Sub-pixel method: icgn1, icgn2 or correli.
+    pub method: String,
     pub zoi_px: usize,
     pub step_px: usize,
     pub threads: usize,
@@ -143,6 +145,7 @@ impl Default for CameraSection {
 impl Default for CorrelatorSection {
     fn default() -> Self {
         CorrelatorSection {
+            method: correlator::settings::Method::default().name().into(),
             zoi_px: 32,
             step_px: 16,
             threads: 2,
@@ -267,6 +270,12 @@ impl RunConfig {
                 c.reference
             )
         })?;
+        let method = correlator::settings::Method::from_name(&c.method).ok_or_else(|| {
+            format!(
+                "[correlator] method = {:?}: expected icgn1, icgn2 or correli",
+                c.method
+            )
+        })?;
         let guess = GuessMode::from_name(&c.guess).ok_or_else(|| {
             format!(
                 "[correlator] guess = {:?}: expected auto, predict or correli",
@@ -274,6 +283,7 @@ impl RunConfig {
             )
         })?;
         let settings = correlator::CorrelatorSettings {
+            method,
             zoi_px: c.zoi_px,
             step_px: c.step_px,
             threads: c.threads,
@@ -445,7 +455,12 @@ impl RunConfig {
         let _ = writeln!(
             t,
             "[correlator]\n\
-             # ZOI side 2^s px and distance between ZOI centres px (paper section 3.b).\n\
+             # Sub-pixel method: correli (the paper; the default, the fastest), icgn1 (inverse\n\
+             # compositional Gauss-Newton, affine subsets: less noise, several times slower)\n\
+             # or icgn2 (second-order subsets).\n\
+             method = {:?}\n\
+             # ZOI (subset) side px (any size from 9 for icgn1/icgn2, 2^s for correli) and\n\
+             # distance between ZOI centres px (paper section 3.b).\n\
              zoi_px = {}\nstep_px = {}\nthreads = {}\n\
              # Node strain measure: log (m = 0), green (m = 1), nominal (m = 1/2) or small.\n\
              strain = {:?}\n\
@@ -462,6 +477,7 @@ impl RunConfig {
              # Remove, to first order, the rigid ZOI's bias under a displacement gradient\n\
              # (beyond the paper; false = CORRELI-GD as published).\n\
              gradient_correction = {}\n",
+            k.method,
             k.zoi_px,
             k.step_px,
             k.threads,
@@ -547,7 +563,12 @@ mod tests {
             "[camera]\nwidth_px = 128\nheight_px = 128\n[correlator]\nzoi_px = 256\n",
             "larger than the ROI",
         );
-        refuse("[correlator]\nzoi_px = 48\n", "power of two");
+        refuse(
+            "[correlator]\nmethod = \"correli\"\nzoi_px = 48\n",
+            "power of two",
+        );
+        refuse("[correlator]\nmethod = \"icgn1\"\nzoi_px = 8\n", "9 to 256");
+        refuse("[correlator]\nmethod = \"icgn3\"\n", "method");
         refuse(
             "[[rig.tests]]\nkind = \"uniaxial\"\nstretch = 7.0\nrate_per_s = 0.08\n",
             "stroke",

@@ -183,6 +183,8 @@ pub fn child_args(
             first_frame_id.to_string(),
         ],
         Role::Correlator => vec![
+            "--method".into(),
+            k.method.clone(),
             "--zoi".into(),
             k.zoi_px.to_string(),
             "--step".into(),

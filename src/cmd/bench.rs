@@ -16,8 +16,10 @@ pub struct BenchArgs {
 /// The benchmarks.
 #[derive(clap::Subcommand, Debug)]
 pub enum BenchCommand {
-    /// Correlator throughput on rendered speckle: ZOIs/s and frames/s per thread count, the
-    /// time split (FFT, window, peak, shift, other) and a plain 2-D FFT timing for scale.
+    /// Correlator throughput on rendered speckle (or two image files): ZOIs/s and frames/s per
+    /// thread count, the time split (FFT, window, peak, shift, other; with IC-GN also the
+    /// interpolation coefficients, the iterations and the check), the IC-GN cost against
+    /// CORRELI-GD at 32 px in the same run, and a plain 2-D FFT timing for scale.
     Correlate(CorrelateBenchArgs),
     /// The live bench as processes on this machine: per-frame latency from capture to field
     /// and to identification, sustained rate, drops, CPU per process; `--fps max` finds the
@@ -33,9 +35,16 @@ pub struct CorrelateBenchArgs {
     /// Image height in px.
     #[arg(long, default_value_t = 1024)]
     pub height: usize,
-    /// ZOI side in px (a power of two).
+    /// Sub-pixel method: icgn1, icgn2 or correli.
+    #[arg(long, value_enum, default_value = super::correlate::MethodArg::default_name())]
+    pub method: super::correlate::MethodArg,
+    /// ZOI (subset) side in px (a power of two for correli).
     #[arg(long, default_value_t = 32)]
     pub zoi: usize,
+    /// Correlate these two image files (reference, deformed) instead of rendered speckle, over
+    /// the whole image (e.g. DIC Challenge sample 14).
+    #[arg(long, value_delimiter = ',')]
+    pub images: Option<Vec<std::path::PathBuf>>,
     /// Distance between ZOI centres in px.
     #[arg(long, default_value_t = 16)]
     pub step: usize,
@@ -61,6 +70,8 @@ const TARGET_ZOIS_PER_S: f64 = 150_000.0;
 const TARGET_KEYPOINT_MS: f64 = 40.0;
 /// The imposed sub-pixel translation (px): every ZOI does its sub-pixel iterations.
 const SHIFT_PX: [f64; 2] = [0.37, -0.21];
+/// The baseline an IC-GN run is compared with: CORRELI-GD at this ZOI, same images, same run.
+const BASELINE_ZOI_PX: usize = 32;
 
 pub fn run(args: BenchArgs) -> Result<()> {
     match args.command {
@@ -105,35 +116,70 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
     if args.threads.is_empty() || args.threads.contains(&0) {
         bail!("--threads: expected positive thread counts, e.g. 1,2");
     }
-    let (w, h) = (args.width, args.height);
+    let t = Instant::now();
+    let (reference, deformed, w, h, source) = match &args.images {
+        Some(files) => {
+            if files.len() != 2 {
+                bail!(
+                    "--images: expected two files, REF,DEF (got {})",
+                    files.len()
+                );
+            }
+            let reference = super::correlate::load(&files[0])?;
+            let deformed = super::correlate::load(&files[1])?;
+            if (reference.width, reference.height) != (deformed.width, deformed.height) {
+                bail!("--images: the two images differ in size");
+            }
+            let (w, h) = (reference.width as usize, reference.height as usize);
+            let label = format!("{} against {}", files[1].display(), files[0].display());
+            (reference.pixels, deformed.pixels, w, h, label)
+        }
+        None => {
+            let (w, h) = (args.width, args.height);
+            let (ex, ey) = ([-16.0, w as f64 + 16.0], [-16.0, h as f64 + 16.0]);
+            let speckle = Speckle::new(SpeckleParams::default(), ex, ey);
+            let renderer = FastRenderer::new(&speckle, ex, ey, 4, 2);
+            let reference = render(&renderer, Motion::IDENTITY, w, h, 1);
+            let moved = Motion::Affine(Affine {
+                translation_px: SHIFT_PX,
+                ..Affine::IDENTITY
+            });
+            let deformed = render(&renderer, moved, w, h, 2);
+            let label = format!(
+                "speckle (producer, 1 % noise, shift {:+.2} {:+.2} px)",
+                SHIFT_PX[0], SHIFT_PX[1]
+            );
+            (reference, deformed, w, h, label)
+        }
+    };
+    let rendered = args.images.is_none();
+    // Image files are correlated over the whole image, rendered speckle over the default ROI.
+    let roi = (!rendered).then_some(correlator::Roi {
+        x_px: 0,
+        y_px: 0,
+        width_px: w,
+        height_px: h,
+    });
     let guess = args.guess.mode();
-    let settings_for = |threads| CorrelatorSettings {
-        zoi_px: args.zoi,
+    let method = args.method.method();
+    let settings_with = |method, zoi_px, threads| CorrelatorSettings {
+        method,
+        zoi_px,
         step_px: args.step,
+        roi,
         threads,
         guess,
         ..CorrelatorSettings::default()
     };
-    // Refuse bad sizes before spending time on rendering.
+    let settings_for = |threads| settings_with(method, args.zoi, threads);
     let probe = Correlator::new(settings_for(1), w, h).context("benchmark settings")?;
     let zois = field_len(&probe);
     drop(probe);
-    let t = Instant::now();
-    let (ex, ey) = ([-16.0, w as f64 + 16.0], [-16.0, h as f64 + 16.0]);
-    let speckle = Speckle::new(SpeckleParams::default(), ex, ey);
-    let renderer = FastRenderer::new(&speckle, ex, ey, 4, 2);
-    let reference = render(&renderer, Motion::IDENTITY, w, h, 1);
-    let moved = Motion::Affine(Affine {
-        translation_px: SHIFT_PX,
-        ..Affine::IDENTITY
-    });
-    let deformed = render(&renderer, moved, w, h, 2);
     let render_s = t.elapsed().as_secs_f64();
     if !args.json {
         println!(
-            "correlate: {w}x{h} px speckle (producer, 1 % noise, shift {:+.2} {:+.2} px), ZOI {} px, step {} px: {zois} ZOIs, {} guess, median of {} frames (rendered in {render_s:.1} s)",
-            SHIFT_PX[0],
-            SHIFT_PX[1],
+            "correlate: {w}x{h} px {source}, {} ZOI {} px, step {} px: {zois} ZOIs, {} guess, median of {} frames (images ready in {render_s:.1} s)",
+            method.name(),
             args.zoi,
             args.step,
             format!("{guess:?}").to_lowercase(),
@@ -141,10 +187,9 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
         );
     }
 
-    let mut runs = Vec::new();
-    let mut split = None;
-    for &threads in &args.threads {
-        let mut correlator = Correlator::new(settings_for(threads), w, h)?;
+    let measure = |settings: CorrelatorSettings| -> Result<(ThreadRun, Correlator)> {
+        let threads = settings.threads;
+        let mut correlator = Correlator::new(settings, w, h)?;
         let t = Instant::now();
         correlator.set_reference(&reference)?;
         let set_reference_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -173,12 +218,22 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
             valid: field.valid,
             mean_iterations: field.nodes.iter().map(|n| n.iterations as f64).sum::<f64>()
                 / field.nodes.len() as f64,
-            error_px: [
-                ok.iter().map(|n| n.u_px).sum::<f64>() / count - SHIFT_PX[0],
-                ok.iter().map(|n| n.v_px).sum::<f64>() / count - SHIFT_PX[1],
-            ],
+            error_px: if rendered {
+                [
+                    ok.iter().map(|n| n.u_px).sum::<f64>() / count - SHIFT_PX[0],
+                    ok.iter().map(|n| n.v_px).sum::<f64>() / count - SHIFT_PX[1],
+                ]
+            } else {
+                [f64::NAN; 2]
+            },
             set_reference_ms,
         };
+        Ok((run, correlator))
+    };
+    let mut runs = Vec::new();
+    let mut split = None;
+    for &threads in &args.threads {
+        let (run, mut correlator) = measure(settings_for(threads))?;
         if !args.json {
             print_run(&run);
         }
@@ -206,10 +261,38 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
         split = Some((correlator.time_split(), 3 * field_len(&correlator)));
     }
     let (split, profiled_zois) = split.expect("measured above");
+    // IC-GN against CORRELI-GD at 32 px on the same images in this run: time per ZOI ratio.
+    let mut baseline = Vec::new();
+    if method.is_icgn() {
+        for &threads in &args.threads {
+            let (run, _) = measure(settings_with(
+                correlator::settings::Method::Correli,
+                BASELINE_ZOI_PX,
+                threads,
+            ))?;
+            let ours = runs
+                .iter()
+                .find(|r| r.threads == threads)
+                .expect("same threads");
+            let ratio = (ours.median_s / ours.nodes as f64) / (run.median_s / run.nodes as f64);
+            if !args.json {
+                print!("  baseline correli ZOI {BASELINE_ZOI_PX}: ");
+                print_run(&run);
+                println!(
+                    "  {} ZOI {} / correli ZOI {BASELINE_ZOI_PX}, {threads} thread(s): {ratio:.2}x the time per ZOI (target <= 2.5x)",
+                    method.name(),
+                    args.zoi
+                );
+            }
+            baseline.push((run, ratio));
+        }
+    }
     let keypoints = keypoint_timing(&reference, &deformed, w, h, args.frames);
-    let fft = correlator::timing::time_ffts(args.zoi, 2000, 7);
+    let fft = correlator::timing::time_ffts(settings_for(1).fft_zoi_px(), 2000, 7);
     let two = runs.iter().find(|r| r.threads == 2);
-    let standard = (w, h, args.zoi, args.step) == (1024, 1024, 32, 16);
+    let standard = rendered
+        && method == correlator::settings::Method::Correli
+        && (w, h, args.zoi, args.step) == (1024, 1024, 32, 16);
 
     let parts = [
         ("fft", split.fft_ns),
@@ -217,12 +300,16 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
         ("peak", split.peak_ns),
         ("shift", split.shift_ns),
         ("other", split.other_ns),
+        ("coefficients", split.coefficients_ns),
+        ("iterations", split.iterations_ns),
+        ("check", split.check_ns),
     ];
     let total_ns: u64 = parts.iter().map(|p| p.1).sum();
     if args.json {
         let json = serde_json::json!({
             "benchmark": "correlate",
             "image": [w, h],
+            "method": method.name(),
             "zoi": args.zoi,
             "step": args.step,
             "guess": format!("{guess:?}").to_lowercase(),
@@ -240,6 +327,12 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
                 "mean_iterations": r.mean_iterations,
                 "mean_error_px": r.error_px,
                 "set_reference_ms": r.set_reference_ms,
+            })).collect::<Vec<_>>(),
+            "baseline_correli": baseline.iter().map(|(r, ratio)| serde_json::json!({
+                "threads": r.threads,
+                "zoi": BASELINE_ZOI_PX,
+                "zois_per_s": r.nodes as f64 / r.median_s,
+                "time_per_zoi_ratio": ratio,
             })).collect::<Vec<_>>(),
             "time_split_1_thread": {
                 "zois_profiled": profiled_zois,
@@ -269,18 +362,14 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
     }
     let pct = |ns: u64| 100.0 * ns as f64 / total_ns.max(1) as f64;
     let us = |ns: u64| ns as f64 / 1e3 / profiled_zois as f64;
+    let listed = parts
+        .iter()
+        .filter(|(_, ns)| *ns > 0)
+        .map(|(name, ns)| format!("{name} {:.0} % ({:.2} µs)", pct(*ns), us(*ns)))
+        .collect::<Vec<_>>()
+        .join(", ");
     println!(
-        "  time split (1 thread, profiled, {profiled_zois} ZOIs): FFT {:.0} % ({:.1} µs/ZOI), window {:.0} % ({:.1}), peak {:.0} % ({:.1}), shift {:.0} % ({:.1}), other {:.0} % ({:.1}); {:.1} µs per ZOI",
-        pct(split.fft_ns),
-        us(split.fft_ns),
-        pct(split.window_ns),
-        us(split.window_ns),
-        pct(split.peak_ns),
-        us(split.peak_ns),
-        pct(split.shift_ns),
-        us(split.shift_ns),
-        pct(split.other_ns),
-        us(split.other_ns),
+        "  time split (1 thread, profiled, {profiled_zois} ZOIs; µs per ZOI): {listed}; {:.1} µs per ZOI",
         us(total_ns)
     );
     println!(
@@ -375,8 +464,17 @@ fn field_len(correlator: &Correlator) -> usize {
 }
 
 fn print_run(r: &ThreadRun) {
+    // Image files carry no truth: no mean error then.
+    let error = if r.error_px[0].is_finite() {
+        format!(
+            "mean error u {:+.4} v {:+.4} px",
+            r.error_px[0], r.error_px[1]
+        )
+    } else {
+        "no truth for image files".to_owned()
+    };
     println!(
-        "  {} thread(s): {:8.0} ZOIs/s, {:6.2} frames/s, {:7.2} ms/frame (min {:.2}, max {:.2}); {} ZOIs, {} valid, {:.2} iterations/ZOI, mean error u {:+.4} v {:+.4} px; set_reference {:.1} ms",
+        "  {} thread(s): {:8.0} ZOIs/s, {:6.2} frames/s, {:7.2} ms/frame (min {:.2}, max {:.2}); {} ZOIs, {} valid, {:.2} iterations/ZOI, {error}; set_reference {:.1} ms",
         r.threads,
         r.nodes as f64 / r.median_s,
         1.0 / r.median_s,
@@ -386,8 +484,6 @@ fn print_run(r: &ThreadRun) {
         r.nodes,
         r.valid,
         r.mean_iterations,
-        r.error_px[0],
-        r.error_px[1],
         r.set_reference_ms
     );
 }

@@ -39,7 +39,7 @@ impl Correlator {
 
     /// The local gradient of node k's neighbourhood of verified results, else the gradient
     /// its ZOI was sampled through.
-    fn local_gradient(&self, k: usize) -> Mat2 {
+    pub(super) fn local_gradient(&self, k: usize) -> Mat2 {
         self.result_gradient(k)
             .map_or(self.results[k].warp_gradient, to_mat2)
     }
@@ -59,7 +59,8 @@ impl Correlator {
         let mesh = (self.mesh.nx, self.mesh.ny);
         let zncc = SharedSlice::new(&mut self.zncc);
         // Results are only read here; the verdicts go to `zncc` and become statuses below.
-        self.pool.run(results.len(), &|_, k| {
+        self.pool.run(results.len(), &|engine, k| {
+            let mut timer = crate::zoi::Timer::start(engine.profile);
             let result = results[k];
             let mut score = 0.0;
             if result.status == NodeStatus::Ok {
@@ -73,6 +74,7 @@ impl Correlator {
                     score = score.max(check(result.warp_gradient).unwrap_or(0.0));
                 }
             }
+            timer.lap(&mut engine.split.check_ns);
             // SAFETY: item k writes only node k's slot.
             unsafe { zncc.write(k, score) };
         });
@@ -102,7 +104,8 @@ impl Correlator {
         {
             self.grow(image);
         }
-        if fresh {
+        // IC-GN refines every node through its own gradient anyway.
+        if fresh && !self.settings.method.is_icgn() {
             self.refine(image);
         }
     }
@@ -236,7 +239,8 @@ impl Correlator {
     /// the new failure. Returns how many nodes verified.
     fn correlate_entries(&mut self, image: Image, replace_verified: bool) -> usize {
         let n = self.settings.zoi_px;
-        let n2 = spectrum_len(n);
+        let (fft, pad) = (self.fft_px, self.fft_pad_px);
+        let n2 = spectrum_len(fft);
         let max_iterations = self.settings.max_iterations;
         let min_zncc = self.settings.min_zncc;
         let reference = Image {
@@ -255,13 +259,13 @@ impl Correlator {
             let r = ref_nodes[k];
             let spectra = ReferenceSpectra {
                 plain: &plain[k * n2..(k + 1) * n2],
-                windowed: &windowed[k * n * n..(k + 1) * n * n],
+                windowed: &windowed[k * fft * fft..(k + 1) * fft * fft],
             };
             let mut result = engine.correlate(
                 &spectra,
                 image,
-                r.top_left.0,
-                r.top_left.1,
+                r.top_left.0 + pad,
+                r.top_left.1 + pad,
                 entry.guess_px,
                 Some(entry.gradient),
                 max_iterations,

@@ -99,7 +99,8 @@ impl Correlator {
     /// its ZOI there correlated with `image` through the gradient, and the final check; the
     /// results and their ZNCC go to `reanchored`, in the order of `entries`.
     fn measure_against_origin(&mut self, image: Image) {
-        let n = self.settings.zoi_px;
+        let (n, pad) = (self.settings.zoi_px, self.fft_pad_px);
+        let offset = (n - self.fft_px) as f64 / 2.0 - pad as f64;
         let max_iterations = self.settings.max_iterations;
         let origin = Image {
             pixels: &self.origin_pixels,
@@ -111,18 +112,47 @@ impl Correlator {
             .resize(self.entries.len(), (ZoiResult::default(), 0.0));
         let (entries, top_left) = (&self.entries, &self.mesh.top_left);
         let out = SharedSlice::new(&mut self.reanchored);
+        // IC-GN methods measure with IC-GN: the origin's subset prepared on the fly.
+        let icgn = self.origin_icgn();
+        let min_zncc = self.settings.min_zncc;
         self.pool.run(entries.len(), &|engine, i| {
             let entry = entries[i];
             let (x0, y0) = top_left[entry.node];
+            if let Some(icgn) = &icgn {
+                let mut scratch = std::mem::take(&mut engine.subset_scratch);
+                let result = icgn.measure((x0, y0), entry.guess_px, entry.gradient, &mut scratch);
+                engine.subset_scratch = scratch;
+                let score = if result.status == NodeStatus::Ok {
+                    let check =
+                        |g| verify::zncc(origin, (x0, y0), n, image, (result.u_px, result.v_px), g);
+                    let own = check(result.warp_gradient).unwrap_or(0.0);
+                    if own < min_zncc {
+                        own.max(check(entry.gradient).unwrap_or(0.0))
+                    } else {
+                        own
+                    }
+                } else {
+                    0.0
+                };
+                // SAFETY: item i writes only slot i.
+                unsafe { out.write(i, (result, score)) };
+                return;
+            }
             let result = engine.correlate_uncached(
                 origin,
-                x0,
-                y0,
+                x0 + pad,
+                y0 + pad,
                 image,
                 entry.guess_px,
                 Some(entry.gradient),
                 max_iterations,
             );
+            // The FFT ZOI's centre is `offset` px from the node's when an odd subset holds an
+            // even FFT ZOI: the node's own displacement is the gradient's step from there.
+            let mut result = result;
+            let g = entry.gradient;
+            result.u_px += (g[0][0] + g[0][1]) * offset;
+            result.v_px += (g[1][0] + g[1][1]) * offset;
             let score = if result.status == NodeStatus::Ok {
                 verify::zncc(
                     origin,

@@ -55,6 +55,34 @@ pub fn shared_data() -> Option<std::path::PathBuf> {
     }
 }
 
+/// An image file as (pixels, width, height); panics naming the file when it cannot be read.
+pub fn load(path: std::path::PathBuf) -> (Vec<u16>, usize, usize) {
+    let image = producer::read_image(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    (image.pixels, image.width as usize, image.height as usize)
+}
+
+/// The rows of a DIC Challenge `command.csv` (one per pixel column), NaN where a value does
+/// not parse.
+pub fn command_columns(path: std::path::PathBuf) -> Vec<Vec<f64>> {
+    let command =
+        std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    command
+        .lines()
+        .map(|line| {
+            line.split(',')
+                .map(|v| v.trim().parse::<f64>().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect()
+}
+
+/// `values` (one per pixel column) linearly interpolated at x (px).
+pub fn linear(values: &[f64], x: f64) -> f64 {
+    let i = (x.floor() as usize).min(values.len() - 2);
+    let t = x - i as f64;
+    values[i] * (1.0 - t) + values[i + 1] * t
+}
+
 pub fn mean_std(values: &[f64]) -> (f64, f64) {
     let n = values.len() as f64;
     let mean = values.iter().sum::<f64>() / n;

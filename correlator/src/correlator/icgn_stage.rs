@@ -1,0 +1,274 @@
+//! The IC-GN stage of the correlator (methods `icgn1`, `icgn2`): the frame's B-spline
+//! coefficients (once per frame, on the pool), the reference subsets (once per reference), and
+//! the refinement of every node whose guess verified: IC-GN from the guess's displacement and
+//! gradient (the node's gradient in the previous frame on a followed mesh, else the
+//! least-squares gradient of its neighbours' guesses), then the same final check as every
+//! result. What IC-GN finds replaces the guess: its displacement, its gradient (the node's
+//! `warp_gradient`), its iterations, and its status (`outside_image` when a sample leaves the
+//! image, `not_converged` at the iteration cap, `low_zncc` when the final check fails).
+
+use super::{Correlator, Entry};
+use crate::field::NodeStatus;
+use crate::icgn::bspline::Coefficients;
+use crate::icgn::shape::{Order, Warp};
+use crate::icgn::subset::{self, PLANES};
+use crate::icgn::{self, Subset};
+use crate::pool::SharedSlice;
+use crate::settings::{GuessMode, Method};
+use crate::verify;
+use crate::zoi::{Image, Timer, ZoiResult};
+
+impl Correlator {
+    fn order(&self) -> Order {
+        match self.settings.method {
+            Method::Icgn2 => Order::Second,
+            Method::Icgn1 | Method::Correli => Order::First,
+        }
+    }
+
+    /// The B-spline coefficients of `pixels` (the frame, or a new reference) into the frame's
+    /// buffer.
+    pub(super) fn prefilter(&mut self, pixels: &[u16]) {
+        let start = self.profiling.then(std::time::Instant::now);
+        let mut coefficients = self
+            .coefficients
+            .take()
+            .expect("IC-GN correlators have a coefficient buffer");
+        self.prefilter_into(&mut coefficients, pixels);
+        self.coefficients = Some(coefficients);
+        if let Some(start) = start {
+            self.coefficients_ns += start.elapsed().as_nanos() as u64;
+        }
+    }
+
+    /// The origin's coefficients are the reference's (right after `set_reference`).
+    pub(super) fn origin_coefficients_from_reference(&mut self) {
+        if let (Some(origin), Some(reference)) = (
+            self.origin_coefficients.as_mut(),
+            self.coefficients.as_ref(),
+        ) {
+            origin.data.copy_from_slice(&reference.data);
+        }
+    }
+
+    /// The B-spline coefficients of `pixels` into `coefficients`, rows then columns spread
+    /// over the pool.
+    pub(super) fn prefilter_into(&self, coefficients: &mut Coefficients, pixels: &[u16]) {
+        let (w, h) = (coefficients.width_px, coefficients.height_px);
+        let (row_items, column_items) = (coefficients.row_items(), coefficients.column_items());
+        let data = SharedSlice::new(&mut coefficients.data);
+        self.pool.run(row_items, &|_, item| {
+            let first = item * crate::icgn::bspline::ROWS_PER_ITEM;
+            let last = (first + crate::icgn::bspline::ROWS_PER_ITEM).min(h);
+            // SAFETY: item `item` writes only its rows.
+            let rows = unsafe { data.slice_mut(first * w, (last - first) * w) };
+            Coefficients::prefilter_rows(pixels, w, first, rows);
+        });
+        self.pool.run(column_items, &|_, item| {
+            // SAFETY: item `item` touches only its columns; the buffer holds w x h values.
+            unsafe { Coefficients::prefilter_columns(data.as_mut_ptr(), w, h, item) };
+        });
+    }
+
+    /// The reference subset of every textured node (the coefficients hold the reference); a
+    /// flat subset is `low_contrast`.
+    pub(super) fn prepare_subsets(&mut self) {
+        let n = self.settings.zoi_px;
+        let order = self.order();
+        let values = PLANES * n * n;
+        let reference = Image {
+            pixels: &self.reference_pixels,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        };
+        let coefficients = self.coefficients.as_ref().expect("IC-GN coefficients");
+        let planes = SharedSlice::new(&mut self.subset_planes);
+        let stats = SharedSlice::new(&mut self.subset_stats);
+        let ref_nodes = SharedSlice::new(&mut self.ref_nodes);
+        self.pool.run(self.mesh.len(), &|_, k| {
+            // SAFETY: item k touches only node k's slots.
+            let mut r = unsafe { ref_nodes.read(k) };
+            if r.status != NodeStatus::Ok {
+                return;
+            }
+            let mut s = subset::SubsetStats::default();
+            let planes = unsafe { planes.slice_mut(k * values, values) };
+            if !subset::prepare(
+                reference,
+                coefficients,
+                r.top_left,
+                n,
+                order,
+                planes,
+                &mut s,
+            ) {
+                r.status = NodeStatus::LowContrast;
+                unsafe { ref_nodes.write(k, r) };
+            }
+            unsafe { stats.write(k, s) };
+        });
+    }
+
+    /// IC-GN of node k's subset in the origin frame against the frame whose coefficients the
+    /// correlator holds, from `guess_px` and `gradient` (`reanchor`): the subset is prepared in
+    /// the engine's scratch. None without IC-GN or without the origin's coefficients.
+    pub(super) fn origin_icgn(&self) -> Option<OriginIcgn<'_>> {
+        if !self.settings.method.is_icgn() || !self.origin_known {
+            return None;
+        }
+        Some(OriginIcgn {
+            origin: Image {
+                pixels: &self.origin_pixels,
+                width_px: self.width_px,
+                height_px: self.height_px,
+            },
+            origin_coefficients: self.origin_coefficients.as_ref()?,
+            frame_coefficients: self.coefficients.as_ref()?,
+            n: self.settings.zoi_px,
+            order: self.order(),
+            max_iterations: self.settings.max_iterations,
+        })
+    }
+
+    /// IC-GN for every node whose guess verified (see the module documentation).
+    pub(super) fn refine_icgn(&mut self, image: Image) {
+        let use_previous = self.settings.guess != GuessMode::Correli;
+        self.entries.clear();
+        for k in 0..self.results.len() {
+            let result = self.results[k];
+            if result.status != NodeStatus::Ok {
+                continue;
+            }
+            // The paper's guess ignores previous frames, and so does its gradient.
+            let previous = self.previous_gradient[k].filter(|_| use_previous);
+            let gradient = previous.unwrap_or_else(|| self.local_gradient(k));
+            self.entries.push(Entry {
+                node: k,
+                guess_px: (result.u_px, result.v_px),
+                gradient,
+            });
+        }
+        let n = self.settings.zoi_px;
+        let half = (n as f64 - 1.0) / 2.0;
+        let values = PLANES * n * n;
+        let (order, max_iterations, min_zncc) = (
+            self.order(),
+            self.settings.max_iterations,
+            self.settings.min_zncc,
+        );
+        let reference = Image {
+            pixels: &self.reference_pixels,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        };
+        let coefficients = self.coefficients.as_ref().expect("IC-GN coefficients");
+        let (entries, ref_nodes) = (&self.entries, &self.ref_nodes);
+        let (planes, stats) = (&self.subset_planes, &self.subset_stats);
+        let results = SharedSlice::new(&mut self.results);
+        let zncc = SharedSlice::new(&mut self.zncc);
+        self.pool.run(entries.len(), &|engine, i| {
+            let entry = entries[i];
+            let k = entry.node;
+            let top_left = ref_nodes[k].top_left;
+            let mut timer = Timer::start(engine.profile);
+            let subset = Subset {
+                planes: &planes[k * values..(k + 1) * values],
+                stats: &stats[k],
+                n,
+                centre_px: (top_left.0 as f64 + half, top_left.1 as f64 + half),
+            };
+            let guess = Warp::affine(entry.guess_px, entry.gradient);
+            let outcome = icgn::solve(&subset, order, coefficients, guess, max_iterations);
+            timer.lap(&mut engine.split.iterations_ns);
+            let mut result = zoi_result(&outcome);
+            let (u, v) = (result.u_px, result.v_px);
+            let mut score = 0.0;
+            if result.status == NodeStatus::Ok {
+                // Through the node's own gradient, or the guess's (smoother than a noisy
+                // subset's own, as the check of the other results falls back to).
+                let check = |g| verify::zncc(reference, top_left, n, image, (u, v), g);
+                score = check(result.warp_gradient).unwrap_or(0.0);
+                if score < min_zncc {
+                    score = score.max(check(entry.gradient).unwrap_or(0.0));
+                }
+                if score < min_zncc {
+                    result.status = NodeStatus::LowZncc;
+                }
+            }
+            timer.lap(&mut engine.split.check_ns);
+            // SAFETY: item i touches only node entries[i].node's slots; nodes are distinct.
+            unsafe {
+                results.write(k, result);
+                zncc.write(k, score);
+            }
+        });
+    }
+}
+
+/// What [`Correlator::origin_icgn`] hands to the pool items of a measurement against the origin.
+pub(super) struct OriginIcgn<'a> {
+    origin: Image<'a>,
+    origin_coefficients: &'a Coefficients,
+    frame_coefficients: &'a Coefficients,
+    n: usize,
+    order: Order,
+    max_iterations: u32,
+}
+
+impl OriginIcgn<'_> {
+    /// Node's subset with top-left `top_left` in the origin, measured in the frame from the
+    /// total displacement `guess_px` and gradient `gradient`, in `scratch` (3 n² values).
+    pub(super) fn measure(
+        &self,
+        top_left: (usize, usize),
+        guess_px: (f64, f64),
+        gradient: crate::interpolate::Mat2,
+        scratch: &mut [f32],
+    ) -> ZoiResult {
+        let n = self.n;
+        let mut stats = subset::SubsetStats::default();
+        if !subset::prepare(
+            self.origin,
+            self.origin_coefficients,
+            top_left,
+            n,
+            self.order,
+            scratch,
+            &mut stats,
+        ) {
+            return ZoiResult {
+                status: NodeStatus::LowContrast,
+                ..ZoiResult::default()
+            };
+        }
+        let half = (n as f64 - 1.0) / 2.0;
+        let subset = Subset {
+            planes: scratch,
+            stats: &stats,
+            n,
+            centre_px: (top_left.0 as f64 + half, top_left.1 as f64 + half),
+        };
+        let outcome = icgn::solve(
+            &subset,
+            self.order,
+            self.frame_coefficients,
+            Warp::affine(guess_px, gradient),
+            self.max_iterations,
+        );
+        zoi_result(&outcome)
+    }
+}
+
+/// IC-GN's outcome as a node result: the displacement of the subset centre, the ZNCC of the
+/// last samples as the score, and the shape function's gradient as the node's gradient.
+fn zoi_result(outcome: &icgn::Outcome) -> ZoiResult {
+    let (u, v) = outcome.warp.displacement();
+    ZoiResult {
+        u_px: u,
+        v_px: v,
+        score: outcome.zncc,
+        iterations: outcome.iterations,
+        status: outcome.status,
+        warp_gradient: outcome.warp.gradient(),
+    }
+}

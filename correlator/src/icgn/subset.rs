@@ -1,0 +1,178 @@
+//! What IC-GN needs of a reference subset, computed once per reference: the subset f
+//! normalised, f̂ = (f − f_m) / f_n (f_m its mean, f_n = ‖f − f_m‖), its gradient ∇f̂ (the
+//! B-spline model's derivative at the pixels, so the steepest-descent images belong to the same
+//! model the deformed image is sampled with), the inverse of the Hessian H = Σ J Jᵀ of the
+//! steepest-descent images J = ∇f̂ ∂W/∂p, and the two constant sums of the ZNSSD update, Σ J
+//! and Σ J f̂ (see [`super::solve`]). J itself is never stored: it is ∇f̂ times the pixel's
+//! offset monomials, rebuilt in the iteration loop from the three planes kept per subset.
+
+use super::bspline::{self, Coefficients};
+use super::shape::Order;
+use crate::zoi::{Image, MIN_STD_COUNTS};
+use nalgebra::SMatrix;
+
+/// Values stored per subset pixel: f̂, ∂f̂/∂x, ∂f̂/∂y (three planes of n² values).
+pub const PLANES: usize = 3;
+
+/// The per-subset constants of the ZNSSD update.
+#[derive(Clone, Copy, Debug)]
+pub struct SubsetStats {
+    /// H⁻¹, row-major P x P (P = the order's parameters), in the order of [`steepest_descent`].
+    pub inverse_hessian: [f64; 144],
+    /// Σ J and Σ J f̂ over the subset.
+    pub sum_j: [f64; 12],
+    pub sum_jf: [f64; 12],
+    /// f_m, subtracted from the deformed samples before their sums (keeps f32 sums exact enough).
+    pub mean: f32,
+}
+
+impl Default for SubsetStats {
+    fn default() -> Self {
+        Self {
+            inverse_hessian: [0.0; 144],
+            sum_j: [0.0; 12],
+            sum_jf: [0.0; 12],
+            mean: 0.0,
+        }
+    }
+}
+
+/// The steepest-descent image at a pixel: ∇f̂ ∂W/∂p for the parameters of `order`, in the order
+/// u, u_x, u_y, (u_xx, u_xy, u_yy,) v, v_x, v_y, (v_xx, v_xy, v_yy).
+#[inline]
+pub fn steepest_descent(order: Order, fx: f64, fy: f64, dx: f64, dy: f64, out: &mut [f64; 12]) {
+    match order {
+        Order::First => {
+            *out = [
+                fx,
+                fx * dx,
+                fx * dy,
+                fy,
+                fy * dx,
+                fy * dy,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            ];
+        }
+        Order::Second => {
+            let (xx, xy, yy) = (0.5 * dx * dx, dx * dy, 0.5 * dy * dy);
+            *out = [
+                fx,
+                fx * dx,
+                fx * dy,
+                fx * xx,
+                fx * xy,
+                fx * yy,
+                fy,
+                fy * dx,
+                fy * dy,
+                fy * xx,
+                fy * xy,
+                fy * yy,
+            ];
+        }
+    }
+}
+
+/// Prepares the n x n subset with top-left `top_left` of the reference image (`coefficients`
+/// are that image's): fills `planes` (3 n² values) and `stats`. False when the subset is flat
+/// (standard deviation below [`MIN_STD_COUNTS`]) or its Hessian is singular.
+pub fn prepare(
+    reference: Image,
+    coefficients: &Coefficients,
+    top_left: (usize, usize),
+    n: usize,
+    order: Order,
+    planes: &mut [f32],
+    stats: &mut SubsetStats,
+) -> bool {
+    let nn = n * n;
+    assert_eq!(planes.len(), PLANES * nn);
+    assert!(reference.contains_block(top_left.0 as i64, top_left.1 as i64, n));
+    *stats = SubsetStats::default();
+    let (values, rest) = planes.split_at_mut(nn);
+    let (gx, gy) = rest.split_at_mut(nn);
+    let mut sum = 0.0f64;
+    let weights = bspline::pixel_weights();
+    for j in 0..n {
+        for i in 0..n {
+            // The model's value (the pixel itself: it interpolates) and gradient.
+            let (f, dx, dy) =
+                coefficients.pixel_value_gradient((top_left.0 + i, top_left.1 + j), &weights);
+            values[j * n + i] = f;
+            gx[j * n + i] = dx;
+            gy[j * n + i] = dy;
+            sum += f as f64;
+        }
+    }
+    let mean = sum / nn as f64;
+    let norm_sq: f64 = values.iter().map(|&f| (f as f64 - mean).powi(2)).sum();
+    if (norm_sq / nn as f64).sqrt() < MIN_STD_COUNTS as f64 {
+        return false;
+    }
+    let inv_norm = 1.0 / norm_sq.sqrt();
+    for v in values.iter_mut() {
+        *v = ((*v as f64 - mean) * inv_norm) as f32;
+    }
+    for g in gx.iter_mut().chain(gy.iter_mut()) {
+        *g = (*g as f64 * inv_norm) as f32;
+    }
+    let count = order.parameters();
+    let half = (n as f64 - 1.0) / 2.0;
+    let mut hessian = [0.0f64; 144];
+    let mut j_pixel = [0.0f64; 12];
+    for j in 0..n {
+        for i in 0..n {
+            let k = j * n + i;
+            steepest_descent(
+                order,
+                gx[k] as f64,
+                gy[k] as f64,
+                i as f64 - half,
+                j as f64 - half,
+                &mut j_pixel,
+            );
+            let f = values[k] as f64;
+            for a in 0..count {
+                stats.sum_j[a] += j_pixel[a];
+                stats.sum_jf[a] += j_pixel[a] * f;
+                for b in a..count {
+                    hessian[a * count + b] += j_pixel[a] * j_pixel[b];
+                }
+            }
+        }
+    }
+    for a in 0..count {
+        for b in 0..a {
+            hessian[a * count + b] = hessian[b * count + a];
+        }
+    }
+    let inverse = match order {
+        Order::First => invert::<6>(&hessian),
+        Order::Second => invert::<12>(&hessian),
+    };
+    let Some(inverse) = inverse else {
+        return false;
+    };
+    stats.inverse_hessian = inverse;
+    stats.mean = mean as f32;
+    true
+}
+
+/// Inverse of the symmetric positive definite P x P matrix in the first P² values (Cholesky);
+/// None when it is not positive definite.
+fn invert<const P: usize>(h: &[f64; 144]) -> Option<[f64; 144]> {
+    let m = SMatrix::<f64, P, P>::from_fn(|r, c| h[r * P + c]);
+    let inverse = m.cholesky()?.inverse();
+    let mut out = [0.0; 144];
+    for r in 0..P {
+        for c in 0..P {
+            out[r * P + c] = inverse[(r, c)];
+        }
+    }
+    out.iter().all(|v| v.is_finite()).then_some(out)
+}
