@@ -14,6 +14,7 @@ pub mod files;
 pub mod frame;
 pub mod identification;
 pub mod instance;
+mod layout_check;
 pub mod owner;
 pub mod pubsub;
 pub mod rig;
