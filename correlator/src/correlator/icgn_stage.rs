@@ -92,6 +92,7 @@ impl Correlator {
                 return;
             }
             let mut s = subset::SubsetStats::default();
+            // SAFETY: node k's planes, stats and reference slot are written by item k alone.
             let planes = unsafe { planes.slice_mut(k * values, values) };
             if !subset::prepare(
                 reference,

@@ -415,6 +415,7 @@ mod tests {
             Coefficients::prefilter_rows(&pixels, w, first, &mut items.data[first * w..last * w]);
         }
         for item in (0..items.column_items()).rev() {
+            // SAFETY: `items.data` holds w * h values and this thread alone touches it.
             unsafe { Coefficients::prefilter_columns(items.data.as_mut_ptr(), w, h, item) };
         }
         assert_eq!(whole.data, items.data);
