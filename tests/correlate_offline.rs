@@ -315,6 +315,19 @@ fn bad_inputs_are_clear_errors() {
         ],
         "step 0 px is invalid",
     );
+    // A ROI beyond the image, said as the user wrote it (not a Rust struct).
+    refused(
+        &[
+            "correlate",
+            path(&reference),
+            path(&reference),
+            "--roi",
+            "500,500,100,100",
+            "--out",
+            path(&out),
+        ],
+        "ROI 500,500,100,100 (x,y,width,height) does not fit",
+    );
     // ZOI larger than the ROI.
     refused(
         &[

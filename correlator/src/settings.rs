@@ -11,6 +11,17 @@ pub struct Roi {
     pub height_px: usize,
 }
 
+/// As `--roi` takes it: `x,y,width,height`.
+impl std::fmt::Display for Roi {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{},{},{},{}",
+            self.x_px, self.y_px, self.width_px, self.height_px
+        )
+    }
+}
+
 /// Strain measure of the per-node strains (the gauge gives all four).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum StrainMeasure {
@@ -239,7 +250,7 @@ pub enum SettingsError {
     StrainWindow { nodes: usize },
     #[error("image {width_px}x{height_px} px is too small: expected at least 16x16 px")]
     ImageTooSmall { width_px: usize, height_px: usize },
-    #[error("ROI {roi:?} does not fit in the {width_px}x{height_px} px image")]
+    #[error("ROI {roi} (x,y,width,height) does not fit in the {width_px}x{height_px} px image")]
     RoiOutside {
         roi: Roi,
         width_px: usize,
