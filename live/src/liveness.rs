@@ -14,7 +14,6 @@ pub struct Counts {
     pub rig_states: u64,
     pub frames: u64,
     pub fields: u64,
-    pub reports: u64,
 }
 
 impl Counts {

@@ -458,7 +458,6 @@ fn counts(recorder: &Recorder) -> Counts {
         rig_states: recorder.rig_samples_seen,
         frames: recorder.frames_seen,
         fields: recorder.fields_seen,
-        reports: recorder.latency_identification.count(),
     }
 }
 
