@@ -434,13 +434,18 @@ impl Supervisor {
     }
 }
 
+/// The fields of `/proc/<pid>/stat` from the third on (state, ppid, ...; stat(5)): those after
+/// the command name, which may hold spaces, so they start after its last ')'.
+fn stat_fields(pid: u32) -> Option<Vec<String>> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let rest = &stat[stat.rfind(')')? + 2..];
+    Some(rest.split_whitespace().map(str::to_string).collect())
+}
+
 /// User + system CPU time of process `pid` (s), from `/proc/<pid>/stat`.
 pub fn process_cpu_s(pid: u32) -> Option<f64> {
-    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
-    // Fields after the command name (which may hold spaces) start after the last ')'.
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    // utime and stime are fields 14 and 15 of stat(5); `rest` starts at field 3.
+    let fields = stat_fields(pid)?;
+    // utime and stime are fields 14 and 15 of stat(5); the list starts at field 3.
     let utime: f64 = fields.get(11)?.parse().ok()?;
     let stime: f64 = fields.get(12)?.parse().ok()?;
     // SAFETY: sysconf has no preconditions.
@@ -451,13 +456,7 @@ pub fn process_cpu_s(pid: u32) -> Option<f64> {
 /// Whether process `pid` is stopped (state `T`, e.g. by SIGSTOP or Ctrl-Z), from
 /// `/proc/<pid>/stat`.
 pub fn process_stopped(pid: u32) -> bool {
-    std::fs::read_to_string(format!("/proc/{pid}/stat"))
-        .ok()
-        .and_then(|stat| {
-            let rest = &stat[stat.rfind(')')? + 2..];
-            rest.split_whitespace().next().map(|state| state == "T")
-        })
-        .unwrap_or(false)
+    stat_fields(pid).is_some_and(|fields| fields.first().is_some_and(|state| state == "T"))
 }
 
 /// CPU time of this process so far (s).
