@@ -4,7 +4,7 @@
 
 use crate::models::Model;
 use crate::online::{FieldOutcome, FieldSample, OnlineConfig, OnlineIdentifier, RigSample};
-use crate::report::{fit_json, write_atomically};
+use crate::report::fit_json;
 use iceoryx2::prelude::*;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -237,9 +237,9 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
                 summary.reports_published += 1;
                 last_fits = fits;
                 if last_json_write.is_none_or(|t| t.elapsed() >= Duration::from_secs(1)) {
-                    write_atomically(
+                    wire::files::write_atomic(
                         &config.output_json,
-                        &final_json(&summary, &online, &last_fits)?,
+                        final_json(&summary, &online, &last_fits)?.as_bytes(),
                     )?;
                     last_json_write = Some(Instant::now());
                 }
@@ -266,9 +266,9 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
         last_fits = online.refit().unwrap_or_default();
     }
     summary.best_model = last_fits.first().map(|f| f.model.name());
-    write_atomically(
+    wire::files::write_atomic(
         &config.output_json,
-        &final_json(&summary, &online, &last_fits)?,
+        final_json(&summary, &online, &last_fits)?.as_bytes(),
     )?;
     summary.points = online.point_counts();
     Ok(summary)

@@ -48,9 +48,3 @@ pub fn fit_json(fit: &Fit) -> Value {
         "converged": fit.converged,
     })
 }
-
-/// Writes `text` to `path` atomically (temporary file in the same folder, then rename). The
-/// error names the path.
-pub fn write_atomically(path: &std::path::Path, text: &str) -> Result<(), wire::files::FileError> {
-    wire::files::write_atomic(path, text.as_bytes())
-}
