@@ -178,7 +178,7 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
     let mut paced_from = (started, session.rig.state().t_s);
     let mut last_flush = started;
     let mut was_max = false;
-    let mut stopped_by = None;
+    let mut stopped_by;
     loop {
         // Commands, between publication periods.
         while let Some(active) = server
@@ -219,7 +219,11 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
         })?;
         summary.samples_published += 1;
         let done = options.exit_when_done && session.done(options.program.is_some());
+        // A termination signal ends the run here too, so its last rows and journal are written
+        // by the one flush below.
+        stopped_by = wire::signals::requested();
         let ending = done
+            || stopped_by.is_some()
             || options
                 .duration_s
                 .is_some_and(|d| session.rig.state().t_s >= d);
@@ -261,19 +265,11 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
                 }
                 let target = Duration::from_secs_f64(((t_s - paced_from.1) / f).max(0.0));
                 let ahead = target.saturating_sub(paced_from.0.elapsed());
-                // Returns early on a signal; only a termination request stops the rig (a
-                // SIGCONT after SIGSTOP just goes on pacing).
+                // Returns early on a signal (seen after the next period); only a termination
+                // request stops the rig (a SIGCONT after SIGSTOP just goes on pacing).
                 let _ = node.wait(ahead);
             }
         }
-        if let Some(signal) = wire::signals::requested() {
-            stopped_by = Some(signal);
-            break;
-        }
-    }
-    if let Some(log) = log.as_mut() {
-        log.append(&rows)?;
-        summary.rows_logged += rows.matches('\n').count() as u64;
     }
     summary.simulated_s = session.rig.state().t_s;
     summary.wall_s = started.elapsed().as_secs_f64();
