@@ -168,7 +168,7 @@ pub fn check_consistency(out: &Path, fields_every: u64, log_hz: f64) -> Result<S
             .next()
             .and_then(|n| n.parse().ok())
             .ok_or(format!("fields/{name}: not a field file"))?;
-        if !ids.contains(&id) || id % fields_every != 0 {
+        if !ids.contains(&id) || !id.is_multiple_of(fields_every) {
             return Err(format!("fields/{name} is not a row of frames.csv"));
         }
     }
