@@ -1,6 +1,9 @@
 //! `dicstream`: one binary, one subcommand per process and per tool a user runs by hand.
 //! Each subcommand lives in its own file under `src/cmd/`; this file only dispatches.
 
+// The one unsafe item is the load-time signal installer below (`link_section`), allowed there.
+#![deny(unsafe_code)]
+
 mod cmd;
 
 use clap::{Parser, Subcommand};
@@ -40,6 +43,7 @@ enum Command {
 /// The termination signals are handled from the moment the program is loaded, before the
 /// Rust runtime and `main` (a signal in the first millisecond is then a request to stop).
 #[used]
+#[allow(unsafe_code)]
 #[link_section = ".init_array"]
 static INSTALL_SIGNAL_HANDLERS_AT_LOAD: extern "C" fn() = {
     extern "C" fn install() {

@@ -35,6 +35,7 @@ mod mesh;
 pub mod output;
 mod peak;
 mod pool;
+#[cfg(feature = "process")]
 pub mod process;
 mod real_fft2d;
 pub mod settings;

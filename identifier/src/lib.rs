@@ -28,6 +28,7 @@ pub mod lsq;
 pub mod models;
 pub mod online;
 pub mod plot;
+#[cfg(feature = "process")]
 pub mod process;
 pub mod report;
 pub mod residuals;

@@ -13,6 +13,7 @@ pub mod config;
 pub mod figures;
 pub mod frames;
 pub mod latency;
+pub mod leftovers;
 pub mod liveness;
 pub mod pipeline;
 pub mod recorder;

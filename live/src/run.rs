@@ -91,6 +91,7 @@ pub struct RunReport {
     pub acceptance: Option<Acceptance>,
     /// What `strain_map.png` shows.
     pub strain_map: Option<StrainMapInfo>,
+    /// Files of the instance left once every process had stopped (named, then removed).
     pub leftover_shm_files: usize,
     /// The exit code of `dicstream run` (see [`exit_code`]).
     pub exit_code: u8,
@@ -374,9 +375,7 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
         crate::children::own_cpu_s() - monitor_cpu_at_start_s,
     );
     drop(supervisor);
-    instance.cleanup_dead_nodes();
-    instance.remove_leftover_files();
-    let leftover_shm_files = instance.leftover_files().len();
+    let leftover_shm_files = crate::leftovers::report_and_remove(&instance);
     let (ending, failure) = match result {
         Ok(ending) => (ending, None),
         Err(e) => (Ending::Failed, Some(e)),

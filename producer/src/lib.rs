@@ -21,6 +21,7 @@ mod scenario;
 mod simulated;
 mod source;
 pub mod speckle;
+#[cfg(feature = "process")]
 pub mod stream;
 
 pub use camera::{CameraModel, BIT_DEPTHS};

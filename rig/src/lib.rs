@@ -17,6 +17,7 @@ pub mod limits;
 pub mod log;
 pub mod params;
 pub mod pidf;
+#[cfg(feature = "process")]
 pub mod process;
 pub mod program;
 pub mod refusal;

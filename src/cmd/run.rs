@@ -97,8 +97,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
     println!("run: results in {}", report.results.display());
     if report.leftover_shm_files > 0 {
         eprintln!(
-            "run: warning: {} shared-memory files of instance {} are left in /dev/shm",
-            report.leftover_shm_files, report.instance
+            "run: warning: the processes of instance {} left {} shared-memory file(s) (named \
+             above, removed)",
+            report.instance, report.leftover_shm_files
         );
     }
     let failure = report.failure.as_deref().unwrap_or("unknown");

@@ -1,6 +1,7 @@
 //! `fields`: one measured displacement/strain field as a `[FieldNode]` slice (row-major over
 //! the ZOI mesh, `mesh_cols * mesh_rows` nodes) behind a [`FieldHeader`].
 
+#[cfg(feature = "ipc")]
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Strain measures of the paper's eq. (13), plus the infinitesimal strain.
@@ -85,8 +86,12 @@ impl NodeStatus {
 
 /// One ZOI of the mesh. Strains are of the measure named in the header.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("dicstream.FieldNode.v2")]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.FieldNode.v2")
+)]
 pub struct FieldNode {
     /// ZOI centre in the reference image (px).
     pub x_px: f32,
@@ -107,8 +112,12 @@ pub struct FieldNode {
 
 /// In-plane strain components (dimensionless).
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("dicstream.GaugeStrain.v2")]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.GaugeStrain.v2")
+)]
 pub struct GaugeStrain {
     pub exx: f64,
     pub eyy: f64,
@@ -117,8 +126,12 @@ pub struct GaugeStrain {
 
 /// Header of one field on the `fields` service.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.FieldHeader.v2")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.FieldHeader.v2")
+)]
 pub struct FieldHeader {
     pub layout_version: u32,
     /// The [`StrainMeasure`] code of the node strains.

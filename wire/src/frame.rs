@@ -1,6 +1,7 @@
 //! `frames`: one camera image as a `[u16]` slice (row-major, `width_px * height_px` values)
 //! behind a [`FrameHeader`].
 
+#[cfg(feature = "ipc")]
 use iceoryx2::prelude::ZeroCopySend;
 
 /// The exact motion imposed on a simulated frame, as a homogeneous transformation about a
@@ -8,8 +9,12 @@ use iceoryx2::prelude::ZeroCopySend;
 /// For heterogeneous scenarios F is the gradient at the centre and the full displacement field
 /// comes from the producer library (see `producer::scenario`).
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.GroundTruth.v2")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.GroundTruth.v2")
+)]
 pub struct GroundTruth {
     /// Deformation gradient, row-major: `[F11, F12, F21, F22]` (dimensionless).
     pub deformation_gradient: [f64; 4],
@@ -40,8 +45,12 @@ impl GroundTruth {
 
 /// Header of one frame on the `frames` service.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.FrameHeader.v2")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.FrameHeader.v2")
+)]
 pub struct FrameHeader {
     /// Always [`crate::LAYOUT_VERSION`]; checked by every reader.
     pub layout_version: u32,

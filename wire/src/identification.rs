@@ -1,5 +1,6 @@
 //! `identification`: the current state of the on-line hyperelastic identification.
 
+#[cfg(feature = "ipc")]
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Most coefficients one reported model may carry.
@@ -9,8 +10,12 @@ pub const MAX_RANKED: usize = 8;
 
 /// One fitted model in the ranking.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.RankedModel.v2")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.RankedModel.v2")
+)]
 pub struct RankedModel {
     /// NUL-padded model name (identifier crate names), see [`crate::text`].
     pub name: [u8; 24],
@@ -20,8 +25,12 @@ pub struct RankedModel {
 
 /// Header-only sample on `identification` (no payload slice).
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.IdentificationReport.v2")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.IdentificationReport.v2")
+)]
 pub struct IdentificationReport {
     pub layout_version: u32,
     /// Points of the load path used, per load case: uniaxial, equibiaxial, pure shear.

@@ -3,6 +3,7 @@
 
 use iceoryx2::prelude::*;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Longest instance name accepted (the prefix lands in file names of `/dev/shm`).
 pub const MAX_NAME_LEN: usize = 48;
@@ -79,11 +80,16 @@ impl std::fmt::Display for InstanceError {
 
 impl std::error::Error for InstanceError {}
 
-/// One run's name and the iceoryx2 configuration that isolates it.
+/// One run's name and the iceoryx2 configuration that isolates it. Dropped after the nodes it
+/// created (declare it first), it removes iceoryx2's node counter of the instance when no node
+/// of the instance is left ([`Instance::release_node_counter_if_unused`]), so a process that
+/// exits normally leaves nothing in `/dev/shm`.
 #[derive(Debug)]
 pub struct Instance {
     name: String,
     config: Config,
+    /// A node was created through this value: its drop then cleans up after it.
+    created_node: AtomicBool,
 }
 
 impl Instance {
@@ -125,6 +131,7 @@ impl Instance {
         Ok(Instance {
             name: name.to_string(),
             config,
+            created_node: AtomicBool::new(false),
         })
     }
 
@@ -155,6 +162,7 @@ impl Instance {
             detail,
         };
         let node_name = NodeName::new(role).map_err(|e| node_error(format!("{e:?}")))?;
+        self.created_node.store(true, Ordering::Relaxed);
         let node = NodeBuilder::new()
             .name(&node_name)
             .config(&self.config)
@@ -195,6 +203,34 @@ impl Instance {
         removed
     }
 
+    /// Removes iceoryx2's node counter of this instance when no node of the instance is left
+    /// (after cleaning the dead ones). The counter, `/dev/shm/<prefix>…_node.<version>.global_mgmt`,
+    /// is created by the first node of a prefix and never removed by iceoryx2 0.10 (it is made
+    /// without ownership; only `iceoryx2::testing` removes it), so without this every process
+    /// left it behind even at a normal exit. Returns whether it was removed.
+    ///
+    /// Harmless against a process starting meanwhile: the counter is only open while a node is
+    /// being created, a process holding it keeps its mapping after the unlink, and a node id is
+    /// unique without it (pid, creation time and counter), so a counter that restarts from zero
+    /// collides with nothing.
+    pub fn release_node_counter_if_unused(&self) -> bool {
+        self.cleanup_dead_nodes();
+        let mut nodes = 0usize;
+        let listed = Node::<ipc::Service>::list(&self.config, |_| {
+            nodes += 1;
+            CallbackProgression::Continue
+        });
+        if listed.is_err() || nodes > 0 {
+            return false;
+        }
+        // SAFETY: iceoryx2 asks that no other process use the instance; none has a node on it
+        // (listed above), and one that is creating its first node meanwhile is safe as said in
+        // this function's documentation. The removal only unlinks the counter's file.
+        let removed =
+            unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(&self.config) };
+        matches!(removed, Ok(true))
+    }
+
     /// Files of this instance left in `/dev/shm` and in iceoryx2's bookkeeping folder.
     pub fn leftover_files(&self) -> Vec<PathBuf> {
         let prefix = self.prefix();
@@ -216,6 +252,14 @@ impl Instance {
             .iter()
             .filter(|path| std::fs::remove_file(path).is_ok())
             .count()
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        if self.created_node.load(Ordering::Relaxed) {
+            self.release_node_counter_if_unused();
+        }
     }
 }
 
@@ -249,5 +293,39 @@ mod tests {
         assert!(Instance::new(&"x".repeat(MAX_NAME_LEN + 1)).is_err());
         assert!(Instance::default_name().starts_with("dicstream_"));
         assert!(Instance::new(&Instance::default_name()).is_ok());
+    }
+
+    fn counter_files(name: &str) -> Vec<PathBuf> {
+        let probe = Instance::new(name).unwrap();
+        probe
+            .leftover_files()
+            .into_iter()
+            .filter(|p| p.to_string_lossy().ends_with(".global_mgmt"))
+            .collect()
+    }
+
+    #[test]
+    fn the_last_user_of_an_instance_removes_its_node_counter() {
+        let name = format!("wire_counter_{}", std::process::id());
+        let first = Instance::new(&name).unwrap();
+        let second = Instance::new(&name).unwrap();
+        let (node, _) = first.create_node("first").unwrap();
+        let (other, _) = second.create_node("second").unwrap();
+        assert_eq!(
+            counter_files(&name).len(),
+            1,
+            "iceoryx2 made its node counter"
+        );
+        drop(node);
+        drop(first);
+        assert_eq!(
+            counter_files(&name).len(),
+            1,
+            "another node still uses the instance"
+        );
+        drop(other);
+        drop(second);
+        assert!(counter_files(&name).is_empty());
+        assert!(Instance::new(&name).unwrap().leftover_files().is_empty());
     }
 }

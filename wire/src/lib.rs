@@ -4,6 +4,11 @@
 //! publish/subscribe wrappers every process uses. One place per concept: no other crate defines
 //! a type that crosses a process boundary.
 //!
+//! Feature `ipc` (default): iceoryx2 and everything built on it (`instance`, `pubsub`,
+//! `shm`, `signals::waitset`, the layouts' `ZeroCopySend` derives). Without it the crate is
+//! the pure contract (layouts with their compile-time size and offset checks, codes, service
+//! specs, files, signals' flag): what the algorithm crates use with their `process` feature off.
+//!
 //! Units are in every field name. Coordinates follow DESIGN.md: x = pixel column, y = pixel row,
 //! origin at the centre of the top-left pixel; u, v are Lagrangian displacements in pixels.
 
@@ -13,12 +18,15 @@ pub mod field;
 pub mod files;
 pub mod frame;
 pub mod identification;
+#[cfg(feature = "ipc")]
 pub mod instance;
 mod layout_check;
 pub mod owner;
+#[cfg(feature = "ipc")]
 pub mod pubsub;
 pub mod rig;
 pub mod services;
+#[cfg(feature = "ipc")]
 pub mod shm;
 pub mod signals;
 pub mod text;
@@ -27,6 +35,7 @@ pub use clock::monotonic_ns;
 pub use field::{FieldHeader, FieldNode, GaugeStrain, NodeStatus, StrainMeasure};
 pub use frame::{FrameHeader, GroundTruth};
 pub use identification::IdentificationReport;
+#[cfg(feature = "ipc")]
 pub use instance::{Instance, InstanceError};
 pub use rig::{ActuatorState, RigCommand, RigCommandKind, RigReply, RigState};
 

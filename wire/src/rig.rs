@@ -1,6 +1,7 @@
 //! `rig/state` (a fixed [`RigState`] sample, decimated from the rig's control rate) and
 //! `rig/command` (request [`RigCommand`], response [`RigReply`]).
 
+#[cfg(feature = "ipc")]
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Actuators in this order everywhere: X+, X−, Y+, Y−, Z+, Z−.
@@ -10,8 +11,12 @@ pub const AXIS_NAMES: [&str; 3] = ["X", "Y", "Z"];
 
 /// One servo-hydraulic actuator at one instant.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("dicstream.ActuatorState.v2")]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.ActuatorState.v2")
+)]
 pub struct ActuatorState {
     pub position_mm: f64,
     pub command_mm: f64,
@@ -25,8 +30,12 @@ pub struct ActuatorState {
 
 /// One decimated sample of the rig.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[type_name("dicstream.RigState.v2")]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.RigState.v2")
+)]
 pub struct RigState {
     pub layout_version: u32,
     /// Program state code (rig crate: idle, running, holding, stopped, tripped).
@@ -98,8 +107,12 @@ impl RigCommandKind {
 
 /// A request on `rig/command`.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.RigCommand.v2")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.RigCommand.v2")
+)]
 pub struct RigCommand {
     pub layout_version: u32,
     /// A [`RigCommandKind`] code.
@@ -128,8 +141,12 @@ impl RigCommand {
 
 /// The answer to a [`RigCommand`]: accepted, or refused with the reason.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[type_name("dicstream.RigReply.v2")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "ipc",
+    derive(ZeroCopySend),
+    type_name("dicstream.RigReply.v2")
+)]
 pub struct RigReply {
     pub layout_version: u32,
     pub accepted: u32,

@@ -6,7 +6,9 @@
 //! SIGSTOP (epoll_wait then fails with EINTR), is only a wake-up; a loop stops when
 //! [`requested`] says so.
 
+#[cfg(feature = "ipc")]
 use iceoryx2::prelude::*;
+#[cfg(feature = "ipc")]
 use iceoryx2::waitset::WaitSetCreateError;
 use std::sync::atomic::{AtomicI32, Ordering};
 
@@ -70,6 +72,7 @@ pub fn name(signal: libc::c_int) -> String {
 
 /// A WaitSet that leaves signals to this module (iceoryx2's default would install its own
 /// SIGINT/SIGTERM handler over ours and report SIGCONT's EINTR as an interrupt).
+#[cfg(feature = "ipc")]
 pub fn waitset() -> Result<WaitSet<ipc::Service>, WaitSetCreateError> {
     WaitSetBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
