@@ -70,6 +70,15 @@ impl fmt::Display for Refusal {
 
 impl std::error::Error for Refusal {}
 
+impl Refusal {
+    /// A malformed command, refused with `reason` (a program's or configuration's error).
+    pub fn invalid(reason: impl fmt::Display) -> Refusal {
+        Refusal::Invalid {
+            reason: reason.to_string(),
+        }
+    }
+}
+
 /// A number as a person reads it: plain when moderate, in exponent form when huge or tiny
 /// (1e300, not three hundred digits).
 pub fn number(value: f64) -> String {
