@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 /// The load path of the journal as curves (cases with enough points).
 pub fn journal_curves(journal: &Path) -> Result<Vec<Curve>, String> {
-    let points = identifier::journal::read(journal)?;
+    let points = identifier::journal::read(journal).map_err(|e| e.to_string())?;
     let mut curves = Vec::new();
     for case in LoadCase::ALL {
         let (stretch, stress): (Vec<f64>, Vec<f64>) = points
@@ -39,7 +39,7 @@ pub fn identification_figures(
     if curves.is_empty() {
         return Ok(Vec::new());
     }
-    let models = identifier::models::parse_model_list(models)?;
+    let models = identifier::models::parse_model_list(models).map_err(|e| e.to_string())?;
     let (fits, _failures) = fit_ranked(&models, &curves, &FitOptions::default());
     // Without both cases the route cannot run: the f(I1) and g(I2) plots show the fits only.
     let route = identifier::route::paper_route(&curves, 2, 2).ok();
