@@ -11,8 +11,9 @@ use crate::config::RunConfig;
 use crate::latency::Percentiles;
 use crate::liveness::{Counts, Liveness};
 use crate::recorder::{Recorder, RecorderSettings};
-use crate::results::{write_atomic, ResultsDir};
+use crate::results::ResultsDir;
 use crate::subscriptions::Subscriptions;
+use anyhow::{anyhow, bail};
 use iceoryx2::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -218,16 +219,14 @@ pub fn child_args(
 }
 
 /// Shared memory the run's services need (bytes), checked against `/dev/shm` at start.
-pub fn shm_needed_bytes(config: &RunConfig) -> Result<u64, String> {
+pub fn shm_needed_bytes(config: &RunConfig) -> anyhow::Result<u64> {
     let frames =
         producer::stream::frames_shm_bytes(config.camera.width_px, config.camera.height_px);
     let settings = config.correlator_settings()?;
-    let roi = settings
-        .resolve_roi(
-            config.camera.width_px as usize,
-            config.camera.height_px as usize,
-        )
-        .map_err(|e| e.to_string())?;
+    let roi = settings.resolve_roi(
+        config.camera.width_px as usize,
+        config.camera.height_px as usize,
+    )?;
     let nodes = (roi.width_px / settings.step_px + 1) * (roi.height_px / settings.step_px + 1);
     let fields = wire::services::FIELDS.shm_bytes(
         std::mem::size_of::<wire::FieldHeader>(),
@@ -284,7 +283,7 @@ pub fn remove_dead_runs() -> usize {
     dead.len()
 }
 
-pub fn run(options: RunOptions) -> Result<RunReport, String> {
+pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
     let config = &options.config;
     config.validate()?;
     let cleaned = remove_dead_runs();
@@ -297,16 +296,15 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
         .instance
         .clone()
         .unwrap_or_else(|| format!("run_{}", std::process::id()));
-    let instance = wire::Instance::new(&instance_name).map_err(|e| e.to_string())?;
+    let instance = wire::Instance::new(&instance_name)?;
     // Before anything is written or started: a second run on this instance is refused.
-    let _owner = instance.claim("run").map_err(|e| e.to_string())?;
-    wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes(config)?)
-        .map_err(|e| e.to_string())?;
+    let _owner = instance.claim("run")?;
+    wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes(config)?)?;
     let results = match &options.results {
         Some(root) => ResultsDir::at(root)?,
         None => ResultsDir::create_dated(Path::new(&config.run.results_dir))?,
     };
-    write_atomic(
+    wire::files::write_atomic(
         &results.config(),
         format!(
             "# The configuration of this run (dicstream run --config {} reruns it).\n{}",
@@ -326,7 +324,7 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
     let t0_ns = wire::monotonic_ns();
     let mut supervisor = Supervisor::new(&options.exe, &results.logs())?;
     let outcome = {
-        let (node, _) = instance.create_node("monitor").map_err(|e| e.to_string())?;
+        let (node, _) = instance.create_node("monitor")?;
         let subscriptions = Subscriptions::new(&node)?;
         let mut recorder = Recorder::new(
             &results,
@@ -379,7 +377,8 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
     let leftover_shm_files = instance.leftover_files().len();
     let (ending, failure) = match result {
         Ok(ending) => (ending, None),
-        Err(e) => (Ending::Failed, Some(e)),
+        // The whole chain: what failed, and why.
+        Err(e) => (Ending::Failed, Some(format!("{e:#}"))),
     };
     finish(
         config,
@@ -401,7 +400,7 @@ fn start_children(
     config: &RunConfig,
     instance: &str,
     results: &ResultsDir,
-) -> Result<bool, String> {
+) -> anyhow::Result<bool> {
     for role in start_order() {
         if wire::signals::requested().is_some() {
             return Ok(false);
@@ -472,14 +471,14 @@ fn event_loop(
     status: bool,
     started: Instant,
     state: &mut LoopState,
-) -> Result<Ending, String> {
-    let waitset = wire::signals::waitset().map_err(|e| format!("monitor WaitSet: {e:?}"))?;
+) -> anyhow::Result<Ending> {
+    let waitset = wire::signals::waitset().map_err(|e| anyhow!("monitor WaitSet: {e:?}"))?;
     let mut guards = Vec::new();
     for listener in subscriptions.listeners() {
         guards.push(
             waitset
                 .attach_notification(listener)
-                .map_err(|e| format!("monitor WaitSet: {e:?}"))?,
+                .map_err(|e| anyhow!("monitor WaitSet: {e:?}"))?,
         );
     }
     let status_every = Duration::from_secs_f64(config.run.status_interval_s);
@@ -496,15 +495,13 @@ fn event_loop(
         // only a termination request stops the run.
         waitset
             .wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, WAIT_SLICE)
-            .map_err(|e| format!("monitor WaitSet: {e:?}"))?;
+            .map_err(|e| anyhow!("monitor WaitSet: {e:?}"))?;
         if let Some(signal) = wire::signals::requested() {
             return Ok(interrupted(signal));
         }
         subscriptions.drain(recorder)?;
         if let Some(error) = &recorder.write_error {
-            return Err(format!(
-                "{error}; the run stops (every earlier row is whole)"
-            ));
+            bail!("{error}; the run stops (every earlier row is whole)");
         }
 
         if matches!(phase, Phase::Running) {
@@ -611,7 +608,7 @@ fn handle_death(
     results: &ResultsDir,
     next_frame_id: u64,
     state: &mut LoopState,
-) -> Result<(), String> {
+) -> anyhow::Result<()> {
     let role = exit.role;
     let report = format!(
         "{} (pid {}) died: {}{}",
@@ -630,21 +627,21 @@ fn handle_death(
     // restarted: it would fail the same way, or start its test over.
     match exit.code {
         Some(code) if code == i32::from(wire::exit::OUTPUT_FAILED) => {
-            return Err(format!("{report}\n(a results file could not be written)"));
+            bail!("{report}\n(a results file could not be written)");
         }
         Some(code) if code == i32::from(wire::exit::CANNOT_RESUME) => {
-            return Err(format!("{report}\n(it could not resume its test safely)"));
+            bail!("{report}\n(it could not resume its test safely)");
         }
         _ => {}
     }
     let count = &mut state.restart_counts[role as usize];
     if !config.run.restart || *count >= config.run.max_restarts {
-        return Err(format!(
+        bail!(
             "{report}\n(restart {}; {} of {} restarts used)",
             if config.run.restart { "on" } else { "off" },
             count,
             config.run.max_restarts
-        ));
+        );
     }
     *count += 1;
     let args = child_args(role, config, instance, results, next_frame_id);
@@ -675,26 +672,28 @@ fn finish(
     failure: Option<String>,
     started: Instant,
     leftover_shm_files: usize,
-) -> Result<RunReport, String> {
+) -> anyhow::Result<RunReport> {
     let mut notes = Vec::new();
-    let mut keep = |what: &str, result: Result<(), String>| {
+    let mut keep = |what: &str, result: anyhow::Result<()>| {
         if let Err(e) = result {
-            notes.push(format!("{what}: {e}"));
+            notes.push(format!("{what}: {e:#}"));
         }
     };
     keep(
         "latency.hgrm",
-        write_atomic(
+        wire::files::write_atomic(
             &results.path("latency.hgrm"),
             recorder.latency_field.hgrm().as_bytes(),
-        ),
+        )
+        .map_err(anyhow::Error::from),
     );
     keep(
         "latency_identification.hgrm",
-        write_atomic(
+        wire::files::write_atomic(
             &results.path("latency_identification.hgrm"),
             recorder.latency_identification.hgrm().as_bytes(),
-        ),
+        )
+        .map_err(anyhow::Error::from),
     );
     keep(
         "latency.png",
@@ -813,18 +812,16 @@ fn finish(
         leftover_shm_files,
         exit_code,
     };
-    let mut json = serde_json::to_value(&report).map_err(|e| e.to_string())?;
+    let mut json = serde_json::to_value(&report)?;
     if !notes.is_empty() {
         json["notes"] = serde_json::json!(notes);
         for note in &notes {
             eprintln!("run: {note}");
         }
     }
-    write_atomic(
+    wire::files::write_atomic(
         &results.summary_json(),
-        serde_json::to_string_pretty(&json)
-            .map_err(|e| e.to_string())?
-            .as_bytes(),
+        serde_json::to_string_pretty(&json)?.as_bytes(),
     )?;
     Ok(report)
 }
@@ -871,12 +868,15 @@ fn verdict(
 }
 
 /// `latency.hgrm` (capture to field) and `latency_identification.hgrm`.
-fn write_histograms(results: &ResultsDir, recorder: &Recorder) -> Result<(), String> {
-    write_atomic(
+fn write_histograms(
+    results: &ResultsDir,
+    recorder: &Recorder,
+) -> Result<(), wire::files::FileError> {
+    wire::files::write_atomic(
         &results.path("latency.hgrm"),
         recorder.latency_field.hgrm().as_bytes(),
     )?;
-    write_atomic(
+    wire::files::write_atomic(
         &results.path("latency_identification.hgrm"),
         recorder.latency_identification.hgrm().as_bytes(),
     )
