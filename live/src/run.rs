@@ -14,10 +14,13 @@ use crate::recorder::{Recorder, RecorderSettings};
 use crate::results::ResultsDir;
 use crate::subscriptions::Subscriptions;
 use anyhow::{anyhow, bail};
+pub use child_args::child_args;
 use iceoryx2::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+
+mod child_args;
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -114,109 +117,6 @@ const DRAIN_TIMEOUT: Duration = Duration::from_secs(10);
 const WAIT_SLICE: Duration = Duration::from_millis(200);
 /// How often the latency histograms are rewritten during the run.
 const HISTOGRAM_EVERY: Duration = Duration::from_secs(10);
-/// Relative margin of the camera's stretch envelope beyond the campaign's largest stretch.
-const STRETCH_MARGIN: f64 = 0.05;
-
-fn fmt_list(values: &[f64]) -> String {
-    values
-        .iter()
-        .map(|v| format!("{v:e}"))
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-/// The command line of each child. `first_frame_id` is where the camera's frame ids start
-/// (past the last id seen when a camera is restarted, so ids never go back).
-pub fn child_args(
-    role: Role,
-    config: &RunConfig,
-    instance: &str,
-    results: &ResultsDir,
-    first_frame_id: u64,
-) -> Vec<String> {
-    let path = |p: PathBuf| p.to_string_lossy().into_owned();
-    let mut args = vec!["--instance".to_string(), instance.to_string()];
-    let c = &config.camera;
-    let k = &config.correlator;
-    let g = &config.rig;
-    let extra: Vec<String> = match role {
-        Role::Rig => vec![
-            "--campaign".into(),
-            config.campaign_spec(),
-            format!("--law-f={}", fmt_list(&config.specimen.law_f)),
-            format!("--law-g={}", fmt_list(&config.specimen.law_g)),
-            "--speed".into(),
-            g.speed.to_string(),
-            "--publish-hz".into(),
-            g.publish_hz.to_string(),
-            "--log".into(),
-            path(results.rig_csv()),
-            "--log-hz".into(),
-            g.log_hz.to_string(),
-            "--seed".into(),
-            g.seed.to_string(),
-            "--state-dir".into(),
-            path(results.rig_state()),
-            "--exit-when-done".into(),
-        ],
-        Role::Producer => vec![
-            "--follow-rig".into(),
-            "--fps".into(),
-            c.fps.to_string(),
-            "--width".into(),
-            c.width_px.to_string(),
-            "--height".into(),
-            c.height_px.to_string(),
-            "--bit-depth".into(),
-            c.bit_depth.to_string(),
-            "--mm-per-px".into(),
-            c.mm_per_px.to_string(),
-            "--max-stretch".into(),
-            // The rig overshoots a level by a little: the camera covers a margin beyond it.
-            (config.max_stretch() * (1.0 + STRETCH_MARGIN)).to_string(),
-            "--speckle-size-px".into(),
-            c.speckle_size_px.to_string(),
-            "--seed".into(),
-            c.seed.to_string(),
-            "--threads".into(),
-            c.threads.to_string(),
-            "--first-frame-id".into(),
-            first_frame_id.to_string(),
-        ],
-        Role::Correlator => vec![
-            "--method".into(),
-            k.method.clone(),
-            "--zoi".into(),
-            k.zoi_px.to_string(),
-            "--step".into(),
-            k.step_px.to_string(),
-            "--threads".into(),
-            k.threads.to_string(),
-            "--strain".into(),
-            k.strain.clone(),
-            "--reference-mode".into(),
-            k.reference.clone(),
-            "--guess".into(),
-            k.guess.clone(),
-            "--min-zncc".into(),
-            k.min_zncc.to_string(),
-            "--gradient-correction".into(),
-            k.gradient_correction.to_string(),
-            "--state-dir".into(),
-            path(results.correlator_state()),
-        ],
-        Role::Identifier => vec![
-            "--output".into(),
-            path(results.identification_json()),
-            "--journal".into(),
-            path(results.journal()),
-            "--model".into(),
-            config.identifier.models.clone(),
-        ],
-    };
-    args.extend(extra);
-    args
-}
 
 /// Shared memory the run's services need (bytes), checked against `/dev/shm` at start.
 pub fn shm_needed_bytes(config: &RunConfig) -> anyhow::Result<u64> {
