@@ -74,6 +74,16 @@ pub enum ProcessError {
     },
 }
 
+impl ProcessError {
+    /// An iceoryx2 error of the `rig/command` port `port`.
+    fn command(port: &'static str, error: impl std::fmt::Debug) -> ProcessError {
+        ProcessError::Command {
+            port,
+            detail: format!("{error:?}"),
+        }
+    }
+}
+
 /// Why a command over `rig/command` was refused (the reply carries the message).
 #[derive(Debug, thiserror::Error)]
 pub enum CommandRefused {
@@ -232,23 +242,17 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
     }
     let publisher =
         wire::pubsub::ValuePublisher::<RigState>::create(&node, &wire::services::RIG_STATE)?;
-    let port_error = |port: &'static str| {
-        move |detail: &dyn std::fmt::Debug| ProcessError::Command {
-            port,
-            detail: format!("{detail:?}"),
-        }
-    };
     let service_name = ServiceName::new(wire::services::RIG_COMMAND)
-        .map_err(|e| port_error("service name rig/command")(&e))?;
+        .map_err(|e| ProcessError::command("service name rig/command", e))?;
     let command_service = node
         .service_builder(&service_name)
         .request_response::<wire::RigCommand, RigReply>()
         .open_or_create()
-        .map_err(|e| port_error("service rig/command")(&e))?;
+        .map_err(|e| ProcessError::command("service rig/command", e))?;
     let server = command_service
         .server_builder()
         .create()
-        .map_err(|e| port_error("server rig/command")(&e))?;
+        .map_err(|e| ProcessError::command("server rig/command", e))?;
 
     let mut summary = ProcessSummary::default();
     // The log grows by whole rows; a resumed rig goes on after the rows its journal names.
@@ -287,7 +291,7 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
         // Commands, between publication periods.
         while let Some(active) = server
             .receive()
-            .map_err(|e| port_error("rig/command receive")(&e))?
+            .map_err(|e| ProcessError::command("rig/command receive", e))?
         {
             let reply = match handle(&mut session.rig, &active, &options) {
                 Ok(()) => {
@@ -302,7 +306,7 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
             };
             active
                 .send_copy(reply)
-                .map_err(|e| port_error("rig/command reply")(&e))?;
+                .map_err(|e| ProcessError::command("rig/command reply", e))?;
         }
 
         let event = session.period(log.is_some().then_some(&mut rows))?;
