@@ -84,10 +84,103 @@ fn main() -> std::process::ExitCode {
         Ok(code) => code,
         Err(error) => {
             eprintln!("dicstream: error: {error:#}");
-            // A code with a meaning for `dicstream run` (a results file that could not be
-            // written, a rig that could not resume), else 1.
-            let code = error.chain().find_map(wire::exit::code_of).unwrap_or(1);
-            std::process::ExitCode::from(code)
+            std::process::ExitCode::from(exit_code_of(&error))
         }
+    }
+}
+
+/// The exit code of a failed subcommand: one with a meaning for `dicstream run` that some
+/// error of the chain asks for (a results file that could not be written, a rig that could not
+/// resume; `wire::exit::code_of`), else 1.
+fn exit_code_of(error: &anyhow::Error) -> u8 {
+    error.chain().find_map(wire::exit::code_of).unwrap_or(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::exit_code_of;
+    use anyhow::Context;
+    use wire::exit::{ExitWith, CANNOT_RESUME, OUTPUT_FAILED};
+
+    fn full_disk(path: &str) -> wire::files::FileError {
+        wire::files::FileError {
+            path: path.into(),
+            what: "write",
+            reason: std::io::Error::from_raw_os_error(libc::ENOSPC),
+        }
+    }
+
+    #[test]
+    fn a_file_error_keeps_its_code_through_contexts_and_is_said_once() {
+        let error: anyhow::Result<()> = Err(full_disk("frames.csv")).context("recorder");
+        let error = error.context("run").unwrap_err();
+        assert_eq!(exit_code_of(&error), OUTPUT_FAILED);
+        let message = format!("{error:#}");
+        assert!(
+            message.starts_with("run: recorder: cannot write frames.csv: "),
+            "{message}"
+        );
+        assert_eq!(message.matches("No space left").count(), 1, "{message}");
+    }
+
+    #[test]
+    fn a_process_error_keeps_the_code_of_its_cause() {
+        // As the process commands say it: flattened, with the code of the cause.
+        let log = rig::process::ProcessError::File(full_disk("rig.csv"));
+        let error = anyhow::Error::from(wire::exit::in_context("rig process", &log));
+        assert_eq!(exit_code_of(&error), OUTPUT_FAILED);
+        assert!(
+            format!("{error:#}").starts_with("rig process: cannot write rig.csv: "),
+            "{error:#}"
+        );
+        // Through anyhow's own chain too (the cause is the variant's source).
+        let error = anyhow::Error::new(rig::process::ProcessError::File(full_disk("rig.csv")))
+            .context("rig process");
+        assert_eq!(exit_code_of(&error), OUTPUT_FAILED);
+        let journal = rig::process::ProcessError::CannotResume(ExitWith {
+            code: CANNOT_RESUME,
+            message: "cannot resume from rig.journal".into(),
+        });
+        let error = anyhow::Error::new(journal).context("rig process");
+        assert_eq!(exit_code_of(&error), CANNOT_RESUME);
+        // A state file of the correlator, through its transparent wrappers.
+        let state = correlator::state::StateError::Write(full_disk("reference.state"));
+        let error = anyhow::Error::new(correlator::process::ProcessError::State(state));
+        assert_eq!(exit_code_of(&error), OUTPUT_FAILED);
+        let error = anyhow::Error::new(identifier::process::ProcessError::File(full_disk(
+            "identification.json",
+        )));
+        assert_eq!(exit_code_of(&error), OUTPUT_FAILED);
+    }
+
+    /// `dicstream run` gives each child the arguments of `live::run::child_args`: every one is
+    /// one its subcommand accepts.
+    #[test]
+    fn every_child_of_a_run_is_given_arguments_its_command_accepts() {
+        use clap::Parser;
+        let config = live::RunConfig::default();
+        let results = live::results::ResultsDir {
+            root: "/results/run".into(),
+        };
+        for role in live::children::Role::ALL {
+            let args = live::run::child_args(role, &config, "bench_7", &results, 5);
+            let line = ["dicstream", role.name()]
+                .into_iter()
+                .map(String::from)
+                .chain(args);
+            if let Err(e) = super::Cli::try_parse_from(line) {
+                panic!("{role:?}: {e}");
+            }
+        }
+    }
+
+    #[test]
+    fn an_error_without_a_code_exits_with_1() {
+        assert_eq!(exit_code_of(&anyhow::anyhow!("no")), 1);
+        let error = anyhow::Error::new(ExitWith {
+            code: 1,
+            message: "the run could not start".into(),
+        });
+        assert_eq!(exit_code_of(&error.context("run")), 1);
     }
 }

@@ -28,7 +28,32 @@ use std::time::{Duration, Instant};
 use wire::pubsub::{SlicePublisher, SliceSubscriber};
 use wire::{services, FieldHeader, FieldNode, FrameHeader, GaugeStrain, Instance};
 
-type BoxError = Box<dyn std::error::Error + Send + Sync>;
+/// Why the correlator process could not start or stopped. A state file that could not be
+/// written stays reachable through `source()` (for `wire::exit::code_of`).
+#[derive(Debug, thiserror::Error)]
+pub enum ProcessError {
+    #[error(transparent)]
+    Settings(#[from] crate::settings::SettingsError),
+    #[error(transparent)]
+    Instance(#[from] wire::InstanceError),
+    #[error(transparent)]
+    State(#[from] crate::state::StateError),
+    #[error("settings refused for the {width_px}x{height_px} px reference {label}: {reason}")]
+    ReferenceSettings {
+        width_px: usize,
+        height_px: usize,
+        label: String,
+        reason: crate::settings::SettingsError,
+    },
+    #[error("reference image {label} is flat: no ZOI has texture to correlate")]
+    FlatReference { label: String },
+    #[error(transparent)]
+    WaitSetCreate(#[from] iceoryx2::waitset::WaitSetCreateError),
+    #[error(transparent)]
+    WaitSetAttach(#[from] iceoryx2::waitset::WaitSetAttachmentError),
+    #[error(transparent)]
+    WaitSetRun(#[from] iceoryx2::waitset::WaitSetRunError),
+}
 
 /// A reference image given by the user instead of the first frame.
 #[derive(Clone, Debug)]
@@ -154,7 +179,7 @@ const MAX_WAIT: Duration = Duration::from_secs(1);
 const REJECT_LOG_BURST: u64 = 5;
 
 /// Runs the process until SIGINT/SIGTERM, `max_frames` or the idle timeout.
-pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
+pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
     config.settings.validate()?;
     let instance = Instance::new(&config.instance)?;
     let _owner = instance.claim("correlator")?;
@@ -334,7 +359,11 @@ impl Live {
     }
 
     /// Makes the fields publisher for a mesh of `nodes` (needs free shared memory).
-    fn open_publisher(&mut self, node: &Node<ipc::Service>, nodes: usize) -> Result<(), BoxError> {
+    fn open_publisher(
+        &mut self,
+        node: &Node<ipc::Service>,
+        nodes: usize,
+    ) -> Result<(), ProcessError> {
         let bytes = services::FIELDS.shm_bytes(
             std::mem::size_of::<FieldHeader>(),
             nodes * std::mem::size_of::<FieldNode>(),
@@ -349,7 +378,7 @@ impl Live {
         node: &Node<ipc::Service>,
         saved: &SavedReference,
         path: &std::path::Path,
-    ) -> Result<(), BoxError> {
+    ) -> Result<(), ProcessError> {
         let correlator = saved.restore(self.settings.clone(), path)?;
         let (nx, ny) = correlator.mesh_size();
         self.open_publisher(node, nx * ny)?;
@@ -367,23 +396,21 @@ impl Live {
         &mut self,
         node: &Node<ipc::Service>,
         image: &ReferenceImage,
-    ) -> Result<(), BoxError> {
+    ) -> Result<(), ProcessError> {
         let mut correlator =
             Correlator::new(self.settings.clone(), image.width_px, image.height_px).map_err(
-                |e| {
-                    format!(
-                        "settings refused for the {}x{} px reference {}: {e}",
-                        image.width_px, image.height_px, image.label
-                    )
+                |reason| ProcessError::ReferenceSettings {
+                    width_px: image.width_px,
+                    height_px: image.height_px,
+                    label: image.label.clone(),
+                    reason,
                 },
             )?;
         correlator.set_reference(&image.pixels)?;
         if correlator.reference_textured_nodes() == 0 {
-            return Err(format!(
-                "reference image {} is flat: no ZOI has texture to correlate",
-                image.label
-            )
-            .into());
+            return Err(ProcessError::FlatReference {
+                label: image.label.clone(),
+            });
         }
         let (nx, ny) = correlator.mesh_size();
         self.open_publisher(node, nx * ny)?;
@@ -423,7 +450,7 @@ impl Live {
         sample: iceoryx2::sample::Sample<ipc::Service, [u16], FrameHeader>,
         t_received_ns: u64,
         state: Option<&mut StateDir>,
-    ) -> Result<(), BoxError> {
+    ) -> Result<(), ProcessError> {
         let header = *sample.user_header();
         let pixels: &[u16] = sample.payload();
         if let Err(reason) = header.validate(pixels.len()) {

@@ -49,52 +49,50 @@ pub const SUMMARY_FILE: &str = "state.json";
 pub const REFERENCE_FROM_FILE: u64 = u64::MAX;
 
 /// Why a state folder could not be used.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum StateError {
-    Io {
-        path: PathBuf,
-        detail: String,
-    },
-    Corrupt {
-        path: PathBuf,
-        detail: String,
-    },
-    Mismatch {
-        path: PathBuf,
-        detail: String,
-    },
+    #[error("{}: {detail}", .path.display())]
+    Io { path: PathBuf, detail: String },
+    #[error("{}: not a usable correlator state ({reason}); remove it to start from a new reference", .path.display())]
+    Corrupt { path: PathBuf, reason: Corruption },
+    #[error("{} was written with other settings: {detail}; run with the same settings or another --state-dir", .path.display())]
+    Mismatch { path: PathBuf, detail: String },
+    #[error("saved reference refused: {0}")]
     Settings(SettingsError),
-    /// A state file could not be written (a full disk, say).
-    Write(wire::files::FileError),
+    /// A state file could not be written (a full disk, say); also the `source()`, so that
+    /// `wire::exit::code_of` finds its exit code.
+    #[error("{0}")]
+    Write(#[source] wire::files::FileError),
 }
 
-impl std::fmt::Display for StateError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            StateError::Io { path, detail } => write!(f, "{}: {detail}", path.display()),
-            StateError::Corrupt { path, detail } => write!(
-                f,
-                "{}: not a usable correlator state ({detail}); remove it to start from a new reference",
-                path.display()
-            ),
-            StateError::Mismatch { path, detail } => write!(
-                f,
-                "{} was written with other settings: {detail}; run with the same settings or another --state-dir",
-                path.display()
-            ),
-            StateError::Settings(e) => write!(f, "saved reference refused: {e}"),
-            StateError::Write(e) => write!(f, "{e}"),
-        }
-    }
-}
-
-impl std::error::Error for StateError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            StateError::Write(e) => Some(e),
-            _ => None,
-        }
-    }
+/// Why the bytes of a state file (`reference.state`, `origin.state`) cannot be read back.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Corruption {
+    #[error("{len_bytes} bytes, shorter than a header")]
+    Short { len_bytes: usize },
+    #[error("wrong magic bytes")]
+    Magic,
+    #[error("format version {version}, this build reads {expected}")]
+    Version { version: u32, expected: u32 },
+    #[error("{len_bytes} bytes but the header ({width_px}x{height_px} px, mesh {mesh_x}x{mesh_y}) needs {expected_bytes:?}")]
+    ReferenceLength {
+        len_bytes: usize,
+        width_px: u32,
+        height_px: u32,
+        mesh_x: u32,
+        mesh_y: u32,
+        /// None when the header's sizes overflow.
+        expected_bytes: Option<u64>,
+    },
+    #[error("{len_bytes} bytes, a {width_px}x{height_px} px origin needs {expected_bytes}")]
+    OriginLength {
+        len_bytes: usize,
+        width_px: usize,
+        height_px: usize,
+        expected_bytes: usize,
+    },
+    #[error("checksum mismatch")]
+    Checksum,
 }
 
 /// The settings and size a state file was written for, as stored in its header.
@@ -366,9 +364,9 @@ impl StateDir {
         let Some(bytes) = read_if_present(&self.path)? else {
             return Ok(None);
         };
-        let mut saved = decode(&bytes).map_err(|detail| StateError::Corrupt {
+        let mut saved = decode(&bytes).map_err(|reason| StateError::Corrupt {
             path: self.path.clone(),
-            detail,
+            reason,
         })?;
         saved.origin_pixels = self.load_origin(&saved)?;
         Ok(Some(saved))
@@ -380,9 +378,9 @@ impl StateDir {
         let Some(bytes) = read_if_present(&self.origin_path)? else {
             return Ok(None);
         };
-        let origin = origin::decode(&bytes).map_err(|detail| StateError::Corrupt {
+        let origin = origin::decode(&bytes).map_err(|reason| StateError::Corrupt {
             path: self.origin_path.clone(),
-            detail,
+            reason,
         })?;
         let same = origin.origin_frame_id == saved.origin_frame_id
             && (origin.width_px, origin.height_px) == (saved.width_px, saved.height_px);
@@ -505,21 +503,24 @@ fn encode(
     assert_eq!(out.len(), layout.file_bytes());
 }
 
-fn decode(bytes: &[u8]) -> Result<SavedReference, String> {
+fn decode(bytes: &[u8]) -> Result<SavedReference, Corruption> {
     if bytes.len() < HEADER_BYTES + 8 {
-        return Err(format!("{} bytes, shorter than a header", bytes.len()));
+        return Err(Corruption::Short {
+            len_bytes: bytes.len(),
+        });
     }
     if &bytes[..8] != MAGIC {
-        return Err("wrong magic bytes".into());
+        return Err(Corruption::Magic);
     }
     let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().expect("4 bytes"));
     let u64_at = |o: usize| u64::from_le_bytes(bytes[o..o + 8].try_into().expect("8 bytes"));
     let f64_at = |o: usize| f64::from_le_bytes(bytes[o..o + 8].try_into().expect("8 bytes"));
     let version = u32_at(8);
     if version != FORMAT_VERSION {
-        return Err(format!(
-            "format version {version}, this build reads {FORMAT_VERSION}"
-        ));
+        return Err(Corruption::Version {
+            version,
+            expected: FORMAT_VERSION,
+        });
     }
     let layout = Layout {
         width_px: u32_at(12),
@@ -543,18 +544,18 @@ fn decode(bytes: &[u8]) -> Result<SavedReference, String> {
         .and_then(|p| p.checked_add(16 * layout.mesh[0] as u64 * layout.mesh[1] as u64))
         .and_then(|p| p.checked_add(HEADER_BYTES as u64 + 8));
     if expected != Some(bytes.len() as u64) {
-        return Err(format!(
-            "{} bytes but the header ({}x{} px, mesh {}x{}) needs {expected:?}",
-            bytes.len(),
-            layout.width_px,
-            layout.height_px,
-            layout.mesh[0],
-            layout.mesh[1]
-        ));
+        return Err(Corruption::ReferenceLength {
+            len_bytes: bytes.len(),
+            width_px: layout.width_px,
+            height_px: layout.height_px,
+            mesh_x: layout.mesh[0],
+            mesh_y: layout.mesh[1],
+            expected_bytes: expected,
+        });
     }
     let body = bytes.len() - 8;
     if wire::frame::byte_checksum(&bytes[..body]) != u64_at(body) {
-        return Err("checksum mismatch".into());
+        return Err(Corruption::Checksum);
     }
     let pixel_end = HEADER_BYTES + 2 * layout.pixels();
     let pixels = bytes[HEADER_BYTES..pixel_end]

@@ -160,7 +160,8 @@ impl Curve {
 pub const MIN_POINTS_PER_CURVE: usize = 2;
 
 /// A data error naming its source and what was expected.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{source_name}: {message}")]
 pub struct DataError {
     pub source_name: String,
     pub message: String,
@@ -174,14 +175,6 @@ impl DataError {
         }
     }
 }
-
-impl fmt::Display for DataError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.source_name, self.message)
-    }
-}
-
-impl std::error::Error for DataError {}
 
 /// Reads a `stretch,nominal_stress_mpa` CSV (one header line, then two numeric columns).
 pub fn read_curve_csv(path: &Path, case: LoadCase) -> Result<Curve, DataError> {

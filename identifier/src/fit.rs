@@ -104,35 +104,19 @@ impl Fit {
 }
 
 /// Fit errors.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FitError {
+    #[error("no data: give at least one load case")]
     NoData,
+    #[error("model {model}: {error}")]
     Lsq { model: String, error: LsqError },
+    #[error("relative residuals need non-zero stresses: {case} point at stretch {stretch} has zero stress")]
     ZeroStressRelative { case: LoadCase, stretch: f64 },
+    #[error("model {model}: undefined at every starting point for these stretches")]
     NoValidStart { model: String },
+    #[error("weight of {case} must be finite and > 0, got {weight}")]
     BadWeight { case: LoadCase, weight: f64 },
 }
-
-impl std::fmt::Display for FitError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            FitError::NoData => write!(f, "no data: give at least one load case"),
-            FitError::Lsq { model, error } => write!(f, "model {model}: {error}"),
-            FitError::ZeroStressRelative { case, stretch } => write!(
-                f,
-                "relative residuals need non-zero stresses: {case} point at stretch {stretch} has zero stress"
-            ),
-            FitError::NoValidStart { model } => {
-                write!(f, "model {model}: undefined at every starting point for these stretches")
-            }
-            FitError::BadWeight { case, weight } => {
-                write!(f, "weight of {case} must be finite and > 0, got {weight}")
-            }
-        }
-    }
-}
-
-impl std::error::Error for FitError {}
 
 struct Problem<'a> {
     set: PointSet<'a>,

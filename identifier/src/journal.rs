@@ -7,9 +7,27 @@
 
 use crate::data::LoadCase;
 use std::io::BufRead;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 pub const HEADER: &str = "case,stretch,nominal_stress_mpa,frame_id";
+
+/// Why a journal could not be read back (lines counted from 1, the header included).
+#[derive(Debug, thiserror::Error)]
+pub enum JournalError {
+    #[error("journal {}: {reason}", .path.display())]
+    Read {
+        path: PathBuf,
+        reason: std::io::Error,
+    },
+    #[error("journal {}: header {header:?}, expected {HEADER:?}", .path.display())]
+    Header { path: PathBuf, header: String },
+    #[error("journal {} line {line}: {row:?} is not case,stretch,stress,frame_id", .path.display())]
+    Row {
+        path: PathBuf,
+        line: usize,
+        row: String,
+    },
+}
 
 /// One accepted point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,24 +40,28 @@ pub struct JournalPoint {
 
 /// Reads a journal. A missing file is an empty journal; a torn last line (the process was
 /// killed while writing it) is ignored; any other malformed line is an error naming it.
-pub fn read(path: &Path) -> Result<Vec<JournalPoint>, String> {
+pub fn read(path: &Path) -> Result<Vec<JournalPoint>, JournalError> {
+    let unreadable = |reason| JournalError::Read {
+        path: path.to_path_buf(),
+        reason,
+    };
     let file = match std::fs::File::open(path) {
         Ok(f) => f,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(format!("journal {}: {e}", path.display())),
+        Err(e) => return Err(unreadable(e)),
     };
     let lines: Vec<String> = std::io::BufReader::new(file)
         .lines()
         .collect::<Result<_, _>>()
-        .map_err(|e| format!("journal {}: {e}", path.display()))?;
+        .map_err(unreadable)?;
     let Some((header, rows)) = lines.split_first() else {
         return Ok(Vec::new());
     };
     if header.trim() != HEADER {
-        return Err(format!(
-            "journal {}: header {header:?}, expected {HEADER:?}",
-            path.display()
-        ));
+        return Err(JournalError::Header {
+            path: path.to_path_buf(),
+            header: header.clone(),
+        });
     }
     let mut points = Vec::with_capacity(rows.len());
     for (k, row) in rows.iter().enumerate() {
@@ -48,11 +70,11 @@ pub fn read(path: &Path) -> Result<Vec<JournalPoint>, String> {
             Some(p) => points.push(p),
             None if last => break,
             None => {
-                return Err(format!(
-                    "journal {} line {}: {row:?} is not case,stretch,stress,frame_id",
-                    path.display(),
-                    k + 2
-                ))
+                return Err(JournalError::Row {
+                    path: path.to_path_buf(),
+                    line: k + 2,
+                    row: row.clone(),
+                })
             }
         }
     }
@@ -149,9 +171,14 @@ mod tests {
             format!("{}\nuniaxial,x,0.31,7\nequibiaxial,1.5,0.9,90\n", HEADER),
         )
         .unwrap();
-        assert!(read(&path).unwrap_err().contains("line 2"));
+        let error = read(&path).unwrap_err();
+        assert!(
+            matches!(error, JournalError::Row { line: 2, .. }),
+            "{error}"
+        );
+        assert!(error.to_string().contains("line 2"), "{error}");
         std::fs::write(&path, "stretch,stress\n").unwrap();
-        assert!(read(&path).unwrap_err().contains("header"));
+        assert!(matches!(read(&path), Err(JournalError::Header { .. })));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

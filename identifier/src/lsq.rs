@@ -11,34 +11,18 @@ pub const RANK_TOLERANCE: f64 = 1e-10;
 /// Maximum Levenberg-Marquardt iterations.
 pub const LM_MAX_ITERATIONS: usize = 300;
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LsqError {
     /// Fewer residuals than parameters (+1 for the residual variance).
+    #[error("too few points: {points} data points for {params} parameters, need at least {}", .params + 1)]
     TooFewPoints { points: usize, params: usize },
     /// Parameters not identifiable from the data (rank of the design < number of parameters).
+    #[error("parameters not identifiable from these load cases: design rank {rank} < {params} parameters")]
     RankDeficient { rank: usize, params: usize },
     /// Non-finite residuals at the starting point.
+    #[error("model not defined at the starting parameters")]
     NonFiniteStart,
 }
-
-impl std::fmt::Display for LsqError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            LsqError::TooFewPoints { points, params } => write!(
-                f,
-                "too few points: {points} data points for {params} parameters, need at least {}",
-                params + 1
-            ),
-            LsqError::RankDeficient { rank, params } => write!(
-                f,
-                "parameters not identifiable from these load cases: design rank {rank} < {params} parameters"
-            ),
-            LsqError::NonFiniteStart => write!(f, "model not defined at the starting parameters"),
-        }
-    }
-}
-
-impl std::error::Error for LsqError {}
 
 /// Rows per column above which [`linear_least_squares`] first reduces a tall system by QR.
 pub const QR_REDUCTION_ROWS_PER_COLUMN: usize = 16;

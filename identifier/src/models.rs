@@ -92,7 +92,7 @@ impl Model {
     }
 
     /// Parses a model name: `mooney`, `rivlin:10,01,11`, `ogden:3` (or `ogden3`), `ldr:2,2`...
-    pub fn parse(name: &str) -> Result<Model, String> {
+    pub fn parse(name: &str) -> Result<Model, ModelError> {
         let lower = name.trim().to_ascii_lowercase();
         let (head, arg) = match lower.split_once(':') {
             Some((h, a)) => (h.to_string(), Some(a.to_string())),
@@ -100,7 +100,10 @@ impl Model {
         };
         let no_arg = |m: Model| match &arg {
             None => Ok(m),
-            Some(a) => Err(format!("model `{name}`: takes no `:{a}` argument")),
+            Some(a) => Err(ModelError::NoArgument {
+                name: name.into(),
+                argument: a.clone(),
+            }),
         };
         match head.as_str() {
             "neo-hookean" | "neohookean" | "neo_hookean" => no_arg(Model::NeoHookean),
@@ -111,9 +114,7 @@ impl Model {
                     .iter()
                     .find(|(count, _)| count.to_string() == n.trim())
                     .map(|(_, terms)| Model::Rivlin(terms.to_vec()))
-                    .ok_or_else(|| {
-                        format!("model `{name}`: Mooney-Rivlin takes 2, 3, 5 or 9 constants")
-                    }),
+                    .ok_or_else(|| ModelError::MooneyRivlinConstants { name: name.into() }),
             },
             "isihara" => no_arg(Model::Isihara),
             "rivlin-saunders" | "rivlin_saunders" => no_arg(Model::RivlinSaunders),
@@ -132,11 +133,17 @@ impl Model {
                         let t = t.trim();
                         let bytes = t.as_bytes();
                         if bytes.len() != 2 || !bytes.iter().all(u8::is_ascii_digit) {
-                            return Err(format!("model `{name}`: Rivlin term `{t}` must be two digits ij, e.g. 10,01,11"));
+                            return Err(ModelError::RivlinTermDigits {
+                                name: name.into(),
+                                term: t.into(),
+                            });
                         }
                         let ij = ((bytes[0] - b'0') as u32, (bytes[1] - b'0') as u32);
                         if ij == (0, 0) || terms.contains(&ij) {
-                            return Err(format!("model `{name}`: Rivlin term `{t}` is 00 or repeated"));
+                            return Err(ModelError::RivlinTermRepeated {
+                                name: name.into(),
+                                term: t.into(),
+                            });
                         }
                         terms.push(ij);
                     }
@@ -144,29 +151,35 @@ impl Model {
                 }
             },
             "lambert-diani-rey" | "ldr" => match arg {
-                None => Ok(Model::LambertDianiRey { f_degree: 2, g_degree: 2 }),
+                None => Ok(Model::LambertDianiRey {
+                    f_degree: 2,
+                    g_degree: 2,
+                }),
                 Some(a) => {
-                    let parts: Vec<Result<usize, _>> = a.split(',').map(|s| s.trim().parse::<usize>()).collect();
+                    let parts: Vec<Result<usize, _>> =
+                        a.split(',').map(|s| s.trim().parse::<usize>()).collect();
                     match parts.as_slice() {
-                        [Ok(f), Ok(g)] if *f <= 4 && *g <= 4 => Ok(Model::LambertDianiRey { f_degree: *f, g_degree: *g }),
-                        _ => Err(format!("model `{name}`: expected `ldr:NF,NG` with degrees 0..=4")),
+                        [Ok(f), Ok(g)] if *f <= 4 && *g <= 4 => Ok(Model::LambertDianiRey {
+                            f_degree: *f,
+                            g_degree: *g,
+                        }),
+                        _ => Err(ModelError::LdrDegrees { name: name.into() }),
                     }
                 }
             },
             _ if head.starts_with("ogden") => {
                 let n_text = arg.unwrap_or_else(|| head.trim_start_matches("ogden").to_string());
-                let n = if n_text.is_empty() { Ok(3) } else { n_text.parse::<usize>() };
+                let n = if n_text.is_empty() {
+                    Ok(3)
+                } else {
+                    n_text.parse::<usize>()
+                };
                 match n {
                     Ok(n) if (1..=MAX_OGDEN_TERMS).contains(&n) => Ok(Model::Ogden(n)),
-                    _ => Err(format!("model `{name}`: Ogden term count must be 1..={MAX_OGDEN_TERMS}")),
+                    _ => Err(ModelError::OgdenTerms { name: name.into() }),
                 }
             }
-            _ => Err(format!(
-                "unknown model `{name}`; expected one of neo-hookean, mooney (= mooney-rivlin:2), \
-                 mooney-rivlin:3|5|9, rivlin[:ij,..], isihara, \
-                 rivlin-saunders, gent-thomas, biderman, hart-smith, alexander, yeoh, ogden[:N], gent, \
-                 arruda-boyce, lambert-diani-rey[:NF,NG], or all"
-            )),
+            _ => Err(ModelError::Unknown { name: name.into() }),
         }
     }
 
@@ -335,6 +348,30 @@ impl Model {
     }
 }
 
+/// Why a model name was refused (the name as given).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    #[error("model `{name}`: takes no `:{argument}` argument")]
+    NoArgument { name: String, argument: String },
+    #[error("model `{name}`: Mooney-Rivlin takes 2, 3, 5 or 9 constants")]
+    MooneyRivlinConstants { name: String },
+    #[error("model `{name}`: Rivlin term `{term}` must be two digits ij, e.g. 10,01,11")]
+    RivlinTermDigits { name: String, term: String },
+    #[error("model `{name}`: Rivlin term `{term}` is 00 or repeated")]
+    RivlinTermRepeated { name: String, term: String },
+    #[error("model `{name}`: expected `ldr:NF,NG` with degrees 0..=4")]
+    LdrDegrees { name: String },
+    #[error("model `{name}`: Ogden term count must be 1..={MAX_OGDEN_TERMS}")]
+    OgdenTerms { name: String },
+    #[error(
+        "unknown model `{name}`; expected one of neo-hookean, mooney (= mooney-rivlin:2), \
+         mooney-rivlin:3|5|9, rivlin[:ij,..], isihara, \
+         rivlin-saunders, gent-thomas, biderman, hart-smith, alexander, yeoh, ogden[:N], gent, \
+         arruda-boyce, lambert-diani-rey[:NF,NG], or all"
+    )]
+    Unknown { name: String },
+}
+
 impl fmt::Display for Model {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.name())
@@ -343,7 +380,7 @@ impl fmt::Display for Model {
 
 /// Parses `NAME[,NAME...]` or `all`. Rivlin and LDR arguments use commas too, so a name is
 /// split only before a token that starts with a letter.
-pub fn parse_model_list(list: &str) -> Result<Vec<Model>, String> {
+pub fn parse_model_list(list: &str) -> Result<Vec<Model>, ModelError> {
     if list.trim().eq_ignore_ascii_case("all") {
         return Ok(Model::all());
     }
@@ -421,6 +458,7 @@ mod tests {
         );
         assert!(Model::parse("mooney-rivlin:4")
             .unwrap_err()
+            .to_string()
             .contains("2, 3, 5 or 9"));
         assert_eq!(list.len(), 4);
         assert_eq!(list[1], Model::Rivlin(vec![(1, 0), (0, 1), (1, 1)]));

@@ -30,16 +30,9 @@ const PALETTE: [RGBColor; 6] = [
 ];
 
 /// A plotting error naming the file.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
 pub struct PlotError(pub String);
-
-impl std::fmt::Display for PlotError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for PlotError {}
 
 /// Registers a system font once; true if text can be drawn.
 pub fn text_available() -> bool {

@@ -41,7 +41,25 @@ pub struct ProcessSummary {
     pub best_model: Option<String>,
 }
 
-type BoxError = Box<dyn std::error::Error + Send + Sync>;
+/// Why the identifier process could not start or stopped. A file that could not be written is
+/// also the error's `source()`, so that `wire::exit::code_of` finds its exit code.
+#[derive(Debug, thiserror::Error)]
+pub enum ProcessError {
+    #[error(transparent)]
+    Instance(#[from] wire::InstanceError),
+    #[error(transparent)]
+    Journal(#[from] crate::journal::JournalError),
+    #[error("{0}")]
+    File(#[from] wire::files::FileError),
+    #[error(transparent)]
+    WaitSetCreate(#[from] iceoryx2::waitset::WaitSetCreateError),
+    #[error(transparent)]
+    WaitSetAttach(#[from] iceoryx2::waitset::WaitSetAttachmentError),
+    #[error(transparent)]
+    WaitSetRun(#[from] iceoryx2::waitset::WaitSetRunError),
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
 
 /// How long one WaitSet wait lasts before the idle clock is checked.
 const WAIT_SLICE: Duration = Duration::from_millis(200);
@@ -122,7 +140,7 @@ pub fn build_report(
 }
 
 /// Runs the process until a termination signal, `max_fields`, or the idle timeout.
-pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
+pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
     let instance = Instance::new(&config.instance)?;
     let _owner = instance.claim("identifier")?;
     let (node, cleaned) = instance.create_node("identifier")?;
@@ -165,13 +183,13 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, BoxError> {
     let mut last_fits = Vec::new();
     let mut last_json_write: Option<Instant> = None;
     let mut last_activity = Instant::now();
-    let mut failure: Option<BoxError> = None;
+    let mut failure: Option<ProcessError> = None;
     loop {
         let mut stop = false;
         let mut accepted_any = false;
         waitset.wait_and_process_once_with_timeout(
             |id| {
-                let mut step = || -> Result<(), BoxError> {
+                let mut step = || -> Result<(), ProcessError> {
                     if id.has_event_from(&rig_guard) {
                         rig.clear_events();
                     }
@@ -279,7 +297,7 @@ fn final_json(
     summary: &ProcessSummary,
     online: &OnlineIdentifier,
     fits: &[crate::fit::Fit],
-) -> Result<String, BoxError> {
+) -> Result<String, ProcessError> {
     let points = online.point_counts();
     let json = serde_json::json!({
         "points": {"uniaxial": points[0], "equibiaxial": points[1], "pure_shear": points[2]},

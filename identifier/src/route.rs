@@ -73,34 +73,19 @@ impl RouteResult {
 }
 
 /// Route errors.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum RouteError {
+    #[error("the paper's route needs {0} data")]
     MissingCase(LoadCase),
+    #[error("{what} = {value} MPa at invariant {invariant} is not positive: its logarithm cannot be fitted")]
     NonPositive {
         what: &'static str,
         invariant: f64,
         value: f64,
     },
-    Lsq {
-        what: &'static str,
-        error: LsqError,
-    },
+    #[error("fitting {what}: {error}")]
+    Lsq { what: &'static str, error: LsqError },
 }
-
-impl std::fmt::Display for RouteError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            RouteError::MissingCase(c) => write!(f, "the paper's route needs {c} data"),
-            RouteError::NonPositive { what, invariant, value } => write!(
-                f,
-                "{what} = {value} MPa at invariant {invariant} is not positive: its logarithm cannot be fitted"
-            ),
-            RouteError::Lsq { what, error } => write!(f, "fitting {what}: {error}"),
-        }
-    }
-}
-
-impl std::error::Error for RouteError {}
 
 /// Fits Σ coeffs_i t^i (i = 0..=degree) to (t, y) points.
 pub fn fit_polynomial(points: &[(f64, f64)], degree: usize) -> Result<Vec<f64>, LsqError> {

@@ -5,6 +5,7 @@
 //! after the role's name marks the process ready. Exits are noticed as they happen and
 //! reported with the exit status or signal and the last lines the process printed.
 
+use anyhow::Context;
 use crossbeam::channel::{unbounded, Receiver, Sender};
 use std::collections::VecDeque;
 use std::io::{BufRead, Write};
@@ -115,9 +116,9 @@ pub struct Supervisor {
 
 impl Supervisor {
     /// Children run `exe` (the `dicstream` binary) and log into `log_dir`.
-    pub fn new(exe: &Path, log_dir: &Path) -> Result<Supervisor, String> {
+    pub fn new(exe: &Path, log_dir: &Path) -> anyhow::Result<Supervisor> {
         std::fs::create_dir_all(log_dir)
-            .map_err(|e| format!("cannot create {}: {e}", log_dir.display()))?;
+            .with_context(|| format!("cannot create {}", log_dir.display()))?;
         let (tx, rx) = unbounded();
         Ok(Supervisor {
             exe: exe.to_path_buf(),
@@ -137,7 +138,7 @@ impl Supervisor {
     }
 
     /// Starts `dicstream <role> <args...>`.
-    pub fn spawn(&mut self, role: Role, args: Vec<String>) -> Result<u32, String> {
+    pub fn spawn(&mut self, role: Role, args: Vec<String>) -> anyhow::Result<u32> {
         if !self.children.iter().any(|m| m.role == role) {
             self.children.push(Managed {
                 role,
@@ -165,11 +166,9 @@ impl Supervisor {
         managed.last_lines.clear();
         managed.cpu_s_ended += std::mem::take(&mut managed.cpu_s_current);
         let generation = managed.generation;
-        let (reader, writer) =
-            std::io::pipe().map_err(|e| format!("{}: cannot make a pipe: {e}", role.name()))?;
-        let writer_err = writer
-            .try_clone()
-            .map_err(|e| format!("{}: cannot make a pipe: {e}", role.name()))?;
+        let pipe = || format!("{}: cannot make a pipe", role.name());
+        let (reader, writer) = std::io::pipe().with_context(pipe)?;
+        let writer_err = writer.try_clone().with_context(pipe)?;
         let mut command = Command::new(&exe);
         command
             .arg(role.name())
@@ -189,7 +188,7 @@ impl Supervisor {
         }
         let child = command
             .spawn()
-            .map_err(|e| format!("cannot start {} {}: {e}", exe.display(), role.name()))?;
+            .with_context(|| format!("cannot start {} {}", exe.display(), role.name()))?;
         drop(command);
         let pid = child.id();
         managed.child = Some(child);
@@ -197,7 +196,7 @@ impl Supervisor {
             .create(true)
             .append(true)
             .open(&log_path)
-            .map_err(|e| format!("{}: {e}", log_path.display()))?;
+            .with_context(|| log_path.display().to_string())?;
         let _ = writeln!(log, "--- start {generation} (pid {pid})");
         std::thread::Builder::new()
             .name(format!("{}-log", role.name()))
@@ -217,7 +216,7 @@ impl Supervisor {
                     }
                 }
             })
-            .map_err(|e| format!("cannot start a log thread: {e}"))?;
+            .context("cannot start a log thread")?;
         Ok(pid)
     }
 
@@ -268,7 +267,7 @@ impl Supervisor {
     /// Waits (bounded) until `role` says it is ready: Ok(true). Ok(false) when a termination
     /// signal arrived first. Its exit or the timeout is an error with the process's last lines;
     /// exits of other children seen meanwhile stay queued for [`Supervisor::take_exits`].
-    pub fn wait_ready(&mut self, role: Role, timeout: Duration) -> Result<bool, String> {
+    pub fn wait_ready(&mut self, role: Role, timeout: Duration) -> anyhow::Result<bool> {
         let deadline = Instant::now() + timeout;
         loop {
             if self.is_ready(role) {
@@ -280,17 +279,17 @@ impl Supervisor {
             self.reap();
             if let Some(at) = self.exited.iter().position(|e| e.role == role) {
                 let exit = self.exited.remove(at);
-                return Err(format!(
+                anyhow::bail!(
                     "{} (pid {}) stopped before it was ready ({}):\n  {}",
                     role.name(),
                     exit.pid,
                     exit.how,
                     exit.last_lines.join("\n  ")
-                ));
+                );
             }
             let now = Instant::now();
             if now >= deadline {
-                return Err(format!(
+                anyhow::bail!(
                     "{} was not ready after {:.0} s; its last lines:\n  {}",
                     role.name(),
                     timeout.as_secs_f64(),
@@ -300,7 +299,7 @@ impl Supervisor {
                         .cloned()
                         .collect::<Vec<_>>()
                         .join("\n  ")
-                ));
+                );
             }
             // Sleep on the line channel: a line (possibly "ready") wakes us at once.
             let slice = (deadline - now).min(Duration::from_millis(100));
@@ -391,7 +390,7 @@ impl Supervisor {
     }
 
     /// Starts `role` again with the arguments of its last start, or `args` if given.
-    pub fn restart(&mut self, role: Role, args: Option<Vec<String>>) -> Result<u32, String> {
+    pub fn restart(&mut self, role: Role, args: Option<Vec<String>>) -> anyhow::Result<u32> {
         let args = args.unwrap_or_else(|| self.managed(role).args.clone());
         self.spawn(role, args)
     }

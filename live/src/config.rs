@@ -5,6 +5,7 @@
 //! what the processes would refuse later: a ZOI larger than the image, a campaign beyond the
 //! rig's stroke or rate limits, a frame the shared memory cannot hold.
 
+use anyhow::{anyhow, bail, Context};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
@@ -210,8 +211,8 @@ const MAX_SIMULATED_SPEED: f64 = 20.0;
 
 impl RunConfig {
     /// Parses a TOML file's text; errors name the file and the offending key or line.
-    pub fn from_toml(text: &str, source: &str) -> Result<RunConfig, String> {
-        toml::from_str(text).map_err(|e| format!("{source}: {e}"))
+    pub fn from_toml(text: &str, source: &str) -> anyhow::Result<RunConfig> {
+        toml::from_str(text).with_context(|| source.to_string())
     }
 
     pub fn to_toml(&self) -> String {
@@ -219,9 +220,9 @@ impl RunConfig {
     }
 
     /// The campaign the rig runs.
-    pub fn campaign(&self) -> Result<rig::Campaign, String> {
+    pub fn campaign(&self) -> anyhow::Result<rig::Campaign> {
         let spec = self.campaign_spec();
-        let campaign = rig::Campaign::parse(&spec).map_err(|e| format!("[rig] tests: {e}"))?;
+        let campaign = rig::Campaign::parse(&spec).context("[rig] tests")?;
         Ok(campaign.with_law(self.law()?))
     }
 
@@ -236,16 +237,16 @@ impl RunConfig {
     }
 
     /// The specimen material.
-    pub fn law(&self) -> Result<identifier::law::InvariantLaw, String> {
+    pub fn law(&self) -> anyhow::Result<identifier::law::InvariantLaw> {
         use identifier::law::{InvariantLaw, LawError};
         InvariantLaw::exp_poly(&self.specimen.law_f, &self.specimen.law_g).map_err(|e| match e {
             LawError::Coefficients {
                 which,
                 coefficients,
-            } => format!(
+            } => anyhow!(
                 "[specimen] law_{which} = {coefficients:?}: expected one or more finite numbers"
             ),
-            LawError::Stiffness { .. } => format!("[specimen] {e}"),
+            LawError::Stiffness { .. } => anyhow!("[specimen] {e}"),
         })
     }
 
@@ -255,29 +256,29 @@ impl RunConfig {
     }
 
     /// The correlator settings the live correlator will run with.
-    pub fn correlator_settings(&self) -> Result<correlator::CorrelatorSettings, String> {
+    pub fn correlator_settings(&self) -> anyhow::Result<correlator::CorrelatorSettings> {
         use correlator::{GuessMode, ReferenceMode, StrainMeasure};
         let c = &self.correlator;
         let strain = StrainMeasure::from_name(&c.strain).ok_or_else(|| {
-            format!(
+            anyhow!(
                 "[correlator] strain = {:?}: expected log, green, nominal or small",
                 c.strain
             )
         })?;
         let reference = ReferenceMode::from_name(&c.reference).ok_or_else(|| {
-            format!(
+            anyhow!(
                 "[correlator] reference = {:?}: expected fixed, incremental or auto",
                 c.reference
             )
         })?;
         let method = correlator::settings::Method::from_name(&c.method).ok_or_else(|| {
-            format!(
+            anyhow!(
                 "[correlator] method = {:?}: expected icgn1, icgn2 or correli",
                 c.method
             )
         })?;
         let guess = GuessMode::from_name(&c.guess).ok_or_else(|| {
-            format!(
+            anyhow!(
                 "[correlator] guess = {:?}: expected auto, predict or correli",
                 c.guess
             )
@@ -296,15 +297,15 @@ impl RunConfig {
         };
         settings
             .validate()
-            .map_err(|e| format!("[correlator] {e}"))?;
+            .map_err(|e| anyhow!("[correlator] {e}"))?;
         settings
             .resolve_roi(
                 self.camera.width_px as usize,
                 self.camera.height_px as usize,
             )
-            .map_err(|e| {
+            .with_context(|| {
                 format!(
-                    "[correlator] with the {}x{} px camera: {e}",
+                    "[correlator] with the {}x{} px camera",
                     self.camera.width_px, self.camera.height_px
                 )
             })?;
@@ -312,13 +313,13 @@ impl RunConfig {
     }
 
     /// Everything a process would refuse, refused now with the section and key named.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> anyhow::Result<()> {
         let r = &self.run;
         if r.results_dir.trim().is_empty() {
-            return Err("[run] results_dir is empty".into());
+            bail!("[run] results_dir is empty");
         }
         if r.fields_every == 0 {
-            return Err("[run] fields_every = 0: expected 1 or more (1 = every field)".into());
+            bail!("[run] fields_every = 0: expected 1 or more (1 = every field)");
         }
         for (name, v) in [
             ("status_interval_s", r.status_interval_s),
@@ -326,74 +327,71 @@ impl RunConfig {
             ("stale_after_s", r.stale_after_s),
         ] {
             if !(v.is_finite() && v > 0.0 && v <= 3600.0) {
-                return Err(format!("[run] {name} = {v}: expected (0, 3600] s"));
+                bail!("[run] {name} = {v}: expected (0, 3600] s");
             }
         }
         let c = &self.camera;
         for (name, side) in [("width_px", c.width_px), ("height_px", c.height_px)] {
             if !(64..=producer::MAX_SIDE_PX).contains(&side) {
-                return Err(format!(
+                bail!(
                     "[camera] {name} = {side}: expected 64 to {} px",
                     producer::MAX_SIDE_PX
-                ));
+                );
             }
         }
         if !(c.fps.is_finite() && c.fps > 0.0 && c.fps <= 1000.0) {
-            return Err(format!("[camera] fps = {}: expected (0, 1000]", c.fps));
+            bail!("[camera] fps = {}: expected (0, 1000]", c.fps);
         }
         if !producer::BIT_DEPTHS.contains(&c.bit_depth) {
-            return Err(format!(
+            bail!(
                 "[camera] bit_depth = {}: expected one of {:?}",
                 c.bit_depth,
                 producer::BIT_DEPTHS
-            ));
+            );
         }
         if !(c.mm_per_px.is_finite() && c.mm_per_px > 0.0) {
-            return Err(format!(
+            bail!(
                 "[camera] mm_per_px = {}: expected a positive scale",
                 c.mm_per_px
-            ));
+            );
         }
         producer::SpeckleParams {
             size_px: c.speckle_size_px,
             ..producer::SpeckleParams::default()
         }
         .validate()
-        .map_err(|e| format!("[camera] {e}"))?;
+        .map_err(|e| anyhow!("[camera] {e}"))?;
         if !(1..=64).contains(&c.threads) {
-            return Err(format!(
-                "[camera] threads = {}: expected 1 to 64",
-                c.threads
-            ));
+            bail!("[camera] threads = {}: expected 1 to 64", c.threads);
         }
         self.correlator_settings()?;
         let g = &self.rig;
         if !(g.speed.is_finite() && g.speed > 0.0 && g.speed <= MAX_SIMULATED_SPEED) {
-            return Err(format!(
+            bail!(
                 "[rig] speed = {}: expected (0, {MAX_SIMULATED_SPEED}] times real time",
                 g.speed
-            ));
+            );
         }
         let rig_config = rig::RigConfig::default();
         for (name, hz) in [("publish_hz", g.publish_hz), ("log_hz", g.log_hz)] {
             if !(hz.is_finite() && hz > 0.0 && hz <= rig_config.control_hz) {
-                return Err(format!(
+                bail!(
                     "[rig] {name} = {hz}: expected (0, {}] Hz",
                     rig_config.control_hz
-                ));
+                );
             }
         }
         let campaign = self.campaign()?;
         campaign
             .check_against(&rig_config)
-            .map_err(|e| format!("[rig] {e}"))?;
+            .map_err(|e| anyhow!("[rig] {e}"))?;
         identifier::models::parse_model_list(&self.identifier.models)
-            .map_err(|e| format!("[identifier] models: {e}"))?;
+            .context("[identifier] models")?;
         Ok(())
     }
 
     /// Wall-clock length of the campaign (s).
-    pub fn campaign_wall_s(&self) -> Result<f64, String> {
+    pub fn campaign_wall_s(&self) -> anyhow::Result<f64> {
         Ok(self.campaign()?.duration_s() / self.rig.speed)
     }
 
@@ -550,13 +548,14 @@ mod tests {
     #[test]
     fn bad_configurations_are_refused_with_the_key_named() {
         let unknown = RunConfig::from_toml("[camera]\nwidht_px = 512\n", "my.toml").unwrap_err();
+        let unknown = format!("{unknown:#}");
         assert!(
             unknown.contains("my.toml") && unknown.contains("widht_px"),
             "{unknown}"
         );
         let refuse = |toml: &str, expected: &str| {
             let config = RunConfig::from_toml(toml, "t.toml").unwrap();
-            let error = config.validate().unwrap_err();
+            let error = format!("{:#}", config.validate().unwrap_err());
             assert!(error.contains(expected), "{toml}: {error}");
         };
         refuse(

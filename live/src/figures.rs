@@ -4,13 +4,14 @@
 //! image (Fig. 12d), and the latency distribution.
 
 use crate::latency::Latency;
+use anyhow::Context;
 use identifier::data::{Curve, LoadCase};
 use identifier::fit::{fit_ranked, FitOptions};
 use identifier::plot::{chart, Series};
 use std::path::{Path, PathBuf};
 
 /// The load path of the journal as curves (cases with enough points).
-pub fn journal_curves(journal: &Path) -> Result<Vec<Curve>, String> {
+pub fn journal_curves(journal: &Path) -> anyhow::Result<Vec<Curve>> {
     let points = identifier::journal::read(journal)?;
     let mut curves = Vec::new();
     for case in LoadCase::ALL {
@@ -34,7 +35,7 @@ pub fn identification_figures(
     dir: &Path,
     journal: &Path,
     models: &str,
-) -> Result<Vec<PathBuf>, String> {
+) -> anyhow::Result<Vec<PathBuf>> {
     let curves = journal_curves(journal)?;
     if curves.is_empty() {
         return Ok(Vec::new());
@@ -43,7 +44,12 @@ pub fn identification_figures(
     let (fits, _failures) = fit_ranked(&models, &curves, &FitOptions::default());
     // Without both cases the route cannot run: the f(I1) and g(I2) plots show the fits only.
     let route = identifier::route::paper_route(&curves, 2, 2).ok();
-    identifier::plot::write_plots(dir, &curves, &fits, route.as_ref()).map_err(|e| e.to_string())
+    Ok(identifier::plot::write_plots(
+        dir,
+        &curves,
+        &fits,
+        route.as_ref(),
+    )?)
 }
 
 /// RGB colour map of a field's exx over its origin image, as PNG at `path`; returns the
@@ -53,7 +59,7 @@ pub fn strain_map(
     grey: &[u16],
     width: usize,
     field: &correlator::Field,
-) -> Result<[f64; 2], String> {
+) -> anyhow::Result<[f64; 2]> {
     let (rgb, range) = correlator::output::colour_map_rgb(grey, width, field, |n| n.exx);
     let height = grey.len() / width;
     let mut bytes = Vec::new();
@@ -64,13 +70,13 @@ pub fn strain_map(
         height as u32,
         image::ExtendedColorType::Rgb8,
     )
-    .map_err(|e| format!("{}: {e}", path.display()))?;
-    crate::results::write_atomic(path, &bytes)?;
+    .with_context(|| path.display().to_string())?;
+    wire::files::write_atomic(path, &bytes)?;
     Ok([range.low, range.high])
 }
 
 /// Latency (ms) against log10 of 1/(1 − percentile), the usual HdrHistogram plot.
-pub fn latency_png(path: &Path, curves: &[(&str, &Latency)]) -> Result<(), String> {
+pub fn latency_png(path: &Path, curves: &[(&str, &Latency)]) -> anyhow::Result<()> {
     let series: Vec<Series> = curves
         .iter()
         .filter(|(_, l)| l.count() > 0)
@@ -88,12 +94,11 @@ pub fn latency_png(path: &Path, curves: &[(&str, &Latency)]) -> Result<(), Strin
     if series.is_empty() {
         return Ok(());
     }
-    chart(
+    Ok(chart(
         path,
         "latency from capture",
         "percentile (log10 1/(1-p): 1 = 90 %, 2 = 99 %, 3 = 99.9 %)",
         "latency (ms)",
         &series,
-    )
-    .map_err(|e| e.to_string())
+    )?)
 }

@@ -109,7 +109,7 @@ fn result_of(report: &RunReport, fps: f64) -> PipelineResult {
 }
 
 /// One trial at `fps`.
-pub fn trial(settings: &PipelineSettings, fps: f64) -> Result<PipelineResult, String> {
+pub fn trial(settings: &PipelineSettings, fps: f64) -> anyhow::Result<PipelineResult> {
     let config = trial_config(settings, fps, &settings.results_dir);
     config.validate()?;
     let report = run(RunOptions {
@@ -120,10 +120,10 @@ pub fn trial(settings: &PipelineSettings, fps: f64) -> Result<PipelineResult, St
         status: false,
     })?;
     if report.ending != Ending::Completed {
-        return Err(format!(
+        anyhow::bail!(
             "the trial at {fps} frames/s did not complete: {}",
             report.failure.as_deref().unwrap_or("interrupted")
-        ));
+        );
     }
     Ok(result_of(&report, fps))
 }
@@ -133,7 +133,7 @@ pub fn trial(settings: &PipelineSettings, fps: f64) -> Result<PipelineResult, St
 pub fn measure(
     settings: &PipelineSettings,
     mut progress: impl FnMut(&PipelineResult),
-) -> Result<PipelineResult, String> {
+) -> anyhow::Result<PipelineResult> {
     if let Some(fps) = settings.fps {
         let result = trial(settings, fps)?;
         progress(&result);
@@ -167,5 +167,5 @@ pub fn measure(
             }
         }
     }
-    best.ok_or_else(|| format!("frames were dropped even at {SEARCH_START_FPS} frames/s"))
+    best.ok_or_else(|| anyhow::anyhow!("frames were dropped even at {SEARCH_START_FPS} frames/s"))
 }

@@ -4,7 +4,8 @@
 
 use crate::frames::{FrameRow, RigHistory, TruthHistory};
 use crate::latency::Latency;
-use crate::results::{write_atomic, CsvAppender, ResultsDir};
+use crate::results::ResultsDir;
+use wire::files::{write_atomic, FileError, RowFile};
 use wire::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, RigState};
 
 /// Rig samples and frame truths kept for pairing (about 40 s at 200 Hz, 100 s at 10 fps).
@@ -21,7 +22,7 @@ pub struct RecorderSettings {
 pub struct Recorder {
     settings: RecorderSettings,
     results: ResultsDir,
-    frames_csv: CsvAppender,
+    frames_csv: RowFile,
     /// Monotonic ns of the run's start: frames.csv times count from it.
     t0_ns: u64,
     rigs: RigHistory,
@@ -51,7 +52,7 @@ pub struct Recorder {
     row: String,
     text: String,
     /// Errors writing results (the run goes on, the error is reported once).
-    pub write_error: Option<String>,
+    pub write_error: Option<FileError>,
 }
 
 impl Recorder {
@@ -59,10 +60,10 @@ impl Recorder {
         results: &ResultsDir,
         settings: RecorderSettings,
         t0_ns: u64,
-    ) -> Result<Recorder, String> {
+    ) -> Result<Recorder, FileError> {
         assert!(settings.fields_every > 0);
         Ok(Recorder {
-            frames_csv: CsvAppender::create(&results.frames_csv(), &crate::frames::csv_header())?,
+            frames_csv: RowFile::create(&results.frames_csv(), &crate::frames::csv_header())?,
             results: results.clone(),
             settings,
             t0_ns,
@@ -88,7 +89,7 @@ impl Recorder {
         })
     }
 
-    fn note_error(&mut self, result: Result<(), String>) {
+    fn note_error(&mut self, result: Result<(), FileError>) {
         if let Err(e) = result {
             if self.write_error.is_none() {
                 eprintln!("run: cannot write results: {e}");
@@ -194,7 +195,7 @@ impl Recorder {
         &mut self,
         header: &FieldHeader,
         nodes: &[FieldNode],
-    ) -> Result<(), String> {
+    ) -> Result<(), FileError> {
         let field = to_correlator_field(header, nodes);
         let stem = self
             .results

@@ -2,6 +2,7 @@
 //! written (appended and flushed per row, or whole files atomically: temporary sibling, then
 //! rename), so a run killed at any moment keeps everything it had.
 
+use anyhow::Context;
 use std::path::{Path, PathBuf};
 
 /// Paths of one run's results.
@@ -12,7 +13,7 @@ pub struct ResultsDir {
 
 impl ResultsDir {
     /// Creates `<parent>/<local date-time>` (with a suffix if it exists already).
-    pub fn create_dated(parent: &Path) -> Result<ResultsDir, String> {
+    pub fn create_dated(parent: &Path) -> anyhow::Result<ResultsDir> {
         let stamp = local_timestamp();
         for k in 0..100 {
             let name = if k == 0 {
@@ -24,19 +25,21 @@ impl ResultsDir {
             match std::fs::create_dir_all(parent).and_then(|_| std::fs::create_dir(&root)) {
                 Ok(()) => return ResultsDir::at(&root),
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-                Err(e) => return Err(format!("cannot create {}: {e}", root.display())),
+                Err(e) => {
+                    return Err(e).with_context(|| format!("cannot create {}", root.display()))
+                }
             }
         }
-        Err(format!("{}: too many runs this second", parent.display()))
+        anyhow::bail!("{}: too many runs this second", parent.display())
     }
 
     /// Uses `root` (created if missing; its files are overwritten, and the resume state of
     /// an earlier run there is removed: this run's children start afresh, and only their own
     /// restarts resume).
-    pub fn at(root: &Path) -> Result<ResultsDir, String> {
+    pub fn at(root: &Path) -> anyhow::Result<ResultsDir> {
         for dir in [root.to_path_buf(), root.join("fields"), root.join("logs")] {
             std::fs::create_dir_all(&dir)
-                .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+                .with_context(|| format!("cannot create {}", dir.display()))?;
         }
         let results = ResultsDir {
             root: root.to_path_buf(),
@@ -44,17 +47,15 @@ impl ResultsDir {
         for state in [results.rig_state(), results.correlator_state()] {
             match std::fs::remove_dir_all(&state) {
                 Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                    return Err(format!("cannot remove {}: {e}", state.display()))
+                    return Err(e).with_context(|| format!("cannot remove {}", state.display()))
                 }
                 _ => {}
             }
         }
         match std::fs::remove_file(results.journal()) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(format!(
-                    "cannot remove {}: {e}",
-                    results.journal().display()
-                ))
+                return Err(e)
+                    .with_context(|| format!("cannot remove {}", results.journal().display()))
             }
             _ => {}
         }
@@ -97,30 +98,6 @@ impl ResultsDir {
     }
 }
 
-/// Writes `bytes` to `path` atomically ([`wire::files::write_atomic`]; the error names the
-/// file).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    wire::files::write_atomic(path, bytes).map_err(|e| e.to_string())
-}
-
-/// A CSV file written row by row, each row whole ([`wire::files::RowFile`]).
-pub struct CsvAppender {
-    rows: wire::files::RowFile,
-}
-
-impl CsvAppender {
-    pub fn create(path: &Path, header: &str) -> Result<CsvAppender, String> {
-        Ok(CsvAppender {
-            rows: wire::files::RowFile::create(path, header).map_err(|e| e.to_string())?,
-        })
-    }
-
-    /// Appends `line` (which ends with a newline), whole or not at all.
-    pub fn append(&mut self, line: &str) -> Result<(), String> {
-        self.rows.append(line).map_err(|e| e.to_string())
-    }
-}
-
 /// `YYYY-MM-DD_HHMMSS` in local time.
 pub fn local_timestamp() -> String {
     let now = std::time::SystemTime::now()
@@ -149,19 +126,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn dated_folders_never_collide_and_writes_are_whole() {
+    fn dated_folders_never_collide_and_a_folder_that_cannot_be_made_is_named() {
         let parent = std::env::temp_dir().join(format!("results_test_{}", std::process::id()));
         let a = ResultsDir::create_dated(&parent).unwrap();
         let b = ResultsDir::create_dated(&parent).unwrap();
         assert_ne!(a.root, b.root);
         assert!(a.fields().is_dir() && a.logs().is_dir());
-        write_atomic(&a.config(), b"x = 1\n").unwrap();
-        assert_eq!(std::fs::read_to_string(a.config()).unwrap(), "x = 1\n");
-        let mut csv = CsvAppender::create(&a.frames_csv(), "a,b").unwrap();
-        csv.append("1,2\n").unwrap();
-        assert_eq!(
-            std::fs::read_to_string(a.frames_csv()).unwrap(),
-            "a,b\n1,2\n"
+        std::fs::write(a.config(), "x = 1\n").unwrap();
+        let error = ResultsDir::at(&a.config().join("below_a_file")).unwrap_err();
+        assert!(
+            format!("{error:#}").starts_with(&format!("cannot create {}", a.config().display())),
+            "{error:#}"
         );
         assert_eq!(local_timestamp().len(), 17);
         std::fs::remove_dir_all(&parent).unwrap();

@@ -11,12 +11,16 @@ use crate::config::RunConfig;
 use crate::latency::Percentiles;
 use crate::liveness::{Counts, Liveness};
 use crate::recorder::{Recorder, RecorderSettings};
-use crate::results::{write_atomic, ResultsDir};
+use crate::results::ResultsDir;
 use crate::subscriptions::Subscriptions;
+use anyhow::{anyhow, bail};
+pub use child_args::child_args;
 use iceoryx2::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+
+mod child_args;
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -114,121 +118,16 @@ const DRAIN_TIMEOUT: Duration = Duration::from_secs(10);
 const WAIT_SLICE: Duration = Duration::from_millis(200);
 /// How often the latency histograms are rewritten during the run.
 const HISTOGRAM_EVERY: Duration = Duration::from_secs(10);
-/// Relative margin of the camera's stretch envelope beyond the campaign's largest stretch.
-const STRETCH_MARGIN: f64 = 0.05;
-
-fn fmt_list(values: &[f64]) -> String {
-    values
-        .iter()
-        .map(|v| format!("{v:e}"))
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-/// The command line of each child. `first_frame_id` is where the camera's frame ids start
-/// (past the last id seen when a camera is restarted, so ids never go back).
-pub fn child_args(
-    role: Role,
-    config: &RunConfig,
-    instance: &str,
-    results: &ResultsDir,
-    first_frame_id: u64,
-) -> Vec<String> {
-    let path = |p: PathBuf| p.to_string_lossy().into_owned();
-    let mut args = vec!["--instance".to_string(), instance.to_string()];
-    let c = &config.camera;
-    let k = &config.correlator;
-    let g = &config.rig;
-    let extra: Vec<String> = match role {
-        Role::Rig => vec![
-            "--campaign".into(),
-            config.campaign_spec(),
-            format!("--law-f={}", fmt_list(&config.specimen.law_f)),
-            format!("--law-g={}", fmt_list(&config.specimen.law_g)),
-            "--speed".into(),
-            g.speed.to_string(),
-            "--publish-hz".into(),
-            g.publish_hz.to_string(),
-            "--log".into(),
-            path(results.rig_csv()),
-            "--log-hz".into(),
-            g.log_hz.to_string(),
-            "--seed".into(),
-            g.seed.to_string(),
-            "--state-dir".into(),
-            path(results.rig_state()),
-            "--exit-when-done".into(),
-        ],
-        Role::Producer => vec![
-            "--follow-rig".into(),
-            "--fps".into(),
-            c.fps.to_string(),
-            "--width".into(),
-            c.width_px.to_string(),
-            "--height".into(),
-            c.height_px.to_string(),
-            "--bit-depth".into(),
-            c.bit_depth.to_string(),
-            "--mm-per-px".into(),
-            c.mm_per_px.to_string(),
-            "--max-stretch".into(),
-            // The rig overshoots a level by a little: the camera covers a margin beyond it.
-            (config.max_stretch() * (1.0 + STRETCH_MARGIN)).to_string(),
-            "--speckle-size-px".into(),
-            c.speckle_size_px.to_string(),
-            "--seed".into(),
-            c.seed.to_string(),
-            "--threads".into(),
-            c.threads.to_string(),
-            "--first-frame-id".into(),
-            first_frame_id.to_string(),
-        ],
-        Role::Correlator => vec![
-            "--method".into(),
-            k.method.clone(),
-            "--zoi".into(),
-            k.zoi_px.to_string(),
-            "--step".into(),
-            k.step_px.to_string(),
-            "--threads".into(),
-            k.threads.to_string(),
-            "--strain".into(),
-            k.strain.clone(),
-            "--reference-mode".into(),
-            k.reference.clone(),
-            "--guess".into(),
-            k.guess.clone(),
-            "--min-zncc".into(),
-            k.min_zncc.to_string(),
-            "--gradient-correction".into(),
-            k.gradient_correction.to_string(),
-            "--state-dir".into(),
-            path(results.correlator_state()),
-        ],
-        Role::Identifier => vec![
-            "--output".into(),
-            path(results.identification_json()),
-            "--journal".into(),
-            path(results.journal()),
-            "--model".into(),
-            config.identifier.models.clone(),
-        ],
-    };
-    args.extend(extra);
-    args
-}
 
 /// Shared memory the run's services need (bytes), checked against `/dev/shm` at start.
-pub fn shm_needed_bytes(config: &RunConfig) -> Result<u64, String> {
+pub fn shm_needed_bytes(config: &RunConfig) -> anyhow::Result<u64> {
     let frames =
         producer::stream::frames_shm_bytes(config.camera.width_px, config.camera.height_px);
     let settings = config.correlator_settings()?;
-    let roi = settings
-        .resolve_roi(
-            config.camera.width_px as usize,
-            config.camera.height_px as usize,
-        )
-        .map_err(|e| e.to_string())?;
+    let roi = settings.resolve_roi(
+        config.camera.width_px as usize,
+        config.camera.height_px as usize,
+    )?;
     let nodes = (roi.width_px / settings.step_px + 1) * (roi.height_px / settings.step_px + 1);
     let fields = wire::services::FIELDS.shm_bytes(
         std::mem::size_of::<wire::FieldHeader>(),
@@ -285,7 +184,7 @@ pub fn remove_dead_runs() -> usize {
     dead.len()
 }
 
-pub fn run(options: RunOptions) -> Result<RunReport, String> {
+pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
     let config = &options.config;
     config.validate()?;
     let cleaned = remove_dead_runs();
@@ -298,16 +197,15 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
         .instance
         .clone()
         .unwrap_or_else(|| format!("run_{}", std::process::id()));
-    let instance = wire::Instance::new(&instance_name).map_err(|e| e.to_string())?;
+    let instance = wire::Instance::new(&instance_name)?;
     // Before anything is written or started: a second run on this instance is refused.
-    let _owner = instance.claim("run").map_err(|e| e.to_string())?;
-    wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes(config)?)
-        .map_err(|e| e.to_string())?;
+    let _owner = instance.claim("run")?;
+    wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes(config)?)?;
     let results = match &options.results {
         Some(root) => ResultsDir::at(root)?,
         None => ResultsDir::create_dated(Path::new(&config.run.results_dir))?,
     };
-    write_atomic(
+    wire::files::write_atomic(
         &results.config(),
         format!(
             "# The configuration of this run (dicstream run --config {} reruns it).\n{}",
@@ -327,7 +225,7 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
     let t0_ns = wire::monotonic_ns();
     let mut supervisor = Supervisor::new(&options.exe, &results.logs())?;
     let outcome = {
-        let (node, _) = instance.create_node("monitor").map_err(|e| e.to_string())?;
+        let (node, _) = instance.create_node("monitor")?;
         let subscriptions = Subscriptions::new(&node)?;
         let mut recorder = Recorder::new(
             &results,
@@ -378,7 +276,8 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
     let leftover_shm_files = crate::leftovers::report_and_remove(&instance);
     let (ending, failure) = match result {
         Ok(ending) => (ending, None),
-        Err(e) => (Ending::Failed, Some(e)),
+        // The whole chain: what failed, and why.
+        Err(e) => (Ending::Failed, Some(format!("{e:#}"))),
     };
     finish(
         config,
@@ -400,7 +299,7 @@ fn start_children(
     config: &RunConfig,
     instance: &str,
     results: &ResultsDir,
-) -> Result<bool, String> {
+) -> anyhow::Result<bool> {
     for role in start_order() {
         if wire::signals::requested().is_some() {
             return Ok(false);
@@ -471,14 +370,14 @@ fn event_loop(
     status: bool,
     started: Instant,
     state: &mut LoopState,
-) -> Result<Ending, String> {
-    let waitset = wire::signals::waitset().map_err(|e| format!("monitor WaitSet: {e:?}"))?;
+) -> anyhow::Result<Ending> {
+    let waitset = wire::signals::waitset().map_err(|e| anyhow!("monitor WaitSet: {e:?}"))?;
     let mut guards = Vec::new();
     for listener in subscriptions.listeners() {
         guards.push(
             waitset
                 .attach_notification(listener)
-                .map_err(|e| format!("monitor WaitSet: {e:?}"))?,
+                .map_err(|e| anyhow!("monitor WaitSet: {e:?}"))?,
         );
     }
     let status_every = Duration::from_secs_f64(config.run.status_interval_s);
@@ -495,15 +394,13 @@ fn event_loop(
         // only a termination request stops the run.
         waitset
             .wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, WAIT_SLICE)
-            .map_err(|e| format!("monitor WaitSet: {e:?}"))?;
+            .map_err(|e| anyhow!("monitor WaitSet: {e:?}"))?;
         if let Some(signal) = wire::signals::requested() {
             return Ok(interrupted(signal));
         }
         subscriptions.drain(recorder)?;
         if let Some(error) = &recorder.write_error {
-            return Err(format!(
-                "{error}; the run stops (every earlier row is whole)"
-            ));
+            bail!("{error}; the run stops (every earlier row is whole)");
         }
 
         if matches!(phase, Phase::Running) {
@@ -610,7 +507,7 @@ fn handle_death(
     results: &ResultsDir,
     next_frame_id: u64,
     state: &mut LoopState,
-) -> Result<(), String> {
+) -> anyhow::Result<()> {
     let role = exit.role;
     let report = format!(
         "{} (pid {}) died: {}{}",
@@ -629,21 +526,21 @@ fn handle_death(
     // restarted: it would fail the same way, or start its test over.
     match exit.code {
         Some(code) if code == i32::from(wire::exit::OUTPUT_FAILED) => {
-            return Err(format!("{report}\n(a results file could not be written)"));
+            bail!("{report}\n(a results file could not be written)");
         }
         Some(code) if code == i32::from(wire::exit::CANNOT_RESUME) => {
-            return Err(format!("{report}\n(it could not resume its test safely)"));
+            bail!("{report}\n(it could not resume its test safely)");
         }
         _ => {}
     }
     let count = &mut state.restart_counts[role as usize];
     if !config.run.restart || *count >= config.run.max_restarts {
-        return Err(format!(
+        bail!(
             "{report}\n(restart {}; {} of {} restarts used)",
             if config.run.restart { "on" } else { "off" },
             count,
             config.run.max_restarts
-        ));
+        );
     }
     *count += 1;
     let args = child_args(role, config, instance, results, next_frame_id);
@@ -674,26 +571,28 @@ fn finish(
     failure: Option<String>,
     started: Instant,
     leftover_shm_files: usize,
-) -> Result<RunReport, String> {
+) -> anyhow::Result<RunReport> {
     let mut notes = Vec::new();
-    let mut keep = |what: &str, result: Result<(), String>| {
+    let mut keep = |what: &str, result: anyhow::Result<()>| {
         if let Err(e) = result {
-            notes.push(format!("{what}: {e}"));
+            notes.push(format!("{what}: {e:#}"));
         }
     };
     keep(
         "latency.hgrm",
-        write_atomic(
+        wire::files::write_atomic(
             &results.path("latency.hgrm"),
             recorder.latency_field.hgrm().as_bytes(),
-        ),
+        )
+        .map_err(anyhow::Error::from),
     );
     keep(
         "latency_identification.hgrm",
-        write_atomic(
+        wire::files::write_atomic(
             &results.path("latency_identification.hgrm"),
             recorder.latency_identification.hgrm().as_bytes(),
-        ),
+        )
+        .map_err(anyhow::Error::from),
     );
     keep(
         "latency.png",
@@ -812,18 +711,16 @@ fn finish(
         leftover_shm_files,
         exit_code,
     };
-    let mut json = serde_json::to_value(&report).map_err(|e| e.to_string())?;
+    let mut json = serde_json::to_value(&report)?;
     if !notes.is_empty() {
         json["notes"] = serde_json::json!(notes);
         for note in &notes {
             eprintln!("run: {note}");
         }
     }
-    write_atomic(
+    wire::files::write_atomic(
         &results.summary_json(),
-        serde_json::to_string_pretty(&json)
-            .map_err(|e| e.to_string())?
-            .as_bytes(),
+        serde_json::to_string_pretty(&json)?.as_bytes(),
     )?;
     Ok(report)
 }
@@ -870,12 +767,15 @@ fn verdict(
 }
 
 /// `latency.hgrm` (capture to field) and `latency_identification.hgrm`.
-fn write_histograms(results: &ResultsDir, recorder: &Recorder) -> Result<(), String> {
-    write_atomic(
+fn write_histograms(
+    results: &ResultsDir,
+    recorder: &Recorder,
+) -> Result<(), wire::files::FileError> {
+    wire::files::write_atomic(
         &results.path("latency.hgrm"),
         recorder.latency_field.hgrm().as_bytes(),
     )?;
-    write_atomic(
+    wire::files::write_atomic(
         &results.path("latency_identification.hgrm"),
         recorder.latency_identification.hgrm().as_bytes(),
     )

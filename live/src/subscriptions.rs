@@ -3,6 +3,7 @@
 //! (header, and the pixels of the first frame only) and released at once.
 
 use crate::recorder::Recorder;
+use anyhow::Context;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
 use wire::pubsub::{SliceSubscriber, ValueSubscriber};
@@ -15,17 +16,13 @@ pub struct Subscriptions {
     reports: ValueSubscriber<IdentificationReport>,
 }
 
-fn err(e: impl std::fmt::Display) -> String {
-    format!("monitor: {e}")
-}
-
 impl Subscriptions {
-    pub fn new(node: &Node<ipc::Service>) -> Result<Subscriptions, String> {
+    pub fn new(node: &Node<ipc::Service>) -> anyhow::Result<Subscriptions> {
         Ok(Subscriptions {
-            frames: SliceSubscriber::create(node, &services::FRAMES).map_err(err)?,
-            fields: SliceSubscriber::create(node, &services::FIELDS).map_err(err)?,
-            rig: ValueSubscriber::create(node, &services::RIG_STATE).map_err(err)?,
-            reports: ValueSubscriber::create(node, &services::IDENTIFICATION).map_err(err)?,
+            frames: SliceSubscriber::create(node, &services::FRAMES).context("monitor")?,
+            fields: SliceSubscriber::create(node, &services::FIELDS).context("monitor")?,
+            rig: ValueSubscriber::create(node, &services::RIG_STATE).context("monitor")?,
+            reports: ValueSubscriber::create(node, &services::IDENTIFICATION).context("monitor")?,
         })
     }
 
@@ -41,22 +38,22 @@ impl Subscriptions {
 
     /// Takes every pending sample of every service into `recorder` (rig states first: fields
     /// name them).
-    pub fn drain(&self, recorder: &mut Recorder) -> Result<(), String> {
+    pub fn drain(&self, recorder: &mut Recorder) -> anyhow::Result<()> {
         self.frames.clear_events();
         self.fields.clear_events();
         self.rig.clear_events();
         self.reports.clear_events();
-        while let Some(state) = self.rig.receive().map_err(err)? {
+        while let Some(state) = self.rig.receive().context("monitor")? {
             recorder.on_rig(state);
         }
-        while let Some(frame) = self.frames.receive().map_err(err)? {
+        while let Some(frame) = self.frames.receive().context("monitor")? {
             recorder.on_frame(frame.user_header(), frame.payload());
         }
-        while let Some(field) = self.fields.receive().map_err(err)? {
+        while let Some(field) = self.fields.receive().context("monitor")? {
             let seen_ns = wire::monotonic_ns();
             recorder.on_field(field.user_header(), field.payload(), seen_ns);
         }
-        while let Some(report) = self.reports.receive().map_err(err)? {
+        while let Some(report) = self.reports.receive().context("monitor")? {
             recorder.on_report(report);
         }
         Ok(())

@@ -46,7 +46,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ProducerError> {
     }
     wire::files::write_atomic(path, bytes).map_err(|e| ProducerError::Io {
         path: e.path,
-        reason: e.source,
+        reason: e.reason,
     })
 }
 

@@ -35,9 +35,9 @@ pub use render_exact::{exact_test_frame, gauss_legendre, ExactRenderer};
 pub use render_fast::FastRenderer;
 pub use replay::{list_images, Replay, IMAGE_EXTENSIONS};
 pub use rig_follow::{
-    NextMotion, RigCamera, RigEnvelope, RigFollowConfig, RigFollower, RigKinematics, RigMotion,
-    DEFAULT_MAX_OFFSET_MM, DEFAULT_MAX_ROTATION_DEG, DEFAULT_MAX_STRETCH, DEFAULT_MM_PER_PX,
-    RIG_SCENARIO_ID,
+    BeyondEnvelope, NextMotion, RigCamera, RigEnvelope, RigFollowConfig, RigFollower,
+    RigKinematics, RigMotion, DEFAULT_MAX_OFFSET_MM, DEFAULT_MAX_ROTATION_DEG, DEFAULT_MAX_STRETCH,
+    DEFAULT_MM_PER_PX, RIG_SCENARIO_ID,
 };
 pub use scenario::{Scenario, ScenarioKind, SCENARIO_NAMES};
 pub use simulated::{

@@ -104,43 +104,68 @@ impl RigEnvelope {
     }
 
     /// `Ok` when `k` lies inside the envelope, else the first reason it does not.
-    pub fn admit(&self, k: &RigKinematics) -> Result<(), String> {
+    pub fn admit(&self, k: &RigKinematics) -> Result<(), BeyondEnvelope> {
         let (lo, hi) = (
             self.min_stretch() * (1.0 - ENVELOPE_TOLERANCE),
             self.max_stretch * (1.0 + ENVELOPE_TOLERANCE),
         );
         for (name, value) in [("stretch_x", k.stretch_x), ("stretch_y", k.stretch_y)] {
             if !(value.is_finite() && (lo..=hi).contains(&value)) {
-                return Err(format!(
-                    "{name} {value:.4} outside [{:.4}, {:.4}] (--max-stretch {}, with the lateral \
-                     contraction max^-1/2)",
-                    self.min_stretch(),
-                    self.max_stretch,
-                    self.max_stretch
-                ));
+                return Err(BeyondEnvelope::Stretch {
+                    name,
+                    value,
+                    min: self.min_stretch(),
+                    max: self.max_stretch,
+                });
             }
         }
         if !(k.rotation_rad.is_finite()
             && k.rotation_rad.abs() <= self.max_rotation_rad * (1.0 + ENVELOPE_TOLERANCE))
         {
-            return Err(format!(
-                "rotation {:.3}° beyond ±{:.3}° (--max-rotation-deg)",
-                k.rotation_rad.to_degrees(),
-                self.max_rotation_rad.to_degrees()
-            ));
+            return Err(BeyondEnvelope::Rotation {
+                rotation_rad: k.rotation_rad,
+                max_rotation_rad: self.max_rotation_rad,
+            });
         }
         for (axis, value) in ["X", "Y"].into_iter().zip(k.centre_offset_mm) {
             if !(value.is_finite()
                 && value.abs() <= self.max_offset_mm * (1.0 + ENVELOPE_TOLERANCE) + 1e-12)
             {
-                return Err(format!(
-                    "centre offset {axis} {value:.4} mm beyond ±{} mm (--max-offset-mm)",
-                    self.max_offset_mm
-                ));
+                return Err(BeyondEnvelope::Offset {
+                    axis,
+                    value_mm: value,
+                    max_mm: self.max_offset_mm,
+                });
             }
         }
         Ok(())
     }
+}
+
+/// Why a rig state lies outside the envelope: the quantity, its bounds and the option that
+/// sets them.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum BeyondEnvelope {
+    #[error("{name} {value:.4} outside [{min:.4}, {max:.4}] (--max-stretch {max}, with the lateral contraction max^-1/2)")]
+    Stretch {
+        /// `stretch_x` or `stretch_y`.
+        name: &'static str,
+        value: f64,
+        min: f64,
+        max: f64,
+    },
+    #[error("rotation {:.3}° beyond ±{:.3}° (--max-rotation-deg)", .rotation_rad.to_degrees(), .max_rotation_rad.to_degrees())]
+    Rotation {
+        rotation_rad: f64,
+        max_rotation_rad: f64,
+    },
+    #[error("centre offset {axis} {value_mm:.4} mm beyond ±{max_mm} mm (--max-offset-mm)")]
+    Offset {
+        /// `X` or `Y`.
+        axis: &'static str,
+        value_mm: f64,
+        max_mm: f64,
+    },
 }
 
 /// How the camera follows the rig.
@@ -227,7 +252,7 @@ pub enum NextMotion {
         /// The sample.
         sample_id: u64,
         /// Why, naming the quantity, its bounds and the option that sets them.
-        reason: String,
+        reason: BeyondEnvelope,
     },
     /// Render this.
     Ready(RigMotion),
@@ -575,6 +600,7 @@ mod tests {
         match f.next_motion() {
             NextMotion::Beyond { sample_id, reason } => {
                 assert_eq!(sample_id, 7);
+                let reason = reason.to_string();
                 assert!(reason.contains("stretch_x 3.2000"), "{reason}");
                 assert!(reason.contains("--max-stretch 3"), "{reason}");
             }
@@ -584,12 +610,18 @@ mod tests {
         let NextMotion::Beyond { reason, .. } = f.next_motion() else {
             panic!("5° is beyond the default 2°");
         };
-        assert!(reason.contains("--max-rotation-deg"), "{reason}");
+        assert!(
+            reason.to_string().contains("--max-rotation-deg"),
+            "{reason}"
+        );
         f.push_kinematics(kin(1.0, 1.0, 0.0, [0.0, -0.6]));
         let NextMotion::Beyond { reason, .. } = f.next_motion() else {
             panic!("0.6 mm is beyond the default 0.5 mm");
         };
-        assert!(reason.contains("offset Y"), "{reason}");
+        assert!(
+            matches!(reason, BeyondEnvelope::Offset { axis: "Y", .. }),
+            "{reason}"
+        );
         f.push_kinematics(kin(f64::NAN, 1.0, 0.0, [0.0, 0.0]));
         assert!(matches!(f.next_motion(), NextMotion::Beyond { .. }));
     }

@@ -82,38 +82,18 @@ pub enum StreamEvent<'a> {
     /// the slot is skipped. `first` is true the first time it happens in a row.
     RigBeyond {
         sample_id: u64,
-        reason: &'a str,
+        reason: crate::rig_follow::BeyondEnvelope,
         first: bool,
     },
 }
 
-#[derive(Debug)]
+/// Why the camera's stream could not start or stopped: the shared memory, or its source.
+#[derive(Debug, thiserror::Error)]
 pub enum StreamError {
-    Wire(InstanceError),
-    Source(ProducerError),
-}
-
-impl std::fmt::Display for StreamError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            StreamError::Wire(e) => write!(f, "{e}"),
-            StreamError::Source(e) => write!(f, "{e}"),
-        }
-    }
-}
-
-impl std::error::Error for StreamError {}
-
-impl From<InstanceError> for StreamError {
-    fn from(e: InstanceError) -> Self {
-        StreamError::Wire(e)
-    }
-}
-
-impl From<ProducerError> for StreamError {
-    fn from(e: ProducerError) -> Self {
-        StreamError::Source(e)
-    }
+    #[error(transparent)]
+    Wire(#[from] InstanceError),
+    #[error(transparent)]
+    Source(#[from] ProducerError),
 }
 
 /// Shared memory the `frames` service needs for frames of `width_px` x `height_px` (bytes).
@@ -359,7 +339,7 @@ pub fn stream_following_rig(
                 shell.report.frames_beyond_envelope += 1;
                 on_event(StreamEvent::RigBeyond {
                     sample_id,
-                    reason: &reason,
+                    reason,
                     first: !beyond_in_a_row,
                 });
                 beyond_in_a_row = true;

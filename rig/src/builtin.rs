@@ -3,8 +3,20 @@
 
 use crate::control::{AxisControl, ControlMode};
 use crate::ids::{Axis, Channel};
-use crate::program::{Program, Step, StopTransition};
+use crate::program::{Program, ProgramError, Step, StopTransition};
 use crate::specimen::{Loading, SpecimenConfig, SpecimenGeometry};
+
+/// Why a built-in test's program was refused: its rate or stretch as the command line gives
+/// them, or the program they make.
+#[derive(Debug, thiserror::Error)]
+pub enum TestError {
+    #[error("--rate {}: expected a positive stretch rate (/s)", crate::refusal::number(*.rate_per_s))]
+    Rate { rate_per_s: f64 },
+    #[error("--stretch {}: expected a stretch in (1, 8]", crate::refusal::number(*.stretch))]
+    Stretch { stretch: f64 },
+    #[error(transparent)]
+    Program(#[from] ProgramError),
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BuiltinTest {
@@ -48,18 +60,12 @@ impl BuiltinTest {
 
     /// Hold 1 s, then ramp the elongation(s) to `stretch` at `rate_per_s` (stretch per second),
     /// then hold 1 s. Stop transition: ramp to zero at 10× the loading rate.
-    pub fn program(self, rate_per_s: f64, stretch: f64) -> Result<Program, String> {
+    pub fn program(self, rate_per_s: f64, stretch: f64) -> Result<Program, TestError> {
         if !(rate_per_s.is_finite() && rate_per_s > 0.0) {
-            return Err(format!(
-                "--rate {}: expected a positive stretch rate (/s)",
-                crate::refusal::number(rate_per_s)
-            ));
+            return Err(TestError::Rate { rate_per_s });
         }
         if !(stretch.is_finite() && stretch > 1.0 && stretch <= 8.0) {
-            return Err(format!(
-                "--stretch {}: expected a stretch in (1, 8]",
-                crate::refusal::number(stretch)
-            ));
+            return Err(TestError::Stretch { stretch });
         }
         let geometry = self.specimen().geometry;
         let axes: &[(Axis, f64)] = match self {

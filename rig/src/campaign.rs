@@ -4,7 +4,7 @@
 //! mounted and its test started. Pure logic on [`Rig`]: the process shell calls
 //! [`Campaign::advance`] between steps.
 
-use crate::builtin::BuiltinTest;
+use crate::builtin::{BuiltinTest, TestError};
 use crate::config::RigConfig;
 use crate::program::{Program, Step};
 use crate::refusal::Refusal;
@@ -23,6 +23,54 @@ pub struct CampaignTest {
     pub rate_per_s: f64,
 }
 
+/// Why a campaign was refused: its text, its tests' programs, or the machine it would run on.
+#[derive(Debug, thiserror::Error)]
+pub enum CampaignError {
+    #[error("campaign test {text:?}: expected TEST:STRETCH@RATE, e.g. uniaxial:3@0.08")]
+    Syntax { text: String },
+    #[error("campaign test {text:?}: unknown test {name:?} (uniaxial or equibiaxial)")]
+    UnknownTest { text: String, name: String },
+    #[error("campaign test {text:?}: {what} {value:?} is not a number")]
+    NotANumber {
+        text: String,
+        what: &'static str,
+        value: String,
+    },
+    #[error("campaign test {text:?}: {reason}")]
+    Test { text: String, reason: TestError },
+    #[error("a campaign needs at least one test")]
+    Empty,
+    #[error(transparent)]
+    Program(#[from] TestError),
+    /// The rig refuses the campaign's configuration (its specimen, its limits).
+    #[error("{at}: {reason}")]
+    Machine { at: NumberedTest, reason: Refusal },
+    #[error("{at}: {reason}")]
+    TestProgram { at: NumberedTest, reason: TestError },
+    #[error("{at} is refused by the rig: {reason}")]
+    RefusedByRig { at: NumberedTest, reason: Refusal },
+}
+
+/// A test of a campaign as a refusal names it: its number (from 1) and what it does.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NumberedTest {
+    pub number: usize,
+    pub test: CampaignTest,
+}
+
+impl std::fmt::Display for NumberedTest {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "campaign test {} ({} to λ {} at {} /s)",
+            self.number,
+            self.test.test.name(),
+            self.test.stretch,
+            self.test.rate_per_s
+        )
+    }
+}
+
 /// How fast a test unloads, relative to its loading rate.
 pub const UNLOAD_RATE_FACTOR: f64 = 5.0;
 /// Hold at the mounting position after unloading (s).
@@ -31,7 +79,7 @@ pub const UNLOADED_HOLD_S: f64 = 0.5;
 impl CampaignTest {
     /// The test's program: hold, ramp to the stretch, hold, ramp back to zero elongation at
     /// [`UNLOAD_RATE_FACTOR`] times the rate, hold.
-    pub fn program(&self) -> Result<Program, String> {
+    pub fn program(&self) -> Result<Program, TestError> {
         let mut program = self.test.program(self.rate_per_s, self.stretch)?;
         let geometry = self.test.specimen().geometry;
         for (_, steps) in &mut program.channels {
@@ -50,31 +98,35 @@ impl CampaignTest {
     }
 
     /// `uniaxial:3@0.08` = uniaxial to λ 3 at 0.08 /s.
-    pub fn parse(text: &str) -> Result<CampaignTest, String> {
-        let expected = "expected TEST:STRETCH@RATE, e.g. uniaxial:3@0.08";
-        let (name, rest) = text
-            .trim()
-            .split_once(':')
-            .ok_or_else(|| format!("campaign test {text:?}: {expected}"))?;
-        let (stretch, rate) = rest
-            .split_once('@')
-            .ok_or_else(|| format!("campaign test {text:?}: {expected}"))?;
-        let test = BuiltinTest::parse(name.trim()).ok_or_else(|| {
-            format!("campaign test {text:?}: unknown test {name:?} (uniaxial or equibiaxial)")
+    pub fn parse(text: &str) -> Result<CampaignTest, CampaignError> {
+        let syntax = || CampaignError::Syntax {
+            text: text.to_string(),
+        };
+        let (name, rest) = text.trim().split_once(':').ok_or_else(syntax)?;
+        let (stretch, rate) = rest.split_once('@').ok_or_else(syntax)?;
+        let test = BuiltinTest::parse(name.trim()).ok_or_else(|| CampaignError::UnknownTest {
+            text: text.to_string(),
+            name: name.to_string(),
         })?;
-        let number = |what: &str, value: &str| {
+        let number = |what: &'static str, value: &str| {
             value
                 .trim()
                 .parse::<f64>()
-                .map_err(|_| format!("campaign test {text:?}: {what} {value:?} is not a number"))
+                .map_err(|_| CampaignError::NotANumber {
+                    text: text.to_string(),
+                    what,
+                    value: value.to_string(),
+                })
         };
         let test = CampaignTest {
             test,
             stretch: number("stretch", stretch)?,
             rate_per_s: number("rate", rate)?,
         };
-        test.program()
-            .map_err(|e| format!("campaign test {text:?}: {e}"))?;
+        test.program().map_err(|reason| CampaignError::Test {
+            text: text.to_string(),
+            reason,
+        })?;
         Ok(test)
     }
 }
@@ -119,9 +171,9 @@ impl Campaign {
         .expect("the paper campaign is valid")
     }
 
-    pub fn new(tests: Vec<CampaignTest>) -> Result<Campaign, String> {
+    pub fn new(tests: Vec<CampaignTest>) -> Result<Campaign, CampaignError> {
         if tests.is_empty() {
-            return Err("a campaign needs at least one test".into());
+            return Err(CampaignError::Empty);
         }
         for test in &tests {
             test.program()?;
@@ -149,7 +201,7 @@ impl Campaign {
     }
 
     /// `uniaxial:3@0.08,equibiaxial:2@0.04`.
-    pub fn parse(text: &str) -> Result<Campaign, String> {
+    pub fn parse(text: &str) -> Result<Campaign, CampaignError> {
         let tests = text
             .split(',')
             .filter(|t| !t.trim().is_empty())
@@ -176,24 +228,21 @@ impl Campaign {
     /// Checks every test against the limits of `config` as the rig itself would when the test
     /// starts (stroke, force range, rate), so a campaign beyond the machine is refused before
     /// anything runs, with the test named.
-    pub fn check_against(&self, config: &RigConfig) -> Result<(), String> {
+    pub fn check_against(&self, config: &RigConfig) -> Result<(), CampaignError> {
         for (k, test) in self.tests.iter().enumerate() {
-            let describe = || {
-                format!(
-                    "campaign test {} ({} to λ {} at {} /s)",
-                    k + 1,
-                    test.test.name(),
-                    test.stretch,
-                    test.rate_per_s
-                )
+            let at = NumberedTest {
+                number: k + 1,
+                test: *test,
             };
             let mut scratch_config = config.clone();
             scratch_config.specimen = Some(self.specimen_of(test));
-            let mut rig =
-                Rig::new(scratch_config, 0).map_err(|e| format!("{}: {e}", describe()))?;
-            let program = test.program().map_err(|e| format!("{}: {e}", describe()))?;
+            let mut rig = Rig::new(scratch_config, 0)
+                .map_err(|reason| CampaignError::Machine { at, reason })?;
+            let program = test
+                .program()
+                .map_err(|reason| CampaignError::TestProgram { at, reason })?;
             rig.command(RigCommand::StartProgram(Box::new(program)))
-                .map_err(|e| format!("{} is refused by the rig: {e}", describe()))?;
+                .map_err(|reason| CampaignError::RefusedByRig { at, reason })?;
         }
         Ok(())
     }
@@ -214,9 +263,7 @@ impl Campaign {
         let Some(&test) = self.tests.get(self.next) else {
             return Ok(CampaignEvent::Done);
         };
-        let program = test
-            .program()
-            .map_err(|reason| Refusal::Invalid { reason })?;
+        let program = test.program().map_err(Refusal::invalid)?;
         rig.command(RigCommand::MountSpecimen(Some(Box::new(
             self.specimen_of(&test),
         ))))?;
@@ -241,18 +288,22 @@ mod tests {
         let c = Campaign::parse("uniaxial:3@0.08, equibiaxial:2@0.04").unwrap();
         assert_eq!(c.tests().len(), 2);
         assert_eq!(c.tests()[1].test, BuiltinTest::Equibiaxial);
-        assert!(Campaign::parse("").unwrap_err().contains("at least one"));
+        assert!(matches!(Campaign::parse(""), Err(CampaignError::Empty)));
         assert!(Campaign::parse("shear:2@0.1")
             .unwrap_err()
+            .to_string()
             .contains("unknown test"));
         assert!(Campaign::parse("uniaxial:two@0.1")
             .unwrap_err()
+            .to_string()
             .contains("not a number"));
         assert!(Campaign::parse("uniaxial:3")
             .unwrap_err()
+            .to_string()
             .contains("STRETCH@RATE"));
         assert!(Campaign::parse("uniaxial:0.5@0.1")
             .unwrap_err()
+            .to_string()
             .contains("stretch"));
         assert!(Campaign::parse("uniaxial:NaN@0.1").is_err());
     }
@@ -265,13 +316,15 @@ mod tests {
         let error = Campaign::parse("uniaxial:7@0.08")
             .unwrap()
             .check_against(&config)
-            .unwrap_err();
+            .unwrap_err()
+            .to_string();
         assert!(error.contains("campaign test 1"), "{error}");
         assert!(error.contains("stroke"), "{error}");
         let error = Campaign::parse("equibiaxial:1.5@50")
             .unwrap()
             .check_against(&config)
-            .unwrap_err();
+            .unwrap_err()
+            .to_string();
         assert!(error.contains("rate"), "{error}");
     }
 }

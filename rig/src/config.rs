@@ -2,9 +2,30 @@
 
 use crate::control::ControlGains;
 use crate::hydraulics::ACTUATOR_COUNT;
-use crate::limits::{ChannelLimits, LimitActions, Limits};
+use crate::limits::{ChannelLimits, LimitActions, Limits, LimitsError};
 use crate::params::ActuatorParams;
-use crate::specimen::SpecimenConfig;
+use crate::specimen::{SpecimenConfig, SpecimenError};
+
+/// Why a rig configuration was refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ConfigError {
+    #[error("control_hz {control_hz} not in [100, 100000]")]
+    ControlRate { control_hz: f64 },
+    #[error("plant_substeps {plant_substeps} not in [1, 64]")]
+    PlantSubsteps { plant_substeps: u32 },
+    #[error("control gains are not finite or not ordered")]
+    Gains,
+    #[error("spool_bias_std {spool_bias_std} not in [0, 0.02)")]
+    SpoolBias { spool_bias_std: f64 },
+    #[error("load_cell_noise_kn {load_cell_noise_kn} is not ≥ 0")]
+    LoadCellNoise { load_cell_noise_kn: f64 },
+    #[error("break_detect_min_kn {break_detect_min_kn} is not > 0")]
+    BreakDetect { break_detect_min_kn: f64 },
+    #[error(transparent)]
+    Specimen(#[from] SpecimenError),
+    #[error(transparent)]
+    Limits(#[from] LimitsError),
+}
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct RigConfig {
@@ -56,43 +77,38 @@ impl RigConfig {
         1.0 / self.control_hz
     }
 
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ConfigError> {
         if !(self.control_hz.is_finite() && (100.0..=100_000.0).contains(&self.control_hz)) {
-            return Err(format!(
-                "control_hz {} not in [100, 100000]",
-                self.control_hz
-            ));
+            return Err(ConfigError::ControlRate {
+                control_hz: self.control_hz,
+            });
         }
         if !(1..=64).contains(&self.plant_substeps) {
-            return Err(format!(
-                "plant_substeps {} not in [1, 64]",
-                self.plant_substeps
-            ));
+            return Err(ConfigError::PlantSubsteps {
+                plant_substeps: self.plant_substeps,
+            });
         }
         if !self.gains.is_valid() {
-            return Err("control gains are not finite or not ordered".into());
+            return Err(ConfigError::Gains);
         }
         if !(self.spool_bias_std.is_finite() && (0.0..0.02).contains(&self.spool_bias_std)) {
-            return Err(format!(
-                "spool_bias_std {} not in [0, 0.02)",
-                self.spool_bias_std
-            ));
+            return Err(ConfigError::SpoolBias {
+                spool_bias_std: self.spool_bias_std,
+            });
         }
         if !(self.load_cell_noise_kn.is_finite() && self.load_cell_noise_kn >= 0.0) {
-            return Err(format!(
-                "load_cell_noise_kn {} is not ≥ 0",
-                self.load_cell_noise_kn
-            ));
+            return Err(ConfigError::LoadCellNoise {
+                load_cell_noise_kn: self.load_cell_noise_kn,
+            });
         }
         if !(self.break_detect_min_kn.is_finite() && self.break_detect_min_kn > 0.0) {
-            return Err(format!(
-                "break_detect_min_kn {} is not > 0",
-                self.break_detect_min_kn
-            ));
+            return Err(ConfigError::BreakDetect {
+                break_detect_min_kn: self.break_detect_min_kn,
+            });
         }
         if let Some(specimen) = &self.specimen {
             specimen.validate()?;
         }
-        self.limits.validate()
+        Ok(self.limits.validate()?)
     }
 }

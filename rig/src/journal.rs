@@ -10,6 +10,34 @@
 
 use crate::snapshot::RigSnapshot;
 
+/// Why a journal's text could not be read.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum JournalError {
+    #[error("no {key}")]
+    Missing { key: &'static str },
+    #[error("{key} = {value:?} is not a count")]
+    NotACount { key: &'static str, value: String },
+    #[error("{key} = {value:?} is not hexadecimal")]
+    NotHexadecimal { key: &'static str, value: String },
+}
+
+/// How a replay differs from where the journal says the rig was.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Mismatch {
+    #[error("the replay reached step {replayed_step} (t = {replayed_t_s} s), the journal says step {step} (t = {t_s} s)")]
+    Step {
+        replayed_step: u64,
+        replayed_t_s: f64,
+        step: u64,
+        t_s: f64,
+    },
+    #[error("the replay's actuator positions {replayed_mm:?} mm differ from the journal's {journal_mm:?} mm")]
+    Positions {
+        replayed_mm: Vec<f64>,
+        journal_mm: Vec<f64>,
+    },
+}
+
 /// Where the rig had got to.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Journal {
@@ -60,20 +88,25 @@ impl Journal {
         )
     }
 
-    pub fn parse(text: &str) -> Result<Journal, String> {
-        let value = |key: &str| -> Result<&str, String> {
+    pub fn parse(text: &str) -> Result<Journal, JournalError> {
+        let value = |key: &'static str| -> Result<&str, JournalError> {
             text.lines()
                 .filter_map(|l| l.split_once('='))
                 .find(|(k, _)| k.trim() == key)
                 .map(|(_, v)| v.trim())
-                .ok_or_else(|| format!("no {key}"))
+                .ok_or(JournalError::Missing { key })
         };
-        let int = |v: &str, key: &str| {
-            v.parse::<u64>()
-                .map_err(|_| format!("{key} = {v:?} is not a count"))
+        let int = |value: &str, key: &'static str| {
+            value.parse::<u64>().map_err(|_| JournalError::NotACount {
+                key,
+                value: value.to_string(),
+            })
         };
-        let hex = |v: &str, key: &str| {
-            u64::from_str_radix(v, 16).map_err(|_| format!("{key} = {v:?} is not hexadecimal"))
+        let hex = |value: &str, key: &'static str| {
+            u64::from_str_radix(value, 16).map_err(|_| JournalError::NotHexadecimal {
+                key,
+                value: value.to_string(),
+            })
         };
         let positions = value("positions_mm_bits")?
             .split(',')
@@ -94,12 +127,14 @@ impl Journal {
 
     /// Why a replay that reached `snapshot` after `self.periods` periods is not where the
     /// journal says the rig was (None: it is, bit for bit).
-    pub fn mismatch(&self, snapshot: &RigSnapshot) -> Option<String> {
+    pub fn mismatch(&self, snapshot: &RigSnapshot) -> Option<Mismatch> {
         if snapshot.step != self.step || snapshot.t_s.to_bits() != self.t_s.to_bits() {
-            return Some(format!(
-                "the replay reached step {} (t = {} s), the journal says step {} (t = {} s)",
-                snapshot.step, snapshot.t_s, self.step, self.t_s
-            ));
+            return Some(Mismatch::Step {
+                replayed_step: snapshot.step,
+                replayed_t_s: snapshot.t_s,
+                step: self.step,
+                t_s: self.t_s,
+            });
         }
         let replayed = Journal::positions_of(snapshot);
         if replayed.len() != self.positions_mm.len()
@@ -108,10 +143,10 @@ impl Journal {
                 .zip(&self.positions_mm)
                 .any(|(a, b)| a.to_bits() != b.to_bits())
         {
-            return Some(format!(
-                "the replay's actuator positions {replayed:?} mm differ from the journal's {:?} mm",
-                self.positions_mm
-            ));
+            return Some(Mismatch::Positions {
+                replayed_mm: replayed,
+                journal_mm: self.positions_mm.clone(),
+            });
         }
         None
     }
@@ -145,10 +180,8 @@ mod tests {
         assert_eq!(back, journal);
         assert_ne!(fingerprint("a"), fingerprint("b"));
         assert!(Journal::parse("periods = x").is_err());
-        assert!(
-            Journal::parse(&journal.to_text().replace("step = 12340\n", ""))
-                .unwrap_err()
-                .contains("no step")
-        );
+        let missing = Journal::parse(&journal.to_text().replace("step = 12340\n", ""));
+        assert_eq!(missing, Err(JournalError::Missing { key: "step" }));
+        assert_eq!(missing.unwrap_err().to_string(), "no step");
     }
 }

@@ -83,7 +83,7 @@ impl ChannelLimits {
         }
     }
 
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ChannelLimitsError> {
         let all = [
             self.stroke_min_mm,
             self.stroke_max_mm,
@@ -94,19 +94,38 @@ impl ChannelLimits {
             self.rate_max_mm_s,
         ];
         if !all.iter().all(|v| v.is_finite()) {
-            return Err("a limit is not a finite number".into());
+            return Err(ChannelLimitsError::NotFinite);
         }
         if self.stroke_min_mm >= self.stroke_max_mm || self.force_min_kn >= self.force_max_kn {
-            return Err("a lower limit is not below its upper limit".into());
+            return Err(ChannelLimitsError::Order);
         }
         if self.following_error_mm <= 0.0
             || self.following_error_kn <= 0.0
             || self.rate_max_mm_s <= 0.0
         {
-            return Err("following-error and rate limits must be positive".into());
+            return Err(ChannelLimitsError::NotPositive);
         }
         Ok(())
     }
+}
+
+/// Why one actuator's limits were refused.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum ChannelLimitsError {
+    #[error("a limit is not a finite number")]
+    NotFinite,
+    #[error("a lower limit is not below its upper limit")]
+    Order,
+    #[error("following-error and rate limits must be positive")]
+    NotPositive,
+}
+
+/// Why the limits of the machine were refused: the first actuator (0..6) whose limits are.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("actuator {actuator}: {reason}")]
+pub struct LimitsError {
+    pub actuator: usize,
+    pub reason: ChannelLimitsError,
 }
 
 /// The action of each kind of limit.
@@ -150,9 +169,10 @@ pub struct Limits {
 }
 
 impl Limits {
-    pub fn validate(&self) -> Result<(), String> {
-        for (i, c) in self.channels.iter().enumerate() {
-            c.validate().map_err(|e| format!("actuator {i}: {e}"))?;
+    pub fn validate(&self) -> Result<(), LimitsError> {
+        for (actuator, c) in self.channels.iter().enumerate() {
+            c.validate()
+                .map_err(|reason| LimitsError { actuator, reason })?;
         }
         Ok(())
     }

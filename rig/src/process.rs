@@ -3,24 +3,126 @@
 //! `rig/command` (request-response: accepted or refused with the reason) and writes `rig.csv`
 //! as it goes. All IPC of the crate lives in this file; the core knows nothing of it.
 
-use crate::builtin::BuiltinTest;
-use crate::campaign::{Campaign, CampaignEvent};
+use crate::builtin::{BuiltinTest, TestError};
+use crate::campaign::{Campaign, CampaignError, CampaignEvent};
 use crate::codes;
 use crate::config::RigConfig;
 use crate::control::{AxisControl, ControlMode};
 use crate::ids::{ActuatorId, Axis};
 use crate::journal::Journal;
 use crate::limits::LimitKind;
-use crate::program::{Program, StopTransition};
+use crate::program::{Program, ProgramError, StopTransition};
+use crate::refusal::Refusal;
 use crate::rig::{Rig, RigCommand};
-use crate::session::{PeriodEvent, Session};
+use crate::session::{PeriodEvent, Session, SessionError};
 use iceoryx2::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use wire::files::RowFile;
 use wire::rig::{RigCommandKind, RigReply, RigState};
 
-type BoxError = Box<dyn std::error::Error + Send + Sync>;
+/// Why the rig process could not start or stopped early. A file that could not be written and
+/// a journal that cannot be followed are named as the error's `source()` too, so that
+/// `wire::exit::code_of` finds the exit code they ask for.
+#[derive(Debug, thiserror::Error)]
+pub enum ProcessError {
+    #[error("--speed {text:?}: expected realtime, max or a positive factor")]
+    Speed { text: String },
+    #[error("{name} {hz}: expected a rate in (0, {control_hz}] Hz")]
+    Rate {
+        name: &'static str,
+        hz: f64,
+        control_hz: f64,
+    },
+    #[error("a program and a campaign cannot run together: choose one")]
+    ProgramAndCampaign,
+    #[error(transparent)]
+    Campaign(#[from] CampaignError),
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    #[error("cannot create {}: {reason}", .path.display())]
+    CreateDir {
+        path: PathBuf,
+        reason: std::io::Error,
+    },
+    #[error("cannot read {}: {reason}", .path.display())]
+    ReadJournal {
+        path: PathBuf,
+        reason: std::io::Error,
+    },
+    /// The journal cannot be followed safely: exit code [`wire::exit::CANNOT_RESUME`].
+    #[error("{0}")]
+    CannotResume(#[source] wire::exit::ExitWith),
+    #[error(transparent)]
+    Instance(#[from] wire::InstanceError),
+    /// An iceoryx2 port of `rig/command` could not be made or used.
+    #[error("{port}: {detail}")]
+    Command { port: &'static str, detail: String },
+    #[error("{0}")]
+    File(#[from] wire::files::FileError),
+    #[error(
+        "stopped by {signal} at t = {t_s:.3} s, before the {what} finished{}",
+        .journal.as_ref().map(|path| format!(" (a restart resumes from {})", path.display())).unwrap_or_default()
+    )]
+    Stopped {
+        /// The signal's name (SIGTERM, ...).
+        signal: String,
+        t_s: f64,
+        /// `campaign` or `program`.
+        what: &'static str,
+        journal: Option<PathBuf>,
+    },
+}
+
+impl ProcessError {
+    /// An iceoryx2 error of the `rig/command` port `port`.
+    fn command(port: &'static str, error: impl std::fmt::Debug) -> ProcessError {
+        ProcessError::Command {
+            port,
+            detail: format!("{error:?}"),
+        }
+    }
+}
+
+/// Why a command over `rig/command` was refused (the reply carries the message).
+#[derive(Debug, thiserror::Error)]
+pub enum CommandRefused {
+    #[error("layout version {found} is not {}", wire::LAYOUT_VERSION)]
+    LayoutVersion { found: u32 },
+    #[error("unknown command kind {kind}")]
+    UnknownKind { kind: u32 },
+    #[error("value is not a finite number")]
+    NotFinite,
+    #[error("channel {channel} is not an actuator (0..6)")]
+    NotAnActuator { channel: u32 },
+    #[error("channel {channel} is not an axis (0..3)")]
+    NotAnAxis { channel: u32 },
+    #[error("channel {channel} is not 0..12")]
+    NotAChannel { channel: u32 },
+    #[error("program {}: {reason}", .path.display())]
+    ProgramUnreadable {
+        path: PathBuf,
+        reason: std::io::Error,
+    },
+    #[error(transparent)]
+    Program(#[from] ProgramError),
+    #[error("built-in test {value} is not 1 (uniaxial) or 2 (equibiaxial)")]
+    UnknownTest { value: f64 },
+    #[error("built-in test {test} needs its specimen; mounted: {}", .mounted.as_ref().map_or("none".into(), |loading| format!("a {loading} specimen")))]
+    NeedsSpecimen {
+        test: &'static str,
+        /// The loading of the mounted specimen, if any.
+        mounted: Option<String>,
+    },
+    #[error(transparent)]
+    Test(#[from] TestError),
+    #[error("mode code {code} is not 0..=4")]
+    ModeCode { code: u32 },
+    #[error("limit code {code} is not 0..=6")]
+    LimitCode { code: u32 },
+    #[error(transparent)]
+    Rig(#[from] Refusal),
+}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Speed {
@@ -32,15 +134,13 @@ pub enum Speed {
 }
 
 impl Speed {
-    pub fn parse(text: &str) -> Result<Speed, String> {
+    pub fn parse(text: &str) -> Result<Speed, ProcessError> {
         match text {
             "realtime" => Ok(Speed::Realtime),
             "max" => Ok(Speed::Max),
             n => match n.parse::<f64>() {
                 Ok(f) if f.is_finite() && f > 0.0 => Ok(Speed::Factor(f)),
-                _ => Err(format!(
-                    "--speed {n:?}: expected realtime, max or a positive factor"
-                )),
+                _ => Err(ProcessError::Speed { text: n.into() }),
             },
         }
     }
@@ -83,21 +183,25 @@ pub struct ProcessSummary {
     pub limits_tripped: u32,
 }
 
-pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
+pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
     let control_hz = options.config.control_hz;
     for (name, hz) in [
         ("publish_hz", options.publish_hz),
         ("log_hz", options.log_hz),
     ] {
         if !(hz.is_finite() && hz > 0.0 && hz <= control_hz) {
-            return Err(format!("{name} {hz}: expected a rate in (0, {control_hz}] Hz").into());
+            return Err(ProcessError::Rate {
+                name,
+                hz,
+                control_hz,
+            });
         }
     }
     let publish_every = (control_hz / options.publish_hz).round().max(1.0) as u64;
     let log_every = (control_hz / options.log_hz).round().max(1.0) as u64;
 
     if options.program.is_some() && options.campaign.is_some() {
-        return Err("a program and a campaign cannot run together: choose one".into());
+        return Err(ProcessError::ProgramAndCampaign);
     }
     if let Some(campaign) = &options.campaign {
         campaign.check_against(&options.config)?;
@@ -118,8 +222,10 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
         .as_ref()
         .map(|dir| dir.join(crate::journal::FILE_NAME));
     if let Some(dir) = &options.state_dir {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|reason| ProcessError::CreateDir {
+            path: dir.clone(),
+            reason,
+        })?;
     }
     let resumed = match &journal_path {
         Some(path) => resume(&mut session, path, settings)?,
@@ -136,15 +242,17 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
     }
     let publisher =
         wire::pubsub::ValuePublisher::<RigState>::create(&node, &wire::services::RIG_STATE)?;
+    let service_name = ServiceName::new(wire::services::RIG_COMMAND)
+        .map_err(|e| ProcessError::command("service name rig/command", e))?;
     let command_service = node
-        .service_builder(&ServiceName::new(wire::services::RIG_COMMAND)?)
+        .service_builder(&service_name)
         .request_response::<wire::RigCommand, RigReply>()
         .open_or_create()
-        .map_err(|e| format!("service {}: {e:?}", wire::services::RIG_COMMAND))?;
+        .map_err(|e| ProcessError::command("service rig/command", e))?;
     let server = command_service
         .server_builder()
         .create()
-        .map_err(|e| format!("server {}: {e:?}", wire::services::RIG_COMMAND))?;
+        .map_err(|e| ProcessError::command("server rig/command", e))?;
 
     let mut summary = ProcessSummary::default();
     // The log grows by whole rows; a resumed rig goes on after the rows its journal names.
@@ -183,7 +291,7 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
         // Commands, between publication periods.
         while let Some(active) = server
             .receive()
-            .map_err(|e| format!("rig/command receive: {e:?}"))?
+            .map_err(|e| ProcessError::command("rig/command receive", e))?
         {
             let reply = match handle(&mut session.rig, &active, &options) {
                 Ok(()) => {
@@ -193,12 +301,12 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
                 Err(reason) => {
                     summary.commands_refused += 1;
                     eprintln!("rig: command refused: {reason}");
-                    RigReply::refused(&reason)
+                    RigReply::refused(&reason.to_string())
                 }
             };
             active
                 .send_copy(reply)
-                .map_err(|e| format!("rig/command reply: {e:?}"))?;
+                .map_err(|e| ProcessError::command("rig/command reply", e))?;
         }
 
         let event = session.period(log.is_some().then_some(&mut rows))?;
@@ -277,21 +385,16 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, BoxError> {
     if let Some(signal) = stopped_by {
         if options.exit_when_done && !session.done(options.program.is_some()) {
             // Not "done": a supervisor must not read this stop as the end of the campaign.
-            return Err(format!(
-                "stopped by {} at t = {:.3} s, before the {} finished{}",
-                wire::signals::name(signal),
-                summary.simulated_s,
-                if session.campaign.is_some() {
+            return Err(ProcessError::Stopped {
+                signal: wire::signals::name(signal),
+                t_s: summary.simulated_s,
+                what: if session.campaign.is_some() {
                     "campaign"
                 } else {
                     "program"
                 },
-                match &journal_path {
-                    Some(path) => format!(" (a restart resumes from {})", path.display()),
-                    None => String::new(),
-                }
-            )
-            .into());
+                journal: journal_path,
+            });
         }
     }
     Ok(summary)
@@ -316,14 +419,23 @@ fn settings_fingerprint(options: &ProcessOptions) -> u64 {
 /// Brings `session` to where the journal at `path` says (None: no journal, a fresh start).
 /// A journal that cannot be followed safely leaves the machine unloaded and stopped: the
 /// error asks for exit code [`wire::exit::CANNOT_RESUME`].
-fn resume(session: &mut Session, path: &Path, settings: u64) -> Result<Option<Journal>, BoxError> {
+fn resume(
+    session: &mut Session,
+    path: &Path,
+    settings: u64,
+) -> Result<Option<Journal>, ProcessError> {
     let text = match std::fs::read_to_string(path) {
         Ok(text) => text,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(format!("cannot read {}: {e}", path.display()).into()),
+        Err(reason) => {
+            return Err(ProcessError::ReadJournal {
+                path: path.to_path_buf(),
+                reason,
+            })
+        }
     };
-    let refuse = |why: String| -> BoxError {
-        Box::new(wire::exit::ExitWith {
+    let refuse = |why: &dyn std::fmt::Display| {
+        ProcessError::CannotResume(wire::exit::ExitWith {
             code: wire::exit::CANNOT_RESUME,
             message: format!(
                 "cannot resume from {}: {why}; the specimen is left unloaded and the rig stopped",
@@ -331,14 +443,14 @@ fn resume(session: &mut Session, path: &Path, settings: u64) -> Result<Option<Jo
             ),
         })
     };
-    let journal = Journal::parse(&text).map_err(|e| refuse(format!("unreadable journal: {e}")))?;
+    let journal =
+        Journal::parse(&text).map_err(|e| refuse(&format_args!("unreadable journal: {e}")))?;
     if journal.settings != settings {
         return Err(refuse(
-            "it was written by a rig with other settings (campaign, material, seed or rates)"
-                .into(),
+            &"it was written by a rig with other settings (campaign, material, seed or rates)",
         ));
     }
-    session.resume(&journal).map_err(refuse)?;
+    session.resume(&journal).map_err(|e| refuse(&e))?;
     Ok(Some(journal))
 }
 
@@ -347,38 +459,41 @@ fn handle(
     rig: &mut Rig,
     request: &wire::RigCommand,
     options: &ProcessOptions,
-) -> Result<(), String> {
+) -> Result<(), CommandRefused> {
     if request.layout_version != wire::LAYOUT_VERSION {
-        return Err(format!(
-            "layout version {} is not {}",
-            request.layout_version,
-            wire::LAYOUT_VERSION
-        ));
+        return Err(CommandRefused::LayoutVersion {
+            found: request.layout_version,
+        });
     }
     let kind = RigCommandKind::from_code(request.kind)
-        .ok_or_else(|| format!("unknown command kind {}", request.kind))?;
+        .ok_or(CommandRefused::UnknownKind { kind: request.kind })?;
     if !request.value.is_finite() {
-        return Err("value is not a finite number".into());
+        return Err(CommandRefused::NotFinite);
     }
+    let channel = request.channel;
     let actuator = || {
         ActuatorId::ALL
-            .get(request.channel as usize)
+            .get(channel as usize)
             .copied()
-            .ok_or_else(|| format!("channel {} is not an actuator (0..6)", request.channel))
+            .ok_or(CommandRefused::NotAnActuator { channel })
     };
     let axis = || {
         Axis::ALL
-            .get(request.channel as usize)
+            .get(channel as usize)
             .copied()
-            .ok_or_else(|| format!("channel {} is not an axis (0..3)", request.channel))
+            .ok_or(CommandRefused::NotAnAxis { channel })
     };
     let command = match kind {
         RigCommandKind::StartProgram => {
             let text = wire::text::read_fixed(&request.text);
             let program = if !text.is_empty() {
                 let path = PathBuf::from(&text);
-                let toml = std::fs::read_to_string(&path)
-                    .map_err(|e| format!("program {}: {e}", path.display()))?;
+                let toml = std::fs::read_to_string(&path).map_err(|reason| {
+                    CommandRefused::ProgramUnreadable {
+                        path: path.clone(),
+                        reason,
+                    }
+                })?;
                 let base = path.parent().map(PathBuf::from).unwrap_or_default();
                 Program::from_toml(&toml, &base)?
             } else {
@@ -387,21 +502,16 @@ fn handle(
                 } else if request.value == codes::TEST_EQUIBIAXIAL {
                     BuiltinTest::Equibiaxial
                 } else {
-                    return Err(format!(
-                        "built-in test {} is not 1 (uniaxial) or 2 (equibiaxial)",
-                        request.value
-                    ));
+                    return Err(CommandRefused::UnknownTest {
+                        value: request.value,
+                    });
                 };
                 let mounted = rig.specimen().map(|s| s.config().loading);
                 if mounted != Some(test.specimen().loading) {
-                    return Err(format!(
-                        "built-in test {} needs its specimen; mounted: {}",
-                        test.name(),
-                        match mounted {
-                            Some(loading) => format!("a {} specimen", loading.name()),
-                            None => "none".into(),
-                        }
-                    ));
+                    return Err(CommandRefused::NeedsSpecimen {
+                        test: test.name(),
+                        mounted: mounted.map(|loading| loading.name()),
+                    });
                 }
                 test.program(options.test_rate_per_s, options.test_stretch)?
             };
@@ -437,7 +547,7 @@ fn handle(
                 axis: axis()?,
                 control: AxisControl::Independent,
             },
-            other => return Err(format!("mode code {other} is not 0..=4")),
+            code => return Err(CommandRefused::ModeCode { code }),
         },
         RigCommandKind::SetLimit => {
             let id = actuator()?;
@@ -451,7 +561,7 @@ fn handle(
                 codes::LIMIT_FOLLOWING_ERROR_MM => limits.following_error_mm = v,
                 codes::LIMIT_FOLLOWING_ERROR_KN => limits.following_error_kn = v,
                 codes::LIMIT_RATE_MM_S => limits.rate_max_mm_s = v,
-                other => return Err(format!("limit code {other} is not 0..=6")),
+                code => return Err(CommandRefused::LimitCode { code }),
             }
             RigCommand::SetLimits {
                 actuator: id,
@@ -460,12 +570,11 @@ fn handle(
         }
         RigCommandKind::EmergencyStop => RigCommand::EmergencyStop,
         RigCommandKind::SetPoint => RigCommand::SetSetpoint {
-            channel: codes::channel(request.channel)
-                .ok_or_else(|| format!("channel {} is not 0..12", request.channel))?,
+            channel: codes::channel(channel).ok_or(CommandRefused::NotAChannel { channel })?,
             value: request.value,
         },
     };
-    rig.command(command).map_err(|e| e.to_string())
+    Ok(rig.command(command)?)
 }
 
 /// The published sample. `command_mm` / `following_error_mm` carry kN for an actuator in

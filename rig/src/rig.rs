@@ -97,9 +97,7 @@ impl Rig {
     /// A rig at rest, actuators at mid stroke (the specimen mounted there, unloaded),
     /// hydraulics on, every actuator in displacement control holding its position.
     pub fn new(config: RigConfig, seed: u64) -> Result<Rig, Refusal> {
-        config
-            .validate()
-            .map_err(|reason| Refusal::Invalid { reason })?;
+        config.validate().map_err(Refusal::invalid)?;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let actuators = std::array::from_fn(|i| {
             let z: f64 = StandardNormal.sample(&mut rng);
@@ -107,9 +105,7 @@ impl Rig {
             Actuator::new(config.actuators[i], 0.0, bias)
         });
         let specimen = match &config.specimen {
-            Some(c) => {
-                Some(Specimen::new(c.clone()).map_err(|reason| Refusal::Invalid { reason })?)
-            }
+            Some(c) => Some(Specimen::new(c.clone()).map_err(Refusal::invalid)?),
             None => None,
         };
         let feedback = Feedback::default();
@@ -259,9 +255,7 @@ impl Rig {
                 Ok(())
             }
             RigCommand::SetLimits { actuator, limits } => {
-                limits
-                    .validate()
-                    .map_err(|reason| Refusal::Invalid { reason })?;
+                limits.validate().map_err(Refusal::invalid)?;
                 self.config.limits.channels[actuator.index()] = limits;
                 Ok(())
             }
@@ -322,10 +316,7 @@ impl Rig {
                     }
                 }
                 let specimen = match &config {
-                    Some(c) => Some(
-                        Specimen::new((**c).clone())
-                            .map_err(|reason| Refusal::Invalid { reason })?,
-                    ),
+                    Some(c) => Some(Specimen::new((**c).clone()).map_err(Refusal::invalid)?),
                     None => None,
                 };
                 self.specimen = specimen;
@@ -369,9 +360,7 @@ impl Rig {
     fn start_program(&mut self, program: &Program) -> Result<(), Refusal> {
         self.refuse_if_program_active()?;
         self.refuse_if_unsafe()?;
-        program
-            .validate()
-            .map_err(|reason| Refusal::Invalid { reason })?;
+        program.validate().map_err(Refusal::invalid)?;
         let saved = self.controller.clone();
         let result = self.bind_program(program);
         if result.is_err() {

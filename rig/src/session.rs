@@ -5,10 +5,27 @@
 //! both times, so the replay is exact.
 
 use crate::campaign::{Campaign, CampaignEvent};
-use crate::journal::Journal;
+use crate::journal::{Journal, Mismatch};
+use crate::refusal::Refusal;
 use crate::rig::{Rig, RigCommand};
 use crate::snapshot::ProgramStatus;
 use crate::{Program, RigConfig};
+
+/// Why a session could not start, go on, or resume.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SessionError {
+    /// The rig refused its configuration.
+    #[error(transparent)]
+    Rig(Refusal),
+    #[error("program refused: {0}")]
+    ProgramRefused(Refusal),
+    #[error("campaign halted: {0}")]
+    CampaignHalted(Refusal),
+    #[error("{count} command(s) were accepted over rig/command; they are not replayed")]
+    CommandsTaken { count: u64 },
+    #[error(transparent)]
+    Mismatch(Mismatch),
+}
 
 pub struct Session {
     pub rig: Rig,
@@ -35,11 +52,11 @@ impl Session {
         campaign: Option<Campaign>,
         publish_every: u64,
         log_every: u64,
-    ) -> Result<Session, String> {
-        let mut rig = Rig::new(config.clone(), seed).map_err(|e| e.to_string())?;
+    ) -> Result<Session, SessionError> {
+        let mut rig = Rig::new(config.clone(), seed).map_err(SessionError::Rig)?;
         if let Some(program) = program {
             rig.command(RigCommand::StartProgram(Box::new(program.clone())))
-                .map_err(|e| format!("program refused: {e}"))?;
+                .map_err(SessionError::ProgramRefused)?;
         }
         Ok(Session {
             rig,
@@ -52,7 +69,7 @@ impl Session {
     }
 
     /// One publication period; the log rows of its steps are appended to `rows` (if given).
-    pub fn period(&mut self, mut rows: Option<&mut String>) -> Result<PeriodEvent, String> {
+    pub fn period(&mut self, mut rows: Option<&mut String>) -> Result<PeriodEvent, SessionError> {
         let mut event = PeriodEvent::Nothing;
         if let Some(campaign) = self.campaign.as_mut() {
             match campaign.advance(&mut self.rig) {
@@ -61,7 +78,7 @@ impl Session {
                     event = PeriodEvent::TestStarted(started);
                 }
                 Ok(CampaignEvent::Busy | CampaignEvent::Done) => {}
-                Err(refusal) => return Err(format!("campaign halted: {refusal}")),
+                Err(refusal) => return Err(SessionError::CampaignHalted(refusal)),
             }
         }
         for _ in 0..self.publish_every {
@@ -94,18 +111,17 @@ impl Session {
 
     /// Runs `journal.periods` periods at once and checks that the machine is where the journal
     /// says it was, bit for bit; refused (with why) otherwise, or when commands were accepted.
-    pub fn resume(&mut self, journal: &Journal) -> Result<(), String> {
+    pub fn resume(&mut self, journal: &Journal) -> Result<(), SessionError> {
         if journal.commands_accepted > 0 {
-            return Err(format!(
-                "{} command(s) were accepted over rig/command; they are not replayed",
-                journal.commands_accepted
-            ));
+            return Err(SessionError::CommandsTaken {
+                count: journal.commands_accepted,
+            });
         }
         while self.periods < journal.periods {
             self.period(None)?;
         }
         match journal.mismatch(self.rig.state()) {
-            Some(why) => Err(why),
+            Some(why) => Err(SessionError::Mismatch(why)),
             None => Ok(()),
         }
     }
@@ -177,9 +193,9 @@ mod tests {
         // A rig that took commands cannot resume.
         let mut commanded = journal.clone();
         commanded.commands_accepted = 1;
-        assert!(session()
-            .resume(&commanded)
-            .unwrap_err()
-            .contains("command"));
+        assert_eq!(
+            session().resume(&commanded),
+            Err(SessionError::CommandsTaken { count: 1 })
+        );
     }
 }

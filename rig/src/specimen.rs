@@ -92,7 +92,7 @@ impl Default for SpecimenConfig {
 }
 
 impl SpecimenConfig {
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SpecimenError> {
         let g = &self.geometry;
         for (name, v) in [
             ("gauge_length_mm", g.gauge_length_mm),
@@ -101,23 +101,38 @@ impl SpecimenConfig {
             ("break_nominal_stress_mpa", self.break_nominal_stress_mpa),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("specimen {name} = {v}, expected a positive number"));
+                return Err(SpecimenError::NotPositive { name, value: v });
             }
         }
         let m = &self.misalignment;
         if !(m.rotation_deg.is_finite() && m.rotation_deg.abs() < 45.0) {
-            return Err(format!("rotation_deg {} not in (−45, 45)", m.rotation_deg));
+            return Err(SpecimenError::Rotation {
+                rotation_deg: m.rotation_deg,
+            });
         }
         if !(m.asymmetry.is_finite() && m.asymmetry.abs() < 1.0) {
-            return Err(format!("asymmetry {} not in (−1, 1)", m.asymmetry));
+            return Err(SpecimenError::Asymmetry {
+                asymmetry: m.asymmetry,
+            });
         }
         if self.loading == Loading::Uniaxial(Axis::Z) {
-            return Err(
-                "uniaxial loading is along X or Y (the sheet lies in the X-Y plane)".into(),
-            );
+            return Err(SpecimenError::UniaxialAlongZ);
         }
         Ok(())
     }
+}
+
+/// Why a specimen's configuration was refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SpecimenError {
+    #[error("specimen {name} = {value}, expected a positive number")]
+    NotPositive { name: &'static str, value: f64 },
+    #[error("rotation_deg {rotation_deg} not in (−45, 45)")]
+    Rotation { rotation_deg: f64 },
+    #[error("asymmetry {asymmetry} not in (−1, 1)")]
+    Asymmetry { asymmetry: f64 },
+    #[error("uniaxial loading is along X or Y (the sheet lies in the X-Y plane)")]
+    UniaxialAlongZ,
 }
 
 /// Result of one evaluation: grip forces (N, tension positive, per actuator) and kinematics.
@@ -136,7 +151,7 @@ pub struct Specimen {
 }
 
 impl Specimen {
-    pub fn new(config: SpecimenConfig) -> Result<Specimen, String> {
+    pub fn new(config: SpecimenConfig) -> Result<Specimen, SpecimenError> {
         config.validate()?;
         Ok(Specimen {
             config,

@@ -95,8 +95,7 @@ pub fn run(args: PipelineBenchArgs) -> Result<()> {
                 trial.fps_requested, trial.dropped
             );
         }
-    })
-    .map_err(anyhow::Error::msg)?;
+    })?;
     if json {
         println!("{}", serde_json::to_string_pretty(&result)?);
     } else {

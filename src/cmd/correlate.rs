@@ -6,7 +6,7 @@
 //! structured grid and colour maps of |u| and exx over the reference image. Every file is
 //! written atomically (temporary sibling, then rename). Images are read by `producer::read_image`.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use correlator::settings::Method;
 use correlator::{
     Correlator, CorrelatorSettings, Field, GaugeStrains, GuessMode, ReferenceMode, Roi,
@@ -180,12 +180,12 @@ pub struct CorrelateArgs {
     pub png: bool,
 }
 
-pub(crate) fn parse_roi(text: &str) -> Result<Roi, String> {
+pub(crate) fn parse_roi(text: &str) -> Result<Roi> {
     let values: Vec<usize> = text
         .split(',')
         .map(|v| v.trim().parse::<usize>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("ROI '{text}': expected four non-negative integers x,y,w,h"))?;
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| anyhow!("ROI '{text}': expected four non-negative integers x,y,w,h"))?;
     match values[..] {
         [x_px, y_px, width_px, height_px] => Ok(Roi {
             x_px,
@@ -193,10 +193,10 @@ pub(crate) fn parse_roi(text: &str) -> Result<Roi, String> {
             width_px,
             height_px,
         }),
-        _ => Err(format!(
+        _ => bail!(
             "ROI '{text}': expected four values x,y,w,h, got {}",
             values.len()
-        )),
+        ),
     }
 }
 

@@ -67,7 +67,7 @@ pub fn run(args: CorrelatorArgs) -> Result<()> {
         ..ProcessConfig::new(&args.instance, settings)
     };
     let summary =
-        run_process(config).map_err(|e| wire::exit::in_context("correlator process", &*e))?;
+        run_process(config).map_err(|e| wire::exit::in_context("correlator process", &e))?;
     eprintln!("{}", summary.final_line());
     Ok(())
 }

@@ -34,7 +34,7 @@ pub struct IdentifierArgs {
 }
 
 pub fn run(args: IdentifierArgs) -> anyhow::Result<()> {
-    let models = parse_model_list(&args.model).map_err(anyhow::Error::msg)?;
+    let models = parse_model_list(&args.model)?;
     let idle_timeout = match args.idle_timeout_s {
         Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
         Some(s) => anyhow::bail!("--idle-timeout-s must be a positive number of seconds, got {s}"),
@@ -66,7 +66,7 @@ pub fn run(args: IdentifierArgs) -> anyhow::Result<()> {
         },
     };
     let summary =
-        run_process(config).map_err(|e| wire::exit::in_context("identifier process", &*e))?;
+        run_process(config).map_err(|e| wire::exit::in_context("identifier process", &e))?;
     eprintln!(
         "identifier: {} fields, {} rig samples, {} reports; points uniaxial/equibiaxial/pure shear = {:?}; best {}; wrote {}",
         summary.fields_received,

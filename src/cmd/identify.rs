@@ -95,7 +95,7 @@ pub fn run_with(
     if curves.is_empty() {
         bail!("no data: give at least one of --uniaxial, --biaxial, --pure-shear");
     }
-    let models = parse_model_list(&args.model).map_err(anyhow::Error::msg)?;
+    let models = parse_model_list(&args.model)?;
     let threads = usize::try_from(args.threads).unwrap_or(1);
     let options = FitOptions {
         residual: match args.residual {

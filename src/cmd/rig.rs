@@ -1,6 +1,7 @@
 //! `dicstream rig`: the simulated ASTREE machine as a process (publishes `rig/state`, answers
 //! `rig/command`, logs `rig.csv`).
 
+use anyhow::Context;
 use rig::builtin::BuiltinTest;
 use rig::process::{run as run_process, ProcessOptions, Speed};
 use rig::{Campaign, Program, RigConfig};
@@ -64,10 +65,10 @@ pub struct RigArgs {
 }
 
 pub fn run(args: RigArgs) -> anyhow::Result<()> {
-    let speed = Speed::parse(&args.speed).map_err(anyhow::Error::msg)?;
+    let speed = Speed::parse(&args.speed)?;
     let mut config = RigConfig::default();
     let campaign = match (&args.campaign, args.test.as_deref()) {
-        (Some(spec), _) => Some(Campaign::parse(spec).map_err(anyhow::Error::msg)?),
+        (Some(spec), _) => Some(Campaign::parse(spec)?),
         (None, Some("campaign")) => Some(Campaign::paper()),
         _ => None,
     };
@@ -102,23 +103,17 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
     let test = args.test.as_deref().filter(|t| *t != "campaign");
     let program = match (&args.program, test) {
         (Some(path), _) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| anyhow::anyhow!("program {}: {e}", path.display()))?;
+            let program = || format!("program {}", path.display());
+            let text = std::fs::read_to_string(path).with_context(program)?;
             let base = path.parent().map(PathBuf::from).unwrap_or_default();
-            Some(
-                Program::from_toml(&text, &base)
-                    .map_err(|e| anyhow::anyhow!("program {}: {e}", path.display()))?,
-            )
+            Some(Program::from_toml(&text, &base).with_context(program)?)
         }
         (None, Some(name)) => {
             let test = BuiltinTest::parse(name).ok_or_else(|| {
                 anyhow::anyhow!("--test {name:?}: expected uniaxial, equibiaxial or campaign")
             })?;
             config.specimen = Some(test.specimen());
-            Some(
-                test.program(args.rate, args.stretch)
-                    .map_err(anyhow::Error::msg)?,
-            )
+            Some(test.program(args.rate, args.stretch)?)
         }
         (None, None) => None,
     };
@@ -138,7 +133,9 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         exit_when_done: args.exit_when_done,
         state_dir: args.state_dir.clone(),
     };
-    let summary = run_process(options).map_err(|e| wire::exit::in_context("rig process", &*e))?;
+    // The process's messages name their causes; `in_context` keeps the exit code its error
+    // asks for (a results file, a journal it cannot follow).
+    let summary = run_process(options).map_err(|e| wire::exit::in_context("rig process", &e))?;
     eprintln!(
         "rig: {:.1} s simulated in {:.1} s wall ({:.0}x), {} samples published, {} log rows, \
          commands {} accepted / {} refused, limits tripped {:#x}",

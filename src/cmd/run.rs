@@ -1,6 +1,7 @@
 //! `dicstream run`: the whole simulated bench (rig, camera, correlator, identifier as
 //! processes), live status, results folder. See the `live` crate.
 
+use anyhow::Context;
 use live::{Ending, RunConfig, RunOptions};
 use std::path::PathBuf;
 
@@ -34,18 +35,15 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
     let config = match &args.config {
         Some(path) => {
             let text = std::fs::read_to_string(path)
-                .map_err(|e| anyhow::anyhow!("--config {}: {e}", path.display()))?;
-            RunConfig::from_toml(&text, &path.display().to_string()).map_err(anyhow::Error::msg)?
+                .with_context(|| format!("--config {}", path.display()))?;
+            RunConfig::from_toml(&text, &path.display().to_string())?
         }
         None => RunConfig::default(),
     };
     let mut config = config;
     config.run.vtk |= args.vtk;
-    config
-        .validate()
-        .map_err(|e| anyhow::anyhow!("configuration refused: {e}"))?;
-    let exe = std::env::current_exe()
-        .map_err(|e| anyhow::anyhow!("cannot find the dicstream binary: {e}"))?;
+    config.validate().context("configuration refused")?;
+    let exe = std::env::current_exe().context("cannot find the dicstream binary")?;
     let report = live::run(RunOptions {
         config,
         exe,
@@ -53,7 +51,12 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
         results: args.out,
         status: !args.quiet,
     })
-    .map_err(anyhow::Error::msg)?;
+    // `run` has exit codes of its own (see live::run::exit_code): one that cannot start
+    // fails with 1, whatever the cause in the error's chain (a file it could not write).
+    .map_err(|e| wire::exit::ExitWith {
+        code: live::run::exit_code::FAILED,
+        message: format!("{e:#}"),
+    })?;
     println!(
         "run: {:?} after {:.1} s: {} frames captured, {} correlated, {} not correlated ({} lost \
          to faults); latency capture to field p50 {:.0} ms p99 {:.0} ms, to identification p50 \

@@ -9,19 +9,12 @@ pub const CANNOT_RESUME: u8 = 75;
 
 /// An error that sets the process's exit code (the binary's `main` looks for it, and for a
 /// [`crate::files::FileError`], in the error's chain).
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
+#[error("{message}")]
 pub struct ExitWith {
     pub code: u8,
     pub message: String,
 }
-
-impl std::fmt::Display for ExitWith {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.message)
-    }
-}
-
-impl std::error::Error for ExitWith {}
 
 /// The exit code an error asks for: an [`ExitWith`]'s, or [`OUTPUT_FAILED`] for a file that
 /// could not be written.
@@ -57,7 +50,7 @@ mod tests {
         let file_error = crate::files::FileError {
             path: "rig.csv".into(),
             what: "write",
-            source: std::io::Error::from_raw_os_error(libc::ENOSPC),
+            reason: std::io::Error::from_raw_os_error(libc::ENOSPC),
         };
         let boxed: Box<dyn std::error::Error + Send + Sync> = Box::new(file_error);
         let exit = in_context("rig process", &*boxed);

@@ -7,48 +7,32 @@
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
-/// A failed file operation, naming the file.
-#[derive(Debug)]
+/// A failed file operation, naming the file. The I/O error is part of the message, not a
+/// `source()` (an error chain printed with `{:#}` says it once).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot {what} {}: {reason}", .path.display())]
 pub struct FileError {
     pub path: PathBuf,
     /// `write`, `create`, `open`, `rename to`...
     pub what: &'static str,
-    pub source: std::io::Error,
+    pub reason: std::io::Error,
 }
 
 impl FileError {
-    fn new(path: &Path, what: &'static str, source: std::io::Error) -> FileError {
+    fn new(path: &Path, what: &'static str, reason: std::io::Error) -> FileError {
         FileError {
             path: path.to_path_buf(),
             what,
-            source,
+            reason,
         }
     }
 
     /// No space (or quota) left on the file's device.
     pub fn is_disk_full(&self) -> bool {
         matches!(
-            self.source.raw_os_error(),
+            self.reason.raw_os_error(),
             Some(libc::ENOSPC) | Some(libc::EDQUOT)
-        ) || self.source.kind() == std::io::ErrorKind::StorageFull
-    }
-}
-
-impl std::fmt::Display for FileError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "cannot {} {}: {}",
-            self.what,
-            self.path.display(),
-            self.source
-        )
-    }
-}
-
-impl std::error::Error for FileError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        None
+        ) || self.reason.kind() == std::io::ErrorKind::StorageFull
     }
 }
 

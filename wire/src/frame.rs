@@ -85,32 +85,47 @@ impl FrameHeader {
     }
 
     /// Checks the header is one this build understands and consistent with its payload length.
-    pub fn validate(&self, payload_len: usize) -> Result<(), String> {
+    pub fn validate(&self, payload_len: usize) -> Result<(), FrameError> {
         if self.layout_version != crate::LAYOUT_VERSION {
-            return Err(format!(
-                "frame layout version {} but this build reads version {}",
-                self.layout_version,
-                crate::LAYOUT_VERSION
-            ));
+            return Err(FrameError::LayoutVersion {
+                layout_version: self.layout_version,
+            });
         }
         if payload_len != self.pixel_count() {
-            return Err(format!(
-                "frame {} header says {}x{} = {} pixels but the payload holds {}",
-                self.frame_id,
-                self.width_px,
-                self.height_px,
-                self.pixel_count(),
-                payload_len
-            ));
+            return Err(FrameError::PayloadLength {
+                frame_id: self.frame_id,
+                width_px: self.width_px,
+                height_px: self.height_px,
+                payload_len,
+            });
         }
         if !matches!(self.bit_depth, 8 | 10 | 12 | 16) {
-            return Err(format!(
-                "frame {} has bit depth {}, expected 8, 10, 12 or 16",
-                self.frame_id, self.bit_depth
-            ));
+            return Err(FrameError::BitDepth {
+                frame_id: self.frame_id,
+                bit_depth: self.bit_depth,
+            });
         }
         Ok(())
     }
+}
+
+/// Why a frame's header was refused by [`FrameHeader::validate`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum FrameError {
+    #[error(
+        "frame layout version {layout_version} but this build reads version {}",
+        crate::LAYOUT_VERSION
+    )]
+    LayoutVersion { layout_version: u32 },
+    #[error("frame {frame_id} header says {width_px}x{height_px} = {} pixels but the payload holds {payload_len}", *.width_px as usize * *.height_px as usize)]
+    PayloadLength {
+        frame_id: u64,
+        width_px: u32,
+        height_px: u32,
+        payload_len: usize,
+    },
+    #[error("frame {frame_id} has bit depth {bit_depth}, expected 8, 10, 12 or 16")]
+    BitDepth { frame_id: u64, bit_depth: u32 },
 }
 
 impl Default for FrameHeader {
@@ -219,16 +234,26 @@ mod tests {
             ..FrameHeader::default()
         };
         assert!(header.validate(8).is_ok());
-        assert!(header.validate(7).unwrap_err().contains("payload holds 7"));
+        assert!(header
+            .validate(7)
+            .unwrap_err()
+            .to_string()
+            .contains("payload holds 7"));
         let old = FrameHeader {
             layout_version: 0,
             ..header
         };
-        assert!(old.validate(8).unwrap_err().contains("version"));
+        assert!(matches!(
+            old.validate(8),
+            Err(FrameError::LayoutVersion { layout_version: 0 })
+        ));
         let odd = FrameHeader {
             bit_depth: 9,
             ..header
         };
-        assert!(odd.validate(8).unwrap_err().contains("bit depth 9"));
+        assert_eq!(
+            odd.validate(8).unwrap_err().to_string(),
+            "frame 0 has bit depth 9, expected 8, 10, 12 or 16"
+        );
     }
 }

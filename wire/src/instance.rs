@@ -8,77 +8,40 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// Longest instance name accepted (the prefix lands in file names of `/dev/shm`).
 pub const MAX_NAME_LEN: usize = 48;
 
-#[derive(Debug)]
+/// Why an instance, its node, a service or the claim of a role could not be had.
+#[derive(Debug, thiserror::Error)]
 pub enum InstanceError {
-    BadName {
-        name: String,
-        reason: String,
-    },
-    Node {
-        role: String,
-        detail: String,
-    },
-    Service {
-        service: String,
-        detail: String,
-    },
+    #[error("instance name {name:?}: {reason}")]
+    BadName { name: String, reason: String },
+    #[error("cannot create the {role} node: {detail}")]
+    Node { role: String, detail: String },
+    #[error("cannot open service {service:?}: {detail}")]
+    Service { service: String, detail: String },
+    #[error(
+        "{path} has {:.1} MiB free but the services need about {:.1} MiB: free some space \
+         (old runs: `ls {path}`), use a smaller frame, or enlarge {path} \
+         (mount -o remount,size=... {path})",
+        *.free_bytes as f64 / 1048576.0,
+        *.needed_bytes as f64 / 1048576.0
+    )]
     ShmSpace {
         needed_bytes: u64,
         free_bytes: u64,
         path: String,
     },
     /// The role already has a process on this instance.
+    #[error(
+        "instance {instance} already has a {role} ({}): stop it, or use another --instance",
+        .pid.map_or("pid unknown".into(), |pid| format!("pid {pid}"))
+    )]
     Owned {
         instance: String,
         role: String,
         pid: Option<u32>,
     },
+    #[error("{0}")]
     Io(String),
 }
-
-impl std::fmt::Display for InstanceError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            InstanceError::BadName { name, reason } => {
-                write!(f, "instance name {name:?}: {reason}")
-            }
-            InstanceError::Node { role, detail } => {
-                write!(f, "cannot create the {role} node: {detail}")
-            }
-            InstanceError::Service { service, detail } => {
-                write!(f, "cannot open service {service:?}: {detail}")
-            }
-            InstanceError::ShmSpace {
-                needed_bytes,
-                free_bytes,
-                path,
-            } => write!(
-                f,
-                "{path} has {:.1} MiB free but the services need about {:.1} MiB: free some space \
-                 (old runs: `ls {path}`), use a smaller frame, or enlarge {path} \
-                 (mount -o remount,size=... {path})",
-                *free_bytes as f64 / 1048576.0,
-                *needed_bytes as f64 / 1048576.0
-            ),
-            InstanceError::Owned {
-                instance,
-                role,
-                pid,
-            } => write!(
-                f,
-                "instance {instance} already has a {role} ({}): stop it, or use another \
-                 --instance",
-                match pid {
-                    Some(pid) => format!("pid {pid}"),
-                    None => "pid unknown".into(),
-                }
-            ),
-            InstanceError::Io(detail) => write!(f, "{detail}"),
-        }
-    }
-}
-
-impl std::error::Error for InstanceError {}
 
 /// One run's name and the iceoryx2 configuration that isolates it. Dropped after the nodes it
 /// created (declare it first), it removes iceoryx2's node counter of the instance when no node

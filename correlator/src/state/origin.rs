@@ -17,6 +17,8 @@
 //! the new origin was), is no origin: the restored correlator then carries its bases as a
 //! correlator without the origin does.
 
+use super::Corruption;
+
 const MAGIC: &[u8; 8] = b"DICSORG1";
 const FORMAT_VERSION: u32 = 1;
 const HEADER_BYTES: usize = 28;
@@ -52,33 +54,38 @@ pub(super) fn encode(
     out.extend_from_slice(&sum.to_le_bytes());
 }
 
-pub(super) fn decode(bytes: &[u8]) -> Result<SavedOrigin, String> {
+pub(super) fn decode(bytes: &[u8]) -> Result<SavedOrigin, Corruption> {
     if bytes.len() < HEADER_BYTES + 8 {
-        return Err(format!("{} bytes, shorter than a header", bytes.len()));
+        return Err(Corruption::Short {
+            len_bytes: bytes.len(),
+        });
     }
     if &bytes[..8] != MAGIC {
-        return Err("wrong magic bytes".into());
+        return Err(Corruption::Magic);
     }
     let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().expect("4 bytes"));
     let version = u32_at(8);
     if version != FORMAT_VERSION {
-        return Err(format!(
-            "format version {version}, this build reads {FORMAT_VERSION}"
-        ));
+        return Err(Corruption::Version {
+            version,
+            expected: FORMAT_VERSION,
+        });
     }
     let (width_px, height_px) = (u32_at(12) as usize, u32_at(16) as usize);
     let origin_frame_id = u64::from_le_bytes(bytes[20..28].try_into().expect("8 bytes"));
     let expected = HEADER_BYTES + 2 * width_px * height_px + 8;
     if bytes.len() != expected {
-        return Err(format!(
-            "{} bytes, a {width_px}x{height_px} px origin needs {expected}",
-            bytes.len()
-        ));
+        return Err(Corruption::OriginLength {
+            len_bytes: bytes.len(),
+            width_px,
+            height_px,
+            expected_bytes: expected,
+        });
     }
     let body = &bytes[..expected - 8];
     let stored = u64::from_le_bytes(bytes[expected - 8..].try_into().expect("8 bytes"));
     if wire::frame::byte_checksum(body) != stored {
-        return Err("checksum mismatch".into());
+        return Err(Corruption::Checksum);
     }
     let pixels = body[HEADER_BYTES..]
         .chunks_exact(2)
