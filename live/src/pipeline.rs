@@ -118,6 +118,7 @@ pub fn trial(settings: &PipelineSettings, fps: f64) -> Result<PipelineResult, St
         instance: None,
         results: None,
         status: false,
+        verbose: false,
     })?;
     if report.ending != Ending::Completed {
         return Err(format!(

@@ -30,6 +30,8 @@ pub struct RunOptions {
     pub results: Option<PathBuf>,
     /// Print the status line (otherwise only the start and the end are printed).
     pub status: bool,
+    /// The long status line (every figure) instead of one that fits 100 columns.
+    pub verbose: bool,
 }
 
 /// How the run ended.
@@ -337,6 +339,8 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
             t0_ns,
         )?;
         let mut state = LoopState::default();
+        state.verbose = options.verbose;
+        state.dashboard = crate::dashboard_view::start(config, &instance_name)?;
         let result = start_children(&mut supervisor, config, &instance_name, &results).and_then(
             |all_ready| match all_ready {
                 false => Ok(Ending::Interrupted),
@@ -374,6 +378,7 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
         crate::children::own_cpu_s() - monitor_cpu_at_start_s,
     );
     drop(supervisor);
+    drop(state.dashboard.take());
     instance.cleanup_dead_nodes();
     instance.remove_leftover_files();
     let leftover_shm_files = instance.leftover_files().len();
@@ -432,6 +437,8 @@ struct LoopState {
     signal: Option<i32>,
     /// CPU seconds per process (children by role, and this monitor).
     cpu_s: std::collections::BTreeMap<String, f64>,
+    dashboard: Option<dashboard::Dashboard>,
+    verbose: bool,
 }
 
 enum Phase {
@@ -583,6 +590,14 @@ fn event_loop(
 
         if Instant::now() >= next_status {
             supervisor.sample_cpu();
+            crate::dashboard_view::update(
+                &state.dashboard,
+                supervisor,
+                &state.faults,
+                &state.restarts,
+                &state.restart_counts,
+                started,
+            );
             if next_histograms <= Instant::now() {
                 // Kept up to date, so a run killed outright still leaves its latencies (a
                 // write error is reported once at the end, when they are written again).
@@ -592,7 +607,7 @@ fn event_loop(
             if status {
                 println!(
                     "{}",
-                    crate::status::status_line(recorder, started.elapsed().as_secs_f64())
+                    crate::status::line(recorder, started.elapsed().as_secs_f64(), state.verbose)
                 );
             }
             next_status += status_every;
