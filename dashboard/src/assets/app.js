@@ -48,6 +48,7 @@ function lineChart(canvas, series, opts) {
   ctx.font = '11px system-ui, sans-serif';
   let xs = [], ys = [];
   for (const s of series) {
+    if (s.noBounds) continue; // drawn clipped to the others' range (a wild early fit)
     for (let i = 0; i < s.x.length; i++) {
       if (s.x[i] !== null && s.y[i] !== null && isFinite(s.x[i]) && isFinite(s.y[i])) { xs.push(s.x[i]); ys.push(s.y[i]); }
     }
@@ -72,6 +73,8 @@ function lineChart(canvas, series, opts) {
   ctx.strokeStyle = '#52606d'; ctx.strokeRect(L, T, W - L - R, H - T - B);
   ctx.fillText(opts.xlabel || '', W / 2 - 30, H - 3);
   let lx = L + 8;
+  ctx.save();
+  ctx.beginPath(); ctx.rect(L, T, W - L - R, H - T - B); ctx.clip();
   for (const s of series) {
     ctx.strokeStyle = s.color; ctx.fillStyle = s.color; ctx.lineWidth = 1.6;
     if (s.dots) {
@@ -91,6 +94,7 @@ function lineChart(canvas, series, opts) {
     }
     if (s.label) { ctx.fillRect(lx, T + 6, 10, 3); ctx.fillText(s.label, lx + 13, T + 11); lx += 20 + ctx.measureText(s.label).width; }
   }
+  ctx.restore();
   dash.chartsDrawn++;
 }
 
@@ -238,7 +242,7 @@ function update(s) {
   [['uniaxial', 0], ['equibiaxial', 1]].forEach(([k, i]) => {
     const c = id[k];
     series.push({ x: c.stretch, y: c.nominal_mpa, color: SERIES_COLORS[i], label: k, dots: true });
-    if (c.fit) series.push({ x: c.fit.stretch, y: c.fit.nominal_mpa, color: SERIES_COLORS[i + 3], label: `fit ${k}` });
+    if (c.fit) series.push({ x: c.fit.stretch, y: c.fit.nominal_mpa, color: SERIES_COLORS[i + 3], label: `fit ${k}`, noBounds: c.stretch.length > 0 });
   });
   lineChart($('stress-chart'), series, { xlabel: 'stretch λ', yZero: true, empty: 'no test data yet' });
 
