@@ -42,6 +42,8 @@ pub struct Proc {
     child: Child,
     lines: Receiver<String>,
     log: Arc<Mutex<Vec<String>>>,
+    /// Says when stderr reached its end (every line is in `log`).
+    stderr_done: Receiver<()>,
 }
 
 impl Proc {
@@ -56,6 +58,7 @@ impl Proc {
         let (tx, lines) = channel();
         let log = Arc::new(Mutex::new(Vec::new()));
         let stderr = child.stderr.take().expect("piped stderr");
+        let (done_tx, stderr_done) = channel();
         {
             let log = log.clone();
             std::thread::spawn(move || {
@@ -63,6 +66,7 @@ impl Proc {
                     log.lock().unwrap().push(line.clone());
                     let _ = tx.send(line);
                 }
+                let _ = done_tx.send(());
             });
         }
         Proc {
@@ -70,6 +74,7 @@ impl Proc {
             child,
             lines,
             log,
+            stderr_done,
         }
     }
 
@@ -117,6 +122,8 @@ impl Proc {
         let give_up = Instant::now() + HANG_GUARD;
         loop {
             if let Some(status) = self.child.try_wait().unwrap() {
+                // Its last lines too (the reader may not have had them yet).
+                let _ = self.stderr_done.recv_timeout(Duration::from_secs(10));
                 return status.code();
             }
             assert!(

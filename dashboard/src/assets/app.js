@@ -143,7 +143,7 @@ function colourRange(values) {
 function drawColorbar(lo, hi, label) {
   const c = $('colorbar'), ctx = c.getContext('2d');
   ctx.clearRect(0, 0, c.width, c.height);
-  const T = 14, B = 14, h = c.height - T - B;
+  const T = 24, B = 14, h = c.height - T - B;
   for (let i = 0; i < h; i++) {
     const [r, g, b] = jet(1 - i / h);
     ctx.fillStyle = `rgb(${r},${g},${b})`;
@@ -246,10 +246,32 @@ function update(s) {
   });
   lineChart($('stress-chart'), series, { xlabel: 'stretch λ', yZero: true, empty: 'no test data yet' });
 
+  drawInvariantFunctions(id);
   updateRig(s.rig);
   updatePipeline(s);
   updateProcesses(s.processes, s.mode);
   updateIdentification(id);
+}
+
+// f(I1) and g(I2) of the identified law (paper Figs. 8 and 14), each over the invariant range
+// its load case reached (uniaxial: I1 = λ² + 2/λ; equibiaxial: I2 = λ⁴ + 2/λ²), once shown.
+function drawInvariantFunctions(id) {
+  const series = [];
+  const curve = (c, top, label, color) => {
+    if (!c || !(top > 3)) return;
+    const x = [], y = [];
+    for (let k = 0; k <= 40; k++) {
+      const inv = 3 + (top - 3) * k / 40;
+      x.push(inv);
+      y.push(Math.exp(c.values.reduce((sum, a, i) => sum + a * Math.pow(inv - 3, i), 0)));
+    }
+    series.push({ x, y, color, label });
+  };
+  const maxStretch = (c) => c && c.stretch.length ? Math.max(...c.stretch) : 1;
+  const lu = maxStretch(id.uniaxial), le = maxStretch(id.equibiaxial);
+  curve(id.f_coefficients, lu * lu + 2 / lu, 'f(I1) against I1', SERIES_COLORS[0]);
+  curve(id.g_coefficients, le ** 4 + 2 / (le * le), 'g(I2) against I2', SERIES_COLORS[1]);
+  lineChart($('fg-chart'), series, { xlabel: 'invariant I1 or I2', yZero: true, empty: 'no coefficient identified yet' });
 }
 
 function updateRig(r) {
