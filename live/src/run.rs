@@ -338,9 +338,11 @@ pub fn run(options: RunOptions) -> Result<RunReport, String> {
             },
             t0_ns,
         )?;
-        let mut state = LoopState::default();
-        state.verbose = options.verbose;
-        state.dashboard = crate::dashboard_view::start(config, &instance_name)?;
+        let mut state = LoopState {
+            dashboard: crate::dashboard_view::start(config, &instance_name)?,
+            verbose: options.verbose,
+            ..LoopState::default()
+        };
         let result = start_children(&mut supervisor, config, &instance_name, &results).and_then(
             |all_ready| match all_ready {
                 false => Ok(Ending::Interrupted),
