@@ -333,6 +333,12 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
         let p = read_page(&browser);
         (p["gauge_points"].as_u64() > restarted["gauge_points"].as_u64()).then_some(())
     });
+    // The monitor attached beside the run went through the restart too.
+    let fields = |addr: &str| get_json(addr, "/snapshot.json")["correlator"]["fields_seen"].clone();
+    let seen = fields(&monitor_addr);
+    until("the monitor's fields growing after the restart", || {
+        (fields(&monitor_addr).as_u64() > seen.as_u64()).then_some(())
+    });
     // The identified law appears (f's coefficients only: the test is uniaxial), on enough
     // points for a meaningful screenshot.
     let coefficients = until("an identification on 40 points on the page", || {
