@@ -59,3 +59,22 @@ pub fn update(
         "restarts": restarts,
     }));
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn off_serves_nothing_and_a_bad_address_is_refused_before_the_run() {
+        let mut config = RunConfig::default();
+        config.run.dashboard = "off".into();
+        config.validate().unwrap();
+        assert!(start(&config, "never_started").unwrap().is_none());
+        config.run.dashboard = "nowhere".into();
+        let refusal = config.validate().unwrap_err();
+        assert!(
+            refusal.starts_with("[run] dashboard address \"nowhere\""),
+            "{refusal}"
+        );
+    }
+}
