@@ -58,9 +58,17 @@ impl Dashboard {
                 .name("dashboard-feed".into())
                 .spawn(move || {
                     let settings = Settings::new(&instance, mode);
-                    feed::feed(&instance, settings, hub, |r| {
+                    let mut started = false;
+                    let fed = feed::feed(&instance, settings, hub, |r| {
+                        started = r.is_ok();
                         let _ = ready_tx.send(r);
-                    })
+                    });
+                    // (An error before it started is returned by `start`.)
+                    if let (Err(e), true) = (&fed, started) {
+                        // Said at once: the page stops updating (a monitor also exits with it).
+                        eprintln!("{e}; the dashboard's page no longer updates");
+                    }
+                    fed
                 })
                 .map_err(|e| format!("dashboard: {e}"))?
         };
