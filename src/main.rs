@@ -28,6 +28,8 @@ enum Command {
     Identify(cmd::identify::IdentifyArgs),
     /// Live identification process: fields + rig/state in, identification reports out.
     Identifier(cmd::identifier::IdentifierArgs),
+    /// Live dashboard in the browser, attached read-only to a running instance.
+    Monitor(cmd::monitor::MonitorArgs),
     /// Camera process: publishes frames (scenario, replay, or following the rig state).
     Producer(cmd::producer::ProducerArgs),
     /// Simulated ASTREE machine: publishes rig/state, answers rig/command, logs rig.csv.
@@ -74,6 +76,7 @@ fn main() -> std::process::ExitCode {
         Command::Correlator(args) => ok(cmd::correlator::run(args)),
         Command::Identify(args) => ok(cmd::identify::run(args)),
         Command::Identifier(args) => ok(cmd::identifier::run(args)),
+        Command::Monitor(args) => ok(cmd::monitor::run(args)),
         Command::Producer(args) => ok(cmd::producer::run(args)),
         Command::Rig(args) => ok(cmd::rig::run(args)),
         Command::Run(args) => cmd::run::run(args),

@@ -38,6 +38,8 @@ pub struct RunSection {
     /// Seconds after which a process that is stopped (SIGSTOP) or publishes nothing while its
     /// input comes is stale: reported, killed and handled like a death.
     pub stale_after_s: f64,
+    /// Address of the live dashboard (ADDR:PORT), or "off".
+    pub dashboard: String,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -124,6 +126,7 @@ impl Default for RunSection {
             status_interval_s: 1.0,
             stop_timeout_s: 5.0,
             stale_after_s: 5.0,
+            dashboard: dashboard::address::DEFAULT.into(),
         }
     }
 }
@@ -330,6 +333,9 @@ impl RunConfig {
                 bail!("[run] {name} = {v}: expected (0, 3600] s");
             }
         }
+        if r.dashboard != "off" {
+            dashboard::address::parse(&r.dashboard).context("[run]")?;
+        }
         let c = &self.camera;
         for (name, side) in [("width_px", c.width_px), ("height_px", c.height_px)] {
             if !(64..=producer::MAX_SIDE_PX).contains(&side) {
@@ -425,6 +431,12 @@ impl RunConfig {
             d.run.status_interval_s,
             d.run.stop_timeout_s,
             d.run.stale_after_s
+        );
+        let _ = writeln!(
+            t,
+            "# The live dashboard (ADDR:PORT, or \"off\"); a non-loopback address serves other\n\
+             # machines too.\ndashboard = {:?}\n",
+            d.run.dashboard
         );
         let c = &d.camera;
         let _ = writeln!(

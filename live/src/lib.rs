@@ -10,6 +10,7 @@
 pub mod acceptance;
 pub mod children;
 pub mod config;
+pub mod dashboard_view;
 pub mod figures;
 pub mod frames;
 pub mod latency;

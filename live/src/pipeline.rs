@@ -118,6 +118,7 @@ pub fn trial(settings: &PipelineSettings, fps: f64) -> anyhow::Result<PipelineRe
         instance: None,
         results: None,
         status: false,
+        verbose: false,
     })?;
     if report.ending != Ending::Completed {
         anyhow::bail!(

@@ -34,6 +34,8 @@ pub struct RunOptions {
     pub results: Option<PathBuf>,
     /// Print the status line (otherwise only the start and the end are printed).
     pub status: bool,
+    /// The long status line (every figure) instead of one that fits 100 columns.
+    pub verbose: bool,
 }
 
 /// How the run ended.
@@ -235,7 +237,11 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
             },
             t0_ns,
         )?;
-        let mut state = LoopState::default();
+        let mut state = LoopState {
+            dashboard: crate::dashboard_view::start(config, &instance_name)?,
+            verbose: options.verbose,
+            ..LoopState::default()
+        };
         let result = start_children(&mut supervisor, config, &instance_name, &results).and_then(
             |all_ready| match all_ready {
                 false => Ok(Ending::Interrupted),
@@ -273,6 +279,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
         crate::children::own_cpu_s() - monitor_cpu_at_start_s,
     );
     drop(supervisor);
+    drop(state.dashboard.take());
     let leftover_shm_files = crate::leftovers::report_and_remove(&instance);
     let (ending, failure) = match result {
         Ok(ending) => (ending, None),
@@ -330,6 +337,8 @@ struct LoopState {
     signal: Option<i32>,
     /// CPU seconds per process (children by role, and this monitor).
     cpu_s: std::collections::BTreeMap<String, f64>,
+    dashboard: Option<dashboard::Dashboard>,
+    verbose: bool,
 }
 
 enum Phase {
@@ -479,6 +488,14 @@ fn event_loop(
 
         if Instant::now() >= next_status {
             supervisor.sample_cpu();
+            crate::dashboard_view::update(
+                &state.dashboard,
+                supervisor,
+                &state.faults,
+                &state.restarts,
+                &state.restart_counts,
+                started,
+            );
             if next_histograms <= Instant::now() {
                 // Kept up to date, so a run killed outright still leaves its latencies (a
                 // write error is reported once at the end, when they are written again).
@@ -488,7 +505,7 @@ fn event_loop(
             if status {
                 println!(
                     "{}",
-                    crate::status::status_line(recorder, started.elapsed().as_secs_f64())
+                    crate::status::line(recorder, started.elapsed().as_secs_f64(), state.verbose)
                 );
             }
             next_status += status_every;

@@ -6,6 +6,7 @@ pub mod correlate;
 pub mod correlator;
 pub mod identifier;
 pub mod identify;
+pub mod monitor;
 pub mod producer;
 pub mod rig;
 pub mod run;

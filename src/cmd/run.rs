@@ -25,6 +25,16 @@ pub struct RunArgs {
     /// No status line (start and end only).
     #[arg(long)]
     pub quiet: bool,
+    /// The long status line (every figure) instead of one that fits 100 columns.
+    #[arg(long)]
+    pub verbose: bool,
+    /// Serve the live dashboard at ADDR:PORT [default: the configuration's `dashboard`,
+    /// 127.0.0.1:8421]; a non-loopback address serves other machines too, with a warning.
+    #[arg(long, conflicts_with = "no_dashboard")]
+    pub dashboard: Option<String>,
+    /// No live dashboard.
+    #[arg(long)]
+    pub no_dashboard: bool,
 }
 
 pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
@@ -42,6 +52,12 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
     };
     let mut config = config;
     config.run.vtk |= args.vtk;
+    if let Some(address) = args.dashboard {
+        config.run.dashboard = address;
+    }
+    if args.no_dashboard {
+        config.run.dashboard = "off".into();
+    }
     config.validate().context("configuration refused")?;
     let exe = std::env::current_exe().context("cannot find the dicstream binary")?;
     let report = live::run(RunOptions {
@@ -50,6 +66,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
         instance: args.instance,
         results: args.out,
         status: !args.quiet,
+        verbose: args.verbose,
     })
     // `run` has exit codes of its own (see live::run::exit_code): one that cannot start
     // fails with 1, whatever the cause in the error's chain (a file it could not write).

@@ -1,0 +1,362 @@
+// dicstream dashboard: receives snapshots over server-sent events (/events) and draws them on
+// canvases by hand (no chart library: a few line and bar charts do not need one). Read-only:
+// the page never sends anything but GET requests.
+'use strict';
+
+// Counters the browser tests read: they must grow while the instance runs.
+const dash = { snapshots: 0, imagesDrawn: 0, chartsDrawn: 0, last: null };
+window.dash = dash;
+
+const $ = (id) => document.getElementById(id);
+const fmt = (v, d = 3) => (v === null || v === undefined || !isFinite(v)) ? '-' : Number(v).toFixed(d);
+const sci = (v) => (v === null || v === undefined || !isFinite(v)) ? '-' : Number(v).toExponential(3);
+const esc = (s) => String(s).replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;' }[c]));
+
+const STATUS_COLORS = ['#00000000', '#ff00ff', '#808080', '#ffffff', '#ff8c00', '#ffff00', '#00ffff'];
+const SERIES_COLORS = ['#d64545', '#2b6cb0', '#2f8132', '#8e44ad', '#c65d07'];
+
+// ---- colour map (jet, as the paper's strain maps) ----
+function jet(t) {
+  t = Math.min(1, Math.max(0, t));
+  const c = (x) => Math.round(255 * Math.min(1, Math.max(0, 1.5 - Math.abs(4 * t - x))));
+  return [c(3), c(2), c(1)];
+}
+
+// ---- charts ----
+function niceTicks(lo, hi, n) {
+  if (!(hi > lo)) { hi = lo + 1; }
+  const raw = (hi - lo) / n;
+  const mag = Math.pow(10, Math.floor(Math.log10(raw)));
+  const step = [1, 2, 5, 10].map((m) => m * mag).find((s) => s >= raw) || raw;
+  const ticks = [];
+  for (let v = Math.ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) ticks.push(v);
+  return ticks;
+}
+
+function tickLabel(v, span) {
+  if (Math.abs(v) < span * 1e-9) return '0';
+  if (span < 0.01 || Math.abs(v) >= 1e4) return v.toExponential(1);
+  const d = Math.max(0, 2 - Math.floor(Math.log10(span)));
+  return v.toFixed(Math.min(d, 4));
+}
+
+// series: [{x: [], y: [], color, label, dots}]
+function lineChart(canvas, series, opts) {
+  const ctx = canvas.getContext('2d');
+  const W = canvas.width, H = canvas.height, L = 58, R = 10, T = 10, B = 30;
+  ctx.clearRect(0, 0, W, H);
+  ctx.font = '11px system-ui, sans-serif';
+  let xs = [], ys = [];
+  for (const s of series) {
+    if (s.noBounds) continue; // drawn clipped to the others' range (a wild early fit)
+    for (let i = 0; i < s.x.length; i++) {
+      if (s.x[i] !== null && s.y[i] !== null && isFinite(s.x[i]) && isFinite(s.y[i])) { xs.push(s.x[i]); ys.push(s.y[i]); }
+    }
+  }
+  ctx.fillStyle = '#52606d';
+  if (xs.length === 0) { ctx.fillText(opts.empty || 'no data yet', L + 10, H / 2); return; }
+  let x0 = Math.min(...xs), x1 = Math.max(...xs), y0 = Math.min(...ys), y1 = Math.max(...ys);
+  if (opts.yZero) { y0 = Math.min(y0, 0); y1 = Math.max(y1, 0); }
+  if (x1 === x0) { x1 = x0 + 1; }
+  if (y1 === y0) { y1 = y0 + (Math.abs(y0) || 1) * 0.1; y0 -= (Math.abs(y0) || 1) * 0.1; }
+  const px = (x) => L + (x - x0) / (x1 - x0) * (W - L - R);
+  const py = (y) => H - B - (y - y0) / (y1 - y0) * (H - T - B);
+  ctx.strokeStyle = '#e4e7eb'; ctx.lineWidth = 1;
+  for (const t of niceTicks(y0, y1, 5)) {
+    ctx.beginPath(); ctx.moveTo(L, py(t)); ctx.lineTo(W - R, py(t)); ctx.stroke();
+    ctx.fillText(tickLabel(t, y1 - y0), 2, py(t) + 4);
+  }
+  for (const t of niceTicks(x0, x1, 6)) {
+    ctx.beginPath(); ctx.moveTo(px(t), T); ctx.lineTo(px(t), H - B); ctx.stroke();
+    ctx.fillText(tickLabel(t, x1 - x0), px(t) - 10, H - B + 13);
+  }
+  ctx.strokeStyle = '#52606d'; ctx.strokeRect(L, T, W - L - R, H - T - B);
+  ctx.fillText(opts.xlabel || '', W / 2 - 30, H - 3);
+  let lx = L + 8;
+  ctx.save();
+  ctx.beginPath(); ctx.rect(L, T, W - L - R, H - T - B); ctx.clip();
+  for (const s of series) {
+    ctx.strokeStyle = s.color; ctx.fillStyle = s.color; ctx.lineWidth = 1.6;
+    if (s.dots) {
+      for (let i = 0; i < s.x.length; i++) {
+        if (s.y[i] === null || !isFinite(s.y[i])) continue;
+        ctx.fillRect(px(s.x[i]) - 1.5, py(s.y[i]) - 1.5, 3, 3);
+      }
+    } else {
+      ctx.beginPath();
+      let pen = false;
+      for (let i = 0; i < s.x.length; i++) {
+        if (s.y[i] === null || !isFinite(s.y[i])) { pen = false; continue; }
+        if (pen) ctx.lineTo(px(s.x[i]), py(s.y[i])); else ctx.moveTo(px(s.x[i]), py(s.y[i]));
+        pen = true;
+      }
+      ctx.stroke();
+    }
+    if (s.label) { ctx.fillRect(lx, T + 6, 10, 3); ctx.fillText(s.label, lx + 13, T + 11); lx += 20 + ctx.measureText(s.label).width; }
+  }
+  ctx.restore();
+  dash.chartsDrawn++;
+}
+
+function barChart(canvas, groups, edges) {
+  const ctx = canvas.getContext('2d');
+  const W = canvas.width, H = canvas.height, L = 40, B = 30, T = 18;
+  ctx.clearRect(0, 0, W, H);
+  ctx.font = '11px system-ui, sans-serif';
+  ctx.fillStyle = '#52606d';
+  const present = groups.filter((g) => g.bins);
+  if (present.length === 0) { ctx.fillText('no latency yet', L, H / 2); return; }
+  const n = edges.length + 1, slot = (W - L - 10) / n, bw = slot / (present.length + 0.5);
+  present.forEach((g, k) => {
+    const total = g.bins.reduce((a, b) => a + b, 0) || 1;
+    const top = Math.max(...g.bins) / total || 1;
+    ctx.fillStyle = g.color;
+    g.bins.forEach((c, i) => {
+      const h = (c / total) / top * (H - T - B);
+      ctx.fillRect(L + i * slot + k * bw, H - B - h, bw - 1, h);
+    });
+    ctx.fillRect(L + 10 + k * 190, 4, 10, 8);
+    ctx.fillText(g.label, L + 24 + k * 190, 12);
+  });
+  ctx.fillStyle = '#52606d';
+  edges.forEach((e, i) => { if (i % 2 === 0) ctx.fillText('≤' + e, L + i * slot, H - B + 13); });
+  ctx.fillText('> ' + edges[edges.length - 1], L + edges.length * slot - 10, H - B + 13);
+  ctx.fillText('latency (ms), share of the samples', W / 2 - 80, H - 3);
+  dash.chartsDrawn++;
+}
+
+// ---- the specimen: image, strain map, mesh ----
+const img = new Image();
+let imgVersion = -1, imgReady = false;
+img.onload = () => { imgReady = true; drawSpecimen(); };
+
+function colourRange(values) {
+  if ($('range-mode').value === 'fixed') {
+    return [parseFloat($('range-min').value), parseFloat($('range-max').value)];
+  }
+  const v = values.filter((x) => x !== null && isFinite(x)).sort((a, b) => a - b);
+  if (v.length === 0) return [0, 1];
+  const lo = v[Math.floor(0.02 * (v.length - 1))], hi = v[Math.ceil(0.98 * (v.length - 1))];
+  return hi > lo ? [lo, hi] : [lo - 1e-4, hi + 1e-4];
+}
+
+function drawColorbar(lo, hi, label) {
+  const c = $('colorbar'), ctx = c.getContext('2d');
+  ctx.clearRect(0, 0, c.width, c.height);
+  const T = 24, B = 14, h = c.height - T - B;
+  for (let i = 0; i < h; i++) {
+    const [r, g, b] = jet(1 - i / h);
+    ctx.fillStyle = `rgb(${r},${g},${b})`;
+    ctx.fillRect(0, T + i, 16, 1);
+  }
+  ctx.fillStyle = '#222'; ctx.font = '11px system-ui, sans-serif';
+  for (let k = 0; k <= 4; k++) {
+    const v = hi - (hi - lo) * k / 4;
+    ctx.fillText(Math.abs(v) < 1e-3 && v !== 0 ? v.toExponential(1) : v.toFixed(4), 19, T + h * k / 4 + 4);
+  }
+  ctx.fillText(label, 0, 10);
+}
+
+function drawSpecimen() {
+  const s = dash.last;
+  const canvas = $('image'), ctx = canvas.getContext('2d');
+  if (!s || !s.image || !imgReady) return;
+  const im = s.image;
+  if (canvas.width !== im.width_px || canvas.height !== im.height_px) {
+    canvas.width = im.width_px; canvas.height = im.height_px;
+  }
+  ctx.drawImage(img, 0, 0);
+  dash.imagesDrawn++;
+  const f = s.field;
+  if (f && f.x.length > 0) {
+    const comp = $('component').value, values = f[comp];
+    const [lo, hi] = colourRange(values);
+    const cell = Math.max(1, f.step_px * f.stride / im.factor);
+    if ($('show-map').checked) {
+      ctx.globalAlpha = 0.55;
+      for (let i = 0; i < f.x.length; i++) {
+        const v = values[i];
+        if (v === null) continue;
+        const [r, g, b] = jet((v - lo) / (hi - lo));
+        ctx.fillStyle = `rgb(${r},${g},${b})`;
+        ctx.fillRect(f.x[i] / im.factor - cell / 2, f.y[i] / im.factor - cell / 2, cell, cell);
+      }
+      ctx.globalAlpha = 1;
+    }
+    for (let i = 0; i < f.x.length; i++) {
+      const x = f.x[i] / im.factor, y = f.y[i] / im.factor;
+      if (f.status[i] !== 0) {
+        // Lost or refused: a cross in the colour of its status.
+        ctx.strokeStyle = STATUS_COLORS[f.status[i]] || '#ff00ff'; ctx.lineWidth = 1.5;
+        ctx.beginPath(); ctx.moveTo(x - 3, y - 3); ctx.lineTo(x + 3, y + 3);
+        ctx.moveTo(x + 3, y - 3); ctx.lineTo(x - 3, y + 3); ctx.stroke();
+      } else if ($('show-mesh').checked) {
+        ctx.fillStyle = '#000'; ctx.fillRect(x - 1, y - 1, 2, 2);
+      }
+    }
+    drawColorbar(lo, hi, `${comp} (${f.measure})`);
+  }
+}
+
+// ---- the snapshot ----
+function setText(id, text) { const e = $(id); if (e.textContent !== String(text)) e.textContent = text; }
+
+function latencyText(l) {
+  return l ? `p50 ${fmt(l.p50, 1)} ms, p90 ${fmt(l.p90, 1)} ms, p99 ${fmt(l.p99, 1)} ms, max ${fmt(l.max, 1)} ms (${l.count})` : '-';
+}
+
+function update(s) {
+  dash.snapshots++;
+  dash.last = s;
+  setText('instance', s.instance);
+  setText('mode', s.mode === 'run' ? 'dicstream run' : 'dicstream monitor');
+  setText('viewers', s.viewers);
+  setText('uptime', `${fmt(s.t_s, 0)} s`);
+
+  // Image and field.
+  if (s.image && s.image.version !== imgVersion) {
+    imgVersion = s.image.version;
+    img.src = `/image.png?v=${imgVersion}`;
+  } else {
+    drawSpecimen();
+  }
+  setText('image-info', s.image
+    ? `frame ${s.image.frame_id}, shown ${s.image.width_px}x${s.image.height_px} px (1/${s.image.factor} of ${s.frames.width_px}x${s.frames.height_px}, ${s.frames.bit_depth} bit)`
+    : (s.image_error || 'no image yet'));
+  const f = s.field;
+  setText('field-info', f ? `field of frame ${f.frame_id}: ${f.valid_nodes}/${f.nodes} nodes ok, ${f.measure} strain, ZOI ${f.zoi_px} px every ${f.step_px} px${f.stride > 1 ? `, every ${f.stride}th node shown` : ''}` : 'no field yet');
+  if (f) {
+    $('status-legend').innerHTML = f.status_counts.filter((c) => c.code !== 0)
+      .map((c) => `<span class="swatch" style="background:${STATUS_COLORS[c.code]}"></span>${esc(c.status)} ${c.count}`).join('') +
+      ' &nbsp;(crosses: nodes lost or refused by the final check)';
+  }
+
+  // Gauge strains.
+  const m = s.gauge.measures[$('measure').value];
+  lineChart($('gauge-chart'), ['exx', 'eyy', 'exy'].map((k, i) => ({ x: s.gauge.t_s, y: m[k], color: SERIES_COLORS[i], label: k })),
+    { xlabel: 'time (s)', yZero: true, empty: 'no field yet' });
+  setText('gauge-points', s.gauge.t_s.length);
+
+  // Stress-stretch.
+  const id = s.identification, series = [];
+  [['uniaxial', 0], ['equibiaxial', 1]].forEach(([k, i]) => {
+    const c = id[k];
+    series.push({ x: c.stretch, y: c.nominal_mpa, color: SERIES_COLORS[i], label: k, dots: true });
+    if (c.fit) series.push({ x: c.fit.stretch, y: c.fit.nominal_mpa, color: SERIES_COLORS[i + 3], label: `fit ${k}`, noBounds: c.stretch.length > 0 });
+  });
+  lineChart($('stress-chart'), series, { xlabel: 'stretch λ', yZero: true, empty: 'no test data yet' });
+
+  drawInvariantFunctions(id);
+  updateRig(s.rig);
+  updatePipeline(s);
+  updateProcesses(s.processes, s.mode);
+  updateIdentification(id);
+}
+
+// f(I1) and g(I2) of the identified law (paper Figs. 8 and 14), each over the invariant range
+// its load case reached (uniaxial: I1 = λ² + 2/λ; equibiaxial: I2 = λ⁴ + 2/λ²), once shown.
+function drawInvariantFunctions(id) {
+  const series = [];
+  const curve = (c, top, label, color) => {
+    if (!c || !(top > 3)) return;
+    const x = [], y = [];
+    for (let k = 0; k <= 40; k++) {
+      const inv = 3 + (top - 3) * k / 40;
+      x.push(inv);
+      y.push(Math.exp(c.values.reduce((sum, a, i) => sum + a * Math.pow(inv - 3, i), 0)));
+    }
+    series.push({ x, y, color, label });
+  };
+  const maxStretch = (c) => c && c.stretch.length ? Math.max(...c.stretch) : 1;
+  const lu = maxStretch(id.uniaxial), le = maxStretch(id.equibiaxial);
+  curve(id.f_coefficients, lu * lu + 2 / lu, 'f(I1) against I1', SERIES_COLORS[0]);
+  curve(id.g_coefficients, le ** 4 + 2 / (le * le), 'g(I2) against I2', SERIES_COLORS[1]);
+  lineChart($('fg-chart'), series, { xlabel: 'invariant I1 or I2', yZero: true, empty: 'no coefficient identified yet' });
+}
+
+function updateRig(r) {
+  const body = $('actuators').tBodies[0];
+  if (!r) { setText('rig-info', 'no rig sample yet'); return; }
+  setText('rig-info', `t_sim ${fmt(r.t_sim_s, 2)} s, ${r.rate_hz.toFixed(0)} samples/s`);
+  body.innerHTML = r.actuators.map((a) => `<tr><td class="text">${esc(a.name)}</td><td class="text">${esc(a.mode)}</td>` +
+    `<td>${fmt(a.position_mm, 3)}</td><td>${fmt(a.command, 3)} ${a.unit}</td><td>${fmt(a.error, 4)} ${a.unit}</td>` +
+    `<td>${fmt(a.force_kn, 4)}</td><td class="text ${a.limits.length ? 'bad' : ''}">${a.limits.length ? esc(a.limits.join(', ')) : 'none'}</td></tr>`).join('');
+  const drift = r.axis_centre_mm.map((c) => fmt(c, 3)).join(' / ');
+  $('rig-more').innerHTML = `program <b id="rig-program">${esc(r.program)}</b>, test ${r.test_index} (${esc(r.load_case)}), ` +
+    `hydraulics <b class="${r.hydraulics_on ? 'good' : 'bad'}">${r.hydraulics_on ? 'on' : 'off'}</b>, ` +
+    `limits <b class="${r.limits_tripped ? 'bad' : 'good'}">${r.limits_tripped ? 'TRIPPED' : 'none tripped'}</b>; ` +
+    `stretch ${fmt(r.stretch[0], 4)} x ${fmt(r.stretch[1], 4)}, rotation ${fmt(r.rotation_deg, 3)}°, ` +
+    `centre drift X/Y/Z ${drift} mm, specimen offset ${fmt(r.centre_offset_mm[0], 3)}, ${fmt(r.centre_offset_mm[1], 3)} mm`;
+  const h = r.history;
+  lineChart($('rig-chart'), [
+    { x: h.t_sim_s, y: h.stretch_x, color: SERIES_COLORS[0], label: 'λx' },
+    { x: h.t_sim_s, y: h.stretch_y, color: SERIES_COLORS[1], label: 'λy' },
+  ], { xlabel: 'simulated time (s)' });
+}
+
+function updatePipeline(s) {
+  setText('frames-seen', s.frames.seen);
+  setText('frame-id', s.frames.last_id ?? '-');
+  setText('frame-rate', `${fmt(s.frames.rate_hz, 1)} /s`);
+  const c = s.correlator;
+  setText('fields-seen', c.fields_seen);
+  setText('field-rate', `${fmt(c.rate_hz, 1)} /s`);
+  setText('correlate-ms', c.correlate_ms === null ? '-' : `${fmt(c.correlate_ms, 1)} ms`);
+  setText('skipped', c.frames_skipped ?? '-');
+  setText('missed', s.frames.missed_by_dashboard);
+  setText('lat-field', latencyText(c.latency_ms));
+  setText('lat-ident', latencyText(s.identification.latency_ms));
+  setText('restarts-seen', `camera ${s.frames.camera_restarts_seen}, correlator ${c.restarts_seen}, rig ${s.rig ? s.rig.restarts_seen : 0} (ids going back)`);
+  const edges = (c.latency_ms || s.identification.latency_ms || { bin_edges_ms: [] }).bin_edges_ms;
+  barChart($('latency-chart'), [
+    { label: 'capture → field', bins: c.latency_ms && c.latency_ms.bins, color: SERIES_COLORS[1] },
+    { label: 'capture → identification', bins: s.identification.latency_ms && s.identification.latency_ms.bins, color: SERIES_COLORS[4] },
+  ], edges);
+}
+
+function updateProcesses(p, mode) {
+  const el = $('processes');
+  if (!p || !p.roles) {
+    el.innerHTML = mode === 'monitor'
+      ? '<p class="small">Attached with <code>dicstream monitor</code>: this dashboard sees the services only. CPU per process, deaths and restarts with their reason are known to <code>dicstream run</code> and shown on its own dashboard; here a restart shows as ids going back (Pipeline).</p>'
+      : '<p class="small">no process report yet</p>';
+    return;
+  }
+  const rows = p.roles.map((r) => `<tr><td class="text">${esc(r.role)}</td><td>${r.pid ?? '-'}</td>` +
+    `<td class="text ${r.alive ? 'good' : 'bad'}">${r.alive ? 'running' : 'not running'}</td><td>${fmt(r.cpu_s, 1)}</td>` +
+    `<td>${fmt(100 * r.cpu_share, 0)} %</td><td id="restarts-${esc(r.role)}">${r.restarts}</td></tr>`).join('');
+  const list = (items, empty) => items.length ? `<ul>${items.map((x) => `<li>${esc(x)}</li>`).join('')}</ul>` : `<p class="small">${empty}</p>`;
+  el.innerHTML = `<table><thead><tr><th class="text">process</th><th>pid</th><th class="text">state</th><th>CPU s</th><th>CPU (one core)</th><th>restarts</th></tr></thead><tbody>${rows}</tbody></table>` +
+    `<h3 class="small">deaths and stale processes (<span id="fault-count">${p.faults.length}</span>)</h3>${list(p.faults, 'none')}` +
+    `<h3 class="small">restarts (<span id="restart-count">${p.restarts.length}</span>)</h3>${list(p.restarts, 'none')}`;
+}
+
+function updateIdentification(id) {
+  if (!id.reports) { setText('ident-info', 'no identification yet'); $('coefficients').innerHTML = ''; return; }
+  setText('ident-info', `${id.reports} reports, last at frame ${id.frame_id}; points uniaxial ${id.points.uniaxial}, equibiaxial ${id.points.equibiaxial}, pure shear ${id.points.pure_shear}`);
+  const table = (name, law, c, waiting) => {
+    if (!c) return `<p class="small">${name}: <i>${waiting}</i></p>`;
+    const cells = c.values.map((v, i) => `<tr><td class="text">${law}<sub>${i}</sub></td><td>${sci(v)}</td><td>± ${sci(c.sigma[i])}</td></tr>`).join('');
+    return `<table class="coef"><thead><tr><th class="text">${name}</th><th>value</th><th>σ</th></tr></thead><tbody>${cells}</tbody></table>`;
+  };
+  $('coefficients').innerHTML = `<div style="display:flex;gap:24px">` +
+    table('f(I1) = exp Σ a_i (I1 − 3)^i', 'a', id.f_coefficients, 'waiting for uniaxial data') +
+    table('g(I2) = exp Σ b_i (I2 − 3)^i', 'b', id.g_coefficients, 'waiting for equibiaxial data') +
+    `</div><p class="small">Lambert-Diani-Rey fit, RMS ${fmt(id.rms_mpa, 4)} MPa</p>`;
+  $('ranking').tBodies[0].innerHTML = id.ranking.map((m, i) => `<tr><td>${i + 1}</td><td class="text">${esc(m.name)}</td><td>${fmt(m.aic, 1)}</td><td>${fmt(m.rms_mpa, 4)}</td></tr>`).join('');
+}
+
+// ---- connection ----
+function connect() {
+  const es = new EventSource('/events');
+  es.onopen = () => { $('conn').textContent = 'live'; $('conn').className = 'good'; };
+  es.onerror = () => { $('conn').textContent = 'reconnecting'; $('conn').className = 'bad'; };
+  es.addEventListener('snapshot', (e) => {
+    try { update(JSON.parse(e.data)); } catch (err) { console.error(err); }
+  });
+}
+for (const id of ['component', 'range-mode', 'range-min', 'range-max', 'show-mesh', 'show-map']) {
+  $(id).addEventListener('change', drawSpecimen);
+}
+$('measure').addEventListener('change', () => dash.last && update(dash.last));
+connect();

@@ -1,0 +1,83 @@
+//! `dicstream run`'s dashboard: the `dashboard` crate attached to the run's instance (its own
+//! node and thread, in this process, never in a child), plus what only the run knows: each
+//! process's pid, CPU time and restarts, and the deaths with their reason.
+
+use crate::children::{Role, Supervisor};
+use crate::config::RunConfig;
+use dashboard::{address, Dashboard, Mode};
+use serde_json::json;
+use std::time::Instant;
+
+/// Starts the dashboard unless `[run] dashboard = "off"`, printing its URL.
+pub fn start(
+    config: &RunConfig,
+    instance: &str,
+) -> Result<Option<Dashboard>, dashboard::DashboardError> {
+    let text = config.run.dashboard.as_str();
+    if text == "off" {
+        return Ok(None);
+    }
+    let addr = address::parse(text)?;
+    if let Some(warning) = address::exposure_warning(&addr) {
+        eprintln!("run: {warning}");
+    }
+    // The default port moves to the next free one (another run has it); a chosen one does not.
+    let dashboard = Dashboard::start(instance, Mode::Run, addr, text == address::DEFAULT)?;
+    eprintln!("run: dashboard at {} (read-only)", dashboard.url());
+    Ok(Some(dashboard))
+}
+
+/// Hands the processes' state to the page (pid, running, CPU, restarts; deaths and restarts
+/// with their reason, as the run noted them).
+pub fn update(
+    dashboard: &Option<Dashboard>,
+    supervisor: &Supervisor,
+    faults: &[String],
+    restarts: &[String],
+    restart_counts: &[u32; 4],
+    started: Instant,
+) {
+    let Some(dashboard) = dashboard else {
+        return;
+    };
+    let wall_s = started.elapsed().as_secs_f64().max(1e-9);
+    let roles: Vec<_> = Role::ALL
+        .iter()
+        .map(|&role| {
+            let cpu_s = supervisor.cpu_seconds(role);
+            json!({
+                "role": role.name(),
+                "pid": supervisor.pid(role),
+                "alive": supervisor.is_running(role),
+                "cpu_s": cpu_s,
+                "cpu_share": cpu_s / wall_s,
+                "restarts": restart_counts[role as usize],
+            })
+        })
+        .collect();
+    dashboard.set_processes(json!({
+        "wall_s": wall_s,
+        "roles": roles,
+        "faults": faults,
+        "restarts": restarts,
+    }));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn off_serves_nothing_and_a_bad_address_is_refused_before_the_run() {
+        let mut config = RunConfig::default();
+        config.run.dashboard = "off".into();
+        config.validate().unwrap();
+        assert!(start(&config, "never_started").unwrap().is_none());
+        config.run.dashboard = "nowhere".into();
+        let refusal = config.validate().unwrap_err();
+        assert!(
+            format!("{refusal:#}").starts_with("[run]: dashboard address \"nowhere\""),
+            "{refusal}"
+        );
+    }
+}
