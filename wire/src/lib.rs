@@ -21,6 +21,7 @@ pub mod rig;
 pub mod services;
 pub mod shm;
 pub mod signals;
+pub mod stats;
 pub mod text;
 
 pub use clock::monotonic_ns;
