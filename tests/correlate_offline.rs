@@ -3,9 +3,9 @@
 //! images of different sizes, non-power-of-two ZOI, step 0, ZOI larger than the ROI, a flat
 //! image), each a clear message or a per-node status, never a crash or a NaN.
 
-mod harness;
+mod common;
 
-use harness::{render, translation, unrelated_speckle};
+use common::camera::{render, translation, unrelated_speckle};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

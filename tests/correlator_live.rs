@@ -4,9 +4,11 @@
 //! queued, bad frames logged and skipped, signals, --reference, --max-frames, restart after
 //! SIGKILL with --state-dir.
 
-mod harness;
+mod common;
 
-use harness::{affine, number_after, render, translation, unrelated_speckle, Bench, FieldCopy};
+use common::camera::{
+    affine, final_line, number_after, render, translation, unrelated_speckle, Bench, FieldCopy,
+};
 use wire::{FrameHeader, NodeStatus, StrainMeasure};
 
 const W: usize = 256;
@@ -85,10 +87,10 @@ fn live_translation_matches_the_truth() {
         }
     }
     let proc = bench.proc(p);
-    proc.signal("INT");
+    proc.signal(libc::SIGINT);
     let status = proc.wait_exit();
     assert!(status.success(), "exit status {status:?}");
-    let last = proc.final_line();
+    let last = final_line(proc);
     assert!(last.contains("stopped (SIGINT)"), "{last}");
     assert_eq!(number_after(&last, "correlated"), 6, "{last}");
     assert_eq!(number_after(&last, "dropped"), 0, "{last}");
@@ -187,7 +189,7 @@ fn stretch_against_a_reference_file() {
     let proc = bench.proc(p);
     let status = proc.wait_exit();
     assert!(status.success(), "{status:?}");
-    let last = proc.final_line();
+    let last = final_line(proc);
     assert!(last.contains("--max-frames"), "{last}");
     bench.finish();
 }
@@ -239,9 +241,9 @@ fn a_burst_is_dropped_and_counted_never_queued() {
         "some frames must have been dropped"
     );
     let proc = bench.proc(p);
-    proc.signal("TERM");
+    proc.signal(libc::SIGTERM);
     assert!(proc.wait_exit().success());
-    let last = proc.final_line();
+    let last = final_line(proc);
     let received = number_after(&last, "frames in");
     let correlated = number_after(&last, "correlated");
     let dropped_total = number_after(&last, "dropped");
@@ -353,9 +355,9 @@ fn bad_frames_are_logged_and_skipped() {
     let [(mu, _), (mv, _)] = field.error_stats(&truth);
     assert!(mu.abs() < 0.01 && mv.abs() < 0.01);
     let proc = bench.proc(p);
-    proc.signal("TERM");
+    proc.signal(libc::SIGTERM);
     assert!(proc.wait_exit().success());
-    let last = proc.final_line();
+    let last = final_line(proc);
     assert_eq!(number_after(&last, "rejected"), 5, "{last}");
     assert_eq!(number_after(&last, "correlated"), 4, "{last}");
     bench.finish();
@@ -369,7 +371,7 @@ fn idle_timeout_ends_the_process() {
     let proc = bench.proc(p);
     proc.wait_line("correlator: ready");
     assert!(proc.wait_exit().success());
-    let last = proc.final_line();
+    let last = final_line(proc);
     assert!(last.contains("idle timeout"), "{last}");
     assert_eq!(number_after(&last, "frames in"), 0, "{last}");
     bench.finish();

@@ -2,9 +2,9 @@
 //! the same reference and keeps measuring the same total displacement; it loses only the frames
 //! it missed. Compared with an uninterrupted correlator fed the same frames (another instance).
 
-mod harness;
+mod common;
 
-use harness::{render, translation, Bench, FieldCopy};
+use common::camera::{final_line, render, translation, Bench, FieldCopy};
 use wire::NodeStatus;
 
 const W: usize = 256;
@@ -87,7 +87,7 @@ fn restart_resumes(mode: &str, test: &str) {
         summary.contains(&format!("\"reference_frame_id\": {expected_reference},")),
         "{summary}"
     );
-    bench.proc(first).signal("KILL");
+    bench.proc(first).signal(libc::SIGKILL);
     let status = bench.proc(first).wait_exit();
     assert!(!status.success(), "SIGKILL: {status:?}");
     // Frame 4 is sent while no correlator runs: the only frame this run loses (it may still
@@ -145,11 +145,11 @@ fn restart_resumes(mode: &str, test: &str) {
         );
     }
     assert_eq!(resumed[0].header.reference_frame_id, expected_reference);
-    plain.proc(p).signal("TERM");
+    plain.proc(p).signal(libc::SIGTERM);
     assert!(plain.proc(p).wait_exit().success());
-    bench.proc(second).signal("TERM");
+    bench.proc(second).signal(libc::SIGTERM);
     assert!(bench.proc(second).wait_exit().success());
-    let last = bench.proc(second).final_line();
+    let last = final_line(bench.proc(second));
     assert!(last.contains("correlated 2"), "{last}");
     plain.finish();
     bench.finish();

@@ -1,22 +1,25 @@
-//! The correlator: mesh, reference cache, worker pool, guesses, reference modes, strains.
+//! The correlator: mesh, reference cache, worker pool, the assembly of a field (final
+//! corrections, consistency, strains). The first pass's guesses are in `guess.rs`, the rescue
+//! of failed nodes in `growth.rs`, IC-GN in `icgn_stage.rs`, the followed mesh at a reference
+//! update in `followed.rs`, measurements against the origin in `reanchor.rs`.
 
+mod followed;
 mod growth;
+mod guess;
 mod icgn_stage;
 mod reanchor;
 
 use crate::field::{Field, Node, NodeStatus};
-use crate::global::{GlobalCorrelator, GlobalMiss};
+use crate::global::GlobalCorrelator;
 use crate::icgn::bspline::Coefficients;
 use crate::icgn::subset::SubsetStats;
 use crate::interpolate::{identity_plus, Mat2};
 use crate::keypoints::{KeypointMatcher, KeypointSet};
 use crate::mesh::Mesh;
 use crate::pool::{Pool, SharedSlice};
-use crate::settings::{CorrelatorSettings, GuessMode, ReferenceMode, Roi, SettingsError};
+use crate::settings::{CorrelatorSettings, GuessMode, Roi, SettingsError};
 use crate::strain::{gauge, node_strains_and_gradients, strains_from_gradients, AffineSums};
-use crate::zoi::{
-    spectrum_len, GradientSensitivity, Image, ReferenceSpectra, TimeSplit, ZoiResult,
-};
+use crate::zoi::{spectrum_len, GradientSensitivity, Image, TimeSplit, ZoiResult};
 use rustfft::num_complex::Complex32;
 
 /// Per-node state of the current reference image.
@@ -491,22 +494,6 @@ impl Correlator {
         Ok(())
     }
 
-    /// Least-squares gradient of the bases of the nodes around k (3x3), zero when none.
-    fn base_fit_gradient(&self, k: usize) -> Mat2 {
-        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
-        let (i, j) = (k % nx, k / nx);
-        let mut sums = AffineSums::default();
-        for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
-            for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
-                let m = jj * nx + ii;
-                let (a, b) = (&self.field.nodes[m], &self.field.nodes[k]);
-                let base = self.ref_nodes[m].base_px;
-                sums.add(a.x_px - b.x_px, a.y_px - b.y_px, base.0, base.1);
-            }
-        }
-        sums.gradient().map_or([[0.0; 2]; 2], to_mat2)
-    }
-
     /// Copies the pixels as the current reference and prepares the spectra (and IC-GN subsets)
     /// of every node at its followed position (`ref_nodes[k].base_px` must be set).
     /// `coefficients_hold_pixels`: the B-spline coefficients are already those of `pixels`
@@ -597,192 +584,6 @@ impl Correlator {
         self.assemble(image);
         self.update_reference(pixels);
         Ok(&self.field)
-    }
-
-    fn run_zois(&mut self, image: Image) {
-        let (n, pad) = (self.fft_px, self.fft_pad_px);
-        let n2 = spectrum_len(n);
-        let max_iterations = self.settings.max_iterations;
-        let use_previous = self.settings.guess != GuessMode::Correli && self.has_previous;
-        let whole_mesh = if use_previous && self.previous.iter().any(|p| p.is_none()) {
-            self.affine_fit_around(None, 0)
-        } else {
-            None
-        };
-        for k in 0..self.guesses.len() {
-            let base = self.ref_nodes[k].base_px;
-            // A node without a previous value (it failed or was outside the image) starts from
-            // what the affine fit of its neighbours' previous values extrapolates to it: the
-            // global (U0, V0) can be far from it (a stretch about the centre has U0 = 0 while
-            // its border moves by pixels), and so can a plain neighbour mean at a border, and
-            // either would make it correlate another area.
-            let previous = match (use_previous, self.previous[k]) {
-                (false, _) => None,
-                // A node moving steadily (a ramp) is where its last step takes it: the last
-                // value plus the last change (at a reversal this overshoots by one step, which
-                // the integer search takes back).
-                (true, Some(p)) => Some(match self.previous2[k] {
-                    Some(q) => (2.0 * p.0 - q.0, 2.0 * p.1 - q.1),
-                    None => p,
-                }),
-                (true, None) => self
-                    .affine_fit_around(Some(k), EXTRAPOLATION_RINGS)
-                    .or(whole_mesh)
-                    .map(|fit| self.extrapolate(k, fit)),
-            };
-            // NaN: no prediction, the node starts from the global (U0, V0).
-            self.guesses[k] =
-                previous.map_or((f64::NAN, f64::NAN), |p| (p.0 - base.0, p.1 - base.1));
-        }
-        // The global correlation (two FFTs of up to 512², and one more of the reference after
-        // each reference update) runs only when some node has no prediction: on a followed
-        // mesh the predictions usually cover every node.
-        let needs_global = !use_previous || self.guesses.iter().any(|g| g.0.is_nan());
-        let global = if needs_global {
-            if self.global_reference_stale {
-                self.global.set_reference(Image {
-                    pixels: &self.reference_pixels,
-                    width_px: self.width_px,
-                    height_px: self.height_px,
-                });
-                self.global_reference_stale = false;
-            }
-            match self.global.displacement(image) {
-                Ok(peak) => Some(peak.displacement_px),
-                // Nothing to match: the ZOIs will say where the texture is missing.
-                Err(GlobalMiss::Flat) => Some((0, 0)),
-                Err(GlobalMiss::NotSignificant) => None,
-            }
-        } else {
-            None
-        };
-        self.field.global_px = global;
-        // Without a significant peak the nodes keep no guess (NaN: `no_guess`), never a
-        // wrong one.
-        if let Some((u0, v0)) = global {
-            for guess in self.guesses.iter_mut().filter(|g| g.0.is_nan()) {
-                *guess = (u0 as f64, v0 as f64);
-            }
-        }
-        let plain = &self.plain_spectra;
-        let windowed = &self.windowed_references;
-        let ref_nodes = &self.ref_nodes;
-        let guesses = &self.guesses;
-        // IC-GN with the previous field: the FFT ZOI is sampled through the node's last
-        // gradient.
-        let no_warps = [None];
-        let warps: &[Option<Mat2>] = if use_previous {
-            &self.previous_gradient
-        } else {
-            &no_warps
-        };
-        let results = SharedSlice::new(&mut self.results);
-        let correlate_node = |engine: &mut crate::zoi::ZoiEngine, k: usize, guess: (f64, f64)| {
-            let r = ref_nodes[k];
-            let result = if r.status != NodeStatus::Ok {
-                ZoiResult {
-                    status: r.status,
-                    ..ZoiResult::default()
-                }
-            } else {
-                let spectra = ReferenceSpectra {
-                    plain: &plain[k * n2..(k + 1) * n2],
-                    windowed: &windowed[k * n * n..(k + 1) * n * n],
-                };
-                engine.correlate(
-                    &spectra,
-                    image,
-                    r.top_left.0 + pad,
-                    r.top_left.1 + pad,
-                    guess,
-                    warps.get(k).copied().flatten(),
-                    max_iterations,
-                )
-            };
-            // SAFETY: each node is written by exactly one item of the job, and only when the
-            // new result is better than what is there (the first pass writes every node).
-            let better = |old: &ZoiResult| {
-                old.status != NodeStatus::Ok
-                    || (result.status == NodeStatus::Ok && result.score > old.score)
-            };
-            if unsafe { better(&results.read(k)) } {
-                unsafe { results.write(k, result) };
-            }
-        };
-        // SAFETY: single-threaded here; the pool is not running.
-        for k in 0..self.mesh.len() {
-            unsafe { results.write(k, ZoiResult::default()) };
-        }
-        if self.settings.guess != GuessMode::Predict || use_previous {
-            self.pool.run(self.mesh.len(), &|engine, k| {
-                correlate_node(engine, k, guesses[k])
-            });
-            if use_previous {
-                // A node the velocity guess failed (at a load reversal the guess overshoots by
-                // twice the last step) gets a second try from its last position.
-                // SAFETY (both closures): the pool is not running.
-                let min_score = self.settings.min_relative_score
-                    * median_ok_score(
-                        (0..self.mesh.len()).map(|k| unsafe { results.read(k) }),
-                        &mut self.scores,
-                    );
-                let retry = &mut self.retry;
-                retry.clear();
-                for k in 0..self.mesh.len() {
-                    // SAFETY: the pool is not running.
-                    let result = unsafe { results.read(k) };
-                    // Outside the image too: an overshooting guess can push a border ZOI out.
-                    let failed = result.status != NodeStatus::Ok || result.score < min_score;
-                    if failed && self.previous[k].is_some() && self.previous2[k].is_some() {
-                        retry.push(k);
-                    }
-                }
-                let (previous, retry) = (&self.previous, &self.retry);
-                self.pool.run(retry.len(), &|engine, i| {
-                    let k = retry[i];
-                    let p = previous[k].expect("retried nodes have a previous value");
-                    let base = ref_nodes[k].base_px;
-                    correlate_node(engine, k, (p.0 - base.0, p.1 - base.1));
-                });
-            }
-            return;
-        }
-        // Predict without a previous field: grow from the centre node, ring by ring; each node
-        // starts from the mean of its converged neighbours of inner rings.
-        let mesh = &self.mesh;
-        for ring in 0..mesh.rings() {
-            let members = &mesh.ring_order[mesh.ring_starts[ring]..mesh.ring_starts[ring + 1]];
-            self.pool.run(members.len(), &|engine, item| {
-                let k = members[item];
-                let (i, j) = ((k % mesh.nx) as i64, (k / mesh.nx) as i64);
-                let (mut su, mut sv, mut count) = (0.0, 0.0, 0.0);
-                for dj in -1..=1i64 {
-                    for di in -1..=1i64 {
-                        let (ii, jj) = (i + di, j + dj);
-                        if ii < 0 || jj < 0 || ii >= mesh.nx as i64 || jj >= mesh.ny as i64 {
-                            continue;
-                        }
-                        let nb = jj as usize * mesh.nx + ii as usize;
-                        if mesh.ring_of[nb] >= ring {
-                            continue;
-                        }
-                        // SAFETY: inner rings were finished by earlier jobs; this job writes only this ring.
-                        let result = unsafe { results.read(nb) };
-                        if result.status == NodeStatus::Ok {
-                            su += result.u_px;
-                            sv += result.v_px;
-                            count += 1.0;
-                        }
-                    }
-                }
-                let guess = if count > 0.0 {
-                    (su / count, sv / count)
-                } else {
-                    guesses[k]
-                };
-                correlate_node(engine, k, guess);
-            });
-        }
     }
 
     /// Results (against the current reference, at the ZOI centres) to total displacements at
@@ -950,162 +751,6 @@ impl Correlator {
             &self.ref_nodes,
             (self.mesh.nx, self.mesh.ny),
             k,
-        )
-    }
-
-    fn update_reference(&mut self, pixels: &[u16]) {
-        self.frames_since_reference += 1;
-        self.field.reference_updated = false;
-        let replace = match self.settings.reference {
-            ReferenceMode::Fixed => false,
-            ReferenceMode::Incremental => true,
-            ReferenceMode::Auto {
-                max_displacement_zoi_fraction,
-                min_mean_score,
-            } => {
-                let limit = max_displacement_zoi_fraction * self.settings.zoi_px as f64;
-                let (mut largest, mut score_sum, mut count) = (0.0f64, 0.0, 0.0);
-                for (k, result) in self.results.iter().enumerate() {
-                    if result.status == NodeStatus::Ok {
-                        let _ = k;
-                        largest = largest.max(result.u_px.abs()).max(result.v_px.abs());
-                        score_sum += result.score;
-                        count += 1.0;
-                    }
-                }
-                count > 0.0 && (largest > limit || score_sum / count < min_mean_score)
-            }
-        };
-        if !replace || self.field.valid == 0 {
-            return;
-        }
-        // New base = total displacement. A node that failed (typically one whose followed point
-        // left the image) gets the displacement the affine fit of its valid neighbours
-        // extrapolates to it: its followed point keeps moving with the material, so it stays
-        // outside while the material is outside and comes back where that material is. A
-        // neighbour mean would pull it back inside the image onto another material point,
-        // which then correlates as a false "ok". The fit uses the never-lost nodes (within
-        // CARRY_RINGS, else the whole mesh): nodes that came back carry their extrapolation
-        // error, and fitting the next ones on them would compound it ring by ring as material
-        // returns (unloading from a large stretch).
-        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
-        let whole_mesh = self.affine_fit(None, 0, None, Support::NeverLost);
-        let whole_mesh_valid = self.affine_fit_around(None, 0);
-        for k in 0..nx * ny {
-            let node = self.field.nodes[k];
-            self.scratch_pairs[k] = if node.status == NodeStatus::Ok {
-                (node.u_px, node.v_px)
-            } else {
-                self.affine_fit(Some(k), CARRY_RINGS, None, Support::NeverLost)
-                    .or(whole_mesh)
-                    .or_else(|| self.affine_fit_around(Some(k), EXTRAPOLATION_RINGS))
-                    .or(whole_mesh_valid)
-                    .map_or((self.field.u_mean_px, self.field.v_mean_px), |fit| {
-                        self.extrapolate(k, fit)
-                    })
-            };
-        }
-        self.bases_from_origin(Image {
-            pixels,
-            width_px: self.width_px,
-            height_px: self.height_px,
-        });
-        for (r, &base) in self.ref_nodes.iter_mut().zip(&self.scratch_pairs) {
-            r.base_px = base;
-        }
-        for k in 0..nx * ny {
-            self.ref_nodes[k].base_gradient = if self.field.nodes[k].status == NodeStatus::Ok {
-                self.field.gradients[k]
-            } else {
-                self.base_fit_gradient(k)
-            };
-        }
-        self.take_reference(pixels, self.settings.method.is_icgn());
-        self.reference_is_origin = false;
-        self.field.reference_updated = true;
-    }
-
-    /// Least-squares affine fit of the total displacement of the valid nodes within `rings`
-    /// of node `centre` (all valid nodes when `centre` is None): the origin of the fit, (u, v)
-    /// there, and ∇u; None with fewer than [`MIN_EXTRAPOLATION_NODES`] valid nodes or collinear.
-    fn affine_fit_around(&self, centre: Option<usize>, rings: usize) -> Option<AffineFit> {
-        self.affine_fit(centre, rings, None, Support::Valid)
-    }
-
-    /// [`Self::affine_fit_around`] over the nodes of `support`, leaving node `exclude` out.
-    fn affine_fit(
-        &self,
-        centre: Option<usize>,
-        rings: usize,
-        exclude: Option<usize>,
-        support: Support,
-    ) -> Option<AffineFit> {
-        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
-        let (i_range, j_range, origin) = match centre {
-            Some(k) => {
-                let (i, j) = (k % nx, k / nx);
-                let node = &self.field.nodes[k];
-                (
-                    i.saturating_sub(rings)..=(i + rings).min(nx - 1),
-                    j.saturating_sub(rings)..=(j + rings).min(ny - 1),
-                    (node.x_px, node.y_px),
-                )
-            }
-            None => (
-                0..=nx - 1,
-                0..=ny - 1,
-                (
-                    0.5 * (self.field.nodes[0].x_px + self.field.nodes[nx * ny - 1].x_px),
-                    0.5 * (self.field.nodes[0].y_px + self.field.nodes[nx * ny - 1].y_px),
-                ),
-            ),
-        };
-        let mut sums = AffineSums::default();
-        let mut count = 0;
-        for j in j_range {
-            for i in i_range.clone() {
-                let m = j * nx + i;
-                let node = &self.field.nodes[m];
-                let supported = match support {
-                    Support::Valid => true,
-                    Support::NeverLost => self.never_lost[m],
-                };
-                if node.status == NodeStatus::Ok && supported && exclude != Some(m) {
-                    sums.add(
-                        node.x_px - origin.0,
-                        node.y_px - origin.1,
-                        node.u_px,
-                        node.v_px,
-                    );
-                    count += 1;
-                }
-            }
-        }
-        if count < MIN_EXTRAPOLATION_NODES {
-            return None;
-        }
-        sums.fit().map(|(at_origin_px, gradient)| AffineFit {
-            origin_px: origin,
-            at_origin_px,
-            gradient,
-        })
-    }
-
-    /// The displacement an affine fit (from [`Self::affine_fit_around`]) gives at node k.
-    fn extrapolate(
-        &self,
-        k: usize,
-        AffineFit {
-            origin_px: origin,
-            at_origin_px: (u0, v0),
-            gradient: g,
-        }: AffineFit,
-    ) -> (f64, f64) {
-        let node = &self.field.nodes[k];
-        let (dx, dy) = (node.x_px - origin.0, node.y_px - origin.1);
-        (
-            u0 + g[(0, 0)] * dx + g[(0, 1)] * dy,
-            v0 + g[(1, 0)] * dx + g[(1, 1)] * dy,
         )
     }
 

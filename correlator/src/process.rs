@@ -21,11 +21,11 @@
 use crate::settings::{CorrelatorSettings, StrainMeasure};
 use crate::state::{ReferenceIds, SavedReference, StateDir, REFERENCE_FROM_FILE};
 use crate::{Correlator, Field, NodeStatus};
-use hdrhistogram::Histogram;
 use iceoryx2::prelude::*;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use wire::pubsub::{SlicePublisher, SliceSubscriber};
+use wire::stats::{Durations, IdGaps, IdStep};
 use wire::{services, FieldHeader, FieldNode, FrameHeader, GaugeStrain, Instance};
 
 /// Why the correlator process could not start or stopped. A state file that could not be
@@ -307,8 +307,8 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
         }
     }
     let mut summary = live.summary.clone();
-    summary.correlate_p50_ms = live.run_hist.value_at_quantile(0.5) as f64 / 1e6;
-    summary.correlate_p99_ms = live.run_hist.value_at_quantile(0.99) as f64 / 1e6;
+    summary.correlate_p50_ms = live.run_hist.median_ms();
+    summary.correlate_p99_ms = live.run_hist.quantile_ms(0.99);
     summary.state_saves = state.as_ref().map_or(0, |s| s.saves);
     Ok(summary)
 }
@@ -326,18 +326,15 @@ struct Live {
     /// (None for a reference image file: it holds for every sequence).
     origin_frame_id: u64,
     sequence_id: Option<u32>,
-    last_frame_id: Option<u64>,
+    /// Frame ids received: gaps are lost frames.
+    frame_ids: IdGaps,
     summary: ProcessSummary,
     /// Correlation time per frame (ns): whole run, and since the last status line.
-    run_hist: Histogram<u64>,
-    window_hist: Histogram<u64>,
+    run_hist: Durations,
+    window_hist: Durations,
     rejects: RateLimit,
     /// Frames with fewer than half their nodes valid.
     few_valid: RateLimit,
-}
-
-fn histogram() -> Histogram<u64> {
-    Histogram::new_with_bounds(1_000, 3_600_000_000_000, 3).expect("valid histogram bounds")
 }
 
 impl Live {
@@ -349,10 +346,10 @@ impl Live {
             reference_frame_id: None,
             origin_frame_id: 0,
             sequence_id: None,
-            last_frame_id: None,
+            frame_ids: IdGaps::default(),
             summary: ProcessSummary::default(),
-            run_hist: histogram(),
-            window_hist: histogram(),
+            run_hist: Durations::new(),
+            window_hist: Durations::new(),
             rejects: RateLimit::default(),
             few_valid: RateLimit::default(),
         }
@@ -426,14 +423,13 @@ impl Live {
     fn note_received(&mut self, header: &FrameHeader) {
         self.summary.frames_received += 1;
         let id = header.frame_id;
-        match self.last_frame_id {
-            Some(last) if id > last => self.summary.frames_lost += id - last - 1,
-            Some(last) if self.rejects.allow() => eprintln!(
+        match self.frame_ids.observe(id) {
+            IdStep::Forward { skipped } => self.summary.frames_lost += skipped,
+            IdStep::Back { from: last } if self.rejects.allow() => eprintln!(
                 "correlator: frame id went back from {last} to {id} (producer restarted?); counting drops from here"
             ),
             _ => {}
         }
-        self.last_frame_id = Some(id);
     }
 
     fn reject(&mut self, frame_id: u64, reason: &dyn std::fmt::Display) {
@@ -544,8 +540,8 @@ impl Live {
         }
         // The frame is no longer needed: the correlator copied it if it became the reference.
         drop(sample);
-        self.run_hist.saturating_record(correlate_ns);
-        self.window_hist.saturating_record(correlate_ns);
+        self.run_hist.record_ns(correlate_ns);
+        self.window_hist.record_ns(correlate_ns);
         self.summary.frames_correlated += 1;
         let frames_dropped = self.summary.frames_dropped();
         if field.reference_updated {
@@ -743,7 +739,7 @@ impl StatusLine {
         }
         let elapsed_s = self.last_print.elapsed().as_secs_f64();
         let rate = (s.frames_correlated - self.last_correlated) as f64 / elapsed_s;
-        let p50_ms = live.window_hist.value_at_quantile(0.5) as f64 / 1e6;
+        let p50_ms = live.window_hist.median_ms();
         eprintln!(
             "correlator: frames in {}, correlated {}, dropped {} (skipped {}, lost {}), rejected {}; correlate p50 {p50_ms:.1} ms; {rate:.1} fields/s; reference {}",
             s.frames_received,

@@ -2,13 +2,15 @@
 
 mod common;
 
-use common::{accuracy, command_columns, load, shared_data};
+use common::{accuracy, command_columns, load};
 use correlator::{Correlator, CorrelatorSettings, GuessMode, NodeStatus};
+use testkit::shared_data;
 
 #[test]
 fn sample5_translation_with_contrast_change() {
-    let Some(data) = shared_data() else { return };
-    let dir = data.join("dic-challenge/sample5");
+    let Some(dir) = shared_data("dic-challenge/sample5") else {
+        return;
+    };
     let (reference, w, h) = load(dir.join("Sample5 Reference.tif"));
     let cases = [
         ("Sample5-000 X0.00 Y0.00 N2 C75 R10.tif", 0.0),
@@ -68,8 +70,9 @@ fn sample5_translation_with_contrast_change() {
 /// is checked on column averages in `sample14_smaller_zones_follow_the_fast_end`.
 #[test]
 fn sample14_l1_chirp_rms() {
-    let Some(data) = shared_data() else { return };
-    let dir = data.join("dic-challenge/sample14");
+    let Some(dir) = shared_data("dic-challenge/sample14") else {
+        return;
+    };
     let (reference, w, h) = load(dir.join("Sample14 Reference.tif"));
     let (deformed, _, _) = load(dir.join("Sample14 L1 Amp0.1b.tif"));
     let command = std::fs::read_to_string(dir.join("command.csv")).unwrap();
@@ -130,8 +133,9 @@ fn sample14_l1_chirp_rms() {
 /// L5 the 64 px zone smooths the oscillation, and the 32 px zone must follow it better.
 #[test]
 fn sample14_smaller_zones_follow_the_fast_end() {
-    let Some(data) = shared_data() else { return };
-    let dir = data.join("dic-challenge/sample14");
+    let Some(dir) = shared_data("dic-challenge/sample14") else {
+        return;
+    };
     let (reference, w, h) = load(dir.join("Sample14 Reference.tif"));
     let columns = command_columns(dir.join("command.csv"));
     assert_eq!(columns.len(), w, "command.csv rows");
@@ -230,8 +234,9 @@ fn bicubic(pixels: &[u16], w: usize, h: usize, x: f64, y: f64) -> f64 {
 /// stay in view valid, none more than 0.5 px off (the resampling itself costs accuracy).
 #[test]
 fn sample5_rotated_photograph() {
-    let Some(data) = shared_data() else { return };
-    let dir = data.join("dic-challenge/sample5");
+    let Some(dir) = shared_data("dic-challenge/sample5") else {
+        return;
+    };
     let (reference, w, h) = load(dir.join("Sample5 Reference.tif"));
     let (second, _, _) = load(dir.join("Sample5-000 X0.00 Y0.00 N2 C75 R10.tif"));
     let c = [(w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0];

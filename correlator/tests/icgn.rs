@@ -8,11 +8,10 @@
 
 mod common;
 
-use common::{
-    accuracy, command_columns, load, mean_std, render, shared_data, stretch, translation,
-};
+use common::{accuracy, command_columns, load, mean_std, render, stretch, translation};
 use correlator::settings::Method;
 use correlator::{Correlator, CorrelatorSettings, Field, NodeStatus, ReferenceMode, Roi};
+use testkit::shared_data;
 
 fn settings(method: Method, zoi_px: usize, step_px: usize) -> CorrelatorSettings {
     CorrelatorSettings {
@@ -43,8 +42,9 @@ fn ok_values(field: &Field, value: impl Fn(&correlator::Node) -> f64) -> Vec<f64
 
 #[test]
 fn sample5_bias_and_std_at_33_px() {
-    let Some(data) = shared_data() else { return };
-    let dir = data.join("dic-challenge/sample5");
+    let Some(dir) = shared_data("dic-challenge/sample5") else {
+        return;
+    };
     let (reference, w, h) = load(dir.join("Sample5 Reference.tif"));
     let (deformed, _, _) = load(dir.join("Sample5-001 X0.10 Y0.10 N2 C100 R20.tif"));
     println!("| sample 5 image 001 | valid | bias u | bias v | std u | std v |");
@@ -73,8 +73,9 @@ fn sample5_bias_and_std_at_33_px() {
 /// RMS of u − command over 150 <= x <= 1900 for L1, L3, L5 (step 8 px over the whole image).
 #[test]
 fn sample14_chirp_rms_at_33_px() {
-    let Some(data) = shared_data() else { return };
-    let dir = data.join("dic-challenge/sample14");
+    let Some(dir) = shared_data("dic-challenge/sample14") else {
+        return;
+    };
     let (reference, w, h) = load(dir.join("Sample14 Reference.tif"));
     let columns = command_columns(dir.join("command.csv"));
     assert_eq!(columns.len(), w, "command.csv rows");

@@ -16,6 +16,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
+use testkit::{TestInstance, HANG_GUARD};
 use wire::pubsub::{SlicePublisher, SliceSubscriber};
 use wire::{services, FieldHeader, FieldNode, FrameHeader, Instance};
 
@@ -49,16 +50,15 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-/// Removes the instance's shared-memory files and the state folder, even when the test fails.
+/// Removes the instance's shared-memory files (the test kit's `TestInstance`) and the state
+/// folder, even when the test fails.
 struct Cleanup {
-    instance: Instance,
+    _instance: TestInstance,
     state_dir: std::path::PathBuf,
 }
 
 impl Drop for Cleanup {
     fn drop(&mut self) {
-        self.instance.cleanup_dead_nodes();
-        self.instance.remove_leftover_files();
         let _ = std::fs::remove_dir_all(&self.state_dir);
     }
 }
@@ -74,12 +74,13 @@ fn steady_state_allocations(
     reference: ReferenceMode,
     with_state: bool,
 ) -> (usize, u64) {
-    let name = format!("alloc_{label}_{}", std::process::id());
+    let test_instance = TestInstance::new(&format!("alloc_{label}"));
+    let name = test_instance.name().to_string();
     let instance = Instance::new(&name).unwrap();
     let state_dir = std::env::temp_dir().join(format!("{name}_state"));
     let _ = std::fs::remove_dir_all(&state_dir);
     let cleanup = Cleanup {
-        instance: Instance::new(&name).unwrap(),
+        _instance: test_instance,
         state_dir: state_dir.clone(),
     };
     let mut config = ProcessConfig::new(
@@ -137,17 +138,14 @@ fn steady_state_allocations(
         // Until the shell subscribed (bounded).
         let start = Instant::now();
         while send(0) == 0 {
-            assert!(
-                start.elapsed() < Duration::from_secs(30),
-                "the shell never subscribed"
-            );
+            assert!(start.elapsed() < HANG_GUARD, "the shell never subscribed");
             std::thread::sleep(Duration::from_millis(10));
         }
         for k in 0..FRAMES {
             if k > 0 {
                 send(k);
             }
-            let deadline = Instant::now() + Duration::from_secs(60);
+            let deadline = Instant::now() + HANG_GUARD;
             let field = loop {
                 if let Some(sample) = fields.receive().unwrap() {
                     break *sample.user_header();

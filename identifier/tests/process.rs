@@ -15,7 +15,9 @@ const STEPS: u64 = 30;
 
 #[test]
 fn live_process_identifies_smactane() {
-    let name = format!("idtest_{}", std::process::id());
+    // Its files are removed when it is dropped, also when the test fails.
+    let test_instance = testkit::TestInstance::new("identifier_process");
+    let name = test_instance.name().to_string();
     let instance = Instance::new(&name).unwrap();
     let output = std::env::temp_dir().join(format!("{name}_identification.json"));
     let journal = std::env::temp_dir().join(format!("{name}_points.csv"));
@@ -41,7 +43,7 @@ fn live_process_identifies_smactane() {
         let start = Instant::now();
         while rig.publish(RigState::default()).unwrap() == 0 {
             assert!(
-                start.elapsed() < Duration::from_secs(10),
+                start.elapsed() < testkit::HANG_GUARD,
                 "process never subscribed"
             );
             std::thread::sleep(Duration::from_millis(10));

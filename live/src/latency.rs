@@ -1,13 +1,10 @@
-//! Per-frame latency: an HDR histogram (1 µs to 10 min, 3 significant digits) with the
-//! percentiles a report quotes and the classic HdrHistogram percentile text (`.hgrm`, the
-//! format HdrHistogram's plotters read), values in milliseconds.
+//! Per-frame latency: the streams' one histogram of durations (`wire::stats::Durations`, ns)
+//! with the percentiles a report quotes and the classic HdrHistogram percentile text
+//! (`.hgrm`, the format HdrHistogram's plotters read), values in milliseconds.
 
-use hdrhistogram::Histogram;
 use serde::Serialize;
 use std::fmt::Write as _;
-
-const LOWEST_US: u64 = 1;
-const HIGHEST_US: u64 = 600_000_000;
+use wire::stats::Durations;
 
 /// Percentiles in milliseconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -22,7 +19,7 @@ pub struct Percentiles {
 
 #[derive(Clone, Debug)]
 pub struct Latency {
-    histogram: Histogram<u64>,
+    durations: Durations,
 }
 
 impl Default for Latency {
@@ -34,43 +31,41 @@ impl Default for Latency {
 impl Latency {
     pub fn new() -> Latency {
         Latency {
-            histogram: Histogram::new_with_bounds(LOWEST_US, HIGHEST_US, 3)
-                .expect("valid histogram bounds"),
+            durations: Durations::new(),
         }
     }
 
     /// Records one latency in ns (clamped into the histogram's range).
     pub fn record_ns(&mut self, latency_ns: u64) {
-        self.histogram
-            .saturating_record((latency_ns / 1000).clamp(LOWEST_US, HIGHEST_US));
+        self.durations.record_ns(latency_ns);
     }
 
     pub fn count(&self) -> u64 {
-        self.histogram.len()
+        self.durations.count()
     }
 
-    fn ms(us: u64) -> f64 {
-        us as f64 * 1e-3
+    fn ms(ns: u64) -> f64 {
+        ns as f64 * 1e-6
     }
 
     pub fn percentiles(&self) -> Percentiles {
-        if self.histogram.is_empty() {
+        if self.durations.is_empty() {
             return Percentiles::default();
         }
-        let q = |quantile: f64| Self::ms(self.histogram.value_at_quantile(quantile));
+        let d = &self.durations;
         Percentiles {
-            count: self.histogram.len(),
-            p50: q(0.5),
-            p90: q(0.9),
-            p99: q(0.99),
-            p999: q(0.999),
-            max: Self::ms(self.histogram.max()),
+            count: d.count(),
+            p50: d.median_ms(),
+            p90: d.quantile_ms(0.9),
+            p99: d.quantile_ms(0.99),
+            p999: d.quantile_ms(0.999),
+            max: Self::ms(d.max_ns()),
         }
     }
 
     /// The percentile distribution in HdrHistogram's text format, values in ms.
     pub fn hgrm(&self) -> String {
-        let h = &self.histogram;
+        let h = self.durations.histogram();
         let mut out = String::new();
         let _ = writeln!(
             out,
@@ -95,8 +90,8 @@ impl Latency {
         let _ = writeln!(
             out,
             "#[Mean    = {:>12.3}, StdDeviation   = {:>12.3}]",
-            h.mean() * 1e-3,
-            h.stdev() * 1e-3
+            h.mean() * 1e-6,
+            h.stdev() * 1e-6
         );
         let _ = writeln!(
             out,
@@ -115,7 +110,8 @@ impl Latency {
 
     /// (latency ms, percentile) pairs of the distribution, for plotting.
     pub fn distribution(&self) -> Vec<(f64, f64)> {
-        self.histogram
+        self.durations
+            .histogram()
             .iter_quantiles(5)
             .map(|s| (Self::ms(s.value_iterated_to()), s.quantile_iterated_to()))
             .collect()

@@ -200,12 +200,9 @@ fn wrong_buffer_is_an_error() {
 
 #[test]
 fn replays_dic_challenge_sample5_when_present() {
-    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data"))
-        .join("dic-challenge/sample5");
-    if !dir.is_dir() {
-        eprintln!("SKIPPED: {} absent", dir.display());
+    let Some(dir) = testkit::shared_data("dic-challenge/sample5") else {
         return;
-    }
+    };
     let mut replay = Replay::open(&dir).expect("sample5 replays");
     let dims = replay.dims();
     assert_eq!((dims.width, dims.height, dims.bit_depth), (512, 512, 8));

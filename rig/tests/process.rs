@@ -12,7 +12,7 @@ fn request(
     command: wire::RigCommand,
 ) -> RigReply {
     let pending = client.send_copy(command).unwrap();
-    let deadline = Instant::now() + Duration::from_secs(20);
+    let deadline = Instant::now() + testkit::HANG_GUARD;
     loop {
         if let Some(reply) = pending.receive().unwrap() {
             return *reply;
@@ -24,7 +24,9 @@ fn request(
 
 #[test]
 fn state_is_published_and_commands_are_answered() {
-    let name = format!("rigtest_{}", std::process::id());
+    // Its files are removed when it is dropped, also when the test fails.
+    let test_instance = testkit::TestInstance::new("rig_process");
+    let name = test_instance.name().to_string();
     let options = ProcessOptions {
         instance: name.clone(),
         config: RigConfig::default(),
@@ -55,7 +57,7 @@ fn state_is_published_and_commands_are_answered() {
         .unwrap();
     let client = service.client_builder().create().unwrap();
     // The server exists once the first state is out: a request sent before would be lost.
-    let deadline = Instant::now() + Duration::from_secs(20);
+    let deadline = Instant::now() + testkit::HANG_GUARD;
     while states.receive().unwrap().is_none() {
         assert!(Instant::now() < deadline, "no rig/state sample");
         std::thread::sleep(Duration::from_millis(2));
@@ -77,7 +79,7 @@ fn state_is_published_and_commands_are_answered() {
     let mut set = wire::RigCommand::new(RigCommandKind::SetPoint);
     set.value = 2.0;
     assert_eq!(request(&client, set).accepted, 1, "set-point");
-    let deadline = Instant::now() + Duration::from_secs(20);
+    let deadline = Instant::now() + testkit::HANG_GUARD;
     let mut last: Option<RigState> = None;
     while Instant::now() < deadline {
         while let Some(s) = states.receive().unwrap() {

@@ -105,14 +105,8 @@ pub fn start_run(run: &mut Run, name: &str, config: &Path, out: &Path, extra: &[
     run.spawn(name, &args).pid()
 }
 
-pub fn signal(pid: i32, signal: i32) {
-    // SAFETY: signalling a process of this test's own tree.
-    assert_eq!(
-        unsafe { libc::kill(pid, signal) },
-        0,
-        "kill -{signal} {pid}"
-    );
-}
+#[allow(unused_imports)]
+pub use testkit::signal;
 
 pub fn summary(folder: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(folder.join("summary.json")).expect("summary.json");

@@ -29,6 +29,7 @@ pub mod services;
 #[cfg(feature = "ipc")]
 pub mod shm;
 pub mod signals;
+pub mod stats;
 pub mod text;
 
 pub use clock::monotonic_ns;

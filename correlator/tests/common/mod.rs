@@ -44,17 +44,6 @@ pub fn stretch(ex: f64, ey: f64, centre_px: [f64; 2]) -> Motion {
     })
 }
 
-/// Folder of the shared data, or None (with a visible message) when absent.
-pub fn shared_data() -> Option<std::path::PathBuf> {
-    let dir = std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data"));
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("SKIPPED: shared data folder {} is absent", dir.display());
-        None
-    }
-}
-
 /// An image file as (pixels, width, height); panics naming the file when it cannot be read.
 pub fn load(path: std::path::PathBuf) -> (Vec<u16>, usize, usize) {
     let image = producer::read_image(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));

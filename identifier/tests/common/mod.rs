@@ -1,17 +1,11 @@
-//! Shared by the integration tests: Treloar's (1944) three load cases from `../shared`.
+//! Shared by the integration tests: Treloar's (1944) three load cases from `../shared/data`.
 
 use identifier::data::{read_curve_csv, Curve, LoadCase};
-use std::path::Path;
 
-pub const DATA_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/treloar1944");
-
-/// Uniaxial, equibiaxial and pure-shear curves, or `None` (said on stderr) without the data.
+/// Uniaxial, equibiaxial and pure-shear curves, or `None` without the data (skipped with a
+/// message; a failure under `DICSTREAM_REQUIRE_SHARED=1`, see `testkit::shared_data`).
 pub fn treloar() -> Option<Vec<Curve>> {
-    let dir = Path::new(DATA_DIR);
-    if !dir.exists() {
-        eprintln!("SKIPPED: Treloar data not found at {DATA_DIR}");
-        return None;
-    }
+    let dir = testkit::shared_data("treloar1944")?;
     let files = [
         ("uniaxial.csv", LoadCase::Uniaxial),
         ("equibiaxial.csv", LoadCase::Equibiaxial),

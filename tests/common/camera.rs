@@ -1,23 +1,14 @@
-//! Harness of the process tests: a test bench per test (its own instance name from the pid
-//! and the test name), the test process as camera (frames rendered with the producer crate,
-//! published with `wire::pubsub`) and as field reader, `dicstream` children with their stderr
-//! collected line by line, and a Drop guard that kills the children and removes the instance's
-//! shared-memory files and the test folders even when the test fails.
-#![allow(dead_code)]
+//! The test process as the camera of a live `dicstream correlator` (frames rendered with the
+//! producer crate, published with `wire::pubsub`) and as its field reader, on a [`Run`] (its own
+//! instance, children and folders, cleaned even when the test fails).
 
+use super::{Proc, Run, HANG_GUARD};
 use producer::motion::Affine;
 use producer::Motion;
-use std::io::BufRead;
 use std::path::PathBuf;
-use std::process::{Child, Command, ExitStatus, Stdio};
-use std::sync::mpsc::{Receiver, RecvTimeoutError};
-use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use wire::pubsub::{SlicePublisher, SliceSubscriber};
-use wire::{services, FieldHeader, FieldNode, FrameHeader, GroundTruth, Instance};
-
-/// Generous bound on every wait, so a broken process fails the test instead of hanging it.
-pub const PATIENCE: Duration = Duration::from_secs(120);
+use wire::{services, FieldHeader, FieldNode, FrameHeader, GroundTruth};
 
 /// A field copied out of shared memory.
 #[derive(Clone, Debug)]
@@ -51,86 +42,10 @@ impl FieldCopy {
     }
 }
 
-/// One `dicstream` child and its stderr.
-pub struct Proc {
-    child: Child,
-    lines: Receiver<String>,
-    log: Arc<Mutex<Vec<String>>>,
-}
-
-impl Proc {
-    pub fn pid(&self) -> u32 {
-        self.child.id()
-    }
-
-    /// Everything the child wrote to stderr so far.
-    pub fn stderr(&self) -> String {
-        self.log.lock().unwrap().join("\n")
-    }
-
-    /// Waits for a stderr line containing `needle`; returns it.
-    pub fn wait_line(&mut self, needle: &str) -> String {
-        let deadline = Instant::now() + PATIENCE;
-        loop {
-            let left = deadline.saturating_duration_since(Instant::now());
-            match self.lines.recv_timeout(left) {
-                Ok(line) if line.contains(needle) => return line,
-                Ok(_) => {}
-                Err(RecvTimeoutError::Timeout) => {
-                    panic!("no line with {needle:?}; stderr so far:\n{}", self.stderr())
-                }
-                Err(RecvTimeoutError::Disconnected) => panic!(
-                    "the process ended without a line with {needle:?}; stderr:\n{}",
-                    self.stderr()
-                ),
-            }
-        }
-    }
-
-    /// Sends a signal by name (INT, TERM, KILL) with kill(1).
-    pub fn signal(&self, name: &str) {
-        let status = Command::new("kill")
-            .arg(format!("-{name}"))
-            .arg(self.pid().to_string())
-            .status()
-            .expect("run kill");
-        assert!(status.success(), "kill -{name} {}", self.pid());
-    }
-
-    /// Waits (bounded) for the child to end.
-    pub fn wait_exit(&mut self) -> ExitStatus {
-        let deadline = Instant::now() + PATIENCE;
-        loop {
-            if let Some(status) = self.child.try_wait().expect("try_wait") {
-                // Let the reader thread collect the last lines.
-                let until = Instant::now() + Duration::from_secs(5);
-                while Instant::now() < until {
-                    match self.lines.recv_timeout(Duration::from_millis(100)) {
-                        Err(RecvTimeoutError::Disconnected) => break,
-                        _ => continue,
-                    }
-                }
-                return status;
-            }
-            assert!(
-                Instant::now() < deadline,
-                "process did not exit; stderr:\n{}",
-                self.stderr()
-            );
-            std::thread::sleep(Duration::from_millis(20));
-        }
-    }
-
-    /// The line of the final summary ("correlator: stopped ...").
-    pub fn final_line(&self) -> String {
-        self.log
-            .lock()
-            .unwrap()
-            .iter()
-            .find(|l| l.starts_with("correlator: stopped"))
-            .cloned()
-            .unwrap_or_else(|| panic!("no final line; stderr:\n{}", self.stderr()))
-    }
+/// The line of a correlator's final summary ("correlator: stopped ...").
+pub fn final_line(proc: &Proc) -> String {
+    proc.line_starting("correlator: stopped")
+        .unwrap_or_else(|| panic!("no final line; stderr:\n{}", proc.stderr()))
 }
 
 /// A number that follows `label ` in `line` (e.g. "dropped 12").
@@ -153,83 +68,50 @@ struct Io {
     _node: iceoryx2::prelude::Node<iceoryx2::prelude::ipc::Service>,
 }
 
-/// One test's bench: instance, camera and field reader, children, folders.
+/// One test's bench: a [`Run`] (instance, children, scratch folder) with the test as camera
+/// and field reader.
 pub struct Bench {
-    pub name: String,
-    pub instance: Instance,
+    pub run: Run,
     io: Option<Io>,
-    procs: Vec<Proc>,
-    dirs: Vec<PathBuf>,
 }
 
 impl Bench {
-    /// `test` must be unique within its test binary; frames up to `max_pixels` values.
+    /// `test` names the bench; frames up to `max_pixels` values.
     pub fn new(test: &str, max_pixels: usize) -> Bench {
-        let mut name = format!("t{}_{test}", std::process::id());
-        name.truncate(wire::instance::MAX_NAME_LEN);
-        let instance = Instance::new(&name).unwrap();
-        instance.remove_leftover_files();
-        let (node, _) = instance.create_node("testbench").unwrap();
+        let run = Run::new(test);
+        let (node, _) = run.instance.create_node("testbench").unwrap();
         let frames = SlicePublisher::create(&node, &services::FRAMES, max_pixels).unwrap();
         let fields = SliceSubscriber::create(&node, &services::FIELDS).unwrap();
         Bench {
-            name,
-            instance,
+            run,
             io: Some(Io {
                 frames,
                 fields,
                 _node: node,
             }),
-            procs: Vec::new(),
-            dirs: Vec::new(),
         }
+    }
+
+    pub fn name(&self) -> &str {
+        self.run.name()
     }
 
     /// A fresh folder removed with the bench.
     pub fn temp_dir(&mut self, label: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("{}_{label}", self.name));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        self.dirs.push(dir.clone());
-        dir
+        self.run.temp_dir(label)
     }
 
     /// Starts `dicstream correlator --instance NAME ARGS...`; returns its index.
     pub fn spawn_correlator(&mut self, args: &[&str]) -> usize {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_dicstream"))
-            .arg("correlator")
-            .arg("--instance")
-            .arg(&self.name)
-            .args(args)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("spawn dicstream");
-        let stderr = child.stderr.take().unwrap();
-        let (tx, rx) = std::sync::mpsc::channel();
-        let log = Arc::new(Mutex::new(Vec::new()));
-        let log_writer = Arc::clone(&log);
-        std::thread::spawn(move || {
-            for line in std::io::BufReader::new(stderr).lines() {
-                let Ok(line) = line else { break };
-                eprintln!("  [child] {line}");
-                log_writer.lock().unwrap().push(line.clone());
-                if tx.send(line).is_err() {
-                    break;
-                }
-            }
-        });
-        self.procs.push(Proc {
-            child,
-            lines: rx,
-            log,
-        });
-        self.procs.len() - 1
+        let name = self.run.name().to_string();
+        let mut all = vec!["correlator", "--instance", &name];
+        all.extend_from_slice(args);
+        self.run.spawn("correlator", &all);
+        self.run.children_started() - 1
     }
 
     pub fn proc(&mut self, index: usize) -> &mut Proc {
-        &mut self.procs[index]
+        self.run.proc(index)
     }
 
     /// Publishes one frame; returns how many subscribers received it.
@@ -270,10 +152,10 @@ impl Bench {
 
     /// The next field, waiting (bounded) on the fields event.
     pub fn next_field(&self) -> FieldCopy {
-        self.try_next_field(PATIENCE).unwrap_or_else(|| {
+        self.try_next_field(HANG_GUARD).unwrap_or_else(|| {
             panic!(
-                "no field within {PATIENCE:?}; stderr:\n{}",
-                self.all_stderr()
+                "no field within {HANG_GUARD:?}; stderr:\n{}",
+                self.run.all_stderr()
             )
         })
     }
@@ -313,32 +195,18 @@ impl Bench {
         }
     }
 
-    fn all_stderr(&self) -> String {
-        self.procs
-            .iter()
-            .map(|p| p.stderr())
-            .collect::<Vec<_>>()
-            .join("\n---\n")
-    }
-
     /// Kills what is left, removes the files and asserts nothing of the instance remains.
     pub fn finish(mut self) {
         self.cleanup();
-        let left = self.instance.leftover_files();
+        let left = self.run.instance.leftover_files();
         assert!(left.is_empty(), "left in shared memory: {left:?}");
     }
 
+    /// The children go first, then the test's own ports, then the instance's files.
     fn cleanup(&mut self) {
-        for proc in &mut self.procs {
-            let _ = proc.child.kill();
-            let _ = proc.child.wait();
-        }
+        self.run.kill_children();
         self.io = None;
-        self.instance.cleanup_dead_nodes();
-        self.instance.remove_leftover_files();
-        for dir in self.dirs.drain(..) {
-            let _ = std::fs::remove_dir_all(dir);
-        }
+        self.run.teardown();
     }
 }
 

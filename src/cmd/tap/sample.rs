@@ -1,0 +1,170 @@
+//! The one-line and JSON summaries of the last sample `dicstream tap` saw.
+
+use serde_json::{json, Value};
+use wire::{FieldHeader, FrameHeader, IdentificationReport, RigState, StrainMeasure};
+
+/// The last sample seen, kept to summarise it.
+#[derive(Debug, Clone)]
+pub(super) enum LastSample {
+    Frame {
+        header: FrameHeader,
+        checksum_ok: bool,
+    },
+    Field {
+        header: FieldHeader,
+    },
+    Rig {
+        state: RigState,
+    },
+    Identification {
+        // Boxed: a report is three times a frame header (and comes a few times a second).
+        report: Box<IdentificationReport>,
+    },
+}
+
+/// Mean of an actuator pair's forces (kN): the axis force, as the identifier reads it.
+pub(super) fn axis_force_kn(state: &RigState, axis: usize) -> f64 {
+    0.5 * (state.actuators[2 * axis].force_kn + state.actuators[2 * axis + 1].force_kn)
+}
+
+pub(super) fn rig_id(id: u64) -> Value {
+    if id == wire::NO_RIG_SAMPLE {
+        Value::Null
+    } else {
+        json!(id)
+    }
+}
+
+impl LastSample {
+    pub(super) fn line(&self) -> String {
+        match self {
+            LastSample::Frame {
+                header,
+                checksum_ok,
+            } => {
+                let mut line = format!(
+                    "frame {}: {}x{} {} bit, checksum {}",
+                    header.frame_id,
+                    header.width_px,
+                    header.height_px,
+                    header.bit_depth,
+                    if *checksum_ok { "ok" } else { "BAD" }
+                );
+                if header.rig_sample_id != wire::NO_RIG_SAMPLE {
+                    line.push_str(&format!(", rig sample {}", header.rig_sample_id));
+                }
+                if header.has_truth == 1 {
+                    let f = header.truth.deformation_gradient;
+                    line.push_str(&format!(
+                        ", truth F [{:.5} {:.5}; {:.5} {:.5}] t ({:.3}, {:.3}) px",
+                        f[0],
+                        f[1],
+                        f[2],
+                        f[3],
+                        header.truth.translation_px[0],
+                        header.truth.translation_px[1]
+                    ));
+                }
+                line
+            }
+            LastSample::Field { header } => {
+                let g = header.gauge_of(StrainMeasure::Log);
+                format!(
+                    "field of frame {}: {}/{} valid nodes, u mean {:.4} px, v mean {:.4} px, \
+                     gauge log strain xx {:.3e} yy {:.3e} xy {:.3e}",
+                    header.frame_id,
+                    header.valid_nodes,
+                    header.node_count(),
+                    header.u_mean_px,
+                    header.v_mean_px,
+                    g.exx,
+                    g.eyy,
+                    g.exy
+                )
+            }
+            LastSample::Rig { state } => format!(
+                "rig sample {}: t_sim {:.3} s, stretch x {:.4} y {:.4}, force X {:.4} kN Y {:.4} kN",
+                state.sample_id,
+                state.t_sim_s,
+                state.specimen_stretch_x,
+                state.specimen_stretch_y,
+                axis_force_kn(state, 0),
+                axis_force_kn(state, 1)
+            ),
+            LastSample::Identification { report } => {
+                let coefficients = |values: &[f64], count: u32| {
+                    values[..(count as usize).min(values.len())]
+                        .iter()
+                        .map(|v| format!("{v:.4e}"))
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                };
+                let best = if report.ranked_count > 0 {
+                    wire::text::read_fixed(&report.ranking[0].name)
+                } else {
+                    "-".to_string()
+                };
+                format!(
+                    "identification at frame {}: points uniaxial {} equibiaxial {} shear {}, \
+                     a [{}], b [{}], rms {:.4} MPa, best {best}",
+                    report.frame_id,
+                    report.points[0],
+                    report.points[1],
+                    report.points[2],
+                    coefficients(&report.a, report.a_count),
+                    coefficients(&report.b, report.b_count),
+                    report.rms_mpa
+                )
+            }
+        }
+    }
+
+    pub(super) fn json(&self) -> Value {
+        match self {
+            LastSample::Frame {
+                header,
+                checksum_ok,
+            } => json!({
+                "frame_id": header.frame_id,
+                "width_px": header.width_px,
+                "height_px": header.height_px,
+                "bit_depth": header.bit_depth,
+                "checksum_ok": checksum_ok,
+                "rig_sample_id": rig_id(header.rig_sample_id),
+                "scenario_id": header.scenario_id,
+                "has_truth": header.has_truth == 1,
+                "deformation_gradient": header.truth.deformation_gradient,
+                "translation_px": header.truth.translation_px,
+                "centre_px": header.truth.centre_px,
+            }),
+            LastSample::Field { header } => {
+                let g = header.gauge_of(StrainMeasure::Log);
+                json!({
+                    "frame_id": header.frame_id,
+                    "rig_sample_id": rig_id(header.rig_sample_id),
+                    "valid_nodes": header.valid_nodes,
+                    "nodes": header.node_count(),
+                    "u_mean_px": header.u_mean_px,
+                    "v_mean_px": header.v_mean_px,
+                    "gauge_log_strain": {"xx": g.exx, "yy": g.eyy, "xy": g.exy},
+                    "correlator_frames_dropped": header.frames_dropped,
+                })
+            }
+            LastSample::Rig { state } => json!({
+                "sample_id": state.sample_id,
+                "t_sim_s": state.t_sim_s,
+                "stretch_x": state.specimen_stretch_x,
+                "stretch_y": state.specimen_stretch_y,
+                "force_x_kn": axis_force_kn(state, 0),
+                "force_y_kn": axis_force_kn(state, 1),
+            }),
+            LastSample::Identification { report } => json!({
+                "frame_id": report.frame_id,
+                "points": report.points,
+                "a": &report.a[..(report.a_count as usize).min(report.a.len())],
+                "b": &report.b[..(report.b_count as usize).min(report.b.len())],
+                "rms_mpa": report.rms_mpa,
+            }),
+        }
+    }
+}

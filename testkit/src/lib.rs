@@ -1,0 +1,25 @@
+//! The integration-test kit of dicstream, used as a dev-dependency by the tests of every
+//! package: a child process with its stderr read line by line ([`Proc`]: readiness, signals,
+//! exit), one hang guard ([`HANG_GUARD`]), a test's own instance whose shared-memory files are
+//! removed even when the test fails ([`TestInstance`]), a test's instance, children and scratch
+//! folder together ([`Run`]), unique instance names, and the path to `../shared/data`
+//! ([`shared_data`]: skipped with a message, or a failure under `DICSTREAM_REQUIRE_SHARED=1`).
+//!
+//! Timeouts here only guard against a hang (a test that would otherwise never end); no test
+//! asserts a wall-clock time.
+
+mod instance;
+mod proc;
+mod run;
+mod shared;
+
+pub use instance::{unique_instance, TestInstance};
+pub use proc::{signal, Proc};
+pub use run::Run;
+pub use shared::{shared_data, REQUIRE_SHARED_VAR, SHARED_DATA_VAR};
+
+use std::time::Duration;
+
+/// The one bound on anything a test waits for (start-up, a line, a field, an exit): a hang
+/// guard, generous enough for a loaded two-core machine.
+pub const HANG_GUARD: Duration = Duration::from_secs(180);
