@@ -1,29 +1,19 @@
-//! Latency distribution for the page: percentiles (HDR histogram, µs resolution) and counts in
-//! fixed log-spaced bins (ms) for a small bar chart. Pure.
+//! Latency distribution for the page: percentiles (`wire::stats::Durations`, the histogram
+//! every latency of dicstream uses) and counts in fixed log-spaced bins (ms) for a small bar
+//! chart. Pure.
 
-use hdrhistogram::Histogram;
 use serde_json::{json, Value};
+use wire::stats::Durations;
 
 /// Upper edges of the display bins (ms); a last bin takes everything above.
 pub const BIN_EDGES_MS: [f64; 12] = [
     1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0,
 ];
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct LatencyStats {
-    histogram_us: Histogram<u64>,
+    durations: Durations,
     bins: [u64; BIN_EDGES_MS.len() + 1],
-}
-
-impl Default for LatencyStats {
-    fn default() -> Self {
-        LatencyStats {
-            // 1 µs to 1 h at 3 significant digits.
-            histogram_us: Histogram::new_with_bounds(1, 3_600_000_000, 3)
-                .expect("valid histogram bounds"),
-            bins: [0; BIN_EDGES_MS.len() + 1],
-        }
-    }
 }
 
 impl LatencyStats {
@@ -34,7 +24,7 @@ impl LatencyStats {
             return;
         }
         let ns = to_ns - from_ns;
-        self.histogram_us.saturating_record((ns / 1000).max(1));
+        self.durations.record_ns(ns);
         let ms = ns as f64 / 1e6;
         let bin = BIN_EDGES_MS
             .iter()
@@ -44,7 +34,7 @@ impl LatencyStats {
     }
 
     pub fn count(&self) -> u64 {
-        self.histogram_us.len()
+        self.durations.count()
     }
 
     /// `{count, p50, p90, p99, max}` in ms and the bins, or `null` before the first value.
@@ -52,13 +42,13 @@ impl LatencyStats {
         if self.count() == 0 {
             return Value::Null;
         }
-        let ms = |q: f64| self.histogram_us.value_at_quantile(q) as f64 / 1e3;
+        let ms = |q: f64| self.durations.quantile_ms(q);
         json!({
             "count": self.count(),
             "p50": ms(0.5),
             "p90": ms(0.9),
             "p99": ms(0.99),
-            "max": self.histogram_us.max() as f64 / 1e3,
+            "max": self.durations.max_ns() as f64 * 1e-6,
             "bin_edges_ms": BIN_EDGES_MS,
             "bins": self.bins,
         })

@@ -84,7 +84,7 @@ impl Run {
         self.spawn(name, args).wait()
     }
 
-    /// Files the instance left, apart from iceoryx2's per-prefix node counter (see
+    /// Files the instance left once its processes ended (see
     /// [`TestInstance::leftovers_after_clean_shutdown`]).
     pub fn leftovers_after_clean_shutdown(&self) -> Vec<PathBuf> {
         self.instance.leftovers_after_clean_shutdown()
