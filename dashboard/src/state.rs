@@ -7,6 +7,7 @@
 use crate::image::{downsample, encode_png};
 use crate::latency::LatencyStats;
 use crate::series::{significant, Decimated, Ids, Rate};
+use material::InvariantFn;
 use serde_json::{json, Value};
 use wire::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, NodeStatus, RigState};
 
@@ -464,6 +465,7 @@ impl LiveState {
                 json!({"name": wire::text::read_fixed(&m.name), "aic": m.aic, "rms_mpa": m.rms_mpa})
             })
             .collect();
+        let (f_points, g_points) = self.route_points(r);
         let mut uniaxial = curves(0);
         uniaxial["fit"] = fit(0);
         let mut equibiaxial = curves(1);
@@ -479,7 +481,58 @@ impl LiveState {
             "latency_ms": self.latency_identification.json(),
             "uniaxial": uniaxial,
             "equibiaxial": equibiaxial,
+            "f_points": f_points,
+            "g_points": g_points,
         })
+    }
+
+    /// The route's experimental points (paper Figs. 8 and 14) from this run's stress-stretch
+    /// points: f(I1) from the uniaxial ones by eq. 19 (with the identified g once the
+    /// equibiaxial test has data, eq. 20 before), g(I2) from the equibiaxial ones by eq. 23
+    /// with the identified f. Points nearer λ = 1 than the route's own threshold are left out,
+    /// as the route does (their division by a vanishing term turns noise into any value).
+    fn route_points(&self, r: &IdentificationReport) -> (Value, Value) {
+        use identifier::data::{Curve, LoadCase};
+        use identifier::route::{f_points, g_points, ROUTE_MIN_STRETCH};
+        let curve = |i: usize, case: LoadCase| {
+            let rows: Vec<[f64; 2]> = self.curves[i]
+                .rows()
+                .iter()
+                .copied()
+                .filter(|p| p[0] >= ROUTE_MIN_STRETCH && p[1].is_finite())
+                .collect();
+            Curve {
+                case,
+                stretch: rows.iter().map(|p| p[0]).collect(),
+                nominal_stress_mpa: rows.iter().map(|p| p[1]).collect(),
+                reference_rows_dropped: 0,
+            }
+        };
+        let part = |values: &[f64], count: u32, points: u32| {
+            let n = (count as usize).min(values.len());
+            (points > 0 && n > 0).then(|| InvariantFn::ExpPoly(values[..n].to_vec()))
+        };
+        let (f, g) = (
+            part(&r.a, r.a_count, r.points[0]),
+            part(&r.b, r.b_count, r.points[1]),
+        );
+        let as_json = |points: Vec<(f64, f64)>| {
+            let kept: Vec<(f64, f64)> = points.into_iter().filter(|p| p.1.is_finite()).collect();
+            json!({
+                "invariant": kept.iter().map(|p| p.0).collect::<Vec<_>>(),
+                "value_mpa": kept.iter().map(|p| p.1).collect::<Vec<_>>(),
+            })
+        };
+        let f_json = if r.points[0] > 0 {
+            as_json(f_points(&curve(0, LoadCase::Uniaxial), g.as_ref()))
+        } else {
+            Value::Null
+        };
+        let g_json = match (&f, r.points[1] > 0) {
+            (Some(f), true) => as_json(g_points(&curve(1, LoadCase::Equibiaxial), f)),
+            _ => Value::Null,
+        };
+        (f_json, g_json)
     }
 }
 
@@ -599,5 +652,57 @@ mod tests {
             .as_f64()
             .unwrap();
         assert!((p - 5.0).abs() < 1e-5, "{p}");
+    }
+    /// Stress points of the true law give the route's points on the true f and g: f(I1) by
+    /// eq. 19 with the identified g, g(I2) by eq. 23 with the identified f; none below λ 1.02.
+    #[test]
+    fn the_route_points_lie_on_the_law_that_made_the_stresses() {
+        let law = material::InvariantLaw::smactane();
+        let mut s = LiveState::new(Settings::new("t", Mode::Run), 0);
+        let section_mm2 = 10.0;
+        let uniaxial = |l: f64| law.uniaxial_nominal_stress_mpa(l);
+        let equibiaxial = |l: f64| law.equibiaxial_nominal_stress_mpa(l);
+        let cases: [(u32, &dyn Fn(f64) -> f64); 2] = [(1, &uniaxial), (2, &equibiaxial)];
+        for (case, nominal) in cases {
+            for k in 0..=30 {
+                let stretch = 1.0 + 1.5 * k as f64 / 30.0;
+                let mut state = RigState {
+                    load_case: case,
+                    hydraulics_on: 1,
+                    specimen_stretch_x: stretch,
+                    specimen_section_x_mm2: section_mm2,
+                    ..RigState::default()
+                };
+                let force_kn = nominal(stretch) * section_mm2 * stretch / 1e3;
+                state.actuators[0].force_kn = force_kn;
+                state.actuators[1].force_kn = force_kn;
+                s.on_rig(&state);
+            }
+        }
+        let (a, b) = (law.f.coefficients(), law.g.coefficients());
+        let mut r = IdentificationReport {
+            points: [31, 31, 0],
+            a_count: a.len() as u32,
+            b_count: b.len() as u32,
+            ..IdentificationReport::default()
+        };
+        r.a[..a.len()].copy_from_slice(a);
+        r.b[..b.len()].copy_from_slice(b);
+        s.on_report(&r);
+        let id = &s.snapshot(1, 0, &Value::Null)["identification"];
+        for (key, function) in [("f_points", &law.f), ("g_points", &law.g)] {
+            let invariants = id[key]["invariant"].as_array().unwrap();
+            let values = id[key]["value_mpa"].as_array().unwrap();
+            // λ = 1 is below the route's threshold (1.02); the 30 others remain.
+            assert_eq!(invariants.len(), 30, "{key}");
+            for (i, v) in invariants.iter().zip(values) {
+                let (i, v) = (i.as_f64().unwrap(), v.as_f64().unwrap());
+                let truth = function.value_mpa(i);
+                assert!(
+                    (v - truth).abs() < 1e-9 * truth.abs().max(1.0),
+                    "{key} at {i}: {v} vs {truth}"
+                );
+            }
+        }
     }
 }

@@ -157,6 +157,31 @@ function drawColorbar(lo, hi, label) {
   ctx.fillText(label, 0, 10);
 }
 
+// Seth-Hill strain measures are functions of the principal stretches on the same axes: log
+// ln λ, Green-Lagrange (λ² − 1)/2, nominal λ − 1. A node's strain in one of them gives its
+// stretches, hence the others. Small strain (sym ∇u) carries no rotation: it converts to none.
+const STRETCH_OF = { log: (e) => Math.exp(e), green: (e) => Math.sqrt(1 + 2 * e), nominal: (e) => 1 + e };
+const STRAIN_OF = { log: (l) => Math.log(l), green: (l) => (l * l - 1) / 2, nominal: (l) => l - 1 };
+function convertStrain(exx, eyy, exy, from, to) {
+  if (from === to) return [exx, eyy, exy];
+  const mean = (exx + eyy) / 2, radius = Math.hypot((exx - eyy) / 2, exy);
+  const theta = 0.5 * Math.atan2(2 * exy, exx - eyy), c = Math.cos(theta), s = Math.sin(theta);
+  const [a, b] = [mean + radius, mean - radius].map((e) => STRAIN_OF[to](STRETCH_OF[from](e)));
+  return [a * c * c + b * s * s, a * s * s + b * c * c, (a - b) * c * s];
+}
+
+// The map's values of component `comp` in the chosen measure (null where the node has none),
+// and the measure's name; null values when the conversion is impossible.
+const finiteOrNull = (v) => (isFinite(v) ? v : null);
+function mapValues(f, comp) {
+  const want = $('map-measure').value;
+  if (want === 'measured' || want === f.measure) return [f[comp], f.measure];
+  if (!(f.measure in STRETCH_OF)) return [null, `${want}: not from ${f.measure} strain`];
+  const k = { exx: 0, eyy: 1, exy: 2 }[comp];
+  return [f.exx.map((v, i) => (v === null || f.eyy[i] === null || f.exy[i] === null) ? null
+    : finiteOrNull(convertStrain(v, f.eyy[i], f.exy[i], f.measure, want)[k])), want];
+}
+
 function drawSpecimen() {
   const s = dash.last;
   const canvas = $('image'), ctx = canvas.getContext('2d');
@@ -169,7 +194,8 @@ function drawSpecimen() {
   dash.imagesDrawn++;
   const f = s.field;
   if (f && f.x.length > 0) {
-    const comp = $('component').value, values = f[comp];
+    const comp = $('component').value, [converted, measureName] = mapValues(f, comp);
+    const values = converted || f[comp].map(() => null);
     const [lo, hi] = colourRange(values);
     const cell = Math.max(1, f.step_px * f.stride / im.factor);
     if ($('show-map').checked) {
@@ -194,7 +220,7 @@ function drawSpecimen() {
         ctx.fillStyle = '#000'; ctx.fillRect(x - 1, y - 1, 2, 2);
       }
     }
-    drawColorbar(lo, hi, `${comp} (${f.measure})`);
+    drawColorbar(lo, hi, `${comp} (${measureName})`);
   }
 }
 
@@ -271,6 +297,11 @@ function drawInvariantFunctions(id) {
   const lu = maxStretch(id.uniaxial), le = maxStretch(id.equibiaxial);
   curve(id.f_coefficients, lu * lu + 2 / lu, 'f(I1) against I1', SERIES_COLORS[0]);
   curve(id.g_coefficients, le ** 4 + 2 / (le * le), 'g(I2) against I2', SERIES_COLORS[1]);
+  // The route's experimental points (eqs. 19/20 and 23) from this run's stresses.
+  [[id.f_points, 'f points (uniaxial)', SERIES_COLORS[3]], [id.g_points, 'g points (equibiaxial)', SERIES_COLORS[4]]]
+    .forEach(([p, label, color]) => {
+      if (p && p.invariant.length) series.push({ x: p.invariant, y: p.value_mpa, color, label, dots: true });
+    });
   lineChart($('fg-chart'), series, { xlabel: 'invariant I1 or I2', yZero: true, empty: 'no coefficient identified yet' });
 }
 
@@ -355,7 +386,7 @@ function connect() {
     try { update(JSON.parse(e.data)); } catch (err) { console.error(err); }
   });
 }
-for (const id of ['component', 'range-mode', 'range-min', 'range-max', 'show-mesh', 'show-map']) {
+for (const id of ['component', 'map-measure', 'range-mode', 'range-min', 'range-max', 'show-mesh', 'show-map']) {
   $(id).addEventListener('change', drawSpecimen);
 }
 $('measure').addEventListener('change', () => dash.last && update(dash.last));
