@@ -7,6 +7,7 @@ pub mod correlator;
 pub mod identifier;
 pub mod identify;
 pub mod producer;
+pub mod producer_watch;
 pub mod rig;
 pub mod run;
 pub mod synth;
