@@ -9,6 +9,7 @@
 //!
 //! Timeouts only guard against a hang; no assertion on a wall-clock time.
 
+use std::fmt::Debug;
 use std::fs::File;
 use std::io::{Cursor, Write};
 use std::path::{Path, PathBuf};
@@ -19,7 +20,8 @@ use std::time::{Duration, Instant};
 use iceoryx2::prelude::*;
 use image::{ImageBuffer, ImageFormat, Luma};
 use wire::pubsub::SliceSubscriber;
-use wire::{services, FrameHeader, Instance};
+use wire::services::ServiceSpec;
+use wire::{services, FieldHeader, FieldNode, FrameHeader, Instance};
 
 /// Bound on anything the test waits for: a hang guard, not a measurement.
 const HANG_GUARD: Duration = Duration::from_secs(120);
@@ -37,6 +39,8 @@ struct Watch {
     instance: Instance,
     dir: PathBuf,
     child: Option<Child>,
+    /// Other processes of the test (a correlator), by name.
+    others: Vec<(String, Child)>,
 }
 
 impl Watch {
@@ -51,6 +55,7 @@ impl Watch {
             instance,
             dir,
             child: None,
+            others: Vec::new(),
         }
     }
 
@@ -77,6 +82,32 @@ impl Watch {
         self.child = Some(child);
     }
 
+    /// Starts `dicstream ARGS --instance <it>` as `name`, stderr to `<name>.stderr.txt`.
+    fn spawn_other(&mut self, name: &str, args: &[&str]) {
+        let err = File::create(self.dir.join(format!("{name}.stderr.txt"))).unwrap();
+        let child = Command::new(env!("CARGO_BIN_EXE_dicstream"))
+            .args(args)
+            .args(["--instance", self.instance.name()])
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(err)
+            .spawn()
+            .unwrap_or_else(|e| panic!("spawning dicstream {args:?}: {e}"));
+        self.others.push((name.to_string(), child));
+    }
+
+    /// SIGTERM to `name`, then its exit status.
+    fn stop_other(&mut self, name: &str) -> ExitStatus {
+        let (_, child) = self.others.iter_mut().find(|(n, _)| n == name).unwrap();
+        // SAFETY: kill(2) on our own child's pid.
+        assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
+        child.wait().unwrap()
+    }
+
+    fn stderr_of(&self, name: &str) -> String {
+        std::fs::read_to_string(self.dir.join(format!("{name}.stderr.txt"))).unwrap_or_default()
+    }
+
     fn stdout(&self) -> String {
         std::fs::read_to_string(self.dir.join("stdout.txt")).unwrap_or_default()
     }
@@ -98,7 +129,8 @@ impl Watch {
 
 impl Drop for Watch {
     fn drop(&mut self) {
-        if let Some(child) = self.child.as_mut() {
+        let others = self.others.iter_mut().map(|(_, child)| child);
+        for child in self.child.iter_mut().chain(others) {
             if child.try_wait().ok().flatten().is_none() {
                 let _ = child.kill();
                 let _ = child.wait();
@@ -110,52 +142,57 @@ impl Drop for Watch {
     }
 }
 
-/// A frame as received: its header and a copy of its pixels (copied at once, so the test
+/// A sample as received: its header and a copy of its payload (copied at once, so the test
 /// keeps up with the producer and never holds a sample).
-struct Received {
-    header: FrameHeader,
-    pixels: Vec<u16>,
+struct Received<T, H> {
+    header: H,
+    payload: Vec<T>,
 }
 
-/// This test as a consumer of `frames`, subscribed before the producer exists.
-struct Consumer {
+/// This test as a consumer of a service (`frames`, `fields`), subscribed before the publisher
+/// exists.
+struct Consumer<T: Debug + ZeroCopySend + Copy + 'static, H: Debug + ZeroCopySend + 'static> {
     _node: Node<ipc::Service>,
-    frames: SliceSubscriber<u16, FrameHeader>,
+    subscriber: SliceSubscriber<T, H>,
     waitset: WaitSet<ipc::Service>,
-    received: Vec<Received>,
+    received: Vec<Received<T, H>>,
 }
 
-impl Consumer {
-    fn new(instance: &Instance) -> Consumer {
+impl<T, H> Consumer<T, H>
+where
+    T: Debug + ZeroCopySend + Copy + 'static,
+    H: Debug + ZeroCopySend + Default + Copy + 'static,
+{
+    fn new(instance: &Instance, spec: &ServiceSpec) -> Self {
         let (node, _) = instance.create_node("test").expect("test node");
-        let frames = SliceSubscriber::create(&node, &services::FRAMES).expect("frames subscriber");
+        let subscriber = SliceSubscriber::create(&node, spec).expect("subscriber");
         let waitset = WaitSetBuilder::new().create::<ipc::Service>().unwrap();
         Consumer {
             _node: node,
-            frames,
+            subscriber,
             waitset,
             received: Vec::new(),
         }
     }
 
     /// Receives until `until` says stop (checked after every wake-up or 100 ms).
-    fn receive_until(&mut self, mut until: impl FnMut(&[Received]) -> bool) {
+    fn receive_until(&mut self, mut until: impl FnMut(&[Received<T, H>]) -> bool) {
         let Consumer {
-            frames,
+            subscriber,
             waitset,
             received,
             ..
         } = self;
-        let _guard = waitset.attach_notification(frames.listener()).unwrap();
+        let _guard = waitset.attach_notification(subscriber.listener()).unwrap();
         let give_up = Instant::now() + HANG_GUARD;
         loop {
-            drain(frames, received);
+            drain(subscriber, received);
             if until(received) {
                 break;
             }
             assert!(
                 Instant::now() < give_up,
-                "hang guard: {} frames received",
+                "hang guard: {} samples received",
                 received.len()
             );
             waitset
@@ -165,16 +202,20 @@ impl Consumer {
                 )
                 .unwrap();
         }
-        drain(frames, received);
+        drain(subscriber, received);
     }
 }
 
-fn drain(frames: &SliceSubscriber<u16, FrameHeader>, received: &mut Vec<Received>) {
-    frames.clear_events();
-    while let Some(sample) = frames.receive().unwrap() {
+fn drain<T, H>(subscriber: &SliceSubscriber<T, H>, received: &mut Vec<Received<T, H>>)
+where
+    T: Debug + ZeroCopySend + Copy + 'static,
+    H: Debug + ZeroCopySend + Default + Copy + 'static,
+{
+    subscriber.clear_events();
+    while let Some(sample) = subscriber.receive().unwrap() {
         received.push(Received {
             header: *sample.user_header(),
-            pixels: sample.payload().to_vec(),
+            payload: sample.payload().to_vec(),
         });
     }
 }
@@ -249,7 +290,8 @@ fn images_written_slowly_are_published_once_whole_in_natural_order_and_bad_files
     std::fs::write(input.join("img_10.tif"), tiff(10)).unwrap();
     std::fs::write(input.join("img_9.tif"), tiff(9)).unwrap();
 
-    let mut consumer = Consumer::new(&watch.instance);
+    let mut consumer: Consumer<u16, FrameHeader> =
+        Consumer::new(&watch.instance, &services::FRAMES);
     let log = watch.dir.join("frames_log.csv");
     watch.start(&[
         "--from-start",
@@ -341,18 +383,18 @@ fn images_written_slowly_are_published_once_whole_in_natural_order_and_bad_files
         assert_eq!((h.width_px, h.height_px, h.bit_depth), (WIDTH, HEIGHT, 16));
         assert_eq!(h.has_truth, 0, "frame {k}: a watched file has no truth");
         assert_eq!(
-            wire::frame::pixel_checksum(&frame.pixels),
+            wire::frame::pixel_checksum(&frame.payload),
             h.pixel_checksum,
             "frame {k} ({name}) torn"
         );
         let seed: u64 = name[4..name.find('.').unwrap()].parse().unwrap();
         assert!(
-            frame.pixels == image(seed),
+            frame.payload == image(seed),
             "frame {k}: pixels are not those of {name}"
         );
         let on_disk = producer::read_image(input.join(name)).unwrap();
         assert!(
-            frame.pixels == on_disk.pixels,
+            frame.payload == on_disk.pixels,
             "frame {k} vs {name} on disk"
         );
         if name == "img_13.png" || name == "img_14.tif" {
@@ -392,7 +434,8 @@ fn files_present_at_start_are_ignored_and_sigint_stops_the_watch_cleanly() {
         )
     };
     std::fs::write(input.join("old_1.tif"), tiff(1)).unwrap();
-    let mut consumer = Consumer::new(&watch.instance);
+    let mut consumer: Consumer<u16, FrameHeader> =
+        Consumer::new(&watch.instance, &services::FRAMES);
     watch.start(&["--settle-ms", &SETTLE_MS.to_string()]);
     // The producer has looked at the folder once it says it is watching.
     let give_up = Instant::now() + HANG_GUARD;
@@ -416,9 +459,126 @@ fn files_present_at_start_are_ignored_and_sigint_stops_the_watch_cleanly() {
     );
     assert!(stdout.contains("stopped by signal"), "{stdout}");
     assert_eq!(consumer.received.len(), 1, "{stderr}");
-    assert!(consumer.received[0].pixels == pixels(2, WIDTH, HEIGHT));
+    assert!(consumer.received[0].payload == pixels(2, WIDTH, HEIGHT));
     assert!(stderr.contains("frame 0 <- new_2.tif"), "{stderr}");
     assert!(!stderr.contains("old_1"), "{stderr}");
+}
+
+/// The DIC Challenge's sample 5 (../shared/data), 512 x 512, 8 bit: reference, u = v = 0,
+/// u = v = +0.1 px (another noise realisation and contrast each).
+const SAMPLE5: [&str; 3] = [
+    "Sample5 Reference.tif",
+    "Sample5-000 X0.00 Y0.00 N2 C75 R10.tif",
+    "Sample5-001 X0.10 Y0.10 N2 C100 R20.tif",
+];
+
+#[test]
+fn a_live_correlator_measures_dic_challenge_images_written_slowly_into_the_folder() {
+    let sample5 =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/dic-challenge/sample5");
+    if !sample5.join(SAMPLE5[0]).is_file() {
+        eprintln!(
+            "SKIPPED: {} is absent (the DIC Challenge images)",
+            sample5.display()
+        );
+        return;
+    }
+    let mut watch = Watch::new("watch_correlator");
+    let input = watch.input();
+    let mut fields: Consumer<FieldNode, FieldHeader> =
+        Consumer::new(&watch.instance, &services::FIELDS);
+    watch.spawn_other("correlator", &["correlator", "--threads", "1"]);
+    let give_up = Instant::now() + HANG_GUARD;
+    while !watch.stderr_of("correlator").contains("correlator: ready") {
+        assert!(
+            Instant::now() < give_up,
+            "hang guard: {}",
+            watch.stderr_of("correlator")
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // --from-start: the writer may begin before the producer's first look at the folder.
+    watch.start(&[
+        "--from-start",
+        "--settle-ms",
+        &SETTLE_MS.to_string(),
+        "--idle-timeout-s",
+        "3",
+    ]);
+    let writer = std::thread::spawn(move || {
+        // Named so that natural order is the sequence order; each written in 8 chunks, the
+        // last by rename from a temporary name.
+        for (k, name) in SAMPLE5.iter().enumerate() {
+            let bytes = std::fs::read(sample5.join(name)).unwrap();
+            let target = input.join(format!("sample5_{}.tif", k + 1));
+            if k == 2 {
+                let temporary = input.join("sample5_3.tif.part");
+                write_slowly(&temporary, &bytes, 8, Duration::from_millis(SETTLE_MS / 4));
+                std::fs::rename(temporary, target).unwrap();
+            } else {
+                write_slowly(&target, &bytes, 8, Duration::from_millis(SETTLE_MS / 4));
+            }
+        }
+    });
+    let mut status = None;
+    fields.receive_until(|_| {
+        status = watch.exited();
+        status.is_some()
+    });
+    writer.join().unwrap();
+    // The last field may come after the producer ended: wait for it (bounded, a hang guard).
+    let give_up = Instant::now() + Duration::from_secs(30);
+    fields.receive_until(|received| {
+        received.iter().any(|f| f.header.frame_id == 2) || Instant::now() > give_up
+    });
+    let correlator_status = watch.stop_other("correlator");
+    let correlator = watch.stderr_of("correlator");
+    assert!(correlator_status.success(), "{correlator}");
+    let (stdout, stderr) = (watch.stdout(), watch.stderr());
+    assert!(status.unwrap().success(), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("3 image(s) published, 0 skipped"),
+        "{stdout}\n{stderr}"
+    );
+    eprintln!("{stderr}{stdout}");
+
+    let ids: Vec<u64> = fields.received.iter().map(|f| f.header.frame_id).collect();
+    assert!(
+        ids.contains(&2),
+        "no field of the last frame: {ids:?}\n{correlator}\n{stderr}"
+    );
+    assert!(
+        ids.windows(2).all(|w| w[0] < w[1]),
+        "each frame correlated once, in order: {ids:?}"
+    );
+    for field in &fields.received {
+        eprintln!(
+            "field of frame {}: mean u {:.4} px, v {:.4} px, {} of {} nodes valid",
+            field.header.frame_id,
+            field.header.u_mean_px,
+            field.header.v_mean_px,
+            field.header.valid_nodes,
+            field.payload.len()
+        );
+        let h = &field.header;
+        assert_eq!(h.has_truth, 0);
+        assert_eq!(h.reference_frame_id, 0, "{correlator}");
+        let expected_px = [0.0, 0.0, 0.1][h.frame_id as usize];
+        assert!(
+            h.valid_nodes as usize * 2 > field.payload.len(),
+            "frame {}: {} of {} nodes valid\n{correlator}",
+            h.frame_id,
+            h.valid_nodes,
+            field.payload.len()
+        );
+        for (axis, mean) in [("u", h.u_mean_px), ("v", h.v_mean_px)] {
+            assert!(
+                (mean - expected_px).abs() < 0.02,
+                "frame {}: mean {axis} {mean:.4} px, imposed {expected_px} px",
+                h.frame_id
+            );
+        }
+    }
 }
 
 #[test]
