@@ -480,6 +480,11 @@ impl Watcher {
             let Ok(name) = entry.file_name().into_string() else {
                 continue;
             };
+            // Handed out or ignored already: not even looked at (a folder keeps every image of
+            // a test, and is listed every poll).
+            if self.done.contains(&name) {
+                continue;
+            }
             let path = entry.path();
             // Follows symbolic links; a file removed meanwhile is skipped.
             let Ok(meta) = std::fs::metadata(&path) else {
@@ -493,7 +498,7 @@ impl Watcher {
                 temporary_ids.extend(id);
                 continue;
             }
-            if !has_image_extension(&name) || self.done.contains(&name) {
+            if !has_image_extension(&name) {
                 continue;
             }
             let modified = meta.modified().unwrap_or(SystemTime::UNIX_EPOCH);
