@@ -1,8 +1,8 @@
 //! `dicstream producer`: the camera process. Publishes `frames` (zero-copy `[u16]` slices behind
 //! a `FrameHeader`) from a simulated scenario, a replayed image folder, or the rig state
 //! (`--follow-rig`), paced to `--fps`, or the images of a watched folder as they become
-//! complete (`--watch`, `producer_watch.rs`). Says "ready" on stderr once the publisher exists and
-//! prints one final line on stdout (also after SIGINT/SIGTERM, then exits 0).
+//! complete (`--watch`, `producer_watch.rs`). Says "ready" on stderr once the publisher exists
+//! and prints one final line on stdout (also after SIGINT/SIGTERM, then exits 0).
 
 use std::path::PathBuf;
 
