@@ -69,6 +69,14 @@ pub enum ProducerError {
         /// The folder or glob given.
         path: PathBuf,
     },
+    /// A watched folder that is missing, not a folder, or cannot be listed.
+    #[error("cannot watch {path}: {reason}")]
+    WatchFolder {
+        /// The folder given.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// An image file's size is not the frame buffer's (a file rewritten with another size).
     #[error("image {path} is {found_width}x{found_height} px, the frame buffer holds {expected_px} pixels")]
     ImageSize {

@@ -1,7 +1,8 @@
 //! Frame producer: simulated speckle camera with exact ground truth, and image-folder replay.
 //!
 //! Pure library, no IPC, except the thin streaming shell (`stream`), which publishes what a
-//! [`FrameSource`] (scenario, replay) or the rig-driven [`RigCamera`] renders.
+//! [`FrameSource`] (scenario, replay), the rig-driven [`RigCamera`] or a watched folder
+//! ([`Watcher`]) gives.
 
 #![forbid(unsafe_code)]
 
@@ -23,6 +24,7 @@ mod source;
 pub mod speckle;
 #[cfg(feature = "process")]
 pub mod stream;
+mod watch;
 
 pub use camera::{CameraModel, BIT_DEPTHS};
 pub use cli::{RendererArg, SimArgs};
@@ -46,3 +48,7 @@ pub use simulated::{
 };
 pub use source::{FrameDims, FrameInfo, FrameSource, Truth};
 pub use speckle::{Speckle, SpeckleParams};
+pub use watch::{
+    is_temporary_name, WatchCounts, WatchEnd, WatchNote, WatchSettings, WatchedFile, Watcher,
+    DEFAULT_MAX_DECODE_ATTEMPTS, DEFAULT_POLL_MS, DEFAULT_SETTLE_MS, TEMPORARY_SUFFIXES,
+};

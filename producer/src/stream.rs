@@ -2,10 +2,11 @@
 //! `frames` service, stamps the header, paces to the requested rate and never waits for a
 //! consumer (safe overflow: a slow or dead reader loses frames, the camera never blocks).
 //!
-//! Two loops share the same shell: [`stream`] pulls a [`FrameSource`] (scenario, replay), and
+//! Three loops share the same shell: [`stream`] pulls a [`FrameSource`] (scenario, replay),
 //! [`stream_following_rig`] subscribes to `rig/state` and renders each frame from the most
-//! recent rig sample with a [`RigCamera`]. Everything else (rendering, the rig kinematics, the
-//! envelope) lives in the pure modules.
+//! recent rig sample with a [`RigCamera`], and [`stream_watched`] (`stream/watched.rs`)
+//! publishes the images of a watched folder as they become complete. Everything else
+//! (rendering, the rig kinematics, the envelope, the folder watcher) lives in the pure modules.
 
 use crate::{FrameDims, FrameInfo, FrameSource, NextMotion, ProducerError, RigCamera};
 use iceoryx2::prelude::*;
@@ -13,6 +14,9 @@ use std::time::{Duration, Instant};
 use wire::frame::pixel_checksum;
 use wire::pubsub::{SlicePublisher, ValueSubscriber};
 use wire::{services, FrameHeader, GroundTruth, Instance, InstanceError, RigState};
+
+mod watched;
+pub use watched::stream_watched;
 
 /// Longest sleep while waiting for the first rig sample (a signal is seen within it).
 const RIG_WAIT_SLICE: Duration = Duration::from_millis(200);

@@ -8,6 +8,7 @@ pub mod identifier;
 pub mod identify;
 pub mod monitor;
 pub mod producer;
+pub mod producer_watch;
 pub mod rig;
 pub mod run;
 pub mod synth;

@@ -1,7 +1,8 @@
 //! `dicstream producer`: the camera process. Publishes `frames` (zero-copy `[u16]` slices behind
 //! a `FrameHeader`) from a simulated scenario, a replayed image folder, or the rig state
-//! (`--follow-rig`), paced to `--fps`. Says "ready" on stderr once the publisher exists and
-//! prints one final line on stdout (also after SIGINT/SIGTERM, then exits 0).
+//! (`--follow-rig`), paced to `--fps`, or the images of a watched folder as they become
+//! complete (`--watch`, `producer_watch.rs`). Says "ready" on stderr once the publisher exists
+//! and prints one final line on stdout (also after SIGINT/SIGTERM, then exits 0).
 
 use std::path::PathBuf;
 
@@ -26,6 +27,25 @@ pub struct ProducerArgs {
     /// With --replay: start again from the first image after the last one, endlessly
     #[arg(long = "loop", requires = "replay")]
     pub looping: bool,
+    /// Watch a folder: publish each image another program writes into DIR once it is complete
+    /// (unchanged for --settle-ms, or renamed from a temporary name), in natural order, each
+    /// file once; name and modification time of each frame on stderr (and in --log)
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scenario", "params", "width", "height", "follow_rig", "replay", "fps"])]
+    pub watch: Option<PathBuf>,
+    /// With --watch: also publish the images already in the folder at start
+    #[arg(long, requires = "watch")]
+    pub from_start: bool,
+    /// With --watch: end (exit 0, with the summary) after this many seconds without a new image
+    #[arg(long, value_name = "S", requires = "watch")]
+    pub idle_timeout_s: Option<f64>,
+    /// With --watch: a file whose size and modification time stay unchanged this long is
+    /// complete, ms
+    #[arg(long, default_value_t = producer::DEFAULT_SETTLE_MS, requires = "watch")]
+    pub settle_ms: u64,
+    /// With --watch: write one CSV row per frame (frame_id,file,modified_unix_ns,size_bytes,
+    /// renamed) to this file
+    #[arg(long, value_name = "FILE", requires = "watch")]
+    pub log: Option<PathBuf>,
     /// Render each frame from the most recent rig/state sample (the rig deforms the specimen);
     /// waits for the first sample
     #[arg(long, conflicts_with_all = ["scenario", "params"])]
@@ -144,6 +164,15 @@ pub fn run(args: ProducerArgs) -> anyhow::Result<()> {
                 .map_or_else(|| "-".to_string(), |id| id.to_string())
         );
         (report, line)
+    } else if let Some(dir) = &args.watch {
+        let watch = super::producer_watch::WatchArgs {
+            dir,
+            from_start: args.from_start,
+            idle_timeout_s: args.idle_timeout_s,
+            settle_ms: args.settle_ms,
+            log: args.log.as_ref(),
+        };
+        super::producer_watch::run(watch, &instance, &settings, &mut on_event)?
     } else if let Some(source) = &args.replay {
         let mut replay = Replay::open(source)?;
         let dims = replay.dims();
@@ -178,7 +207,8 @@ pub fn run(args: ProducerArgs) -> anyhow::Result<()> {
         );
         (report, line)
     };
-    println!("{}", final_line(&report, args.fps, &source_line));
+    let fps = if args.watch.is_some() { 0.0 } else { args.fps };
+    println!("{}", final_line(&report, fps, &source_line));
     Ok(())
 }
 
