@@ -11,12 +11,15 @@
 //! Without chromium the browser test says so and passes, except under CI (`CI` set), where
 //! it fails: `.ci/run` installs chromium.
 
+mod common;
 mod dashboard_support;
 
+use common::Run;
 use dashboard_support::webdriver::Browser;
-use dashboard_support::{get_json, http, unique_instance, until, Events, InstanceFiles, Proc};
+use dashboard_support::{dashboard_address, get_json, http, Events};
 use serde_json::Value;
 use std::path::PathBuf;
+use testkit::until;
 
 fn artefacts() -> PathBuf {
     PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("dashboard")
@@ -50,15 +53,16 @@ fn frames_seen(snapshot: &Value) -> u64 {
 
 #[test]
 fn monitor_serves_a_read_only_event_stream_with_growing_snapshots_and_images() {
-    let instance = unique_instance("sse");
-    let _files = InstanceFiles(instance.clone());
+    let mut bench = Run::new("sse");
+    let instance = bench.name().to_string();
     let args = producer_args(&instance);
-    let mut producer = Proc::spawn(
-        "producer",
-        &args.iter().map(String::as_str).collect::<Vec<_>>(),
-    );
-    producer.wait_line("producer ready", |l| l.contains("ready"));
-    let mut monitor = Proc::spawn(
+    bench
+        .spawn(
+            "producer",
+            &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        )
+        .wait_for_stderr("producer ready", |l| l.contains("ready"));
+    let monitor = bench.spawn(
         "monitor",
         &[
             "monitor",
@@ -68,7 +72,8 @@ fn monitor_serves_a_read_only_event_stream_with_growing_snapshots_and_images() {
             "127.0.0.1:0",
         ],
     );
-    let addr = monitor.dashboard_address();
+    let addr =
+        dashboard_address(&monitor.wait_for_stderr("dashboard URL", |l| l.contains("http://")));
 
     // The page and its assets come from the binary; anything but GET is refused.
     let (status, page) = http(&addr, "GET", "/", None);
@@ -137,26 +142,24 @@ fn monitor_serves_a_read_only_event_stream_with_growing_snapshots_and_images() {
 
     // Ctrl-C ends the monitor cleanly; the camera is unaffected.
     drop(second);
+    let monitor = bench.child("monitor");
     monitor.signal(libc::SIGINT);
-    assert_eq!(monitor.wait_exit(), Some(0), "{}", monitor.stderr_so_far());
+    assert_eq!(monitor.wait_exit().code(), Some(0), "{}", monitor.stderr());
+    let producer = bench.child("producer");
     producer.signal(libc::SIGINT);
     producer.wait_exit();
 }
 
 #[test]
 fn monitor_refuses_a_bad_address_naming_it() {
-    let mut monitor = Proc::spawn(
+    let mut bench = Run::new("bad_address");
+    let instance = bench.name().to_string();
+    let monitor = bench.spawn(
         "monitor",
-        &[
-            "monitor",
-            "--instance",
-            "td_bad_address",
-            "--dashboard",
-            "nowhere",
-        ],
+        &["monitor", "--instance", &instance, "--dashboard", "nowhere"],
     );
-    assert_ne!(monitor.wait_exit(), Some(0));
-    let stderr = monitor.stderr_so_far();
+    assert_ne!(monitor.wait_exit().code(), Some(0));
+    let stderr = monitor.stderr();
     assert!(
         stderr.contains("\"nowhere\"") && stderr.contains("ADDR:PORT"),
         "{stderr}"
@@ -234,10 +237,10 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
         eprintln!("SKIPPED: no /usr/bin/chromium or /usr/bin/chromedriver (apt-get install chromium chromium-driver)");
         return;
     };
-    let instance = unique_instance("browser");
-    let _files = InstanceFiles(instance.clone());
+    let mut bench = Run::new("browser");
+    let instance = bench.name().to_string();
     let config = write_config(&dir.join("run"));
-    let mut run = Proc::spawn(
+    let run = bench.spawn(
         "run",
         &[
             "run",
@@ -250,15 +253,17 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
             "--quiet",
         ],
     );
-    let run_addr = run.dashboard_address();
-    let correlator_line = run.wait_line("correlator ready", |l| l.contains("correlator ready"));
+    let run_addr =
+        dashboard_address(&run.wait_for_stderr("dashboard URL", |l| l.contains("http://")));
+    let correlator_line =
+        run.wait_for_stderr("correlator ready", |l| l.contains("correlator ready"));
     let correlator_pid: i32 = correlator_line
         .split("pid ")
         .nth(1)
         .and_then(|s| s.trim_end_matches(')').parse().ok())
         .unwrap_or_else(|| panic!("{correlator_line}"));
-    run.wait_line("rig ready", |l| l.contains("rig ready"));
-    let mut monitor = Proc::spawn(
+    run.wait_for_stderr("rig ready", |l| l.contains("rig ready"));
+    let monitor = bench.spawn(
         "monitor",
         &[
             "monitor",
@@ -268,7 +273,8 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
             "127.0.0.1:0",
         ],
     );
-    let monitor_addr = monitor.dashboard_address();
+    let monitor_addr =
+        dashboard_address(&monitor.wait_for_stderr("dashboard URL", |l| l.contains("http://")));
 
     // 1. The monitor's page: image, charts and counters update.
     browser.goto(&format!("http://{monitor_addr}/"));
@@ -316,10 +322,8 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
     until("the process table", || {
         (read_page(&browser)["correlator_restarts"] == "0").then_some(())
     });
-    // SAFETY: kill(2) of the run's correlator, a process of this test's own run.
-    unsafe {
-        libc::kill(correlator_pid, libc::SIGKILL);
-    }
+    // The run's correlator, a process of this test's own run.
+    testkit::signal(correlator_pid, libc::SIGKILL);
     let restarted = until("the restart on the page", || {
         let p = read_page(&browser);
         (p["correlator_restarts"] == "1").then_some(p)
@@ -357,8 +361,10 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
     eprintln!("screenshots: {} and monitor.png", shot.display());
 
     // The monitor outlives nothing it should not: both end on Ctrl-C.
+    let monitor = bench.child("monitor");
     monitor.signal(libc::SIGINT);
-    assert_eq!(monitor.wait_exit(), Some(0), "{}", monitor.stderr_so_far());
+    assert_eq!(monitor.wait_exit().code(), Some(0), "{}", monitor.stderr());
+    let run = bench.child("run");
     run.signal(libc::SIGINT);
-    assert_eq!(run.wait_exit(), Some(130), "{}", run.stderr_so_far());
+    assert_eq!(run.wait_exit().code(), Some(130), "{}", run.stderr());
 }

@@ -2,8 +2,9 @@
 //! package: a child process with its stderr read line by line ([`Proc`]: readiness, signals,
 //! exit), one hang guard ([`HANG_GUARD`]), a test's own instance whose shared-memory files are
 //! removed even when the test fails ([`TestInstance`]), a test's instance, children and scratch
-//! folder together ([`Run`]), unique instance names, and the path to `../shared/data`
-//! ([`shared_data`]: skipped with a message, or a failure under `DICSTREAM_REQUIRE_SHARED=1`).
+//! folder together ([`Run`]), unique instance names, polling for a condition no line announces
+//! ([`until`]), and the path to `../shared/data` ([`shared_data`]: skipped with a message, or a
+//! failure under `DICSTREAM_REQUIRE_SHARED=1`).
 //!
 //! Timeouts here only guard against a hang (a test that would otherwise never end); no test
 //! asserts a wall-clock time.
@@ -12,11 +13,13 @@ mod instance;
 mod proc;
 mod run;
 mod shared;
+mod until;
 
 pub use instance::{unique_instance, TestInstance};
 pub use proc::{signal, Proc};
 pub use run::Run;
 pub use shared::{shared_data, REQUIRE_SHARED_VAR, SHARED_DATA_VAR};
+pub use until::until;
 
 use std::time::Duration;
 

@@ -1,6 +1,7 @@
-//! Helpers of `tests/dashboard.rs` (its own, small): `dicstream` child processes whose stderr
-//! is read as it comes, a plain HTTP/1.1 client and a server-sent-event reader over
-//! `TcpStream`, and a WebDriver client of Debian's chromium (`webdriver.rs`).
+//! What only `tests/dashboard.rs` needs, beside the test kit (`testkit`: child processes,
+//! instances, [`until`](testkit::until), the hang guard): the dashboard's address from its
+//! stderr line, a plain HTTP/1.1 client and a server-sent-event reader over `TcpStream`, and a
+//! WebDriver client of Debian's chromium (`webdriver.rs`).
 //!
 //! Every wait is bounded by [`HANG_GUARD`], a guard against a hang only: no test asserts a
 //! wall-clock time.
@@ -12,150 +13,18 @@ pub mod webdriver;
 use serde_json::Value;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc::{channel, Receiver};
-use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use testkit::HANG_GUARD;
 
-pub const HANG_GUARD: Duration = Duration::from_secs(150);
-
-/// A unique instance name for this test.
-pub fn unique_instance(test: &str) -> String {
-    format!("td{}_{test}", std::process::id())
-}
-
-/// Calls `probe` every 200 ms until it gives a value; panics naming `what` after the guard.
-pub fn until<T>(what: &str, mut probe: impl FnMut() -> Option<T>) -> T {
-    let give_up = Instant::now() + HANG_GUARD;
-    loop {
-        if let Some(v) = probe() {
-            return v;
-        }
-        assert!(Instant::now() < give_up, "no {what} within {HANG_GUARD:?}");
-        std::thread::sleep(Duration::from_millis(200));
-    }
-}
-
-/// A `dicstream` child; killed (SIGKILL) when dropped if still running.
-pub struct Proc {
-    pub name: String,
-    child: Child,
-    lines: Receiver<String>,
-    log: Arc<Mutex<Vec<String>>>,
-    /// Says when stderr reached its end (every line is in `log`).
-    stderr_done: Receiver<()>,
-}
-
-impl Proc {
-    pub fn spawn(name: &str, args: &[&str]) -> Proc {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_dicstream"))
-            .args(args)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap_or_else(|e| panic!("{name}: cannot start dicstream: {e}"));
-        let (tx, lines) = channel();
-        let log = Arc::new(Mutex::new(Vec::new()));
-        let stderr = child.stderr.take().expect("piped stderr");
-        let (done_tx, stderr_done) = channel();
-        {
-            let log = log.clone();
-            std::thread::spawn(move || {
-                for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-                    log.lock().unwrap().push(line.clone());
-                    let _ = tx.send(line);
-                }
-                let _ = done_tx.send(());
-            });
-        }
-        Proc {
-            name: name.to_string(),
-            child,
-            lines,
-            log,
-            stderr_done,
-        }
-    }
-
-    pub fn pid(&self) -> i32 {
-        self.child.id() as i32
-    }
-
-    pub fn stderr_so_far(&self) -> String {
-        self.log.lock().unwrap().join("\n")
-    }
-
-    /// The first stderr line (from now) that matches; panics with the log on exit or hang.
-    pub fn wait_line(&mut self, what: &str, matches: impl Fn(&str) -> bool) -> String {
-        loop {
-            match self.lines.recv_timeout(HANG_GUARD) {
-                Ok(line) if matches(&line) => return line,
-                Ok(_) => {}
-                Err(_) => panic!(
-                    "{}: no {what}; stderr:\n{}",
-                    self.name,
-                    self.stderr_so_far()
-                ),
-            }
-        }
-    }
-
-    /// The URL the process printed (`... at http://ADDR:PORT/ ...`), as `ADDR:PORT`.
-    pub fn dashboard_address(&mut self) -> String {
-        let line = self.wait_line("dashboard URL", |l| l.contains("http://"));
-        let url = line.split("http://").nth(1).unwrap();
-        let addr = url.split('/').next().unwrap().to_string();
-        assert!(addr.starts_with("127.0.0.1:"), "{line}");
-        addr
-    }
-
-    pub fn signal(&self, signal: i32) {
-        // SAFETY: kill(2) on the pid of a child this test started and has not reaped.
-        unsafe {
-            libc::kill(self.pid(), signal);
-        }
-    }
-
-    /// Waits for the exit (hang guard), returning the exit code.
-    pub fn wait_exit(&mut self) -> Option<i32> {
-        let give_up = Instant::now() + HANG_GUARD;
-        loop {
-            if let Some(status) = self.child.try_wait().unwrap() {
-                // Its last lines too (the reader may not have had them yet).
-                let _ = self.stderr_done.recv_timeout(Duration::from_secs(10));
-                return status.code();
-            }
-            assert!(
-                Instant::now() < give_up,
-                "{} did not exit; stderr:\n{}",
-                self.name,
-                self.stderr_so_far()
-            );
-            std::thread::sleep(Duration::from_millis(100));
-        }
-    }
-}
-
-impl Drop for Proc {
-    fn drop(&mut self) {
-        if let Ok(None) = self.child.try_wait() {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
-        }
-    }
-}
-
-/// Removes an instance's files when dropped (after the processes, declared before them).
-pub struct InstanceFiles(pub String);
-
-impl Drop for InstanceFiles {
-    fn drop(&mut self) {
-        if let Ok(instance) = wire::Instance::new(&self.0) {
-            instance.cleanup_dead_nodes();
-            instance.remove_leftover_files();
-        }
-    }
+/// The address a dashboard's stderr `line` gives (`... at http://ADDR:PORT/ ...`), as
+/// `ADDR:PORT`; panics unless it is a loopback one.
+pub fn dashboard_address(line: &str) -> String {
+    let url = line
+        .split("http://")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no URL in {line:?}"));
+    let addr = url.split('/').next().unwrap().to_string();
+    assert!(addr.starts_with("127.0.0.1:"), "{line}");
+    addr
 }
 
 /// One HTTP/1.1 request (`Connection: close`): status and body.

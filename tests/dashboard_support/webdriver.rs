@@ -2,10 +2,11 @@
 //! HTTP and JSON, so no async runtime). Started with the flags this machine's closed network
 //! needs (no background connections) and a fresh profile folder.
 
-use super::{http, until, HANG_GUARD};
+use super::http;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
+use testkit::{until, HANG_GUARD};
 
 pub const CHROMIUM: &str = "/usr/bin/chromium";
 pub const CHROMEDRIVER: &str = "/usr/bin/chromedriver";
