@@ -9,137 +9,34 @@
 //!
 //! Timeouts only guard against a hang; no assertion on a wall-clock time.
 
+mod common;
+
 use std::fmt::Debug;
 use std::fs::File;
 use std::io::{Cursor, Write};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitStatus, Stdio};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
+use common::{Proc, Run, HANG_GUARD};
 use iceoryx2::prelude::*;
 use image::{ImageBuffer, ImageFormat, Luma};
 use wire::pubsub::SliceSubscriber;
 use wire::services::ServiceSpec;
 use wire::{services, FieldHeader, FieldNode, FrameHeader, Instance};
 
-/// Bound on anything the test waits for: a hang guard, not a measurement.
-const HANG_GUARD: Duration = Duration::from_secs(120);
 /// The producer's settle time in these tests, ms; pauses inside a file are shorter, except the
 /// one long pause that is meant to outlast it.
 const SETTLE_MS: u64 = 300;
 const WIDTH: u32 = 160;
 const HEIGHT: u32 = 120;
 
-static COUNTER: AtomicUsize = AtomicUsize::new(0);
-
-/// One test's instance, producer and scratch folder; on drop (passed or panicked) the producer
-/// is killed if it still runs and the instance's files and the folder are removed.
-struct Watch {
-    instance: Instance,
-    dir: PathBuf,
-    child: Option<Child>,
-    /// Other processes of the test (a correlator), by name.
-    others: Vec<(String, Child)>,
-}
-
-impl Watch {
-    fn new(test: &str) -> Watch {
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let name = format!("t{}_{test}_{n}", std::process::id());
-        let instance = Instance::new(&name).expect("valid instance name");
-        let dir = std::env::temp_dir().join(format!("dicstream-test-{name}"));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(dir.join("in")).expect("scratch folder");
-        Watch {
-            instance,
-            dir,
-            child: None,
-            others: Vec::new(),
-        }
-    }
-
-    fn input(&self) -> PathBuf {
-        self.dir.join("in")
-    }
-
-    /// Starts `dicstream producer --watch <input> --instance <it> EXTRA`, stdout and stderr to
-    /// files of the scratch folder.
-    fn start(&mut self, extra: &[&str]) {
-        let out = File::create(self.dir.join("stdout.txt")).unwrap();
-        let err = File::create(self.dir.join("stderr.txt")).unwrap();
-        let child = Command::new(env!("CARGO_BIN_EXE_dicstream"))
-            .arg("producer")
-            .arg("--watch")
-            .arg(self.input())
-            .args(["--instance", self.instance.name()])
-            .args(extra)
-            .stdin(Stdio::null())
-            .stdout(out)
-            .stderr(err)
-            .spawn()
-            .expect("spawning dicstream producer");
-        self.child = Some(child);
-    }
-
-    /// Starts `dicstream ARGS --instance <it>` as `name`, stderr to `<name>.stderr.txt`.
-    fn spawn_other(&mut self, name: &str, args: &[&str]) {
-        let err = File::create(self.dir.join(format!("{name}.stderr.txt"))).unwrap();
-        let child = Command::new(env!("CARGO_BIN_EXE_dicstream"))
-            .args(args)
-            .args(["--instance", self.instance.name()])
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(err)
-            .spawn()
-            .unwrap_or_else(|e| panic!("spawning dicstream {args:?}: {e}"));
-        self.others.push((name.to_string(), child));
-    }
-
-    /// SIGTERM to `name`, then its exit status.
-    fn stop_other(&mut self, name: &str) -> ExitStatus {
-        let (_, child) = self.others.iter_mut().find(|(n, _)| n == name).unwrap();
-        // SAFETY: kill(2) on our own child's pid.
-        assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
-        child.wait().unwrap()
-    }
-
-    fn stderr_of(&self, name: &str) -> String {
-        std::fs::read_to_string(self.dir.join(format!("{name}.stderr.txt"))).unwrap_or_default()
-    }
-
-    fn stdout(&self) -> String {
-        std::fs::read_to_string(self.dir.join("stdout.txt")).unwrap_or_default()
-    }
-
-    fn stderr(&self) -> String {
-        std::fs::read_to_string(self.dir.join("stderr.txt")).unwrap_or_default()
-    }
-
-    fn exited(&mut self) -> Option<ExitStatus> {
-        self.child.as_mut()?.try_wait().unwrap()
-    }
-
-    fn signal(&self, signal: i32) {
-        let pid = self.child.as_ref().expect("started").id() as i32;
-        // SAFETY: kill(2) on our own child's pid.
-        assert_eq!(unsafe { libc::kill(pid, signal) }, 0);
-    }
-}
-
-impl Drop for Watch {
-    fn drop(&mut self) {
-        let others = self.others.iter_mut().map(|(_, child)| child);
-        for child in self.child.iter_mut().chain(others) {
-            if child.try_wait().ok().flatten().is_none() {
-                let _ = child.kill();
-                let _ = child.wait();
-            }
-        }
-        self.instance.cleanup_dead_nodes();
-        self.instance.remove_leftover_files();
-        let _ = std::fs::remove_dir_all(&self.dir);
-    }
+/// Starts `dicstream producer --watch <input> --instance <the run's> EXTRA` as `producer`.
+fn start_producer<'a>(run: &'a mut Run, input: &Path, extra: &[&str]) -> &'a mut Proc {
+    let instance = run.name().to_string();
+    let input = input.to_str().expect("UTF-8 scratch path").to_string();
+    let mut args = vec!["producer", "--watch", &input, "--instance", &instance];
+    args.extend_from_slice(extra);
+    run.spawn("producer", &args)
 }
 
 /// A sample as received: its header and a copy of its payload (copied at once, so the test
@@ -279,8 +176,8 @@ fn log_rows(path: &Path) -> Vec<(u64, String, bool)> {
 
 #[test]
 fn images_written_slowly_are_published_once_whole_in_natural_order_and_bad_files_skipped() {
-    let mut watch = Watch::new("watch_slow");
-    let input = watch.input();
+    let mut run = Run::new("watch_slow");
+    let input = run.temp_dir("in");
     let short = Duration::from_millis(SETTLE_MS / 4);
     let image = |seed: u64| pixels(seed, WIDTH, HEIGHT);
     let tiff = move |seed: u64| encode(&image(seed), WIDTH, HEIGHT, ImageFormat::Tiff);
@@ -290,18 +187,21 @@ fn images_written_slowly_are_published_once_whole_in_natural_order_and_bad_files
     std::fs::write(input.join("img_10.tif"), tiff(10)).unwrap();
     std::fs::write(input.join("img_9.tif"), tiff(9)).unwrap();
 
-    let mut consumer: Consumer<u16, FrameHeader> =
-        Consumer::new(&watch.instance, &services::FRAMES);
-    let log = watch.dir.join("frames_log.csv");
-    watch.start(&[
-        "--from-start",
-        "--settle-ms",
-        &SETTLE_MS.to_string(),
-        "--idle-timeout-s",
-        "3",
-        "--log",
-        log.to_str().unwrap(),
-    ]);
+    let mut consumer: Consumer<u16, FrameHeader> = Consumer::new(&run.instance, &services::FRAMES);
+    let log = run.dir.join("frames_log.csv");
+    start_producer(
+        &mut run,
+        &input,
+        &[
+            "--from-start",
+            "--settle-ms",
+            &SETTLE_MS.to_string(),
+            "--idle-timeout-s",
+            "3",
+            "--log",
+            log.to_str().unwrap(),
+        ],
+    );
 
     let writer_dir = input.clone();
     let writer = std::thread::spawn(move || {
@@ -341,17 +241,12 @@ fn images_written_slowly_are_published_once_whole_in_natural_order_and_bad_files
         std::fs::write(dir.join("img_19.png"), png(19)).unwrap();
     });
 
-    let mut status = None;
-    consumer.receive_until(|_| {
-        status = watch.exited();
-        status.is_some()
-    });
+    consumer.receive_until(|_| !run.child("producer").is_running());
     writer.join().unwrap();
-    let status = status.unwrap();
-    let (stdout, stderr) = (watch.stdout(), watch.stderr());
+    let (status, stdout, stderr) = run.child("producer").wait();
     assert!(status.success(), "producer: {status}\n{stdout}\n{stderr}");
     // Shown with --nocapture: what the producer said.
-    eprintln!("{stderr}{stdout}");
+    eprintln!("{stderr}\n{stdout}");
     assert!(
         stdout.contains("7 image(s) published, 3 skipped")
             && stdout.contains("without a new image"),
@@ -423,8 +318,8 @@ fn images_written_slowly_are_published_once_whole_in_natural_order_and_bad_files
 
 #[test]
 fn files_present_at_start_are_ignored_and_sigint_stops_the_watch_cleanly() {
-    let mut watch = Watch::new("watch_sigint");
-    let input = watch.input();
+    let mut run = Run::new("watch_sigint");
+    let input = run.temp_dir("in");
     let tiff = |seed: u64| {
         encode(
             &pixels(seed, WIDTH, HEIGHT),
@@ -434,27 +329,18 @@ fn files_present_at_start_are_ignored_and_sigint_stops_the_watch_cleanly() {
         )
     };
     std::fs::write(input.join("old_1.tif"), tiff(1)).unwrap();
-    let mut consumer: Consumer<u16, FrameHeader> =
-        Consumer::new(&watch.instance, &services::FRAMES);
-    watch.start(&["--settle-ms", &SETTLE_MS.to_string()]);
+    let mut consumer: Consumer<u16, FrameHeader> = Consumer::new(&run.instance, &services::FRAMES);
+    let settle_ms = SETTLE_MS.to_string();
+    let producer = start_producer(&mut run, &input, &["--settle-ms", &settle_ms]);
     // The producer has looked at the folder once it says it is watching.
-    let give_up = Instant::now() + HANG_GUARD;
-    while !watch.stderr().contains("producer: watching") {
-        assert!(Instant::now() < give_up, "hang guard: {}", watch.stderr());
-        assert!(watch.exited().is_none(), "{}", watch.stderr());
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    producer.wait_line("producer: watching");
     std::fs::write(input.join("new_2.tif"), tiff(2)).unwrap();
     consumer.receive_until(|frames| !frames.is_empty());
-    watch.signal(libc::SIGINT);
-    let mut status = None;
-    consumer.receive_until(|_| {
-        status = watch.exited();
-        status.is_some()
-    });
-    let (stdout, stderr) = (watch.stdout(), watch.stderr());
+    run.child("producer").signal(libc::SIGINT);
+    consumer.receive_until(|_| !run.child("producer").is_running());
+    let (status, stdout, stderr) = run.child("producer").wait();
     assert!(
-        status.unwrap().success(),
+        status.success(),
         "SIGINT is a clean stop\n{stdout}\n{stderr}"
     );
     assert!(stdout.contains("stopped by signal"), "{stdout}");
@@ -474,37 +360,31 @@ const SAMPLE5: [&str; 3] = [
 
 #[test]
 fn a_live_correlator_measures_dic_challenge_images_written_slowly_into_the_folder() {
-    let sample5 =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/dic-challenge/sample5");
-    if !sample5.join(SAMPLE5[0]).is_file() {
-        eprintln!(
-            "SKIPPED: {} is absent (the DIC Challenge images)",
-            sample5.display()
-        );
+    let Some(sample5) = testkit::shared_data("dic-challenge/sample5") else {
         return;
-    }
-    let mut watch = Watch::new("watch_correlator");
-    let input = watch.input();
+    };
+    let mut run = Run::new("watch_correlator");
+    let input = run.temp_dir("in");
     let mut fields: Consumer<FieldNode, FieldHeader> =
-        Consumer::new(&watch.instance, &services::FIELDS);
-    watch.spawn_other("correlator", &["correlator", "--threads", "1"]);
-    let give_up = Instant::now() + HANG_GUARD;
-    while !watch.stderr_of("correlator").contains("correlator: ready") {
-        assert!(
-            Instant::now() < give_up,
-            "hang guard: {}",
-            watch.stderr_of("correlator")
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
+        Consumer::new(&run.instance, &services::FIELDS);
+    let instance = run.name().to_string();
+    run.spawn(
+        "correlator",
+        &["correlator", "--threads", "1", "--instance", &instance],
+    )
+    .wait_line("correlator: ready");
     // --from-start: the writer may begin before the producer's first look at the folder.
-    watch.start(&[
-        "--from-start",
-        "--settle-ms",
-        &SETTLE_MS.to_string(),
-        "--idle-timeout-s",
-        "3",
-    ]);
+    start_producer(
+        &mut run,
+        &input,
+        &[
+            "--from-start",
+            "--settle-ms",
+            &SETTLE_MS.to_string(),
+            "--idle-timeout-s",
+            "3",
+        ],
+    );
     let writer = std::thread::spawn(move || {
         // Named so that natural order is the sequence order; each written in 8 chunks, the
         // last by rename from a temporary name.
@@ -520,27 +400,24 @@ fn a_live_correlator_measures_dic_challenge_images_written_slowly_into_the_folde
             }
         }
     });
-    let mut status = None;
-    fields.receive_until(|_| {
-        status = watch.exited();
-        status.is_some()
-    });
+    fields.receive_until(|_| !run.child("producer").is_running());
     writer.join().unwrap();
     // The last field may come after the producer ended: wait for it (bounded, a hang guard).
     let give_up = Instant::now() + Duration::from_secs(30);
     fields.receive_until(|received| {
         received.iter().any(|f| f.header.frame_id == 2) || Instant::now() > give_up
     });
-    let correlator_status = watch.stop_other("correlator");
-    let correlator = watch.stderr_of("correlator");
+    let correlator_proc = run.child("correlator");
+    correlator_proc.signal(libc::SIGTERM);
+    let (correlator_status, _, correlator) = correlator_proc.wait();
     assert!(correlator_status.success(), "{correlator}");
-    let (stdout, stderr) = (watch.stdout(), watch.stderr());
-    assert!(status.unwrap().success(), "{stdout}\n{stderr}");
+    let (status, stdout, stderr) = run.child("producer").wait();
+    assert!(status.success(), "{stdout}\n{stderr}");
     assert!(
         stdout.contains("3 image(s) published, 0 skipped"),
         "{stdout}\n{stderr}"
     );
-    eprintln!("{stderr}{stdout}");
+    eprintln!("{stderr}\n{stdout}");
 
     let ids: Vec<u64> = fields.received.iter().map(|f| f.header.frame_id).collect();
     assert!(
@@ -583,21 +460,13 @@ fn a_live_correlator_measures_dic_challenge_images_written_slowly_into_the_folde
 
 #[test]
 fn a_missing_folder_is_refused_at_start() {
-    let mut watch = Watch::new("watch_missing");
-    std::fs::remove_dir_all(watch.input()).unwrap();
-    watch.start(&["--idle-timeout-s", "1"]);
-    let give_up = Instant::now() + HANG_GUARD;
-    let status = loop {
-        if let Some(status) = watch.exited() {
-            break status;
-        }
-        assert!(Instant::now() < give_up, "hang guard");
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let stderr = watch.stderr();
+    let mut run = Run::new("watch_missing");
+    // Never created.
+    let input = run.dir.join("in");
+    let (status, _, stderr) = start_producer(&mut run, &input, &["--idle-timeout-s", "1"]).wait();
     assert!(!status.success(), "{stderr}");
     assert!(
-        stderr.contains(&format!("cannot watch {}", watch.input().display())),
+        stderr.contains(&format!("cannot watch {}", input.display())),
         "{stderr}"
     );
 }
