@@ -1,6 +1,6 @@
 //! Bounded histories for the charts and counters (pure): a time series that halves its
-//! resolution when full (so a test of any length fits in a fixed number of points), a rate over
-//! the last seconds, and consecutive ids whose gaps are drops.
+//! resolution when full (so a test of any length fits in a fixed number of points) and a rate
+//! over the last seconds (gaps in ids: `wire::stats::IdGaps`).
 
 use std::collections::VecDeque;
 
@@ -107,25 +107,6 @@ impl Rate {
     }
 }
 
-/// Ids that should be consecutive: a gap is a drop, an id that goes back a publisher restart.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Ids {
-    pub last: Option<u64>,
-    pub drops: u64,
-    pub restarts: u64,
-}
-
-impl Ids {
-    pub fn observe(&mut self, id: u64) {
-        match self.last {
-            Some(last) if id > last => self.drops += id - last - 1,
-            Some(_) => self.restarts += 1,
-            None => {}
-        }
-        self.last = Some(id);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -158,14 +139,5 @@ mod tests {
             r.mark(i * 500_000_000, i * 5);
         }
         assert!((r.per_s() - 10.0).abs() < 1e-9);
-    }
-
-    #[test]
-    fn gaps_are_drops_and_going_back_is_a_restart() {
-        let mut ids = Ids::default();
-        for id in [0, 1, 2, 5, 6, 0, 1] {
-            ids.observe(id);
-        }
-        assert_eq!((ids.drops, ids.restarts, ids.last), (2, 1, Some(1)));
     }
 }

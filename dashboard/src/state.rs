@@ -6,9 +6,10 @@
 
 use crate::image::{downsample, encode_png};
 use crate::latency::LatencyStats;
-use crate::series::{significant, Decimated, Ids, Rate};
+use crate::series::{significant, Decimated, Rate};
 use material::InvariantFn;
 use serde_json::{json, Value};
+use wire::stats::IdGaps;
 use wire::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, NodeStatus, RigState};
 
 /// Who serves the page: `dicstream run` (knows its processes) or `dicstream monitor`.
@@ -74,14 +75,14 @@ pub struct LiveState {
     settings: Settings,
     t0_ns: u64,
     frames_seen: u64,
-    frame_ids: Ids,
+    frame_ids: IdGaps,
     frame_rate: Rate,
     last_frame: Option<FrameHeader>,
     image: Option<ImageInfo>,
     last_image_ns: Option<u64>,
     image_error: Option<String>,
     fields_seen: u64,
-    field_ids: Ids,
+    field_ids: IdGaps,
     field_rate: Rate,
     last_field: Option<FieldHeader>,
     nodes: Vec<FieldNode>,
@@ -90,7 +91,7 @@ pub struct LiveState {
     /// t (s since the dashboard started), then exx, eyy, exy for each of the 4 measures.
     gauge: Decimated<13>,
     rig_seen: u64,
-    rig_ids: Ids,
+    rig_ids: IdGaps,
     rig_rate: Rate,
     last_rig: Option<RigState>,
     /// t_sim, stretch x, y, force X, Y (kN).
@@ -108,14 +109,14 @@ impl LiveState {
             settings,
             t0_ns,
             frames_seen: 0,
-            frame_ids: Ids::default(),
+            frame_ids: IdGaps::default(),
             frame_rate: Rate::new(RATE_WINDOW_NS),
             last_frame: None,
             image: None,
             last_image_ns: None,
             image_error: None,
             fields_seen: 0,
-            field_ids: Ids::default(),
+            field_ids: IdGaps::default(),
             field_rate: Rate::new(RATE_WINDOW_NS),
             last_field: None,
             nodes: Vec::new(),
@@ -123,7 +124,7 @@ impl LiveState {
             latency_identification: LatencyStats::default(),
             gauge: Decimated::new(n),
             rig_seen: 0,
-            rig_ids: Ids::default(),
+            rig_ids: IdGaps::default(),
             rig_rate: Rate::new(RATE_WINDOW_NS),
             last_rig: None,
             rig_history: Decimated::new(n),
@@ -278,7 +279,7 @@ impl LiveState {
             "seen": self.frames_seen,
             "last_id": self.frame_ids.last,
             "rate_hz": self.frame_rate.per_s(),
-            "missed_by_dashboard": self.frame_ids.drops,
+            "missed_by_dashboard": self.frame_ids.lost,
             "camera_restarts_seen": self.frame_ids.restarts,
             "width_px": self.last_frame.map(|f| f.width_px),
             "height_px": self.last_frame.map(|f| f.height_px),
