@@ -1,7 +1,18 @@
-//! Load cases, their kinematics, and the `stretch,nominal_stress_mpa` CSV reader.
+//! Load cases, general biaxial states, their kinematics, and the CSV readers
+//! (`stretch,nominal_stress_mpa` per canonical case; `lambda1,lambda2,nominal_stress1_mpa,
+//! nominal_stress2_mpa` for general biaxial states).
 //!
-//! Every load case is a homogeneous incompressible plane-stress state: the loaded stretch λ
-//! along direction 1, the traction-free thickness along direction 3 (σ3 = 0).
+//! Every datum is a homogeneous incompressible membrane state (plane stress): in-plane
+//! principal stretches (λ1, λ2), the traction-free thickness λ3 = 1/(λ1 λ2) (σ3 = 0). With
+//! W(I1, I2), I1 = λ1² + λ2² + λ3², I2 = λ1⁻² + λ2⁻² + λ3⁻², W1 = ∂W/∂I1, W2 = ∂W/∂I2, the
+//! pressure eliminated by σ3 = 0:
+//!
+//! σ_k = 2 W1 (λ_k² − λ3²) − 2 W2 (λ_k⁻² − λ3⁻²),   P_k = σ_k / λ_k   (k = 1, 2).
+//!
+//! A [`BiaxialState`] measures both P1 and P2 and gives the fit two points: P1 at (λ1, λ2) and
+//! P2 at (λ2, λ1) (same invariants, roles swapped; [`crate::gradient::Kinematics::in_plane`]).
+//! The three canonical [`LoadCase`]s are the special paths λ2 = λ^(−1/2) (uniaxial), λ2 = λ
+//! (equibiaxial), λ2 = 1 (pure shear) of a [`Curve`], which measures P1 alone.
 //!
 //! Stretch exactly 1.0 is the undeformed reference: both sides of eq. 19 vanish there, so it
 //! carries no information on W (and would divide by zero in eqs 20, 23 and in relative
@@ -61,6 +72,218 @@ impl LoadCase {
     pub fn invariants(self, stretch: f64) -> (f64, f64) {
         crate::law::invariants(self.stretches(stretch))
     }
+
+    /// The path ratio ρ = ln λ2 / ln λ1 of the case: −1/2, 1, 0.
+    pub fn path_ratio(self) -> f64 {
+        match self {
+            LoadCase::Uniaxial => -0.5,
+            LoadCase::Equibiaxial => 1.0,
+            LoadCase::PureShear => 0.0,
+        }
+    }
+
+    /// The canonical case a state of path ratio `ratio` (ρ = ln λ2 / ln λ1, λ1 the larger
+    /// stretch) is within `tolerance` of, if any.
+    pub fn of_path_ratio(ratio: f64, tolerance: f64) -> Option<LoadCase> {
+        LoadCase::ALL
+            .into_iter()
+            .find(|c| (ratio - c.path_ratio()).abs() < tolerance)
+    }
+}
+
+/// What a group of fitted points is: a canonical curve, or the general biaxial states.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum DataGroup {
+    Case(LoadCase),
+    /// [`BiaxialState`]s, both directions.
+    BiaxialGeneral,
+}
+
+impl DataGroup {
+    /// Name used in tables and JSON keys.
+    pub fn name(self) -> &'static str {
+        match self {
+            DataGroup::Case(case) => case.name(),
+            DataGroup::BiaxialGeneral => "biaxial_general",
+        }
+    }
+}
+
+impl fmt::Display for DataGroup {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One measured homogeneous biaxial state: both in-plane stretches and both nominal stresses
+/// (force over reference section, MPa), direction 3 traction-free.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BiaxialState {
+    pub stretch1: f64,
+    pub stretch2: f64,
+    pub nominal_stress1_mpa: f64,
+    pub nominal_stress2_mpa: f64,
+}
+
+impl BiaxialState {
+    /// Thickness stretch λ3 = 1/(λ1 λ2).
+    pub fn stretch3(&self) -> f64 {
+        1.0 / (self.stretch1 * self.stretch2)
+    }
+
+    /// The larger in-plane stretch.
+    pub fn max_stretch(&self) -> f64 {
+        self.stretch1.max(self.stretch2)
+    }
+
+    /// ρ = ln λ_small / ln λ_large (`None` at the undeformed state).
+    pub fn path_ratio(&self) -> Option<f64> {
+        let (large, small) = if self.stretch1 >= self.stretch2 {
+            (self.stretch1, self.stretch2)
+        } else {
+            (self.stretch2, self.stretch1)
+        };
+        (large > 1.0).then(|| small.ln() / large.ln())
+    }
+
+    /// Checks positivity and finiteness; the message says what is wrong.
+    pub fn check(&self) -> Result<(), String> {
+        let values = [
+            ("lambda1", self.stretch1),
+            ("lambda2", self.stretch2),
+            ("nominal_stress1_mpa", self.nominal_stress1_mpa),
+            ("nominal_stress2_mpa", self.nominal_stress2_mpa),
+        ];
+        for (name, v) in values {
+            if !v.is_finite() {
+                return Err(format!("{name} {v} is not a finite number"));
+            }
+        }
+        for (name, v) in &values[..2] {
+            if *v <= 0.0 {
+                return Err(format!("{name} {v} must be > 0"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The states that are canonical cases (path ratio within `tolerance`, see
+/// [`LoadCase::of_path_ratio`]) as one curve per case with at least [`MIN_POINTS_PER_CURVE`]
+/// points: loaded stretch the larger one and its nominal stress (equibiaxial: the means of
+/// both directions), sorted by stretch (a repeated stretch keeps its first state). For the
+/// curve views (plots) of a state set; fits take the states themselves.
+pub fn canonical_curves(states: &[BiaxialState], tolerance: f64) -> Vec<Curve> {
+    let mut curves = Vec::new();
+    for case in LoadCase::ALL {
+        let mut rows: Vec<(f64, f64)> = states
+            .iter()
+            .filter(|s| {
+                s.path_ratio()
+                    .and_then(|r| LoadCase::of_path_ratio(r, tolerance))
+                    == Some(case)
+            })
+            .map(|s| match case {
+                LoadCase::Equibiaxial => (
+                    0.5 * (s.stretch1 + s.stretch2),
+                    0.5 * (s.nominal_stress1_mpa + s.nominal_stress2_mpa),
+                ),
+                _ if s.stretch1 >= s.stretch2 => (s.stretch1, s.nominal_stress1_mpa),
+                _ => (s.stretch2, s.nominal_stress2_mpa),
+            })
+            .collect();
+        rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+        rows.dedup_by(|b, a| b.0 <= a.0);
+        let (stretch, stress) = rows.into_iter().unzip();
+        if let Ok(curve) = Curve::new(case, stretch, stress) {
+            curves.push(curve);
+        }
+    }
+    curves
+}
+
+/// The header of a general biaxial CSV.
+pub const BIAXIAL_HEADER: &str = "lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa";
+
+/// Reads a general biaxial CSV ([`BIAXIAL_HEADER`], then one state a row).
+pub fn read_biaxial_csv(path: &Path) -> Result<Vec<BiaxialState>, DataError> {
+    let source = path.display().to_string();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| DataError::new(&source, format!("cannot read the file: {e}")))?;
+    parse_biaxial_csv(&text, &source)
+}
+
+/// Parses general biaxial CSV text: the header is required (its four names, in order); every
+/// row has four finite numbers, positive stretches; the undeformed state (λ1 = λ2 = 1) is
+/// dropped (it carries no information, as in [`Curve`]); at least
+/// [`MIN_POINTS_PER_CURVE`] states remain. Errors name the line (counted from 1).
+pub fn parse_biaxial_csv(text: &str, source_name: &str) -> Result<Vec<BiaxialState>, DataError> {
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let Some((header_index, header)) = lines.next() else {
+        return Err(DataError::new(
+            source_name,
+            format!("empty file: expected a header `{BIAXIAL_HEADER}` then data rows"),
+        ));
+    };
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    if names != BIAXIAL_HEADER.split(',').collect::<Vec<_>>() {
+        return Err(DataError::new(
+            source_name,
+            format!(
+                "line {}: expected the header `{BIAXIAL_HEADER}`, found `{header}`",
+                header_index + 1
+            ),
+        ));
+    }
+    let mut states = Vec::new();
+    for (index, line) in lines {
+        let line_no = index + 1;
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        if cells.len() != 4 {
+            return Err(DataError::new(
+                source_name,
+                format!(
+                    "line {line_no}: expected 4 cells `{BIAXIAL_HEADER}`, found {} in `{line}`",
+                    cells.len()
+                ),
+            ));
+        }
+        let mut values = [0.0; 4];
+        for (value, (cell, name)) in values.iter_mut().zip(cells.iter().zip(&names)) {
+            *value = cell.parse::<f64>().map_err(|_| {
+                DataError::new(
+                    source_name,
+                    format!("line {line_no}: {name} `{cell}` is not a number"),
+                )
+            })?;
+        }
+        let state = BiaxialState {
+            stretch1: values[0],
+            stretch2: values[1],
+            nominal_stress1_mpa: values[2],
+            nominal_stress2_mpa: values[3],
+        };
+        state
+            .check()
+            .map_err(|m| DataError::new(source_name, format!("line {line_no}: {m}")))?;
+        if state.stretch1 == 1.0 && state.stretch2 == 1.0 {
+            continue;
+        }
+        states.push(state);
+    }
+    if states.len() < MIN_POINTS_PER_CURVE {
+        return Err(DataError::new(
+            source_name,
+            format!(
+                "too few states: {} deformed, expected at least {MIN_POINTS_PER_CURVE}",
+                states.len()
+            ),
+        ));
+    }
+    Ok(states)
 }
 
 impl fmt::Display for LoadCase {
@@ -303,6 +526,65 @@ mod tests {
         assert!((i1 - 8.0625).abs() < 1e-12 && (i2 - 16.5).abs() < 1e-12);
         let (i1, i2) = LoadCase::PureShear.invariants(2.0);
         assert!((i1 - i2).abs() < 1e-12, "pure shear has I1 = I2");
+    }
+
+    #[test]
+    fn biaxial_csv_reads_and_refuses_bad_rows_naming_the_line() {
+        let good = format!("{BIAXIAL_HEADER}\n1,1,0,0\n1.2,1.1,0.3,0.2\n\n1.4,1.2,0.5,0.3\n");
+        let states = parse_biaxial_csv(&good, "g.csv").unwrap();
+        assert_eq!(states.len(), 2, "the undeformed row is dropped");
+        assert_eq!(states[1].nominal_stress2_mpa, 0.3);
+        let bad = |text: &str, needle: &str| {
+            let e = parse_biaxial_csv(text, "b.csv").unwrap_err().to_string();
+            assert!(e.starts_with("b.csv: ") && e.contains(needle), "{e}");
+        };
+        bad("", "empty file");
+        bad(
+            "1.2,1.1,0.3,0.2\n1.3,1.1,0.3,0.2\n",
+            "line 1: expected the header",
+        );
+        bad(
+            "lambda1,lambda2,p1,p2\n1.2,1.1,0.3,0.2\n",
+            "line 1: expected the header",
+        );
+        let h = BIAXIAL_HEADER;
+        bad(
+            &format!("{h}\n1.2,1.1,0.3,0.2\n1.3,1.1,0.4\n"),
+            "line 3: expected 4 cells",
+        );
+        bad(
+            &format!("{h}\n1.2,1.1,0.3,0.2\n1.3,x,0.4,0.1\n"),
+            "line 3: lambda2 `x` is not a number",
+        );
+        bad(
+            &format!("{h}\n1.2,1.1,NaN,0.2\n1.3,1.1,0.4,0.1\n"),
+            "line 2: nominal_stress1_mpa NaN is not a finite",
+        );
+        bad(
+            &format!("{h}\n1.2,1.1,0.3,inf\n1.3,1.1,0.4,0.1\n"),
+            "line 2: nominal_stress2_mpa inf is not a finite",
+        );
+        bad(
+            &format!("{h}\n1.2,-1.1,0.3,0.2\n1.3,1.1,0.4,0.1\n"),
+            "line 2: lambda2 -1.1 must be > 0",
+        );
+        bad(&format!("{h}\n1.2,1.1,0.3,0.2\n"), "too few states: 1");
+    }
+
+    #[test]
+    fn canonical_cases_are_path_ratios() {
+        for case in LoadCase::ALL {
+            let (l1, l2) = case.in_plane_stretches(1.7);
+            let state = BiaxialState {
+                stretch1: l1,
+                stretch2: l2,
+                nominal_stress1_mpa: 0.0,
+                nominal_stress2_mpa: 0.0,
+            };
+            let rho = state.path_ratio().unwrap();
+            assert_eq!(LoadCase::of_path_ratio(rho, 0.01), Some(case));
+        }
+        assert_eq!(LoadCase::of_path_ratio(0.5, 0.15), None);
     }
 
     #[test]

@@ -1,11 +1,17 @@
-//! Fitting one model of the catalogue to any combination of load cases, with statistics.
+//! Fitting one model of the catalogue to any combination of load cases and general biaxial
+//! states ([`FitData`]), with statistics.
+//!
+//! Every fitted point is one measured nominal stress along one in-plane direction of an
+//! incompressible plane-stress state ([`crate::gradient::Kinematics::in_plane`]): a canonical
+//! curve gives one a row (P1), a [`BiaxialState`] two (P1 at (λ1, λ2), P2 at (λ2, λ1)).
 //!
 //! Parameters in which the stress is linear are solved by linear least squares (SVD); the
 //! others by Levenberg-Marquardt from a grid of starts, the linear ones re-solved at each start
 //! (variable projection for the starts only). Objective: Σ_cases w_c Σ_points r², with
 //! r = P_model − P_data (absolute, MPa) or (P_model − P_data)/|P_data| (relative).
 
-use crate::data::{Curve, LoadCase};
+use crate::data::{BiaxialState, Curve, DataGroup, LoadCase};
+use crate::gradient::Kinematics;
 use crate::lsq::{self, LsqError};
 use crate::models::Model;
 use crate::residuals::PointSet;
@@ -39,7 +45,7 @@ pub enum JacobianPath {
 #[derive(Clone, Debug, Default)]
 pub struct FitOptions {
     pub residual: ResidualKind,
-    /// Per-load-case weights w_c (default 1).
+    /// Per-load-case weights w_c (default 1; general biaxial states weigh 1).
     pub weights: BTreeMap<LoadCase, f64>,
     /// Extra starting points (full parameter vectors) for the nonlinear search.
     pub extra_starts: Vec<Vec<f64>>,
@@ -62,10 +68,10 @@ pub enum FitStage {
     Refining { start: usize, starts: usize },
 }
 
-/// Statistics of one load case.
+/// Statistics of one group of points (a load case, or the general biaxial states).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CaseStats {
-    pub case: LoadCase,
+    pub case: DataGroup,
     pub points: usize,
     /// RMS of P_model − P_data, MPa.
     pub rms_mpa: f64,
@@ -111,7 +117,7 @@ pub enum FitError {
     #[error("model {model}: {error}")]
     Lsq { model: String, error: LsqError },
     #[error("relative residuals need non-zero stresses: {case} point at stretch {stretch} has zero stress")]
-    ZeroStressRelative { case: LoadCase, stretch: f64 },
+    ZeroStressRelative { case: DataGroup, stretch: f64 },
     #[error("model {model}: undefined at every starting point for these stretches")]
     NoValidStart { model: String },
     #[error("weight of {case} must be finite and > 0, got {weight}")]
@@ -211,9 +217,74 @@ impl Problem<'_> {
 /// Number of best starts refined by Levenberg-Marquardt.
 pub const LM_STARTS_REFINED: usize = 6;
 
+/// The data of a fit: canonical curves (P1 along the loaded direction) and general biaxial
+/// states (P1 and P2). Either may be empty.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FitData<'a> {
+    pub curves: &'a [Curve],
+    pub states: &'a [BiaxialState],
+}
+
+impl<'a> FitData<'a> {
+    pub fn curves(curves: &'a [Curve]) -> Self {
+        FitData {
+            curves,
+            states: &[],
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.curves.iter().all(|c| c.is_empty()) && self.states.is_empty()
+    }
+
+    /// Every measured point, by group: (group, kinematics of its direction, its loaded
+    /// stretch, nominal stress MPa). The one place data become fitted points.
+    pub fn points(&self) -> Vec<(DataGroup, Kinematics, f64, f64)> {
+        let mut points = Vec::new();
+        for curve in self.curves {
+            for (&stretch, &stress) in curve.stretch.iter().zip(&curve.nominal_stress_mpa) {
+                let k = Kinematics::of(curve.case, stretch);
+                points.push((DataGroup::Case(curve.case), k, stretch, stress));
+            }
+        }
+        for s in self.states {
+            for (l, other, stress) in [
+                (s.stretch1, s.stretch2, s.nominal_stress1_mpa),
+                (s.stretch2, s.stretch1, s.nominal_stress2_mpa),
+            ] {
+                let k = Kinematics::in_plane(l, other);
+                points.push((DataGroup::BiaxialGeneral, k, l, stress));
+            }
+        }
+        points
+    }
+
+    /// The groups present, in [`FitData::points`] order.
+    fn groups(&self) -> Vec<DataGroup> {
+        let mut groups: Vec<DataGroup> = self
+            .curves
+            .iter()
+            .map(|c| DataGroup::Case(c.case))
+            .collect();
+        if !self.states.is_empty() {
+            groups.push(DataGroup::BiaxialGeneral);
+        }
+        groups
+    }
+
+    /// The largest in-plane stretch of the data (1 if none).
+    pub fn max_stretch(&self) -> f64 {
+        self.curves
+            .iter()
+            .flat_map(|c| c.stretch.iter().copied())
+            .chain(self.states.iter().map(BiaxialState::max_stretch))
+            .fold(1.0, f64::max)
+    }
+}
+
 /// Fits `model` to `curves`.
 pub fn fit_model(model: &Model, curves: &[Curve], options: &FitOptions) -> Result<Fit, FitError> {
-    fit_model_with_progress(model, curves, options, &mut |_| {})
+    fit_data(model, FitData::curves(curves), options, &mut |_| {})
 }
 
 /// [`fit_model`], telling `progress` where it is (at every start of the nonlinear search).
@@ -223,34 +294,46 @@ pub fn fit_model_with_progress(
     options: &FitOptions,
     progress: &mut dyn FnMut(FitStage),
 ) -> Result<Fit, FitError> {
+    fit_data(model, FitData::curves(curves), options, progress)
+}
+
+/// Fits `model` to curves and general biaxial states at once, telling `progress` where it is.
+pub fn fit_data(
+    model: &Model,
+    data: FitData,
+    options: &FitOptions,
+    progress: &mut dyn FnMut(FitStage),
+) -> Result<Fit, FitError> {
     let name = model.name();
-    if curves.iter().all(|c| c.is_empty()) {
+    if data.is_empty() {
         return Err(FitError::NoData);
     }
-    let mut points = Vec::new();
-    for curve in curves {
-        let weight = options.weights.get(&curve.case).copied().unwrap_or(1.0);
-        if !(weight.is_finite() && weight > 0.0) {
-            return Err(FitError::BadWeight {
-                case: curve.case,
-                weight,
-            });
-        }
-        for (&stretch, &stress) in curve.stretch.iter().zip(&curve.nominal_stress_mpa) {
-            let scale = match options.residual {
-                ResidualKind::Absolute => 1.0,
-                ResidualKind::Relative => {
-                    if stress == 0.0 {
-                        return Err(FitError::ZeroStressRelative {
-                            case: curve.case,
-                            stretch,
-                        });
-                    }
-                    stress.abs()
+    let all = data.points();
+    let mut points = Vec::with_capacity(all.len());
+    for &(group, kinematics, stretch, stress) in &all {
+        let weight = match group {
+            DataGroup::Case(case) => {
+                let weight = options.weights.get(&case).copied().unwrap_or(1.0);
+                if !(weight.is_finite() && weight > 0.0) {
+                    return Err(FitError::BadWeight { case, weight });
                 }
-            };
-            points.push((curve.case, stretch, stress, weight.sqrt() / scale));
-        }
+                weight
+            }
+            DataGroup::BiaxialGeneral => 1.0,
+        };
+        let scale = match options.residual {
+            ResidualKind::Absolute => 1.0,
+            ResidualKind::Relative => {
+                if stress == 0.0 {
+                    return Err(FitError::ZeroStressRelative {
+                        case: group,
+                        stretch,
+                    });
+                }
+                stress.abs()
+            }
+        };
+        points.push((kinematics, stress, weight.sqrt() / scale));
     }
     let m = points.len();
     let n = model.param_names().len();
@@ -297,7 +380,7 @@ pub fn fit_model_with_progress(
     } else {
         let mut candidates: Vec<(f64, Vec<f64>)> = Vec::new();
         let mut last_error = None;
-        let starts: Vec<Vec<f64>> = nonlinear_starts(model, curves)
+        let starts: Vec<Vec<f64>> = nonlinear_starts(model, &data)
             .into_iter()
             .chain(options.extra_starts.iter().cloned())
             .collect();
@@ -366,41 +449,8 @@ pub fn fit_model_with_progress(
             .collect(),
         None => vec![None; n],
     };
-    let mut cases = Vec::new();
-    let mut total_sq = 0.0;
-    for curve in curves {
-        let predicted: Vec<f64> = curve
-            .stretch
-            .iter()
-            .map(|&l| {
-                model
-                    .nominal_stress_mpa(&params, curve.case, l)
-                    .unwrap_or(f64::NAN)
-            })
-            .collect();
-        let ss_res: f64 = predicted
-            .iter()
-            .zip(&curve.nominal_stress_mpa)
-            .map(|(p, d)| (p - d).powi(2))
-            .sum();
-        let mean = curve.nominal_stress_mpa.iter().sum::<f64>() / curve.len() as f64;
-        let ss_tot: f64 = curve
-            .nominal_stress_mpa
-            .iter()
-            .map(|d| (d - mean).powi(2))
-            .sum();
-        total_sq += ss_res;
-        cases.push(CaseStats {
-            case: curve.case,
-            points: curve.len(),
-            rms_mpa: (ss_res / curve.len() as f64).sqrt(),
-            r2: 1.0 - ss_res / ss_tot,
-        });
-    }
-    let max_stretch = curves
-        .iter()
-        .flat_map(|c| c.stretch.iter().copied())
-        .fold(1.0, f64::max);
+    let (rms_mpa, cases) = group_stats(model, &params, &data);
+    let max_stretch = data.max_stretch();
     let stability = LoadCase::ALL
         .iter()
         .map(|&case| drucker_stability(model, &params, case, max_stretch))
@@ -410,7 +460,7 @@ pub fn fit_model_with_progress(
         param_names: model.param_names(),
         params,
         stderr,
-        rms_mpa: (total_sq / m as f64).sqrt(),
+        rms_mpa,
         cases,
         aic: m as f64 * (objective.max(f64::MIN_POSITIVE) / m as f64).ln() + 2.0 * n as f64,
         objective,
@@ -419,40 +469,44 @@ pub fn fit_model_with_progress(
     })
 }
 
-/// Evaluates a model with given parameters against curves (no fitting): (overall RMS, per case).
-pub fn evaluate(model: &Model, params: &[f64], curves: &[Curve]) -> (f64, Vec<CaseStats>) {
+/// Σ (P_model − P_data)² over `points` (unweighted, MPa²).
+fn r_abs_sq(model: &Model, params: &[f64], points: &[(DataGroup, Kinematics, f64, f64)]) -> f64 {
+    points
+        .iter()
+        .map(|(_, k, _, d)| {
+            (model.nominal_stress_at(params, k, None).unwrap_or(f64::NAN) - d).powi(2)
+        })
+        .sum()
+}
+
+/// (overall RMS, per group) of a model with given parameters against `data`.
+fn group_stats(model: &Model, params: &[f64], data: &FitData) -> (f64, Vec<CaseStats>) {
+    let points = data.points();
     let mut cases = Vec::new();
-    let mut total_sq = 0.0;
-    let mut m = 0;
-    for curve in curves {
-        let ss: f64 = curve
-            .stretch
-            .iter()
-            .zip(&curve.nominal_stress_mpa)
-            .map(|(&l, d)| {
-                (model
-                    .nominal_stress_mpa(params, curve.case, l)
-                    .unwrap_or(f64::NAN)
-                    - d)
-                    .powi(2)
-            })
-            .sum();
-        let mean = curve.nominal_stress_mpa.iter().sum::<f64>() / curve.len() as f64;
-        let ss_tot: f64 = curve
-            .nominal_stress_mpa
-            .iter()
-            .map(|d| (d - mean).powi(2))
-            .sum();
-        total_sq += ss;
-        m += curve.len();
+    for group in data.groups() {
+        let mine: Vec<_> = points.iter().filter(|p| p.0 == group).copied().collect();
+        let ss = r_abs_sq(model, params, &mine);
+        let mean = mine.iter().map(|p| p.3).sum::<f64>() / mine.len() as f64;
+        let ss_tot: f64 = mine.iter().map(|p| (p.3 - mean).powi(2)).sum();
         cases.push(CaseStats {
-            case: curve.case,
-            points: curve.len(),
-            rms_mpa: (ss / curve.len() as f64).sqrt(),
+            case: group,
+            points: mine.len(),
+            rms_mpa: (ss / mine.len() as f64).sqrt(),
             r2: 1.0 - ss / ss_tot,
         });
     }
-    ((total_sq / m.max(1) as f64).sqrt(), cases)
+    let total = r_abs_sq(model, params, &points);
+    ((total / points.len().max(1) as f64).sqrt(), cases)
+}
+
+/// Evaluates a model with given parameters against curves (no fitting): (overall RMS, per case).
+pub fn evaluate(model: &Model, params: &[f64], curves: &[Curve]) -> (f64, Vec<CaseStats>) {
+    group_stats(model, params, &FitData::curves(curves))
+}
+
+/// [`evaluate`] against curves and general biaxial states.
+pub fn evaluate_data(model: &Model, params: &[f64], data: FitData) -> (f64, Vec<CaseStats>) {
+    group_stats(model, params, &data)
 }
 
 /// Fits several models; successful fits sorted by AIC (best first), failures listed apart.
@@ -471,11 +525,21 @@ pub fn fit_ranked_with_progress(
     options: &FitOptions,
     progress: &mut dyn FnMut(usize, Option<FitStage>),
 ) -> (Vec<Fit>, Vec<(Model, FitError)>) {
+    fit_ranked_data(models, FitData::curves(curves), options, progress)
+}
+
+/// [`fit_ranked_with_progress`] on curves and general biaxial states.
+pub fn fit_ranked_data(
+    models: &[Model],
+    data: FitData,
+    options: &FitOptions,
+    progress: &mut dyn FnMut(usize, Option<FitStage>),
+) -> (Vec<Fit>, Vec<(Model, FitError)>) {
     let mut fits = Vec::new();
     let mut failures = Vec::new();
     for (index, model) in models.iter().enumerate() {
         progress(index, None);
-        let result = fit_model_with_progress(model, curves, options, &mut |stage| {
+        let result = fit_data(model, data, options, &mut |stage| {
             progress(index, Some(stage))
         });
         match result {
@@ -488,13 +552,12 @@ pub fn fit_ranked_with_progress(
 }
 
 /// Starting values (full vectors; linear entries are re-solved) for the nonlinear parameters.
-fn nonlinear_starts(model: &Model, curves: &[Curve]) -> Vec<Vec<f64>> {
-    let mut max_i1_minus_3: f64 = 0.0;
-    for c in curves {
-        for &l in &c.stretch {
-            max_i1_minus_3 = max_i1_minus_3.max(c.case.invariants(l).0 - 3.0);
-        }
-    }
+fn nonlinear_starts(model: &Model, data: &FitData) -> Vec<Vec<f64>> {
+    let max_i1_minus_3: f64 = data
+        .points()
+        .iter()
+        .map(|p| p.1.i1 - 3.0)
+        .fold(0.0, f64::max);
     let max_chain_stretch_sq = (max_i1_minus_3 + 3.0) / 3.0;
     let mut starts = Vec::new();
     match model {
@@ -559,7 +622,7 @@ fn nonlinear_starts(model: &Model, curves: &[Curve]) -> Vec<Vec<f64>> {
                     starts.push(s);
                 }
             }
-            if let Ok(route) = crate::route::paper_route(curves, *f_degree, *g_degree) {
+            if let Ok(route) = crate::route::paper_route(data.curves, *f_degree, *g_degree) {
                 starts.push(route.coefficients());
             }
         }

@@ -39,8 +39,18 @@ pub struct Kinematics {
 }
 
 impl Kinematics {
+    /// A canonical load case at its loaded stretch: [`Kinematics::in_plane`] of its stretches.
     pub fn of(case: LoadCase, stretch: f64) -> Self {
         let (l1, l2) = case.in_plane_stretches(stretch);
+        Kinematics::in_plane(l1, l2)
+    }
+
+    /// Any incompressible plane-stress state, the stress being measured along the direction
+    /// of `stretch` (the other in-plane stretch `other_stretch`): λ3 = 1/(λ λ_other). The
+    /// stress across (direction 2 of a biaxial state) is `in_plane(λ2, λ1)`: same invariants,
+    /// roles swapped.
+    pub fn in_plane(stretch: f64, other_stretch: f64) -> Self {
+        let (l1, l2) = (stretch, other_stretch);
         let l3 = 1.0 / (l1 * l2);
         let (i1, i2) = crate::law::invariants([l1, l2, l3]);
         Kinematics {

@@ -1,15 +1,20 @@
-//! The identifier's journal: every accepted load-path point, one CSV line each, appended and
+//! The identifier's journal: every accepted biaxial state, one CSV line each, appended and
 //! flushed as it is accepted. A restarted identifier reads it back and goes on from the same
-//! path, so a process killed mid-test loses no point it had accepted.
+//! path, so a process killed mid-test loses no state it had accepted.
 //!
-//! Format: header `case,stretch,nominal_stress_mpa,frame_id`, then one row per point, `case`
-//! one of `uniaxial`, `equibiaxial`, `pure_shear`.
+//! Format: header `lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa,frame_id` (the
+//! general biaxial CSV's columns and the frame), then one row per state. A journal of the
+//! earlier per-case format (`case,stretch,nominal_stress_mpa,frame_id`: one stress a point,
+//! where a state has two) is refused with a message saying so, never misread.
 
-use crate::data::LoadCase;
+use crate::data::BiaxialState;
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
-pub const HEADER: &str = "case,stretch,nominal_stress_mpa,frame_id";
+pub const HEADER: &str = "lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa,frame_id";
+
+/// The header of the earlier per-case journals.
+pub const PER_CASE_HEADER: &str = "case,stretch,nominal_stress_mpa,frame_id";
 
 /// Why a journal could not be read back (lines counted from 1, the header included).
 #[derive(Debug, thiserror::Error)]
@@ -21,7 +26,9 @@ pub enum JournalError {
     },
     #[error("journal {}: header {header:?}, expected {HEADER:?}", .path.display())]
     Header { path: PathBuf, header: String },
-    #[error("journal {} line {line}: {row:?} is not case,stretch,stress,frame_id", .path.display())]
+    #[error("journal {}: written by an earlier version (header {PER_CASE_HEADER:?}: one stress a point, where a biaxial state has two); move it aside to start a new path", .path.display())]
+    PerCase { path: PathBuf },
+    #[error("journal {} line {line}: {row:?} is not {HEADER}", .path.display())]
     Row {
         path: PathBuf,
         line: usize,
@@ -29,12 +36,10 @@ pub enum JournalError {
     },
 }
 
-/// One accepted point.
+/// One accepted state.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JournalPoint {
-    pub case: LoadCase,
-    pub stretch: f64,
-    pub nominal_stress_mpa: f64,
+    pub state: BiaxialState,
     pub frame_id: u64,
 }
 
@@ -57,6 +62,11 @@ pub fn read(path: &Path) -> Result<Vec<JournalPoint>, JournalError> {
     let Some((header, rows)) = lines.split_first() else {
         return Ok(Vec::new());
     };
+    if header.trim() == PER_CASE_HEADER {
+        return Err(JournalError::PerCase {
+            path: path.to_path_buf(),
+        });
+    }
     if header.trim() != HEADER {
         return Err(JournalError::Header {
             path: path.to_path_buf(),
@@ -82,21 +92,22 @@ pub fn read(path: &Path) -> Result<Vec<JournalPoint>, JournalError> {
 }
 
 fn parse_row(row: &str) -> Option<JournalPoint> {
-    let mut cells = row.split(',');
-    let case_name = cells.next()?.trim();
-    let case = LoadCase::ALL.into_iter().find(|c| c.name() == case_name)?;
-    let stretch: f64 = cells.next()?.trim().parse().ok()?;
-    let nominal_stress_mpa: f64 = cells.next()?.trim().parse().ok()?;
-    let frame_id: u64 = cells.next()?.trim().parse().ok()?;
-    if cells.next().is_some() || !stretch.is_finite() || !nominal_stress_mpa.is_finite() {
+    let mut cells = row.split(',').map(str::trim);
+    let mut values = [0.0; 4];
+    for v in &mut values {
+        *v = cells.next()?.parse().ok()?;
+    }
+    let frame_id: u64 = cells.next()?.parse().ok()?;
+    let state = BiaxialState {
+        stretch1: values[0],
+        stretch2: values[1],
+        nominal_stress1_mpa: values[2],
+        nominal_stress2_mpa: values[3],
+    };
+    if cells.next().is_some() || state.check().is_err() {
         return None;
     }
-    Some(JournalPoint {
-        case,
-        stretch,
-        nominal_stress_mpa,
-        frame_id,
-    })
+    Some(JournalPoint { state, frame_id })
 }
 
 /// Appends points to a journal, each row whole ([`wire::files::RowFile`]: a row a full disk
@@ -114,12 +125,10 @@ impl JournalWriter {
     }
 
     pub fn append(&mut self, point: &JournalPoint) -> Result<(), wire::files::FileError> {
+        let s = &point.state;
         let line = format!(
-            "{},{},{},{}\n",
-            point.case.name(),
-            point.stretch,
-            point.nominal_stress_mpa,
-            point.frame_id
+            "{},{},{},{},{}\n",
+            s.stretch1, s.stretch2, s.nominal_stress1_mpa, s.nominal_stress2_mpa, point.frame_id
         );
         self.rows.append(&line)
     }
@@ -136,17 +145,19 @@ mod tests {
         let path = dir.join("points.csv");
         let _ = std::fs::remove_file(&path);
         assert!(read(&path).unwrap().is_empty());
+        let state = |l1: f64, l2: f64, p1: f64, p2: f64| BiaxialState {
+            stretch1: l1,
+            stretch2: l2,
+            nominal_stress1_mpa: p1,
+            nominal_stress2_mpa: p2,
+        };
         let points = [
             JournalPoint {
-                case: LoadCase::Uniaxial,
-                stretch: 1.25,
-                nominal_stress_mpa: 0.31,
+                state: state(1.25, 0.9, 0.31, 0.0),
                 frame_id: 7,
             },
             JournalPoint {
-                case: LoadCase::Equibiaxial,
-                stretch: 1.5,
-                nominal_stress_mpa: 0.9,
+                state: state(1.5, 1.2, 0.9, 0.6),
                 frame_id: 90,
             },
         ];
@@ -159,16 +170,12 @@ mod tests {
         w.append(&points[1]).unwrap();
         assert_eq!(read(&path).unwrap(), points.to_vec());
         // A kill mid-write leaves a torn last line: ignored.
-        std::fs::write(
-            &path,
-            format!("{}\nuniaxial,1.25,0.31,7\nequibiaxial,1.5,0.", HEADER),
-        )
-        .unwrap();
+        std::fs::write(&path, format!("{}\n1.25,0.9,0.31,0,7\n1.5,1.2,0.", HEADER)).unwrap();
         assert_eq!(read(&path).unwrap(), points[..1].to_vec());
         // A bad line in the middle is an error naming the line.
         std::fs::write(
             &path,
-            format!("{}\nuniaxial,x,0.31,7\nequibiaxial,1.5,0.9,90\n", HEADER),
+            format!("{}\n1.25,x,0.31,0,7\n1.5,1.2,0.9,0.6,90\n", HEADER),
         )
         .unwrap();
         let error = read(&path).unwrap_err();
@@ -177,8 +184,22 @@ mod tests {
             "{error}"
         );
         assert!(error.to_string().contains("line 2"), "{error}");
+        // NaN is refused like any malformed line.
+        std::fs::write(
+            &path,
+            format!("{}\n1.25,0.9,NaN,0,7\n1.5,1.2,0.9,0.6,90\n", HEADER),
+        )
+        .unwrap();
+        assert!(matches!(
+            read(&path),
+            Err(JournalError::Row { line: 2, .. })
+        ));
         std::fs::write(&path, "stretch,stress\n").unwrap();
         assert!(matches!(read(&path), Err(JournalError::Header { .. })));
+        // An earlier per-case journal is refused with a message saying what it is.
+        std::fs::write(&path, format!("{PER_CASE_HEADER}\nuniaxial,1.25,0.31,7\n")).unwrap();
+        let error = read(&path).unwrap_err();
+        assert!(error.to_string().contains("earlier version"), "{error}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1,5 +1,5 @@
 //! On-line identification, pure logic (no IPC): pair measured strains with rig forces by rig
-//! sample id, classify each state into a load case, accumulate the loading path, refit.
+//! sample id, keep every biaxial state of the loading path, refit.
 //!
 //! Inputs are plain structs so the logic is tested without shared memory; the process shell
 //! (`process` module) converts wire samples into them.
@@ -9,13 +9,23 @@
 //! in a bounded queue ([`OnlineConfig::pending_fields`]) and is dropped (counted) when the queue
 //! is full or its sample has left the ring.
 //!
-//! Classification by the ratio ρ = ln λ2 / ln λ1 (λ1 the larger in-plane stretch):
-//! uniaxial −1/2, pure shear 0, equibiaxial 1, within [`OnlineConfig::classify_tolerance`].
-//! Only the loading branch is kept: a point is accepted when its stretch exceeds the last
-//! accepted one of its case by [`OnlineConfig::min_stretch_increment`].
+//! States: a paired field gives one [`BiaxialState`] (λx, λy, Px, Py) with λ = exp(gauge log
+//! strain) and P = F / (current section · λ) along each axis (the nominal stress, as the
+//! current section is the reference one over λ). Every state is kept and fitted, both
+//! directions at once ([`crate::fit::FitData`]; the membrane formulas are in
+//! [`crate::data`]): the canonical cases are special paths, named for the counts only, by
+//! the ratio ρ = ln λ_small / ln λ_large: uniaxial −1/2, pure shear 0, equibiaxial 1 within
+//! [`OnlineConfig::classify_tolerance`].
+//!
+//! Loading branch only: states are grouped into paths by their direction in the log-strain
+//! plane, θ = atan2(ln λy, ln λx), a state joining the nearest path within
+//! [`OnlineConfig::path_tolerance_rad`] of the path's newest state (or opening a new one, at most
+//! [`OnlineConfig::max_paths`]); it is kept when its larger stretch exceeds the last kept one of
+//! its path by [`OnlineConfig::min_stretch_increment`] (unloading and reloading below the
+//! maximum reached are skipped, as the Mullins effect makes them another material).
 
-use crate::data::{Curve, LoadCase};
-use crate::fit::{fit_model, Fit, FitOptions};
+use crate::data::{BiaxialState, LoadCase};
+use crate::fit::{fit_data, Fit, FitData, FitOptions};
 use crate::models::Model;
 use std::collections::VecDeque;
 
@@ -46,10 +56,15 @@ pub struct FieldSample {
 pub struct OnlineConfig {
     pub rig_history: usize,
     pub pending_fields: usize,
+    /// |ρ − ρ_case| below which a state counts as a canonical case (names, counts).
     pub classify_tolerance: f64,
+    /// Largest angle between a state's direction in the (ln λx, ln λy) plane and its path's.
+    pub path_tolerance_rad: f64,
+    /// Paths kept at most (a state opening one more is refused, counted).
+    pub max_paths: usize,
     pub min_stretch_increment: f64,
-    /// Points per case kept at most (later points are refused, counted).
-    pub max_points_per_case: usize,
+    /// States per path kept at most (later ones are refused, counted).
+    pub max_points_per_path: usize,
     /// Models ranked at each refit (keep them cheap: refits run at each new point).
     pub models: Vec<Model>,
     /// Points in total before the first refit.
@@ -62,8 +77,10 @@ impl Default for OnlineConfig {
             rig_history: 4096,
             pending_fields: 64,
             classify_tolerance: 0.15,
+            path_tolerance_rad: 0.05,
+            max_paths: 8,
             min_stretch_increment: 2e-3,
-            max_points_per_case: 2000,
+            max_points_per_path: 2000,
             models: vec![
                 Model::LambertDianiRey {
                     f_degree: 2,
@@ -83,11 +100,10 @@ impl Default for OnlineConfig {
 /// What happened to one field.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FieldOutcome {
-    /// Paired and accepted as a new point of `case`.
+    /// Paired and accepted as a new state (of canonical `case`, if it is one).
     Accepted {
-        case: LoadCase,
-        stretch: f64,
-        nominal_stress_mpa: f64,
+        case: Option<LoadCase>,
+        state: BiaxialState,
     },
     /// Waiting for its rig sample.
     Pending,
@@ -100,9 +116,9 @@ pub enum FieldOutcome {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SkipReason {
     NotStretched,
-    Unclassified,
     NotIncreasing,
-    CaseFull,
+    PathFull,
+    TooManyPaths,
     BadSection,
 }
 
@@ -120,27 +136,41 @@ pub struct OnlineIdentifier {
     config: OnlineConfig,
     rig: VecDeque<RigSample>,
     pending: VecDeque<FieldSample>,
-    /// (stretch, nominal stress MPa) per case, in [`LoadCase::ALL`] order.
-    points: [Vec<(f64, f64)>; 3],
+    /// Every kept state, in arrival order.
+    states: Vec<BiaxialState>,
+    paths: Vec<LoadPath>,
     pub counters: OnlineCounters,
     /// The last field accepted (frame id, capture time ns).
     pub last_accepted: Option<(u64, u64)>,
     /// Per configured model, its last fitted parameters (the next refit's start).
     warm: Vec<Option<Vec<f64>>>,
     refits: u64,
-    /// Load cases in the last refit (a new case calls for a full search).
-    fitted_cases: usize,
+    /// Paths in the last refit (a new path calls for a full search).
+    fitted_paths: usize,
+}
+
+/// One loading path: its direction θ in the log-strain plane (its newest state's) and how far
+/// it went.
+#[derive(Clone, Copy, Debug)]
+struct LoadPath {
+    angle_rad: f64,
+    last_max_stretch: f64,
+    states: usize,
+}
+
+/// The direction θ = atan2(ln λy, ln λx) of a state in the log-strain plane.
+fn path_angle_rad(state: &BiaxialState) -> f64 {
+    state.stretch2.ln().atan2(state.stretch1.ln())
+}
+
+/// Angle between two directions, in [0, π].
+fn angle_between_rad(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(std::f64::consts::TAU);
+    d.min(std::f64::consts::TAU - d)
 }
 
 /// A full multi-start search every this many refits (the others start from the last fit).
 pub const FULL_SEARCH_EVERY: u64 = 16;
-
-fn case_index(case: LoadCase) -> usize {
-    LoadCase::ALL
-        .iter()
-        .position(|c| *c == case)
-        .expect("case in ALL")
-}
 
 impl OnlineIdentifier {
     pub fn new(config: OnlineConfig) -> Self {
@@ -151,12 +181,13 @@ impl OnlineIdentifier {
         OnlineIdentifier {
             rig: VecDeque::with_capacity(config.rig_history),
             pending: VecDeque::with_capacity(config.pending_fields),
-            points: [Vec::new(), Vec::new(), Vec::new()],
+            states: Vec::new(),
+            paths: Vec::new(),
             counters: OnlineCounters::default(),
             last_accepted: None,
             warm: vec![None; config.models.len()],
             refits: 0,
-            fitted_cases: 0,
+            fitted_paths: 0,
             config,
         }
     }
@@ -225,124 +256,144 @@ impl OnlineIdentifier {
 
     fn accept(&mut self, field: FieldSample, rig: RigSample) -> FieldOutcome {
         let (sx, sy) = (field.log_strain_xx.exp(), field.log_strain_yy.exp());
-        // Loaded direction 1: the larger stretch.
-        let (l1, l2, force_n, section_mm2) = if sx >= sy {
-            (sx, sy, rig.force_x_n, rig.section_x_mm2)
-        } else {
-            (sy, sx, rig.force_y_n, rig.section_y_mm2)
-        };
-        if l1 <= 1.0 + 1e-6 {
+        if sx.max(sy) <= 1.0 + 1e-6 {
             return FieldOutcome::Skipped(SkipReason::NotStretched);
         }
-        if !(section_mm2 > 0.0 && section_mm2.is_finite() && force_n.is_finite()) {
+        let section_ok = |a: f64| a > 0.0 && a.is_finite();
+        if !(section_ok(rig.section_x_mm2)
+            && section_ok(rig.section_y_mm2)
+            && rig.force_x_n.is_finite()
+            && rig.force_y_n.is_finite())
+        {
             return FieldOutcome::Skipped(SkipReason::BadSection);
         }
-        let rho = l2.ln() / l1.ln();
-        let tol = self.config.classify_tolerance;
-        let case = if (rho + 0.5).abs() < tol {
-            LoadCase::Uniaxial
-        } else if rho.abs() < tol {
-            LoadCase::PureShear
-        } else if (rho - 1.0).abs() < tol {
-            LoadCase::Equibiaxial
-        } else {
-            return FieldOutcome::Skipped(SkipReason::Unclassified);
+        let state = BiaxialState {
+            stretch1: sx,
+            stretch2: sy,
+            nominal_stress1_mpa: rig.force_x_n / rig.section_x_mm2 / sx,
+            nominal_stress2_mpa: rig.force_y_n / rig.section_y_mm2 / sy,
         };
-        let (stretch, cauchy_mpa) = match case {
-            // Equibiaxial: mean of both directions.
-            LoadCase::Equibiaxial => {
-                let sig_x = rig.force_x_n / rig.section_x_mm2;
-                let sig_y = rig.force_y_n / rig.section_y_mm2;
-                if !(rig.section_y_mm2 > 0.0 && sig_y.is_finite()) {
-                    return FieldOutcome::Skipped(SkipReason::BadSection);
-                }
-                (0.5 * (sx + sy), 0.5 * (sig_x + sig_y))
+        match self.keep(state) {
+            Ok(case) => {
+                self.last_accepted = Some((field.frame_id, field.t_capture_ns));
+                FieldOutcome::Accepted { case, state }
             }
-            _ => (l1, force_n / section_mm2),
+            Err(reason) => FieldOutcome::Skipped(reason),
+        }
+    }
+
+    /// The loading-branch rule (module doc): keeps `state` or says why not.
+    fn keep(&mut self, state: BiaxialState) -> Result<Option<LoadCase>, SkipReason> {
+        if state.check().is_err() {
+            return Err(SkipReason::BadSection);
+        }
+        let Some(ratio) = state.path_ratio() else {
+            return Err(SkipReason::NotStretched);
         };
-        let nominal_stress_mpa = cauchy_mpa / stretch;
-        let points = &mut self.points[case_index(case)];
-        if points.len() >= self.config.max_points_per_case {
-            return FieldOutcome::Skipped(SkipReason::CaseFull);
-        }
-        if let Some(&(last, _)) = points.last() {
-            if stretch < last + self.config.min_stretch_increment {
-                return FieldOutcome::Skipped(SkipReason::NotIncreasing);
-            }
-        }
-        points.push((stretch, nominal_stress_mpa));
-        self.last_accepted = Some((field.frame_id, field.t_capture_ns));
-        FieldOutcome::Accepted {
-            case,
-            stretch,
-            nominal_stress_mpa,
-        }
-    }
-
-    /// Puts back a point accepted by an earlier run (from its journal), with the same
-    /// loading-branch rule as live points; returns whether it was kept.
-    pub fn restore(&mut self, case: LoadCase, stretch: f64, nominal_stress_mpa: f64) -> bool {
-        let points = &mut self.points[case_index(case)];
-        let increasing = points
-            .last()
-            .is_none_or(|&(last, _)| stretch >= last + self.config.min_stretch_increment);
-        let ok = stretch > 1.0
-            && nominal_stress_mpa.is_finite()
-            && increasing
-            && points.len() < self.config.max_points_per_case;
-        if ok {
-            points.push((stretch, nominal_stress_mpa));
-        }
-        ok
-    }
-
-    /// Points accepted per case, in [`LoadCase::ALL`] order.
-    pub fn point_counts(&self) -> [usize; 3] {
-        [
-            self.points[0].len(),
-            self.points[1].len(),
-            self.points[2].len(),
-        ]
-    }
-
-    /// The accumulated load path as curves (cases with at least 2 points).
-    pub fn curves(&self) -> Vec<Curve> {
-        LoadCase::ALL
+        let angle = path_angle_rad(&state);
+        let nearest = self
+            .paths
             .iter()
-            .zip(&self.points)
-            .filter(|(_, p)| p.len() >= crate::data::MIN_POINTS_PER_CURVE)
-            .filter_map(|(&case, p)| {
-                Curve::new(
-                    case,
-                    p.iter().map(|q| q.0).collect(),
-                    p.iter().map(|q| q.1).collect(),
-                )
-                .ok()
-            })
-            .collect()
+            .enumerate()
+            .map(|(i, p)| (i, angle_between_rad(angle, p.angle_rad)))
+            .filter(|&(_, d)| d <= self.config.path_tolerance_rad)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(i, _)| i);
+        let stretch = state.max_stretch();
+        match nearest {
+            Some(i) => {
+                let path = &mut self.paths[i];
+                if path.states >= self.config.max_points_per_path {
+                    return Err(SkipReason::PathFull);
+                }
+                if stretch < path.last_max_stretch + self.config.min_stretch_increment {
+                    return Err(SkipReason::NotIncreasing);
+                }
+                path.last_max_stretch = stretch;
+                // The newest (largest) state gives the direction best: follows the path.
+                path.angle_rad = angle;
+                path.states += 1;
+            }
+            None => {
+                if self.paths.len() >= self.config.max_paths {
+                    return Err(SkipReason::TooManyPaths);
+                }
+                self.paths.push(LoadPath {
+                    angle_rad: angle,
+                    last_max_stretch: stretch,
+                    states: 1,
+                });
+            }
+        }
+        self.states.push(state);
+        Ok(LoadCase::of_path_ratio(
+            ratio,
+            self.config.classify_tolerance,
+        ))
     }
 
-    /// Refits the configured models on the path so far; `None` before enough points. Each
+    /// Puts back a state accepted by an earlier run (from its journal), with the same
+    /// loading-branch rule as live states; returns whether it was kept.
+    pub fn restore(&mut self, state: BiaxialState) -> bool {
+        self.keep(state).is_ok()
+    }
+
+    /// States kept per canonical case, in [`LoadCase::ALL`] order (the others are in
+    /// [`OnlineIdentifier::general_count`]).
+    pub fn point_counts(&self) -> [usize; 3] {
+        let mut counts = [0; 3];
+        for state in &self.states {
+            let case = state
+                .path_ratio()
+                .and_then(|r| LoadCase::of_path_ratio(r, self.config.classify_tolerance));
+            if let Some(case) = case {
+                counts[LoadCase::ALL
+                    .iter()
+                    .position(|c| *c == case)
+                    .expect("in ALL")] += 1;
+            }
+        }
+        counts
+    }
+
+    /// States kept that are none of the canonical cases.
+    pub fn general_count(&self) -> usize {
+        self.states.len() - self.point_counts().iter().sum::<usize>()
+    }
+
+    /// Every state kept, in arrival order.
+    pub fn states(&self) -> &[BiaxialState] {
+        &self.states
+    }
+
+    /// Loading paths seen so far.
+    pub fn path_count(&self) -> usize {
+        self.paths.len()
+    }
+
+    /// Refits the configured models on every state so far; `None` before enough states. Each
     /// model starts from its last solution (a few Levenberg-Marquardt steps after a few more
-    /// points); every [`FULL_SEARCH_EVERY`]th refit, when a case appears, or when the warm
+    /// points); every [`FULL_SEARCH_EVERY`]th refit, when a path appears, or when the warm
     /// start fails, the full multi-start search runs instead.
     pub fn refit(&mut self) -> Option<Vec<Fit>> {
-        let total: usize = self.point_counts().iter().sum();
-        if total < self.config.min_points_to_fit {
+        if self.states.len() < self.config.min_points_to_fit {
             return None;
         }
-        let curves = self.curves();
-        let cases = curves.len();
-        let full = self.refits.is_multiple_of(FULL_SEARCH_EVERY) || cases != self.fitted_cases;
+        let paths = self.paths.len();
+        let full = self.refits.is_multiple_of(FULL_SEARCH_EVERY) || paths != self.fitted_paths;
         self.refits += 1;
-        self.fitted_cases = cases;
+        self.fitted_paths = paths;
+        let data = FitData {
+            curves: &[],
+            states: &self.states,
+        };
         let mut fits = Vec::with_capacity(self.config.models.len());
         for (k, model) in self.config.models.iter().enumerate() {
             let options = FitOptions {
                 warm_start: if full { None } else { self.warm[k].clone() },
                 ..FitOptions::default()
             };
-            match fit_model(model, &curves, &options) {
+            match fit_data(model, data, &options, &mut |_| {}) {
                 Ok(fit) => {
                     self.warm[k] = Some(fit.params.clone());
                     fits.push(fit);
@@ -402,12 +453,9 @@ mod tests {
                 id.push_rig(rig);
                 let out = id.push_field(field);
                 match out {
-                    FieldOutcome::Accepted {
-                        case: c,
-                        nominal_stress_mpa,
-                        ..
-                    } => {
-                        assert_eq!(c, case);
+                    FieldOutcome::Accepted { case: c, state } => {
+                        assert_eq!(c, Some(case));
+                        let nominal_stress_mpa = state.nominal_stress1_mpa;
                         let expected = s.nominal_stress_mpa[0];
                         assert!(
                             (nominal_stress_mpa - expected).abs() < 1e-9 * expected.abs().max(1.0)
@@ -443,6 +491,132 @@ mod tests {
             ldr.model.name(),
             "exact model ranks first"
         );
+    }
+
+    /// A deterministic noise in [−1, 1] (hash of `k`).
+    fn noise(k: u64) -> f64 {
+        let mut x = k.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
+        x ^= x >> 31;
+        x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        x ^= x >> 29;
+        (x >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    /// Feeds a proportional path ln λy = ρ ln λx up to λx = `max_stretch` (`steps` states),
+    /// with a strain noise of ±`strain_noise` and a force noise of ±`force_noise` (relative);
+    /// returns the next sample id.
+    fn general_path(
+        id: &mut OnlineIdentifier,
+        ratio: f64,
+        max_stretch: f64,
+        steps: u64,
+        first_sample: u64,
+        (strain_noise, force_noise): (f64, f64),
+    ) -> u64 {
+        let law = InvariantLaw::smactane();
+        for k in 1..=steps {
+            let sample_id = first_sample + k;
+            let ex = max_stretch.ln() * k as f64 / steps as f64;
+            let (l1, l2) = (ex.exp(), (ratio * ex).exp());
+            let s = law.in_plane_stress(l1, l2);
+            let (section_x_mm2, section_y_mm2) =
+                (20.0 * l2 * 2.0 * s.stretch3, 20.0 * l1 * 2.0 * s.stretch3);
+            let rig = RigSample {
+                sample_id,
+                force_x_n: s.cauchy_stress_mpa[0]
+                    * section_x_mm2
+                    * (1.0 + force_noise * noise(4 * sample_id)),
+                force_y_n: s.cauchy_stress_mpa[1]
+                    * section_y_mm2
+                    * (1.0 + force_noise * noise(4 * sample_id + 1)),
+                section_x_mm2,
+                section_y_mm2,
+            };
+            id.push_rig(rig);
+            id.push_field(FieldSample {
+                frame_id: sample_id,
+                rig_sample_id: sample_id,
+                t_capture_ns: sample_id * 1000,
+                log_strain_xx: l1.ln() + strain_noise * noise(4 * sample_id + 2),
+                log_strain_yy: l2.ln() + strain_noise * noise(4 * sample_id + 3),
+            });
+        }
+        first_sample + steps
+    }
+
+    /// Largest |P_fit − P_true| / P_true over both directions of the proportional paths
+    /// `ratios` for λx in [1.05, `max_stretch`].
+    fn worst_relative_error(fit: &Fit, ratios: &[f64], max_stretch: f64) -> f64 {
+        let law = InvariantLaw::smactane();
+        let mut worst: f64 = 0.0;
+        for &ratio in ratios {
+            for k in 0..=50 {
+                let l1 = 1.05 + (max_stretch - 1.05) * k as f64 / 50.0;
+                let l2 = (ratio * l1.ln()).exp();
+                let truth = law.in_plane_stress(l1, l2).nominal_stress_mpa;
+                let sigma = fit
+                    .model
+                    .in_plane_cauchy_stress_mpa(&fit.params, l1, l2)
+                    .expect("in the model's domain");
+                for (fitted, truth) in [(sigma[0] / l1, truth[0]), (sigma[1] / l2, truth[1])] {
+                    worst = worst.max((fitted - truth).abs() / truth.abs());
+                }
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn general_biaxial_paths_give_the_true_law_within_two_percent() {
+        // Noise: ±2e-4 on the gauge log strains (a good DIC gauge), ±0.5 % on the forces.
+        let noisy = (2e-4, 5e-3);
+        for ratios in [&[0.5][..], &[1.0], &[0.5, 1.0]] {
+            let mut id = OnlineIdentifier::new(OnlineConfig::default());
+            let mut next = 0;
+            for &ratio in ratios {
+                next = general_path(&mut id, ratio, 1.8, 80, next, noisy);
+            }
+            assert_eq!(id.path_count(), ratios.len(), "{ratios:?}");
+            let kept = id.states().len();
+            assert!(kept >= 70 * ratios.len(), "{ratios:?}: {kept} states kept");
+            // ρ = 0.5 is no canonical case: every state of it is a general one.
+            let general = id.general_count();
+            let half = ratios.iter().filter(|&&r| r == 0.5).count();
+            assert!(general >= 70 * half && general <= 80 * half, "{general}");
+            let fits = id.refit().expect("enough states");
+            let ldr = fits
+                .iter()
+                .find(|f| matches!(f.model, Model::LambertDianiRey { .. }))
+                .expect("the exp-poly law fits");
+            let worst = worst_relative_error(ldr, ratios, 1.8);
+            eprintln!("paths {ratios:?}: {kept} states, worst |ΔP|/P = {worst:.4}");
+            assert!(
+                worst < 0.02,
+                "paths {ratios:?}: worst relative error {worst}"
+            );
+            // Both directions are fitted: the general group has 2 points a state.
+            assert_eq!(ldr.cases.len(), 1);
+            assert_eq!(ldr.cases[0].points, 2 * kept);
+        }
+    }
+
+    #[test]
+    fn unloading_and_reloading_below_the_maximum_are_skipped_per_path() {
+        let mut id = OnlineIdentifier::new(OnlineConfig::default());
+        let next = general_path(&mut id, 0.5, 1.5, 20, 0, (0.0, 0.0));
+        assert_eq!(id.states().len(), 20);
+        // Reloading the same path up to the same maximum adds nothing...
+        let next = general_path(&mut id, 0.5, 1.5, 20, next, (0.0, 0.0));
+        assert_eq!(id.states().len(), 20);
+        assert_eq!(id.counters.skipped, 20);
+        // ...another direction is another path, from its start.
+        general_path(&mut id, 1.0, 1.3, 10, next, (0.0, 0.0));
+        assert_eq!((id.states().len(), id.path_count()), (30, 2));
+        assert_eq!(id.point_counts(), [0, 10, 0]);
+        assert_eq!(id.general_count(), 20);
+        // A restored state obeys the same rule.
+        let last = *id.states().last().unwrap();
+        assert!(!id.restore(last), "not beyond its path's maximum");
     }
 
     #[test]

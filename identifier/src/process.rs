@@ -164,10 +164,7 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
     let mut journal = match &config.journal {
         Some(path) => {
             let restored = crate::journal::read(path)?;
-            let kept = restored
-                .iter()
-                .filter(|p| online.restore(p.case, p.stretch, p.nominal_stress_mpa))
-                .count();
+            let kept = restored.iter().filter(|p| online.restore(p.state)).count();
             if !restored.is_empty() {
                 eprintln!(
                     "identifier: rebuilt the load path from {}: {kept} of {} points",
@@ -198,18 +195,11 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
                     }
                     // Rig first: fields name rig samples.
                     let mut record = |field: &FieldSample, outcome: FieldOutcome| {
-                        if let FieldOutcome::Accepted {
-                            case,
-                            stretch,
-                            nominal_stress_mpa,
-                        } = outcome
-                        {
+                        if let FieldOutcome::Accepted { state, .. } = outcome {
                             accepted_any = true;
                             if let Some(journal) = journal.as_mut() {
                                 journal.append(&crate::journal::JournalPoint {
-                                    case,
-                                    stretch,
-                                    nominal_stress_mpa,
+                                    state,
                                     frame_id: field.frame_id,
                                 })?;
                             }
@@ -300,7 +290,8 @@ fn final_json(
 ) -> Result<String, ProcessError> {
     let points = online.point_counts();
     let json = serde_json::json!({
-        "points": {"uniaxial": points[0], "equibiaxial": points[1], "pure_shear": points[2]},
+        "points": {"uniaxial": points[0], "equibiaxial": points[1], "pure_shear": points[2], "biaxial_general": online.general_count()},
+        "paths": online.path_count(),
         "fields_received": summary.fields_received,
         "rig_samples_received": summary.rig_samples_received,
         "pairing": {"accepted": online.counters.accepted, "skipped": online.counters.skipped, "dropped": online.counters.dropped},

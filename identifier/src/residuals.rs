@@ -8,7 +8,6 @@
 //! problem with fewer blocks than threads uses fewer threads). No allocation per evaluation
 //! on one thread; with more, only the threads' own.
 
-use crate::data::LoadCase;
 use crate::gradient::Kinematics;
 use crate::lsq::LeastSquares;
 use crate::models::Model;
@@ -59,16 +58,17 @@ pub struct PointSet<'a> {
 }
 
 impl<'a> PointSet<'a> {
-    /// `points`: (load case, stretch, nominal stress MPa, factor); `threads` ≥ 1 (0 is 1).
-    pub fn new(model: &'a Model, points: &[(LoadCase, f64, f64, f64)], threads: usize) -> Self {
+    /// `points`: (kinematics of the measured direction, nominal stress MPa along it, factor);
+    /// `threads` ≥ 1 (0 is 1).
+    pub fn new(model: &'a Model, points: &[(Kinematics, f64, f64)], threads: usize) -> Self {
         let params = model.param_names().len();
         let blocks = points.len().div_ceil(BLOCK_POINTS);
         PointSet {
             points: Points {
                 model,
-                kinematics: points.iter().map(|p| Kinematics::of(p.0, p.1)).collect(),
-                stresses_mpa: points.iter().map(|p| p.2).collect(),
-                factors: points.iter().map(|p| p.3).collect(),
+                kinematics: points.iter().map(|p| p.0).collect(),
+                stresses_mpa: points.iter().map(|p| p.1).collect(),
+                factors: points.iter().map(|p| p.2).collect(),
             },
             params,
             threads: threads.max(1),

@@ -1,9 +1,10 @@
 //! The documented limit on the points a fit uses: above it, the fit runs on a deterministic
 //! subsample that keeps every load path's shape: each curve keeps a share of the limit in
 //! proportion to its length (at least its two ends), evenly spaced along its rows, in order,
-//! first and last point always kept. The caller says so (stderr and JSON), never silently.
+//! first and last point always kept (general biaxial states likewise, two points each). The
+//! caller says so (stderr and JSON), never silently.
 
-use crate::data::{Curve, MIN_POINTS_PER_CURVE};
+use crate::data::{BiaxialState, Curve, MIN_POINTS_PER_CURVE};
 
 /// Default largest number of points fitted (over all curves) before subsampling.
 pub const DEFAULT_MAX_FIT_POINTS: usize = 200_000;
@@ -22,15 +23,25 @@ pub struct Subsample {
 /// The curves with at most about `max_points` points in all (never fewer than
 /// [`MIN_POINTS_PER_CURVE`] per curve), or `None` when they hold no more than `max_points`.
 pub fn subsample(curves: &[Curve], max_points: usize) -> Option<(Vec<Curve>, Subsample)> {
-    let total: usize = curves.iter().map(Curve::len).sum();
+    subsample_data(curves, &[], max_points).map(|(curves, _, s)| (curves, s))
+}
+
+/// [`subsample`] of curves and general biaxial states together: a state is two fitted
+/// points (P1, P2); the states, in their order, are one more load path sharing the limit.
+pub fn subsample_data(
+    curves: &[Curve],
+    states: &[BiaxialState],
+    max_points: usize,
+) -> Option<(Vec<Curve>, Vec<BiaxialState>, Subsample)> {
+    let total: usize = curves.iter().map(Curve::len).sum::<usize>() + 2 * states.len();
     if total <= max_points {
         return None;
     }
+    let share = |len: usize| (max_points as u128 * len as u128 / total as u128) as usize;
     let kept: Vec<Curve> = curves
         .iter()
         .map(|curve| {
-            let share = (max_points as u128 * curve.len() as u128 / total as u128) as usize;
-            let keep = share.clamp(MIN_POINTS_PER_CURVE, curve.len());
+            let keep = share(curve.len()).clamp(MIN_POINTS_PER_CURVE, curve.len());
             let rows = evenly_spaced_rows(curve.len(), keep);
             Curve {
                 case: curve.case,
@@ -40,9 +51,19 @@ pub fn subsample(curves: &[Curve], max_points: usize) -> Option<(Vec<Curve>, Sub
             }
         })
         .collect();
-    let points_fitted = kept.iter().map(Curve::len).sum();
+    let kept_states: Vec<BiaxialState> = if states.len() <= MIN_POINTS_PER_CURVE {
+        states.to_vec()
+    } else {
+        let keep = (share(2 * states.len()) / 2).clamp(MIN_POINTS_PER_CURVE, states.len());
+        evenly_spaced_rows(states.len(), keep)
+            .into_iter()
+            .map(|i| states[i])
+            .collect()
+    };
+    let points_fitted = kept.iter().map(Curve::len).sum::<usize>() + 2 * kept_states.len();
     Some((
         kept,
+        kept_states,
         Subsample {
             points_total: total,
             points_fitted,

@@ -7,6 +7,7 @@ mod common;
 use common::treloar;
 use identifier::data::{Curve, LoadCase};
 use identifier::fit::{fit_model, FitOptions, JacobianPath};
+use identifier::gradient::Kinematics;
 use identifier::lsq::{LeastSquares, ResidualVector};
 use identifier::models::Model;
 use identifier::residuals::PointSet;
@@ -68,8 +69,12 @@ fn one_pass_normal_equations_match_the_formed_jacobian() {
                 .map(move |(&l, &s)| (c.case, l, s, 1.0))
         })
         .collect();
+    let measured: Vec<(Kinematics, f64, f64)> = points
+        .iter()
+        .map(|&(case, l, s, f)| (Kinematics::of(case, l), s, f))
+        .collect();
     for threads in [1, 2] {
-        let mut set = PointSet::new(&model, &points, threads);
+        let mut set = PointSet::new(&model, &measured, threads);
         let residuals = |q: &[f64]| set_residuals(&model, &points, q);
         let mut reference = ResidualVector {
             residuals: &residuals,

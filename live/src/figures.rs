@@ -5,28 +5,19 @@
 
 use crate::latency::Latency;
 use anyhow::Context;
-use identifier::data::{Curve, LoadCase};
+use identifier::data::Curve;
 use identifier::fit::{fit_ranked, FitOptions};
 use identifier::plot::{chart, Series};
 use std::path::{Path, PathBuf};
 
-/// The load path of the journal as curves (cases with enough points).
+/// The load path of the journal as curves (canonical cases with enough points).
 pub fn journal_curves(journal: &Path) -> anyhow::Result<Vec<Curve>> {
-    let points = identifier::journal::read(journal)?;
-    let mut curves = Vec::new();
-    for case in LoadCase::ALL {
-        let (stretch, stress): (Vec<f64>, Vec<f64>) = points
-            .iter()
-            .filter(|p| p.case == case)
-            .map(|p| (p.stretch, p.nominal_stress_mpa))
-            .unzip();
-        if stretch.len() >= identifier::data::MIN_POINTS_PER_CURVE {
-            if let Ok(curve) = Curve::new(case, stretch, stress) {
-                curves.push(curve);
-            }
-        }
-    }
-    Ok(curves)
+    let states: Vec<_> = identifier::journal::read(journal)?
+        .iter()
+        .map(|p| p.state)
+        .collect();
+    let tolerance = identifier::online::OnlineConfig::default().classify_tolerance;
+    Ok(identifier::data::canonical_curves(&states, tolerance))
 }
 
 /// Stress-stretch per case with the ranked fits, f(I1) and g(I2) with the paper's route, into

@@ -1,19 +1,21 @@
 //! `dicstream identify`: offline identification of hyperelastic potentials from CSV load cases
-//! (`stretch,nominal_stress_mpa`), ranked by AIC; table, JSON, and optional PNG plots.
+//! (`stretch,nominal_stress_mpa`) and general biaxial states (`--biaxial-general`:
+//! `lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa`, both stresses fitted at once),
+//! ranked by AIC; table, JSON, and optional PNG plots (of the canonical curves).
 //!
 //! Above `--max-fit-points` the fit runs on a load-path-preserving subsample, said on stderr and
 //! in the JSON. When stderr is a terminal, one progress line per model (model, start k/n,
 //! elapsed) is drawn there; never on stdout, which holds the JSON alone with `--json`.
 
 use anyhow::{bail, Context};
-use identifier::data::{read_curve_csv, Curve, LoadCase};
+use identifier::data::{read_biaxial_csv, read_curve_csv, BiaxialState, Curve, LoadCase};
 use identifier::fit::{
-    evaluate, fit_ranked_with_progress, Fit, FitOptions, FitStage, ResidualKind,
+    evaluate_data, fit_ranked_data, Fit, FitData, FitOptions, FitStage, ResidualKind,
 };
 use identifier::models::{parse_model_list, Model};
 use identifier::report::fit_json;
 use identifier::route::paper_route;
-use identifier::subsample::{subsample, Subsample, DEFAULT_MAX_FIT_POINTS};
+use identifier::subsample::{subsample_data, Subsample, DEFAULT_MAX_FIT_POINTS};
 use serde_json::{json, Value};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -39,6 +41,11 @@ pub struct IdentifyArgs {
     /// Pure shear (planar tension) CSV: header, then `stretch,nominal_stress_mpa`.
     #[arg(long = "pure-shear", value_name = "F.csv")]
     pub pure_shear: Option<PathBuf>,
+    /// General biaxial states (any λ1, λ2, e.g. Kawabata's tests on a multiaxial machine):
+    /// header `lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa`, then one state a row;
+    /// both stresses are fitted, with the other files if given.
+    #[arg(long = "biaxial-general", value_name = "F.csv")]
+    pub biaxial_general: Option<PathBuf>,
     /// Models: NAME[,NAME...] (e.g. mooney,ogden:3,rivlin:10,01,11) or `all`.
     #[arg(long, default_value = "all")]
     pub model: String,
@@ -92,8 +99,14 @@ pub fn run_with(
                 .push(read_curve_csv(path, case).with_context(|| format!("reading {case} data"))?);
         }
     }
-    if curves.is_empty() {
-        bail!("no data: give at least one of --uniaxial, --biaxial, --pure-shear");
+    let states: Vec<BiaxialState> = match &args.biaxial_general {
+        Some(path) => read_biaxial_csv(path).context("reading general biaxial data")?,
+        None => Vec::new(),
+    };
+    if curves.is_empty() && states.is_empty() {
+        bail!(
+            "no data: give at least one of --uniaxial, --biaxial, --pure-shear, --biaxial-general"
+        );
     }
     let models = parse_model_list(&args.model)?;
     let threads = usize::try_from(args.threads).unwrap_or(1);
@@ -106,24 +119,30 @@ pub fn run_with(
         ..FitOptions::default()
     };
     let max_fit_points = usize::try_from(args.max_fit_points).unwrap_or(usize::MAX);
-    let subsampled = subsample(&curves, max_fit_points);
-    if let Some((_, s)) = &subsampled {
+    let subsampled = subsample_data(&curves, &states, max_fit_points);
+    if let Some((_, _, s)) = &subsampled {
         writeln!(
             err,
             "{} points exceed --max-fit-points {}: fitting a subsample of {} (each curve's ends and shape kept); RMS and R² over every point",
             s.points_total, s.max_points, s.points_fitted
         )?;
     }
-    let fitted_curves = subsampled.as_ref().map_or(&curves[..], |(c, _)| &c[..]);
+    let all = FitData {
+        curves: &curves,
+        states: &states,
+    };
+    let fitted = subsampled.as_ref().map_or(all, |(c, s, _)| FitData {
+        curves: c,
+        states: s,
+    });
     let mut line = ProgressLine::new(&models, progress, PROGRESS_REDRAW);
-    let (mut fits, failures) =
-        fit_ranked_with_progress(&models, fitted_curves, &options, &mut |index, stage| {
-            line.update(err, index, stage)
-        });
+    let (mut fits, failures) = fit_ranked_data(&models, fitted, &options, &mut |index, stage| {
+        line.update(err, index, stage)
+    });
     line.finish(err);
     if subsampled.is_some() {
         for fit in &mut fits {
-            (fit.rms_mpa, fit.cases) = evaluate(&fit.model, &fit.params, &curves);
+            (fit.rms_mpa, fit.cases) = evaluate_data(&fit.model, &fit.params, all);
         }
     }
     let route = match paper_route(&curves, 2, 2) {
@@ -144,12 +163,12 @@ pub fn run_with(
         if let Some(r) = &route {
             json_out["paper_route"] = json!({"a": r.a, "b": r.b, "c": r.c});
         }
-        if let Some((_, s)) = &subsampled {
+        if let Some((_, _, s)) = &subsampled {
             json_out["subsample"] = subsample_json(s);
         }
         writeln!(out, "{}", serde_json::to_string_pretty(&json_out)?)?;
     } else {
-        print_table(out, &fits, &curves)?;
+        print_table(out, &fits, &curves, !states.is_empty())?;
         for (m, e) in &failures {
             writeln!(err, "not fitted: {m}: {e}")?;
         }
@@ -160,6 +179,12 @@ pub fn run_with(
                 r.a, r.b, r.c
             )?;
         }
+    }
+    if let (Some(_), false) = (&args.plot, states.is_empty()) {
+        writeln!(
+            err,
+            "plots: the canonical curves only; the general biaxial states are not drawn"
+        )?;
     }
     if let Some(dir) = &args.plot {
         let written = identifier::plot::write_plots(dir, &curves, &fits, route.as_ref())
@@ -263,8 +288,16 @@ fn progress_text(
     )
 }
 
-fn print_table(out: &mut dyn Write, fits: &[Fit], curves: &[Curve]) -> std::io::Result<()> {
-    let cases: Vec<&str> = curves.iter().map(|c| c.case.name()).collect();
+fn print_table(
+    out: &mut dyn Write,
+    fits: &[Fit],
+    curves: &[Curve],
+    general: bool,
+) -> std::io::Result<()> {
+    let mut cases: Vec<&str> = curves.iter().map(|c| c.case.name()).collect();
+    if general {
+        cases.push(identifier::data::DataGroup::BiaxialGeneral.name());
+    }
     write!(
         out,
         "{:>2} {:<22} {:>9} {:>9}",
@@ -351,6 +384,7 @@ mod tests {
                 uniaxial: Some(self.0.join("u.csv")),
                 biaxial: Some(self.0.join("b.csv")),
                 pure_shear: None,
+                biaxial_general: None,
                 model: "mooney,ogden:2".into(),
                 residual: ResidualArg::Absolute,
                 json,
@@ -467,6 +501,141 @@ mod tests {
         );
         off.finish(&mut quiet);
         assert!(quiet.is_empty());
+    }
+
+    /// A general biaxial CSV from the Smactane law along ρ = 0.5 and ρ = 1 (and ρ = 0.5 along
+    /// y) up to λ = 1.8, ±0.5 % stress noise; removed on drop.
+    fn general_csv(tag: &str) -> (Data, PathBuf) {
+        let dir =
+            std::env::temp_dir().join(format!("dicstream_identify_{tag}_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let law = identifier::law::InvariantLaw::smactane();
+        let mut text = String::from("lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa\n");
+        let mut k = 0u64;
+        for (ratio, swap) in [(0.5, false), (1.0, false), (0.5, true)] {
+            for step in 1..=40 {
+                k += 1;
+                let e = 1.8f64.ln() * step as f64 / 40.0;
+                let (mut l1, mut l2) = (e.exp(), (ratio * e).exp());
+                if swap {
+                    std::mem::swap(&mut l1, &mut l2);
+                }
+                let p = law.in_plane_stress(l1, l2).nominal_stress_mpa;
+                let wobble =
+                    |j: u64| 1.0 + 0.005 * (((k * 7919 + j * 104_729) % 21) as f64 / 10.0 - 1.0);
+                text.push_str(&format!(
+                    "{l1},{l2},{},{}\n",
+                    p[0] * wobble(0),
+                    p[1] * wobble(1)
+                ));
+            }
+        }
+        let path = dir.join("general.csv");
+        std::fs::write(&path, text).unwrap();
+        (Data(dir), path)
+    }
+
+    fn general_args(path: PathBuf, model: &str) -> IdentifyArgs {
+        IdentifyArgs {
+            uniaxial: None,
+            biaxial: None,
+            pure_shear: None,
+            biaxial_general: Some(path),
+            model: model.into(),
+            residual: ResidualArg::Absolute,
+            json: true,
+            plot: None,
+            max_fit_points: DEFAULT_MAX_FIT_POINTS as u64,
+            threads: 1,
+        }
+    }
+
+    #[test]
+    fn biaxial_general_csv_gives_the_true_law_within_two_percent() {
+        let (_data, path) = general_csv("general");
+        let (out, err) = run_captured(general_args(path.clone(), "ldr:2,2,mooney"), false);
+        let value: Value = serde_json::from_str(&out).expect("stdout is one JSON document");
+        let best = &value["fits"][0];
+        assert_eq!(best["model"], "lambert-diani-rey:2,2", "{out}");
+        assert!(
+            best["rms_by_case_mpa"]["biaxial_general"].is_number(),
+            "{out}"
+        );
+        let model = Model::parse(best["model"].as_str().unwrap()).unwrap();
+        let params: Vec<f64> = model
+            .param_names()
+            .iter()
+            .map(|n| best["params"][n].as_f64().unwrap())
+            .collect();
+        let law = identifier::law::InvariantLaw::smactane();
+        let mut worst: f64 = 0.0;
+        for ratio in [0.5, 1.0] {
+            for k in 0..=50 {
+                let l1 = 1.05 + 0.75 * k as f64 / 50.0;
+                let l2 = (ratio * l1.ln()).exp();
+                let truth = law.in_plane_stress(l1, l2).nominal_stress_mpa;
+                let sigma = model.in_plane_cauchy_stress_mpa(&params, l1, l2).unwrap();
+                for (fitted, truth) in [(sigma[0] / l1, truth[0]), (sigma[1] / l2, truth[1])] {
+                    worst = worst.max((fitted - truth).abs() / truth);
+                }
+            }
+        }
+        eprintln!("identify --biaxial-general: worst |ΔP|/P = {worst:.4}");
+        assert!(worst < 0.02, "worst relative error {worst}");
+        // No canonical curve: the paper's route says why it did not run, on stderr only.
+        assert!(err.contains("paper route"), "{err}");
+        // The table names the group.
+        let mut args = general_args(path, "mooney");
+        args.json = false;
+        let (table, _) = run_captured(args, false);
+        assert!(table.contains("r2_biaxial_general"), "{table}");
+    }
+
+    #[test]
+    fn biaxial_general_bad_input_is_a_clear_error_naming_the_line() {
+        let (data, _) = general_csv("general_bad");
+        let h = "lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa";
+        for (text, needle) in [
+            (
+                format!("{h}\n1.2,1.1,0.3,0.2\n1.3,1.1,NaN,0.2\n"),
+                "line 3: nominal_stress1_mpa NaN is not a finite number",
+            ),
+            (format!("{h}\n1.2,1.1,0.3\n"), "line 2: expected 4 cells"),
+            (
+                "1.2,1.1,0.3,0.2\n1.3,1.2,0.4,0.3\n".to_string(),
+                "line 1: expected the header",
+            ),
+            (
+                format!("{h}\n1.2,0,0.3,0.2\n1.3,1.2,0.4,0.3\n"),
+                "line 2: lambda2 0 must be > 0",
+            ),
+        ] {
+            let path = data.0.join("bad.csv");
+            std::fs::write(&path, &text).unwrap();
+            let (mut out, mut err) = (Vec::new(), Vec::new());
+            let error = run_with(
+                general_args(path.clone(), "mooney"),
+                &mut out,
+                &mut err,
+                false,
+            )
+            .unwrap_err();
+            let message = format!("{error:#}");
+            assert!(
+                message.contains("reading general biaxial data"),
+                "{message}"
+            );
+            assert!(message.contains(&path.display().to_string()), "{message}");
+            assert!(message.contains(needle), "{needle}: {message}");
+            assert!(out.is_empty(), "nothing on stdout on error");
+        }
+        let missing = general_args(data.0.join("missing.csv"), "mooney");
+        let (mut out, mut err) = (Vec::new(), Vec::new());
+        let message = format!(
+            "{:#}",
+            run_with(missing, &mut out, &mut err, false).unwrap_err()
+        );
+        assert!(message.contains("cannot read the file"), "{message}");
     }
 
     #[test]
