@@ -588,6 +588,34 @@ mod tests {
     }
 
     #[test]
+    fn canonical_curves_of_states_leave_the_general_ones_out() {
+        let state = |l1: f64, l2: f64| BiaxialState {
+            stretch1: l1,
+            stretch2: l2,
+            nominal_stress1_mpa: l1 - 1.0,
+            nominal_stress2_mpa: l2 - 1.0,
+        };
+        let mut states = Vec::new();
+        for k in 1..=5 {
+            let l = 1.0 + 0.1 * k as f64;
+            states.push(state(1.0 / l.sqrt(), l)); // uniaxial along y
+            states.push(state(l, l)); // equibiaxial
+            states.push(state(l, l.sqrt())); // ρ = 0.5
+        }
+        let curves = canonical_curves(&states, 0.15);
+        assert_eq!(curves.len(), 2);
+        assert_eq!(curves[0].case, LoadCase::Uniaxial);
+        assert_eq!(curves[0].len(), 5);
+        assert!(
+            (curves[0].stretch[4] - 1.5).abs() < 1e-12,
+            "loaded stretch: the larger"
+        );
+        assert!((curves[0].nominal_stress_mpa[4] - 0.5).abs() < 1e-12);
+        assert_eq!(curves[1].case, LoadCase::Equibiaxial);
+        assert_eq!(curves[1].len(), 5);
+    }
+
+    #[test]
     fn section_and_stresses_agree() {
         let a = current_section_mm2(LoadCase::Uniaxial, 2.0, 10.0, 2.0);
         assert!((a - 10.0).abs() < 1e-12);
