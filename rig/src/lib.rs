@@ -35,4 +35,6 @@ pub use program::{Program, StopTransition};
 pub use refusal::Refusal;
 pub use rig::{Rig, RigCommand};
 pub use snapshot::{ProgramStatus, RigSnapshot, SpecimenKinematics};
-pub use specimen::{Loading, Misalignment, SpecimenConfig, SpecimenGeometry};
+pub use specimen::{
+    GaugeFraction, GripEffects, Loading, Misalignment, SpecimenConfig, SpecimenGeometry,
+};
