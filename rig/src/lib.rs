@@ -25,6 +25,7 @@ pub mod rig;
 pub mod session;
 pub mod snapshot;
 pub mod specimen;
+pub mod strain;
 
 pub use campaign::{Campaign, CampaignEvent, CampaignTest};
 pub use config::RigConfig;
