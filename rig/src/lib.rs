@@ -25,6 +25,7 @@ pub mod rig;
 pub mod session;
 pub mod snapshot;
 pub mod specimen;
+pub mod strain;
 
 pub use campaign::{Campaign, CampaignEvent, CampaignTest};
 pub use config::RigConfig;
@@ -35,4 +36,6 @@ pub use program::{Program, StopTransition};
 pub use refusal::Refusal;
 pub use rig::{Rig, RigCommand};
 pub use snapshot::{ProgramStatus, RigSnapshot, SpecimenKinematics};
-pub use specimen::{Loading, Misalignment, SpecimenConfig, SpecimenGeometry};
+pub use specimen::{
+    GaugeFraction, GripEffects, Loading, Misalignment, SpecimenConfig, SpecimenGeometry,
+};

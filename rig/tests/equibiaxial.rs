@@ -3,7 +3,7 @@
 //! grip forces against eq. (19) evaluated directly with the law (`material`).
 
 use material::InvariantLaw;
-use rig::{Axis, Program, ProgramStatus, Rig, RigCommand, RigConfig};
+use rig::{Axis, GripEffects, Program, ProgramStatus, Rig, RigCommand, RigConfig};
 
 const PROGRAM: &str = r#"
 name = "equibiaxial to 2 at 1e-3 /s"
@@ -23,7 +23,10 @@ segments = [{ kind = "hold", duration_s = 1.0 }, { kind = "ramp", to = 100.0, ra
 
 #[test]
 fn equibiaxial_ramp_to_stretch_two() {
-    let config = RigConfig::default();
+    // The homogeneous sheet: this test checks the grips against eq. (19); the grip effects
+    // have their own tests (tests/strain_control.rs, rig/tests/campaign.rs).
+    let mut config = RigConfig::default();
+    config.specimen.as_mut().unwrap().grip = GripEffects::none();
     let specimen = config.specimen.clone().unwrap();
     let gauge_mm = specimen.geometry.gauge_length_mm;
     let section_mm2 = specimen.geometry.width_mm * specimen.geometry.thickness_mm;

@@ -1,0 +1,130 @@
+//! Interlocks of strain control: what makes the strain channel unusable. Any of them puts the
+//! rig on a displacement hold at its present position and is reported with its reason.
+
+use crate::strain::outer::GaugeMeasurement;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InterlockLimits {
+    /// Largest age of the newest field (rig time now − its capture time), s.
+    pub stale_s: f64,
+    /// Fewest converged correlation nodes of a usable field.
+    pub min_valid_nodes: u32,
+    /// Largest |measured − predicted| gauge log strain of a field (a jump).
+    pub jump_log: f64,
+}
+
+impl Default for InterlockLimits {
+    fn default() -> Self {
+        InterlockLimits {
+            stale_s: 0.5,
+            min_valid_nodes: 16,
+            jump_log: 0.03,
+        }
+    }
+}
+
+/// Why strain control holds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum HoldReason {
+    /// The newest field is older than the limit (fields stopped: correlator gone, camera gone).
+    Stale {
+        age_s: f64,
+        limit_s: f64,
+    },
+    TooFewNodes {
+        valid: u32,
+        min: u32,
+    },
+    NotFinite,
+    /// The field disagrees with the model by more than the jump limit.
+    Jump {
+        innovation: [f64; 2],
+        limit: f64,
+    },
+    /// The field's capture time is outside the rig's history (clock mismatch, or very late).
+    NotAligned {
+        t_capture_s: f64,
+    },
+    /// The rig refused the set-point (stroke, force limit...).
+    Refused(String),
+}
+
+impl std::fmt::Display for HoldReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            HoldReason::Stale { age_s, limit_s } => {
+                write!(
+                    f,
+                    "stale fields: newest is {age_s:.3} s old (limit {limit_s} s)"
+                )
+            }
+            HoldReason::TooFewNodes { valid, min } => {
+                write!(f, "field with {valid} valid nodes (at least {min} needed)")
+            }
+            HoldReason::NotFinite => write!(f, "field strain is not finite"),
+            HoldReason::Jump { innovation, limit } => write!(
+                f,
+                "strain jump: field off the model by ({:.4}, {:.4}) (limit {limit})",
+                innovation[0], innovation[1]
+            ),
+            HoldReason::NotAligned { t_capture_s } => write!(
+                f,
+                "field captured at {t_capture_s:.3} s is outside the rig's history"
+            ),
+            HoldReason::Refused(reason) => write!(f, "set-point refused: {reason}"),
+        }
+    }
+}
+
+impl InterlockLimits {
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.stale_s.is_finite() && self.stale_s > 0.0) {
+            return Err(format!(
+                "stale_s {}: expected a positive number",
+                self.stale_s
+            ));
+        }
+        if !(self.jump_log.is_finite() && self.jump_log > 0.0) {
+            return Err(format!(
+                "jump_log {}: expected a positive number",
+                self.jump_log
+            ));
+        }
+        Ok(())
+    }
+
+    /// The sample's own checks: finite strains and capture time, enough nodes.
+    pub fn check_sample(&self, m: &GaugeMeasurement) -> Result<(), HoldReason> {
+        if !(m.log_strain.iter().all(|v| v.is_finite()) && m.t_capture_s.is_finite()) {
+            return Err(HoldReason::NotFinite);
+        }
+        if m.valid_nodes < self.min_valid_nodes {
+            return Err(HoldReason::TooFewNodes {
+                valid: m.valid_nodes,
+                min: self.min_valid_nodes,
+            });
+        }
+        Ok(())
+    }
+
+    pub fn check_jump(&self, innovation: [f64; 2]) -> Result<(), HoldReason> {
+        if innovation.iter().any(|v| v.abs() > self.jump_log) {
+            return Err(HoldReason::Jump {
+                innovation,
+                limit: self.jump_log,
+            });
+        }
+        Ok(())
+    }
+
+    pub fn check_age(&self, now_s: f64, t_capture_s: f64) -> Result<(), HoldReason> {
+        let age_s = now_s - t_capture_s;
+        if age_s > self.stale_s {
+            return Err(HoldReason::Stale {
+                age_s,
+                limit_s: self.stale_s,
+            });
+        }
+        Ok(())
+    }
+}

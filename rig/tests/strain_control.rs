@@ -1,0 +1,501 @@
+//! Strain control closed on a simulated plant, without processes: the rig (hydraulics,
+//! centroid displacement loops, the default specimen with its grip effects) and a delayed
+//! "measurement" that is the gauge zone's truth plus noise, captured at a frame rate of 10 to
+//! 25 Hz and delivered a latency later, as the live correlator's fields are (issue 16).
+
+// Axis loops index the rig's axes and the test's arrays alike.
+#![allow(clippy::needless_range_loop)]
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+use rig::strain::control::OnRestore;
+use rig::strain::{
+    GaugeMeasurement, HoldReason, InterlockLimits, OuterLoopConfig, StrainControl, StrainEvent,
+    StrainMode, StrainPath, StrainSegment,
+};
+use rig::{Axis, AxisControl, ControlMode, Program, Rig, RigCommand, RigConfig};
+use std::collections::VecDeque;
+
+/// The camera + correlator: captures the gauge truth at `fps`, delivers it `latency_s` later.
+struct DelayedMeasurement {
+    fps: f64,
+    latency_s: f64,
+    noise: Normal<f64>,
+    rng: ChaCha8Rng,
+    next_capture_s: f64,
+    in_flight: VecDeque<GaugeMeasurement>,
+    newest: Option<GaugeMeasurement>,
+    /// Deliveries stop (the correlator killed) from this time on.
+    stop_at_s: f64,
+}
+
+impl DelayedMeasurement {
+    fn new(fps: f64, latency_s: f64, seed: u64) -> Self {
+        DelayedMeasurement {
+            fps,
+            latency_s,
+            noise: Normal::new(0.0, 1.0e-4).unwrap(),
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            next_capture_s: 0.0,
+            in_flight: VecDeque::new(),
+            newest: None,
+            stop_at_s: f64::INFINITY,
+        }
+    }
+
+    /// After `rig.step()`: capture when a frame is due, deliver what has arrived.
+    fn observe(&mut self, rig: &Rig) {
+        let s = rig.state();
+        if s.t_s >= self.next_capture_s {
+            self.next_capture_s += 1.0 / self.fps;
+            let truth = [s.specimen.stretch_x.ln(), s.specimen.stretch_y.ln()];
+            let m = GaugeMeasurement {
+                t_capture_s: s.t_s,
+                log_strain: [
+                    truth[0] + self.noise.sample(&mut self.rng),
+                    truth[1] + self.noise.sample(&mut self.rng),
+                ],
+                valid_nodes: 400,
+            };
+            self.in_flight.push_back(m);
+        }
+        while let Some(m) = self.in_flight.front() {
+            if m.t_capture_s + self.latency_s > s.t_s {
+                break;
+            }
+            let m = self.in_flight.pop_front().unwrap();
+            if s.t_s < self.stop_at_s {
+                self.newest = Some(m);
+            }
+        }
+    }
+}
+
+fn truth(rig: &Rig) -> [f64; 2] {
+    let k = rig.state().specimen;
+    [k.stretch_x.ln(), k.stretch_y.ln()]
+}
+
+/// A rig at rest with the default specimen, strain control idle, fields flowing for 0.5 s.
+fn bench(fps: f64, latency_s: f64, seed: u64) -> (Rig, StrainControl, DelayedMeasurement) {
+    bench_with(fps, latency_s, seed, OnRestore::Resume)
+}
+
+fn bench_with(
+    fps: f64,
+    latency_s: f64,
+    seed: u64,
+    on_restore: OnRestore,
+) -> (Rig, StrainControl, DelayedMeasurement) {
+    let mut rig = Rig::new(RigConfig::default(), seed).unwrap();
+    let mut control = StrainControl::new(
+        &rig,
+        OuterLoopConfig::default(),
+        InterlockLimits::default(),
+        on_restore,
+    )
+    .unwrap();
+    let mut camera = DelayedMeasurement::new(fps, latency_s, seed);
+    for _ in 0..(0.5 * rig.config().control_hz) as usize {
+        control.advance(&mut rig, camera.newest.as_ref());
+        rig.step();
+        camera.observe(&rig);
+    }
+    (rig, control, camera)
+}
+
+/// Per step until the program ends: (target, gauge truth).
+fn run_path(
+    rig: &mut Rig,
+    control: &mut StrainControl,
+    camera: &mut DelayedMeasurement,
+    path: StrainPath,
+) -> Vec<([f64; 2], [f64; 2])> {
+    let latest = camera.newest.unwrap();
+    control.start(rig, path, &latest).unwrap();
+    let mut trace = Vec::new();
+    let budget = (400.0 * rig.config().control_hz) as usize;
+    for _ in 0..budget {
+        let event = control.advance(rig, camera.newest.as_ref());
+        rig.step();
+        camera.observe(rig);
+        trace.push((control.target(), truth(rig)));
+        match event {
+            Some(StrainEvent::Finished) => return trace,
+            Some(StrainEvent::Held(reason)) => panic!("held: {reason}"),
+            _ => {}
+        }
+    }
+    panic!("strain program did not finish in budget");
+}
+
+/// Worst |ρ − ρ_target| over the states with the larger stretch ≥ 1.05 while loading.
+fn worst_ratio_error(trace: &[([f64; 2], [f64; 2])], ratio: f64) -> f64 {
+    trace
+        .iter()
+        .filter(|(_, y)| y[0].max(y[1]) >= 1.05f64.ln())
+        .map(|(_, y)| (y[1] / y[0] - ratio).abs())
+        .fold(0.0, f64::max)
+}
+
+const RATE_LOG_PER_S: f64 = 0.02;
+
+#[test]
+fn equibiaxial_in_strain_control_holds_the_ratio_where_displacement_control_misses_it() {
+    for (fps, latency_s, seed) in [(10.0, 0.15, 1), (25.0, 0.06, 2)] {
+        let (mut rig, mut control, mut camera) = bench(fps, latency_s, seed);
+        let path = StrainPath::ratio_path(1.0, 1.8, RATE_LOG_PER_S).unwrap();
+        let trace = run_path(&mut rig, &mut control, &mut camera, path);
+        let worst = worst_ratio_error(&trace, 1.0);
+        let end = truth(&rig);
+        println!(
+            "strain control {fps} fps, latency {latency_s} s: worst |ρ−1| {worst:.5}, end λ ({:.4}, {:.4})",
+            end[0].exp(),
+            end[1].exp()
+        );
+        assert!(worst <= 0.01, "|ρ − 1| {worst}");
+        // Reaches the target, with no overshoot or oscillation above 1 % of it.
+        let target = 1.8f64.ln();
+        for (_, y) in &trace {
+            assert!(y[0] <= 1.01 * target && y[1] <= 1.01 * target, "{y:?}");
+        }
+        assert!((end[0] - target).abs() < 0.01 * target, "{end:?}");
+        assert!((end[1] - target).abs() < 0.01 * target, "{end:?}");
+        assert_eq!(control.mode(), &StrainMode::Done);
+    }
+    // Displacement control of the same test: both grips to the elongation that gives λ 1.8
+    // along x; the gauge zone's ρ is off by more than 0.05.
+    let mut rig = Rig::new(RigConfig::default(), 3).unwrap();
+    let program = Program::from_toml(
+        r#"
+name = "equibiaxial in displacement"
+[[setup]]
+axis = "x"
+control = "centroid_displacement"
+[[setup]]
+axis = "y"
+control = "centroid_displacement"
+[[channel]]
+target = "x.elongation"
+segments = [{ kind = "ramp", to = 110.0, rate_per_s = 20.0 }]
+[[channel]]
+target = "y.elongation"
+segments = [{ kind = "ramp", to = 110.0, rate_per_s = 20.0 }]
+"#,
+        std::path::Path::new("."),
+    )
+    .unwrap();
+    rig.command(RigCommand::StartProgram(Box::new(program)))
+        .unwrap();
+    let mut worst = 0.0f64;
+    let mut best = f64::INFINITY;
+    for _ in 0..(6.0 * rig.config().control_hz) as usize {
+        rig.step();
+        let y = truth(&rig);
+        if y[0].max(y[1]) >= 1.05f64.ln() {
+            let e = (y[1] / y[0] - 1.0).abs();
+            worst = worst.max(e);
+            best = best.min(e);
+        }
+    }
+    println!("displacement control: |ρ−1| from {best:.4} to {worst:.4}");
+    assert!(best > 0.05, "displacement control |ρ − 1| only {best}");
+}
+
+#[test]
+fn pure_shear_and_ratio_one_half_paths() {
+    let (mut rig, mut control, mut camera) = bench(15.0, 0.1, 4);
+    let path = StrainPath::ratio_path(0.0, 1.8, RATE_LOG_PER_S).unwrap();
+    let trace = run_path(&mut rig, &mut control, &mut camera, path);
+    let worst_y = trace.iter().map(|(_, y)| y[1].abs()).fold(0.0, f64::max);
+    let at = trace
+        .iter()
+        .position(|(_, y)| y[1].abs() == worst_y)
+        .unwrap();
+    println!(
+        "pure shear: worst |ln λy| {worst_y:.5} at step {at} of {}, ln λx {:.4}",
+        trace.len(),
+        trace[at].1[0]
+    );
+    assert!(worst_y <= 0.002, "|ln λy| {worst_y}");
+    assert!((truth(&rig)[0] - 1.8f64.ln()).abs() < 0.01);
+
+    let (mut rig, mut control, mut camera) = bench(15.0, 0.1, 5);
+    let path = StrainPath::ratio_path(0.5, 1.8, RATE_LOG_PER_S).unwrap();
+    let trace = run_path(&mut rig, &mut control, &mut camera, path);
+    let worst = worst_ratio_error(&trace, 0.5);
+    println!("ρ = 0.5: worst |ρ−0.5| {worst:.5}");
+    assert!(worst <= 0.01, "|ρ − 0.5| {worst}");
+}
+
+#[test]
+fn step_response_settles_without_overshoot_beyond_one_percent() {
+    for (fps, latency_s) in [(10.0, 0.15), (25.0, 0.06)] {
+        let (mut rig, mut control, mut camera) = bench(fps, latency_s, 6);
+        // Ramp to ln λ 0.2 on both, hold 2 s, then a step of +0.02 on x (a fast ramp), hold 3 s.
+        let path = StrainPath::new(vec![
+            StrainSegment::Ramp {
+                to_log: [0.2, 0.2],
+                rate_log_per_s: 0.05,
+            },
+            StrainSegment::Hold { duration_s: 2.0 },
+            StrainSegment::Ramp {
+                to_log: [0.22, 0.2],
+                rate_log_per_s: 10.0,
+            },
+            StrainSegment::Hold { duration_s: 3.0 },
+        ])
+        .unwrap();
+        let trace = run_path(&mut rig, &mut control, &mut camera, path);
+        let dt = rig.dt_s();
+        let n_step = trace.iter().position(|(t, _)| t[0] > 0.2 + 1e-9).unwrap();
+        let after = &trace[n_step..];
+        let (y0, y1) = (0.2, 0.22);
+        let rise_s = |f: f64| {
+            after
+                .iter()
+                .position(|(_, y)| y[0] >= y0 + f * (y1 - y0))
+                .map(|k| k as f64 * dt)
+        };
+        let rise = rise_s(0.9).unwrap() - rise_s(0.1).unwrap();
+        let peak = after.iter().map(|(_, y)| y[0]).fold(f64::MIN, f64::max);
+        let overshoot = (peak - y1) / (y1 - y0);
+        // Last second: amplitude of what remains.
+        let last = &after[after.len() - (1.0 / dt) as usize..];
+        let lo = last.iter().map(|(_, y)| y[0]).fold(f64::MAX, f64::min);
+        let hi = last.iter().map(|(_, y)| y[0]).fold(f64::MIN, f64::max);
+        println!(
+            "step 0.2→0.22 at {fps} fps, latency {latency_s} s: rise 10–90 % {:.1} ms, overshoot {:.1} % of the step, last-second band {:.2e}, end error {:.2e}",
+            rise * 1e3,
+            overshoot * 100.0,
+            hi - lo,
+            last.last().unwrap().1[0] - y1
+        );
+        assert!(
+            peak <= y1 * 1.01,
+            "overshoot beyond 1 % of the target: {peak}"
+        );
+        assert!(hi - lo <= 0.01 * y1, "oscillation {lo}..{hi}");
+        assert!((last.last().unwrap().1[0] - y1).abs() < 0.01 * y1);
+    }
+}
+
+#[test]
+fn fields_stopped_mid_ramp_hold_position_and_resume_bumplessly() {
+    let (mut rig, mut control, mut camera) = bench(15.0, 0.1, 7);
+    let path = StrainPath::ratio_path(1.0, 1.5, 0.05).unwrap();
+    control
+        .start(&mut rig, path, &camera.newest.unwrap())
+        .unwrap();
+    let hz = rig.config().control_hz;
+    let stop_at = rig.state().t_s + 4.0;
+    camera.stop_at_s = stop_at;
+    let mut held_at = None;
+    let mut elongation_at_hold = [0.0; 2];
+    let mut finished = false;
+    for _ in 0..(60.0 * hz) as usize {
+        let event = control.advance(&mut rig, camera.newest.as_ref());
+        rig.step();
+        camera.observe(&rig);
+        let t = rig.state().t_s;
+        match event {
+            Some(StrainEvent::Held(reason)) => {
+                assert!(matches!(reason, HoldReason::Stale { .. }), "{reason}");
+                assert!(reason.to_string().contains("stale"));
+                // Within the stale limit of the last delivered field.
+                assert!(t - stop_at <= 0.5 + 1.0 / 15.0 + 1e-3, "held at {t}");
+                held_at = Some(t);
+                elongation_at_hold = [
+                    rig.state().axes[0].elongation_mm,
+                    rig.state().axes[1].elongation_mm,
+                ];
+                assert_eq!(control.mode().code(), "strain_held");
+            }
+            Some(StrainEvent::Resumed) => {
+                assert!(held_at.is_some());
+                assert_eq!(control.mode(), &StrainMode::Strain);
+            }
+            Some(StrainEvent::Finished) => {
+                finished = true;
+                break;
+            }
+            None => {}
+        }
+        // While held: the position stays (displacement hold, no runaway).
+        if let (Some(h), StrainMode::Held(_)) = (held_at, control.mode()) {
+            if t > h + 0.2 {
+                for i in 0..2 {
+                    let e = rig.state().axes[i].elongation_mm;
+                    assert!(
+                        (e - elongation_at_hold[i]).abs() < 0.05,
+                        "axis {i}: {e} vs {elongation_at_hold:?}"
+                    );
+                }
+            }
+            // The correlator comes back after 3 s of hold.
+            if t > h + 3.0 {
+                camera.stop_at_s = f64::INFINITY;
+            }
+        }
+    }
+    assert!(held_at.is_some(), "never held");
+    assert!(finished, "did not resume and finish");
+    let end = truth(&rig);
+    assert!((end[0] - 1.5f64.ln()).abs() < 0.01 * 1.5f64.ln(), "{end:?}");
+}
+
+#[test]
+fn fields_back_after_a_hold_end_the_test_held_when_configured_to_stop() {
+    let (mut rig, mut control, mut camera) = bench_with(15.0, 0.1, 10, OnRestore::Stop);
+    let path = StrainPath::ratio_path(1.0, 1.5, 0.05).unwrap();
+    control
+        .start(&mut rig, path, &camera.newest.unwrap())
+        .unwrap();
+    let hz = rig.config().control_hz;
+    camera.stop_at_s = rig.state().t_s + 3.0;
+    let mut events = Vec::new();
+    let mut held = [0.0; 2];
+    for _ in 0..(10.0 * hz) as usize {
+        if let Some(event) = control.advance(&mut rig, camera.newest.as_ref()) {
+            if matches!(event, StrainEvent::Held(_)) {
+                held = [
+                    rig.state().axes[0].elongation_mm,
+                    rig.state().axes[1].elongation_mm,
+                ];
+                camera.stop_at_s = f64::INFINITY;
+            }
+            events.push(event);
+        }
+        rig.step();
+        camera.observe(&rig);
+    }
+    assert_eq!(events.len(), 2, "{events:?}");
+    assert!(matches!(
+        events[0],
+        StrainEvent::Held(HoldReason::Stale { .. })
+    ));
+    assert_eq!(events[1], StrainEvent::Finished);
+    assert_eq!(control.mode().code(), "displacement");
+    for i in 0..2 {
+        assert!((rig.state().axes[i].elongation_mm - held[i]).abs() < 0.05);
+    }
+}
+
+#[test]
+fn bad_fields_hold_at_once_with_the_reason() {
+    for (bad, expect) in [
+        (
+            GaugeMeasurement {
+                t_capture_s: 0.0,
+                log_strain: [f64::NAN, 0.0],
+                valid_nodes: 400,
+            },
+            "not finite",
+        ),
+        (
+            GaugeMeasurement {
+                t_capture_s: 0.0,
+                log_strain: [0.0, 0.0],
+                valid_nodes: 3,
+            },
+            "valid nodes",
+        ),
+        (
+            GaugeMeasurement {
+                t_capture_s: 0.0,
+                log_strain: [0.3, 0.0],
+                valid_nodes: 400,
+            },
+            "jump",
+        ),
+    ] {
+        let (mut rig, mut control, mut camera) = bench(20.0, 0.05, 8);
+        let path = StrainPath::ratio_path(1.0, 1.5, 0.05).unwrap();
+        control
+            .start(&mut rig, path, &camera.newest.unwrap())
+            .unwrap();
+        for _ in 0..(2.0 * rig.config().control_hz) as usize {
+            control.advance(&mut rig, camera.newest.as_ref());
+            rig.step();
+            camera.observe(&rig);
+        }
+        let mut bad = bad;
+        bad.t_capture_s = rig.state().t_s - 0.01;
+        let event = control.advance(&mut rig, Some(&bad));
+        let Some(StrainEvent::Held(reason)) = event else {
+            panic!("{expect}: no hold, {event:?}");
+        };
+        assert!(reason.to_string().contains(expect), "{reason}");
+        let held = [
+            rig.state().axes[0].elongation_mm,
+            rig.state().axes[1].elongation_mm,
+        ];
+        for _ in 0..(1.0 * rig.config().control_hz) as usize {
+            rig.step();
+        }
+        for i in 0..2 {
+            assert!((rig.state().axes[i].elongation_mm - held[i]).abs() < 0.05);
+        }
+        assert_eq!(
+            rig.state().axes[0].control,
+            AxisControl::Centroid(ControlMode::Displacement)
+        );
+    }
+}
+
+#[test]
+fn switching_to_strain_and_back_is_bumpless() {
+    let (mut rig, mut control, mut camera) = bench(20.0, 0.05, 9);
+    // Displacement first: elongations to 20 mm by set-points, then settle.
+    for axis in [Axis::X, Axis::Y] {
+        rig.command(RigCommand::SetAxisControl {
+            axis,
+            control: AxisControl::Centroid(ControlMode::Displacement),
+        })
+        .unwrap();
+        rig.command(RigCommand::SetSetpoint {
+            channel: rig::Channel::Elongation(axis),
+            value: 20.0,
+        })
+        .unwrap();
+    }
+    for _ in 0..(2.0 * rig.config().control_hz) as usize {
+        control.advance(&mut rig, camera.newest.as_ref());
+        rig.step();
+        camera.observe(&rig);
+    }
+    let before = [
+        rig.state().axes[0].elongation_mm,
+        rig.state().axes[1].elongation_mm,
+    ];
+    // Strain control holding the measured state: the grips do not jump.
+    let path = StrainPath::new(vec![StrainSegment::Hold { duration_s: 2.0 }]).unwrap();
+    control
+        .start(&mut rig, path, &camera.newest.unwrap())
+        .unwrap();
+    let mut worst = 0.0f64;
+    for _ in 0..(1.0 * rig.config().control_hz) as usize {
+        control.advance(&mut rig, camera.newest.as_ref());
+        rig.step();
+        camera.observe(&rig);
+        for i in 0..2 {
+            worst = worst.max((rig.state().axes[i].elongation_mm - before[i]).abs());
+        }
+    }
+    println!("displacement → strain: largest elongation change {worst:.4} mm");
+    assert!(worst < 0.1, "bump of {worst} mm");
+    // Back to displacement: the set-points stay.
+    control.stop();
+    let at = [
+        rig.state().axes[0].elongation_mm,
+        rig.state().axes[1].elongation_mm,
+    ];
+    for _ in 0..(1.0 * rig.config().control_hz) as usize {
+        control.advance(&mut rig, camera.newest.as_ref());
+        rig.step();
+    }
+    for i in 0..2 {
+        assert!((rig.state().axes[i].elongation_mm - at[i]).abs() < 0.05);
+    }
+}
