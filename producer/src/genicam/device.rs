@@ -185,10 +185,13 @@ impl Acquisition {
                 }
             }
         })?;
-        let id = camera
-            .device_id()
-            .map(|s| s.to_string())
-            .unwrap_or_else(|_| spec.id.clone().unwrap_or_default());
+        // Aravis' id (as `dicstream cameras` lists it): the one asked for, or the first found,
+        // which is the one `Camera::new(None)` opens.
+        let id = spec
+            .id
+            .clone()
+            .or_else(|| list_ids().into_iter().next())
+            .unwrap_or_else(|| "(first found)".into());
         let set = |what: &str, result: Result<(), aravis::glib::Error>| {
             result.map_err(|e| GenicamError::Setting {
                 id: id.clone(),
