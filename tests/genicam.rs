@@ -373,3 +373,78 @@ fn an_unsupported_pixel_format_is_a_clear_error() {
         "nothing published: {stderr}"
     );
 }
+
+/// Median time of `runs` copies of `bytes` bytes, µs (the scale for the figures below).
+fn memcpy_median_us(bytes: usize, runs: usize) -> f64 {
+    let src = vec![0x5Au8; bytes];
+    let mut dst = vec![0u8; bytes];
+    let mut times: Vec<f64> = (0..runs)
+        .map(|i| {
+            let start = Instant::now();
+            dst.copy_from_slice(std::hint::black_box(&src));
+            std::hint::black_box(&mut dst)[i % bytes] ^= 1;
+            start.elapsed().as_secs_f64() * 1e6
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[runs / 2]
+}
+
+/// Benchmark (run by hand, prints figures, asserts no time): from the driver's complete buffer
+/// to a subscriber, per 1 MPx frame in Mono8 and Mono16, against a memcpy of the same sizes in
+/// the same run. The latency is the tap's, from `t_capture_ns` (the host receive time, taken
+/// when the driver hands the buffer over, before the one conversion copy into the loaned
+/// slice) to the tap's receipt: conversion, checksum, publish and the subscriber's wake-up.
+///
+/// `cargo test --release --features genicam --test genicam bench_ -- --ignored --nocapture`
+#[test]
+#[ignore = "benchmark: prints figures, run by hand"]
+fn bench_genicam_buffer_to_subscriber_per_1_mpx_frame() {
+    let Some(mut ns) = Netns::new("bench_genicam") else {
+        return;
+    };
+    ns.start_camera("camera");
+    let mut lines = Vec::new();
+    for (format, source_bytes) in [("Mono8", 1usize << 20), ("Mono16", 2 << 20)] {
+        let mut run = Run::new("genicam_bench");
+        spawn_producer(
+            &mut ns,
+            &run,
+            &["--pixel-format", format, "--roi", "0,0,1024,1024"],
+        )
+        .wait_for_stderr("ready", |l| l.contains("producer: ready"));
+        let taps: Vec<serde_json::Value> = (0..3)
+            .map(|i| tap(&mut run, &format!("tap{i}"), 60))
+            .collect();
+        let producer = ns.child("producer");
+        producer.signal(libc::SIGTERM);
+        producer.wait();
+        let memcpy_source = memcpy_median_us(source_bytes, 201);
+        let memcpy_payload = memcpy_median_us(2 << 20, 201);
+        let mut p50s: Vec<f64> = taps
+            .iter()
+            .map(|t| {
+                assert_eq!(t["checksum_failures"], 0, "{t}");
+                t["latency_us"]["p50"].as_f64().unwrap()
+            })
+            .collect();
+        p50s.sort_by(f64::total_cmp);
+        let p50 = p50s[1];
+        lines.push(format!(
+            "genicam {format} 1024x1024: buffer to subscriber p50 {p50:.0} µs (median of 3 taps x \
+             60 frames; p50s {p50s:?}, p90s {:?}); memcpy {:.0} µs for the camera's {} MiB, {:.0} \
+             µs for the {} MiB payload; ratio to the payload memcpy {:.1}",
+            taps.iter()
+                .map(|t| t["latency_us"]["p90"].as_f64().unwrap().round())
+                .collect::<Vec<_>>(),
+            memcpy_source,
+            source_bytes >> 20,
+            memcpy_payload,
+            2,
+            p50 / memcpy_payload
+        ));
+    }
+    for line in lines {
+        eprintln!("BENCH {line}");
+    }
+}
