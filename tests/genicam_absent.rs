@@ -8,7 +8,10 @@ use std::process::Command;
 const DICSTREAM: &str = env!("CARGO_BIN_EXE_dicstream");
 
 fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(DICSTREAM).args(args).output().expect("dicstream");
+    let out = Command::new(DICSTREAM)
+        .args(args)
+        .output()
+        .expect("dicstream");
     (
         out.status.success(),
         String::from_utf8_lossy(&out.stdout).into_owned(),

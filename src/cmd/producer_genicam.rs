@@ -162,7 +162,7 @@ pub fn run(
             CameraNote::Skipped { counts } => {
                 let skipped = counts.skipped();
                 // The first one, then at 10, 100, 1000...: visible, never a flood.
-                if skipped == 1 || (skipped % 10 == 0 && (skipped as f64).log10().fract() == 0.0) {
+                if is_power_of_ten(skipped) {
                     eprintln!(
                         "producer: camera buffer skipped, not published ({} incomplete, {} \
                          failed, {} of the wrong size or format so far)",
@@ -214,4 +214,22 @@ pub fn run(
         }
     );
     Ok((report, line))
+}
+
+/// 1, 10, 100, ...: when a count is worth a line.
+#[cfg_attr(not(feature = "genicam"), allow(dead_code))]
+fn is_power_of_ten(mut n: u64) -> bool {
+    while n >= 10 && n % 10 == 0 {
+        n /= 10;
+    }
+    n == 1
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn skipped_buffers_are_reported_at_powers_of_ten() {
+        let reported: Vec<u64> = (0..=1000).filter(|&n| super::is_power_of_ten(n)).collect();
+        assert_eq!(reported, [1, 10, 100, 1000]);
+    }
 }
