@@ -14,6 +14,7 @@ use producer::genicam::{CameraSpec, PixelFormat, Roi, Trigger};
 use producer::stream::{StreamEvent, StreamReport, StreamSettings};
 
 /// The header of the `--log` CSV for a camera.
+#[cfg_attr(not(feature = "genicam"), allow(dead_code))]
 pub const LOG_HEADER: &str = "frame_id,camera_frame_id,camera_timestamp_ns,host_receive_ns";
 
 /// The camera options of `dicstream producer`.
@@ -219,7 +220,7 @@ pub fn run(
 /// 1, 10, 100, ...: when a count is worth a line.
 #[cfg_attr(not(feature = "genicam"), allow(dead_code))]
 fn is_power_of_ten(mut n: u64) -> bool {
-    while n >= 10 && n % 10 == 0 {
+    while n >= 10 && n.is_multiple_of(10) {
         n /= 10;
     }
     n == 1
