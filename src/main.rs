@@ -20,6 +20,8 @@ enum Command {
     // One variant per subcommand; keep one line each so parallel edits stay simple.
     /// Speed benchmarks a user can reproduce (`bench correlate`).
     Bench(cmd::bench::BenchArgs),
+    /// The GenICam cameras found (GigE Vision, USB3 Vision); needs the `genicam` feature.
+    Cameras(cmd::cameras::CamerasArgs),
     /// Offline correlation of image files: fields (CSV, VTK, PNG) and summary.json.
     Correlate(cmd::correlate::CorrelateArgs),
     /// Live correlation process: frames in, fields out (zero-copy); resumes from --state-dir.
@@ -72,6 +74,7 @@ fn main() -> std::process::ExitCode {
     let result: anyhow::Result<std::process::ExitCode> = match cli.command {
         // One arm per subcommand.
         Command::Bench(args) => ok(cmd::bench::run(args)),
+        Command::Cameras(args) => ok(cmd::cameras::run(args)),
         Command::Correlate(args) => ok(cmd::correlate::run(args)),
         Command::Correlator(args) => ok(cmd::correlator::run(args)),
         Command::Identify(args) => ok(cmd::identify::run(args)),

@@ -2,10 +2,11 @@
 //! `frames` service, stamps the header, paces to the requested rate and never waits for a
 //! consumer (safe overflow: a slow or dead reader loses frames, the camera never blocks).
 //!
-//! Three loops share the same shell: [`stream`] pulls a [`FrameSource`] (scenario, replay),
+//! The loops share the same shell: [`stream`] pulls a [`FrameSource`] (scenario, replay),
 //! [`stream_following_rig`] subscribes to `rig/state` and renders each frame from the most
 //! recent rig sample with a [`RigCamera`], and [`stream_watched`] (`stream/watched.rs`)
-//! publishes the images of a watched folder as they become complete. Everything else
+//! publishes the images of a watched folder as they become complete, and [`stream_genicam`]
+//! (`stream/genicam.rs`, feature `genicam`) those of a real camera. Everything else
 //! (rendering, the rig kinematics, the envelope, the folder watcher) lives in the pure modules.
 
 use crate::{FrameDims, FrameInfo, FrameSource, NextMotion, ProducerError, RigCamera};
@@ -15,7 +16,11 @@ use wire::frame::pixel_checksum;
 use wire::pubsub::{SlicePublisher, ValueSubscriber};
 use wire::{services, FrameHeader, GroundTruth, Instance, InstanceError, RigState};
 
+#[cfg(feature = "genicam")]
+mod genicam;
 mod watched;
+#[cfg(feature = "genicam")]
+pub use genicam::{stream_genicam, CameraNote, CameraReport};
 pub use watched::stream_watched;
 
 /// Longest sleep while waiting for the first rig sample (a signal is seen within it).
@@ -98,6 +103,18 @@ pub enum StreamError {
     Wire(#[from] InstanceError),
     #[error(transparent)]
     Source(#[from] ProducerError),
+    #[cfg(feature = "genicam")]
+    #[error(transparent)]
+    Camera(#[from] crate::genicam::device::GenicamError),
+    /// The camera came back with another image size or format than the stream was opened
+    /// with: the frames service cannot change shape mid-run.
+    #[cfg(feature = "genicam")]
+    #[error("camera {id} came back with {now}, the stream was opened with {before}: restart the producer")]
+    CameraChanged {
+        id: String,
+        before: String,
+        now: String,
+    },
 }
 
 /// Shared memory the `frames` service needs for frames of `width_px` x `height_px` (bytes).
@@ -203,11 +220,21 @@ impl Shell {
         &mut self,
         render: impl FnOnce(&mut [u16]) -> Result<Option<FrameInfo>, ProducerError>,
     ) -> Result<Option<FrameHeader>, StreamError> {
+        self.publish_stamped(None, render)
+    }
+
+    /// [`Shell::publish`] with the capture time given (a real camera's host receive time,
+    /// [`wire::monotonic_ns`]) instead of read when the slice is loaned.
+    fn publish_stamped(
+        &mut self,
+        t_capture_ns: Option<u64>,
+        render: impl FnOnce(&mut [u16]) -> Result<Option<FrameInfo>, ProducerError>,
+    ) -> Result<Option<FrameHeader>, StreamError> {
         let frame_id = self.first_frame_id + self.report.frames_sent;
         let dims = self.dims;
         let mut sent_header = FrameHeader::default();
         let outcome = self.publisher.publish(dims.len_px(), |header, pixels| {
-            let t_capture_ns = wire::monotonic_ns();
+            let t_capture_ns = t_capture_ns.unwrap_or_else(wire::monotonic_ns);
             let Some(info) = render(pixels)? else {
                 return Ok(false);
             };

@@ -2,12 +2,14 @@
 
 pub mod bench;
 pub mod bench_pipeline;
+pub mod cameras;
 pub mod correlate;
 pub mod correlator;
 pub mod identifier;
 pub mod identify;
 pub mod monitor;
 pub mod producer;
+pub mod producer_genicam;
 pub mod producer_watch;
 pub mod rig;
 pub mod run;

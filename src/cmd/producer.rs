@@ -1,7 +1,8 @@
 //! `dicstream producer`: the camera process. Publishes `frames` (zero-copy `[u16]` slices behind
 //! a `FrameHeader`) from a simulated scenario, a replayed image folder, or the rig state
 //! (`--follow-rig`), paced to `--fps`, or the images of a watched folder as they become
-//! complete (`--watch`, `producer_watch.rs`). Says "ready" on stderr once the publisher exists
+//! complete (`--watch`, `producer_watch.rs`), or a real GenICam camera (`--camera`,
+//! `producer_genicam.rs`, feature `genicam`). Says "ready" on stderr once the publisher exists
 //! and prints one final line on stdout (also after SIGINT/SIGTERM, then exits 0).
 
 use std::path::PathBuf;
@@ -43,9 +44,12 @@ pub struct ProducerArgs {
     #[arg(long, default_value_t = producer::DEFAULT_SETTLE_MS, requires = "watch")]
     pub settle_ms: u64,
     /// With --watch: write one CSV row per frame (frame_id,file,modified_unix_ns,size_bytes,
-    /// renamed) to this file
-    #[arg(long, value_name = "FILE", requires = "watch")]
+    /// renamed) to this file. With --camera: (frame_id,camera_frame_id,camera_timestamp_ns,
+    /// host_receive_ns)
+    #[arg(long, value_name = "FILE")]
     pub log: Option<PathBuf>,
+    #[command(flatten)]
+    pub genicam: super::producer_genicam::CameraArgs,
     /// Render each frame from the most recent rig/state sample (the rig deforms the specimen);
     /// waits for the first sample
     #[arg(long, conflicts_with_all = ["scenario", "params"])]
@@ -91,6 +95,10 @@ pub fn run(args: ProducerArgs) -> anyhow::Result<()> {
     anyhow::ensure!(
         args.frames != Some(0),
         "--frames 0: expected at least 1 frame"
+    );
+    anyhow::ensure!(
+        args.log.is_none() || args.watch.is_some() || args.genicam.camera.is_some(),
+        "--log: only with --watch (one row per file) or --camera (one row per frame's timestamps)"
     );
     let instance = wire::Instance::new(&args.instance)?;
     let settings = StreamSettings {
@@ -173,6 +181,16 @@ pub fn run(args: ProducerArgs) -> anyhow::Result<()> {
             log: args.log.as_ref(),
         };
         super::producer_watch::run(watch, &instance, &settings, &mut on_event)?
+    } else if let Some(spec) = &args.genicam.camera {
+        super::producer_genicam::run(
+            spec,
+            &args.genicam,
+            args.fps,
+            args.log.as_ref(),
+            &instance,
+            &settings,
+            &mut on_event,
+        )?
     } else if let Some(source) = &args.replay {
         let mut replay = Replay::open(source)?;
         let dims = replay.dims();
@@ -207,7 +225,11 @@ pub fn run(args: ProducerArgs) -> anyhow::Result<()> {
         );
         (report, line)
     };
-    let fps = if args.watch.is_some() { 0.0 } else { args.fps };
+    let fps = if args.watch.is_some() || args.genicam.camera.is_some() {
+        0.0
+    } else {
+        args.fps
+    };
     println!("{}", final_line(&report, fps, &source_line));
     Ok(())
 }
