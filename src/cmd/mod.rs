@@ -10,6 +10,7 @@ pub mod monitor;
 pub mod producer;
 pub mod producer_watch;
 pub mod rig;
+pub mod rig_follow_csv;
 pub mod run;
 pub mod synth;
 pub mod tap;

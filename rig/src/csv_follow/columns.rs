@@ -358,6 +358,15 @@ impl Layout {
         Ok(row)
     }
 
+    /// The followed columns and where they are: `Time (cell 1), Fx (cell 3)`.
+    pub fn describe(&self) -> String {
+        self.names
+            .iter()
+            .map(|(at, name)| format!("{name} (cell {})", at + 1))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     fn name_of(&self, at: usize) -> &str {
         self.names
             .iter()

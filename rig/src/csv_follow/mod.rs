@@ -4,10 +4,13 @@
 //! waits for its newline), [`tail`] reads what was appended to the file since the last poll
 //! (waiting for a file that does not exist yet, noticing truncation and rotation), and
 //! [`Follower`] ties them: bytes in, rows or reported malformed lines out. The process shell
-//! that publishes the rows on `rig/state` is `process_csv` (feature `process`).
+//! that publishes the rows on `rig/state` is [`process`] (feature `process`).
 
+pub mod clock;
 pub mod columns;
 pub mod lines;
+#[cfg(feature = "process")]
+pub mod process;
 pub mod tail;
 
 pub use columns::{ColumnSpec, CsvColumns, CsvError, Layout, Row};
