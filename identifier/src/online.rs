@@ -601,7 +601,10 @@ mod tests {
                 assert_eq!(case, LoadCase::Uniaxial);
                 assert!((stretch - stretch_at(t)).abs() < 1e-12);
                 let expected = 0.5 * (nominal_at(50_000_000) + nominal_at(60_000_000));
-                assert!((nominal_stress_mpa - expected).abs() < 1e-12, "{nominal_stress_mpa} {expected}");
+                assert!(
+                    (nominal_stress_mpa - expected).abs() < 1e-12,
+                    "{nominal_stress_mpa} {expected}"
+                );
             }
             other => panic!("{other:?}"),
         }
@@ -609,7 +612,10 @@ mod tests {
         let t = 105_000_000;
         assert_eq!(id.push_field(field(t)), FieldOutcome::Pending);
         let resolved = id.push_rig(sample(11));
-        assert!(matches!(resolved[..], [(_, FieldOutcome::Accepted { .. })]), "{resolved:?}");
+        assert!(
+            matches!(resolved[..], [(_, FieldOutcome::Accepted { .. })]),
+            "{resolved:?}"
+        );
         // Before the oldest kept sample: dropped.
         let mut small = OnlineIdentifier::new(OnlineConfig {
             rig_history: 2,

@@ -42,6 +42,9 @@ struct Watch {
 pub struct Liveness {
     stale_after: Duration,
     watches: [Option<Watch>; 4],
+    /// Roles whose silence is not a hang (a real camera, a followed machine log): only their
+    /// stopped state is watched.
+    silence_ignored: [bool; 4],
 }
 
 impl Liveness {
@@ -49,7 +52,13 @@ impl Liveness {
         Liveness {
             stale_after,
             watches: [None; 4],
+            silence_ignored: [false; 4],
         }
+    }
+
+    /// Watches only whether `role` is stopped, not whether it publishes.
+    pub fn ignore_silence(&mut self, role: Role) {
+        self.silence_ignored[role as usize] = true;
     }
 
     /// Starts (or starts again, after a restart) watching `role` from `now`.
@@ -95,6 +104,9 @@ impl Liveness {
             let Some((output, input)) = counts.of(role) else {
                 continue;
             };
+            if self.silence_ignored[role as usize] {
+                continue;
+            }
             if output != watch.output {
                 watch.output = output;
                 watch.output_since = now;

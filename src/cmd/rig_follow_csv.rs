@@ -46,7 +46,12 @@ pub struct FollowCsvArgs {
     #[arg(long, default_value = ",", requires = "follow_csv")]
     pub delimiter: String,
     /// Seconds added to the machine's time to put it on the camera's (camera − machine)
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, requires = "follow_csv")]
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        allow_hyphen_values = true,
+        requires = "follow_csv"
+    )]
     pub offset_s: f64,
     /// Initial sections of the specimen normal to X and Y, mm² (Cauchy stress = force over
     /// the current section, which the identifier derives from them and the measured stretch)
@@ -100,7 +105,12 @@ pub fn columns(args: &FollowCsvArgs) -> anyhow::Result<CsvColumns> {
             spec(&args.displacement_z_column),
         ],
         time_unit: unit(&args.time_unit, "--time-unit", TimeUnit::parse, TIME_UNITS)?,
-        force_unit: unit(&args.force_unit, "--force-unit", ForceUnit::parse, FORCE_UNITS)?,
+        force_unit: unit(
+            &args.force_unit,
+            "--force-unit",
+            ForceUnit::parse,
+            FORCE_UNITS,
+        )?,
         displacement_unit: unit(
             &args.displacement_unit,
             "--displacement-unit",
@@ -109,7 +119,9 @@ pub fn columns(args: &FollowCsvArgs) -> anyhow::Result<CsvColumns> {
         )?,
         delimiter,
     };
-    columns.validate().map_err(|e| anyhow::anyhow!("--follow-csv: {e}"))?;
+    columns
+        .validate()
+        .map_err(|e| anyhow::anyhow!("--follow-csv: {e}"))?;
     Ok(columns)
 }
 

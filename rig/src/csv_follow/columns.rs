@@ -382,7 +382,10 @@ mod tests {
     #[test]
     fn header_cells_give_name_and_unit() {
         assert_eq!(split_unit(" Fx (kN) "), ("Fx".into(), Some("kN".into())));
-        assert_eq!(split_unit("\"Time [s]\""), ("Time".into(), Some("s".into())));
+        assert_eq!(
+            split_unit("\"Time [s]\""),
+            ("Time".into(), Some("s".into()))
+        );
         assert_eq!(split_unit("Fx"), ("Fx".into(), None));
     }
 

@@ -35,7 +35,10 @@ mod tests {
     fn lines_are_whole_only_at_their_newline() {
         let mut s = LineSplitter::default();
         assert!(s.push(b"ab").is_empty());
-        assert_eq!(s.push(b"c\nde\n\nf"), vec![b"abc".to_vec(), b"de".to_vec(), vec![]]);
+        assert_eq!(
+            s.push(b"c\nde\n\nf"),
+            vec![b"abc".to_vec(), b"de".to_vec(), vec![]]
+        );
         assert_eq!(s.pending_len(), 1);
         assert_eq!(s.push(b"\r\n"), vec![b"f\r".to_vec()]);
     }

@@ -86,15 +86,15 @@ impl Follower {
                     events.push(LineEvent::Header);
                 }
                 Some(layout) => {
-                    let parsed = layout.parse_row(text).and_then(|row| {
-                        match self.last_time_s {
+                    let parsed = layout
+                        .parse_row(text)
+                        .and_then(|row| match self.last_time_s {
                             Some(last) if row.t_s < last => Err(format!(
                                 "time {} s goes back (previous row {last} s)",
                                 row.t_s
                             )),
                             _ => Ok(row),
-                        }
-                    });
+                        });
                     match parsed {
                         Ok(row) => {
                             self.last_time_s = Some(row.t_s);
@@ -193,7 +193,10 @@ mod tests {
             .collect();
         assert_eq!(bad.len(), 3, "{bad:?}");
         assert_eq!(bad[0].0, 3);
-        assert!(bad[0].1.contains("Fx") && bad[0].1.contains("oops"), "{bad:?}");
+        assert!(
+            bad[0].1.contains("Fx") && bad[0].1.contains("oops"),
+            "{bad:?}"
+        );
         assert!(bad[1].1.contains("2 cells"), "{bad:?}");
         assert!(bad[2].1.contains("goes back"), "{bad:?}");
         assert_eq!(f.counters.malformed, 3);
@@ -221,7 +224,10 @@ mod tests {
         let mut s = spec();
         s.force[1] = Some(ColumnSpec::new("Fy", None));
         let mut f = Follower::new(s).unwrap();
-        let e = f.feed(b"Time (s),Fx (kN),Dx (mm)\n").unwrap_err().to_string();
+        let e = f
+            .feed(b"Time (s),Fx (kN),Dx (mm)\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("\"Fy\"") && e.contains("Time (s)"), "{e}");
     }
 

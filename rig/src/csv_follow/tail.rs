@@ -122,17 +122,24 @@ mod tests {
         assert_eq!(tail.poll().unwrap(), TailRead::Missing);
         std::fs::write(&path, b"a,b\n1,").unwrap();
         assert_eq!(appended(tail.poll().unwrap()), b"a,b\n1,");
-        let mut f = std::fs::OpenOptions::new().append(true).open(&path).unwrap();
+        let mut f = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .unwrap();
         f.write_all(b"2\n").unwrap();
         assert_eq!(appended(tail.poll().unwrap()), b"2\n");
         assert_eq!(appended(tail.poll().unwrap()), b"");
         std::fs::write(&path, b"a\n").unwrap();
-        assert!(matches!(tail.poll().unwrap(), TailRead::StartedOver { why } if why.contains("truncated")));
+        assert!(
+            matches!(tail.poll().unwrap(), TailRead::StartedOver { why } if why.contains("truncated"))
+        );
         assert_eq!(appended(tail.poll().unwrap()), b"a\n");
         let other = dir.join("log.csv.new");
         std::fs::write(&other, b"x,y\n").unwrap();
         std::fs::rename(&other, &path).unwrap();
-        assert!(matches!(tail.poll().unwrap(), TailRead::StartedOver { why } if why.contains("rotated")));
+        assert!(
+            matches!(tail.poll().unwrap(), TailRead::StartedOver { why } if why.contains("rotated"))
+        );
         assert_eq!(appended(tail.poll().unwrap()), b"x,y\n");
         std::fs::remove_dir_all(&dir).unwrap();
     }
