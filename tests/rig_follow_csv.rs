@@ -4,7 +4,7 @@
 //! appends rows at 100 Hz, each written in two pieces (a partial last line), plus one
 //! malformed line, while this test, subscribed to `rig/state` before the follower starts,
 //! receives every sample. Timeouts only guard against a hang; no assertion on a wall-clock
-//! time.
+//! time. Also: a GenICam camera the binary cannot open fails the run at start, said.
 
 mod common;
 
@@ -282,4 +282,30 @@ fn a_run_on_a_watched_folder_and_a_machine_log_ends_with_results_without_truth()
         assert!(f > 0.0 && f <= 10.0 * t + 1e-9, "{r:?}");
     }
     assert!(out.join("watched_frames.csv").is_file());
+}
+
+#[test]
+fn a_genicam_camera_the_binary_cannot_open_fails_the_run_at_start_and_says_why() {
+    let mut run = Run::new("run_genicam_missing");
+    let config = run.dir.join("genicam.toml");
+    std::fs::write(
+        &config,
+        "[run]\ndashboard = \"off\"\n[camera]\nsource = \"genicam\"\nwidth_px = 256\n\
+         height_px = 256\n[correlator]\nthreads = 1\n",
+    )
+    .unwrap();
+    let out = run.dir.join("out");
+    start_run(&mut run, "run", &config, &out, &["--quiet"]);
+    let (status, stdout, stderr) = run.child("run").wait();
+    // This test's binary may or may not have the genicam feature; with it, no camera is found
+    // here (no network namespace with a fake camera): either way the run fails at start.
+    assert_eq!(status.code(), Some(1), "{stdout}\n{stderr}");
+    let s = summary(&out);
+    assert_eq!(s["ending"], "failed");
+    let failure = s["failure"].as_str().unwrap();
+    assert!(
+        failure.contains("producer") && failure.contains("genicam"),
+        "{failure}"
+    );
+    assert_eq!(s["frames_captured"], 0);
 }

@@ -165,6 +165,26 @@ mod tests {
     }
 
     #[test]
+    fn a_real_camera_and_a_followed_log_may_be_silent_but_not_stopped() {
+        let t0 = Instant::now();
+        let mut counts = Counts::default();
+        let mut liveness = watching_all(&counts, t0);
+        liveness.ignore_silence(Role::Rig);
+        liveness.ignore_silence(Role::Producer);
+        // Rows come, no image: neither the log nor the camera is stale.
+        counts.rig_states += 100;
+        let later = t0 + Duration::from_secs(60);
+        assert!(liveness.check(&counts, |_| false, later).is_empty());
+        // A stopped camera still is.
+        liveness.check(&counts, |r| r == Role::Producer, later);
+        let stale = liveness.check(&counts, |r| r == Role::Producer, later + STALE);
+        assert_eq!(
+            stale.iter().map(|s| s.0).collect::<Vec<_>>(),
+            [Role::Producer]
+        );
+    }
+
+    #[test]
     fn a_correlator_without_frames_is_not_stale_but_one_fed_and_silent_is() {
         let t0 = Instant::now();
         let mut counts = Counts::default();

@@ -35,7 +35,7 @@ pub enum FollowError {
     Columns {
         path: String,
         #[source]
-        error: ConfigError,
+        error: Box<ConfigError>,
     },
     #[error("cannot read {path}: {reason}")]
     Read {
@@ -59,7 +59,7 @@ impl FollowError {
         };
         FollowError::Columns {
             path: path.display().to_string(),
-            error: ConfigError(error, exit),
+            error: Box::new(ConfigError(error, exit)),
         }
     }
 }
