@@ -35,7 +35,7 @@ enum Command {
     /// Camera process: publishes frames (scenario, replay, or following the rig state).
     Producer(cmd::producer::ProducerArgs),
     /// Simulated ASTREE machine: publishes rig/state, answers rig/command, logs rig.csv.
-    Rig(cmd::rig::RigArgs),
+    Rig(Box<cmd::rig::RigArgs>),
     /// The whole simulated bench: rig, camera, correlator, identifier; live status; results.
     Run(cmd::run::RunArgs),
     /// Write simulated speckle images with their exact ground truth (truth.csv).
@@ -81,7 +81,7 @@ fn main() -> std::process::ExitCode {
         Command::Identifier(args) => ok(cmd::identifier::run(args)),
         Command::Monitor(args) => ok(cmd::monitor::run(args)),
         Command::Producer(args) => ok(cmd::producer::run(args)),
-        Command::Rig(args) => ok(cmd::rig::run(args)),
+        Command::Rig(args) => ok(cmd::rig::run(*args)),
         Command::Run(args) => cmd::run::run(args),
         Command::Synth(args) => ok(cmd::synth::run(args)),
         Command::Tap(args) => ok(cmd::tap::run(args)),

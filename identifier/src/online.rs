@@ -23,16 +23,28 @@
 //! [`OnlineConfig::max_paths`]); it is kept when its larger stretch exceeds the last kept one of
 //! its path by [`OnlineConfig::min_stretch_increment`] (unloading and reloading below the
 //! maximum reached are skipped, as the Mullins effect makes them another material).
+//!
+//! A field whose frame names no rig sample ([`PAIR_BY_TIME`]: a real camera, a watched folder,
+//! beside a followed machine log) is paired by time: its capture instant against the samples'
+//! instants ([`RigSample::t_ns`], one monotonic clock), forces interpolated between the two
+//! samples around it; it waits until a sample at or after it has come. Such samples come
+//! from a machine's log, which knows no specimen model: their sections are the initial ones
+//! A0, and the current section normal to an axis is A0 / λ of that axis (incompressible).
 
 use crate::data::{BiaxialState, LoadCase};
 use crate::fit::{fit_data, Fit, FitData, FitOptions};
 use crate::models::Model;
 use std::collections::VecDeque;
 
+/// `FieldSample::rig_sample_id` of a field paired by time (its frame names no rig sample).
+pub const PAIR_BY_TIME: u64 = u64::MAX;
+
 /// One rig sample as the identifier needs it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RigSample {
     pub sample_id: u64,
+    /// Its instant on the monotonic clock, ns (`rig/state`'s `t_published_ns`).
+    pub t_ns: u64,
     /// Grip force along x and y (mean of the two opposed actuators), N, tension positive.
     pub force_x_n: f64,
     pub force_y_n: f64,
@@ -207,7 +219,11 @@ impl OnlineIdentifier {
         let mut resolved = Vec::new();
         let waiting: Vec<FieldSample> = self.pending.drain(..).collect();
         for field in waiting {
-            if field.rig_sample_id <= sample.sample_id {
+            let due = match field.rig_sample_id {
+                PAIR_BY_TIME => field.t_capture_ns <= sample.t_ns,
+                id => id <= sample.sample_id,
+            };
+            if due {
                 let outcome = self.push_field(field);
                 resolved.push((field, outcome));
             } else {
@@ -217,8 +233,66 @@ impl OnlineIdentifier {
         resolved
     }
 
+    fn queue(&mut self, field: FieldSample) -> FieldOutcome {
+        if self.pending.len() == self.config.pending_fields {
+            self.pending.pop_front();
+            self.counters.dropped += 1;
+        }
+        self.pending.push_back(field);
+        FieldOutcome::Pending
+    }
+
+    /// The rig state at the field's capture instant, interpolated between the samples around
+    /// it, with the current sections from the initial ones (see the module's text); `Err` with
+    /// the outcome when there is none (yet, or any more).
+    fn at_time(&mut self, field: FieldSample) -> Result<RigSample, FieldOutcome> {
+        let t = field.t_capture_ns;
+        match self.rig.back() {
+            Some(newest) if newest.t_ns >= t => {}
+            _ => return Err(self.queue(field)),
+        }
+        let after = self.rig.partition_point(|s| s.t_ns < t);
+        let b = self.rig[after];
+        let a = if after == 0 {
+            if b.t_ns != t {
+                return Err(FieldOutcome::Dropped);
+            }
+            b
+        } else {
+            self.rig[after - 1]
+        };
+        let w = if b.t_ns > a.t_ns {
+            (t - a.t_ns) as f64 / (b.t_ns - a.t_ns) as f64
+        } else {
+            1.0
+        };
+        let mix = |x: f64, y: f64| x + w * (y - x);
+        Ok(RigSample {
+            sample_id: b.sample_id,
+            t_ns: t,
+            force_x_n: mix(a.force_x_n, b.force_x_n),
+            force_y_n: mix(a.force_y_n, b.force_y_n),
+            section_x_mm2: mix(a.section_x_mm2, b.section_x_mm2) / field.log_strain_xx.exp(),
+            section_y_mm2: mix(a.section_y_mm2, b.section_y_mm2) / field.log_strain_yy.exp(),
+        })
+    }
+
     /// Adds a measured field; pairs it with its rig sample if present.
     pub fn push_field(&mut self, field: FieldSample) -> FieldOutcome {
+        if field.rig_sample_id == PAIR_BY_TIME {
+            let outcome = match self.at_time(field) {
+                Ok(rig) => self.accept(field, rig),
+                Err(FieldOutcome::Pending) => return FieldOutcome::Pending,
+                Err(other) => other,
+            };
+            match outcome {
+                FieldOutcome::Accepted { .. } => self.counters.accepted += 1,
+                FieldOutcome::Skipped(_) => self.counters.skipped += 1,
+                FieldOutcome::Dropped => self.counters.dropped += 1,
+                FieldOutcome::Pending => {}
+            }
+            return outcome;
+        }
         let newest = self.rig.back().map(|s| s.sample_id);
         let found = self
             .rig
@@ -429,6 +503,7 @@ mod tests {
             let section_y_mm2 = 20.0 * l1 * 2.0 * l3;
             let rig = RigSample {
                 sample_id,
+                t_ns: sample_id * 1000,
                 force_x_n: s.cauchy_stress_mpa[0] * section_x_mm2,
                 force_y_n: s.cauchy_stress_mpa[1] * section_y_mm2,
                 section_x_mm2,
@@ -523,6 +598,7 @@ mod tests {
                 (20.0 * l2 * 2.0 * s.stretch3, 20.0 * l1 * 2.0 * s.stretch3);
             let rig = RigSample {
                 sample_id,
+                t_ns: sample_id * 10_000_000,
                 force_x_n: s.cauchy_stress_mpa[0]
                     * section_x_mm2
                     * (1.0 + force_noise * noise(4 * sample_id)),
@@ -630,6 +706,7 @@ mod tests {
         for s in 10..20 {
             id.push_rig(RigSample {
                 sample_id: s,
+                t_ns: s,
                 force_x_n: 1.0,
                 force_y_n: 0.0,
                 section_x_mm2: 1.0,
@@ -654,5 +731,72 @@ mod tests {
             );
         }
         assert_eq!(id.counters.dropped, 1 + 3);
+    }
+
+    #[test]
+    fn fields_without_a_rig_sample_are_paired_by_time_with_interpolated_forces() {
+        let mut id = OnlineIdentifier::new(OnlineConfig::default());
+        let law = InvariantLaw::smactane();
+        // A machine log: a uniaxial strip of initial section 40 mm², a sample every 10 ms.
+        let a0 = 40.0;
+        let stretch_at = |t_ns: u64| 1.0 + 1e-9 * t_ns as f64;
+        let nominal_at = |t_ns: u64| {
+            let l = stretch_at(t_ns);
+            law.in_plane_stress(l, l.powf(-0.5)).nominal_stress_mpa[0]
+        };
+        let field = |t_ns: u64| {
+            let l = stretch_at(t_ns);
+            FieldSample {
+                frame_id: t_ns,
+                rig_sample_id: PAIR_BY_TIME,
+                t_capture_ns: t_ns,
+                log_strain_xx: l.ln(),
+                log_strain_yy: -0.5 * l.ln(),
+            }
+        };
+        let sample = |k: u64| RigSample {
+            sample_id: k,
+            t_ns: k * 10_000_000,
+            force_x_n: nominal_at(k * 10_000_000) * a0,
+            force_y_n: 0.0,
+            section_x_mm2: a0,
+            section_y_mm2: 50.0,
+        };
+        for k in 0..=10 {
+            id.push_rig(sample(k));
+        }
+        // Between two samples: the force interpolated, the section A0 / λ.
+        let t = 55_000_000;
+        match id.push_field(field(t)) {
+            FieldOutcome::Accepted { case, state } => {
+                assert_eq!(case, Some(LoadCase::Uniaxial));
+                assert!((state.stretch1 - stretch_at(t)).abs() < 1e-12);
+                let nominal_stress_mpa = state.nominal_stress1_mpa;
+                let expected = 0.5 * (nominal_at(50_000_000) + nominal_at(60_000_000));
+                assert!(
+                    (nominal_stress_mpa - expected).abs() < 1e-12,
+                    "{nominal_stress_mpa} {expected}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        // After the newest sample: waits for the next, then is resolved by it.
+        let t = 105_000_000;
+        assert_eq!(id.push_field(field(t)), FieldOutcome::Pending);
+        let resolved = id.push_rig(sample(11));
+        assert!(
+            matches!(resolved[..], [(_, FieldOutcome::Accepted { .. })]),
+            "{resolved:?}"
+        );
+        // Before the oldest kept sample: dropped.
+        let mut small = OnlineIdentifier::new(OnlineConfig {
+            rig_history: 2,
+            ..OnlineConfig::default()
+        });
+        for k in 0..5 {
+            small.push_rig(sample(k));
+        }
+        assert_eq!(small.push_field(field(5_000_000)), FieldOutcome::Dropped);
+        assert_eq!(small.counters.dropped, 1);
     }
 }

@@ -68,6 +68,7 @@ fn rig_sample(state: &RigState) -> RigSample {
     let a = &state.actuators;
     RigSample {
         sample_id: state.sample_id,
+        t_ns: state.t_published_ns,
         force_x_n: 500.0 * (a[0].force_kn + a[1].force_kn),
         force_y_n: 500.0 * (a[2].force_kn + a[3].force_kn),
         section_x_mm2: state.specimen_section_x_mm2,
@@ -76,14 +77,17 @@ fn rig_sample(state: &RigState) -> RigSample {
 }
 
 fn field_sample(header: &FieldHeader) -> Option<FieldSample> {
-    if header.rig_sample_id == wire::NO_RIG_SAMPLE || header.layout_version != wire::LAYOUT_VERSION
-    {
+    if header.layout_version != wire::LAYOUT_VERSION {
         return None;
     }
     let gauge = header.gauge_of(StrainMeasure::Log);
     Some(FieldSample {
         frame_id: header.frame_id,
-        rig_sample_id: header.rig_sample_id,
+        // A frame without a rig sample (a real camera's) is paired by time.
+        rig_sample_id: match header.rig_sample_id {
+            wire::NO_RIG_SAMPLE => crate::online::PAIR_BY_TIME,
+            id => id,
+        },
         t_capture_ns: header.t_capture_ns,
         log_strain_xx: gauge.exx,
         log_strain_yy: gauge.eyy,

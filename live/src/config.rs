@@ -55,6 +55,116 @@ pub struct CameraSection {
     pub seed: u64,
     /// Rendering threads of the simulated camera.
     pub threads: usize,
+    /// Where frames come from: simulated, watch, replay or genicam (see [`CameraSource`]).
+    pub source: String,
+    /// watch: the folder another program writes images into, and its options.
+    pub watch_dir: String,
+    pub watch_from_start: bool,
+    /// watch: the camera ends after this long without a new image (0: never).
+    pub watch_idle_timeout_s: f64,
+    pub watch_settle_ms: u64,
+    /// replay: a folder or a glob of images, sent at `fps`.
+    pub replay_files: String,
+    /// genicam: the camera's id ("" = the first found), and what is set on it ("" or absent:
+    /// left as the camera has it).
+    pub genicam_id: String,
+    pub genicam_exposure_us: Option<f64>,
+    pub genicam_gain_db: Option<f64>,
+    pub genicam_pixel_format: String,
+    /// x,y,w,h px.
+    pub genicam_roi: String,
+    /// software, hardware or free.
+    pub genicam_trigger: String,
+}
+
+/// Where a run's frames come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraSource {
+    /// Rendered from the simulated rig's motion: ground truth in every frame.
+    Simulated,
+    /// Images another program writes into a folder.
+    Watch,
+    /// Image files sent at a fixed rate.
+    Replay,
+    /// A GenICam camera (a build with the `genicam` feature).
+    Genicam,
+}
+
+impl CameraSource {
+    pub fn parse(text: &str) -> Option<CameraSource> {
+        match text {
+            "simulated" => Some(CameraSource::Simulated),
+            "watch" => Some(CameraSource::Watch),
+            "replay" => Some(CameraSource::Replay),
+            "genicam" => Some(CameraSource::Genicam),
+            _ => None,
+        }
+    }
+
+    /// Only the simulated camera's frames carry the exact motion (truth columns, acceptance).
+    pub fn has_truth(self) -> bool {
+        self == CameraSource::Simulated
+    }
+}
+
+/// Where a run's rig samples come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RigSource {
+    /// The simulated machine runs the campaign of `[[rig.tests]]`.
+    Simulated,
+    /// A test machine's CSV log, followed as it grows (`[rig.csv]`).
+    CsvFollow,
+}
+
+/// `[rig.csv]`: the test machine's CSV log a `csv-follow` rig follows.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CsvFollowSection {
+    pub file: String,
+    /// Column names as in the header, without their unit ("" = not logged).
+    pub time_column: String,
+    pub force_x_column: String,
+    pub force_y_column: String,
+    pub force_z_column: String,
+    pub displacement_x_column: String,
+    pub displacement_y_column: String,
+    pub displacement_z_column: String,
+    /// s, ms or min; N or kN; mm, um or m ("" = as the header says: `Fx (kN)`).
+    pub time_unit: String,
+    pub force_unit: String,
+    pub displacement_unit: String,
+    /// ",", ";" or "tab".
+    pub delimiter: String,
+    /// Seconds added to the machine's time to put it on the camera's (camera − machine).
+    pub offset_s: f64,
+    /// Initial specimen sections normal to X and Y, mm² (0: unknown, no stress).
+    pub section_x_mm2: f64,
+    pub section_y_mm2: f64,
+    /// The test is over after this long without a new row.
+    pub idle_timeout_s: f64,
+}
+
+impl Default for CsvFollowSection {
+    fn default() -> Self {
+        CsvFollowSection {
+            file: String::new(),
+            time_column: String::new(),
+            force_x_column: String::new(),
+            force_y_column: String::new(),
+            force_z_column: String::new(),
+            displacement_x_column: String::new(),
+            displacement_y_column: String::new(),
+            displacement_z_column: String::new(),
+            time_unit: String::new(),
+            force_unit: String::new(),
+            displacement_unit: String::new(),
+            delimiter: ",".into(),
+            offset_s: 0.0,
+            section_x_mm2: 0.0,
+            section_y_mm2: 0.0,
+            idle_timeout_s: 10.0,
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -88,6 +198,9 @@ pub struct RigSection {
     pub seed: u64,
     /// The tests, in order; each mounts its own specimen and unloads at the end.
     pub tests: Vec<TestSection>,
+    /// simulated or csv-follow.
+    pub source: String,
+    pub csv: CsvFollowSection,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -142,6 +255,18 @@ impl Default for CameraSection {
             speckle_size_px: 4.0,
             seed: 1,
             threads: 1,
+            source: "simulated".into(),
+            watch_dir: String::new(),
+            watch_from_start: false,
+            watch_idle_timeout_s: 0.0,
+            watch_settle_ms: producer::DEFAULT_SETTLE_MS,
+            replay_files: String::new(),
+            genicam_id: String::new(),
+            genicam_exposure_us: None,
+            genicam_gain_db: None,
+            genicam_pixel_format: String::new(),
+            genicam_roi: String::new(),
+            genicam_trigger: String::new(),
         }
     }
 }
@@ -179,6 +304,8 @@ impl Default for RigSection {
             log_hz: 50.0,
             seed: 1,
             tests,
+            source: "simulated".into(),
+            csv: CsvFollowSection::default(),
         }
     }
 }
@@ -220,6 +347,151 @@ impl RunConfig {
 
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(self).expect("the run configuration serialises")
+    }
+
+    /// Where frames come from (validated: an unknown name is refused by [`Self::validate`]).
+    pub fn camera_source(&self) -> CameraSource {
+        CameraSource::parse(&self.camera.source).unwrap_or(CameraSource::Simulated)
+    }
+
+    /// Where rig samples come from.
+    pub fn rig_source(&self) -> RigSource {
+        match self.rig.source.as_str() {
+            "csv-follow" => RigSource::CsvFollow,
+            _ => RigSource::Simulated,
+        }
+    }
+
+    fn validate_sources(&self) -> anyhow::Result<()> {
+        let c = &self.camera;
+        let camera = CameraSource::parse(&c.source).ok_or_else(|| {
+            anyhow!(
+                "[camera] source = {:?}: expected simulated, watch, replay or genicam",
+                c.source
+            )
+        })?;
+        match camera {
+            CameraSource::Watch if c.watch_dir.trim().is_empty() => {
+                bail!("[camera] source = \"watch\" needs watch_dir = \"FOLDER\"")
+            }
+            CameraSource::Replay if c.replay_files.trim().is_empty() => {
+                bail!("[camera] source = \"replay\" needs replay_files = \"FOLDER or GLOB\"")
+            }
+            _ => {}
+        }
+        if !(c.watch_idle_timeout_s.is_finite() && c.watch_idle_timeout_s >= 0.0) {
+            bail!(
+                "[camera] watch_idle_timeout_s = {}: expected 0 (never) or more s",
+                c.watch_idle_timeout_s
+            );
+        }
+        if !c.genicam_pixel_format.is_empty()
+            && !["Mono8", "Mono10", "Mono12", "Mono16"].contains(&c.genicam_pixel_format.as_str())
+        {
+            bail!(
+                "[camera] genicam_pixel_format = {:?}: expected Mono8, Mono10, Mono12 or Mono16",
+                c.genicam_pixel_format
+            );
+        }
+        if !c.genicam_trigger.is_empty()
+            && !["software", "hardware", "free"].contains(&c.genicam_trigger.as_str())
+        {
+            bail!(
+                "[camera] genicam_trigger = {:?}: expected software, hardware or free",
+                c.genicam_trigger
+            );
+        }
+        if !c.genicam_roi.is_empty() {
+            let parts: Vec<Option<u32>> = c
+                .genicam_roi
+                .split(',')
+                .map(|p| p.trim().parse().ok())
+                .collect();
+            if parts.len() != 4 || parts.iter().any(Option::is_none) {
+                bail!(
+                    "[camera] genicam_roi = {:?}: expected \"x,y,w,h\" in px",
+                    c.genicam_roi
+                );
+            }
+        }
+        let rig = match self.rig.source.as_str() {
+            "simulated" => RigSource::Simulated,
+            "csv-follow" => RigSource::CsvFollow,
+            other => bail!("[rig] source = {other:?}: expected simulated or csv-follow"),
+        };
+        if rig == RigSource::CsvFollow {
+            if camera == CameraSource::Simulated {
+                bail!(
+                    "[rig] source = \"csv-follow\" with [camera] source = \"simulated\": the \
+                     simulated camera renders the simulated rig's motion; choose watch, replay \
+                     or genicam for a real test"
+                );
+            }
+            let v = &self.rig.csv;
+            if v.file.trim().is_empty() {
+                bail!("[rig.csv] file is empty: the machine's CSV log to follow");
+            }
+            if v.time_column.trim().is_empty() {
+                bail!("[rig.csv] time_column is empty: the name of the time column");
+            }
+            if [&v.force_x_column, &v.force_y_column, &v.force_z_column]
+                .iter()
+                .all(|c| c.trim().is_empty())
+            {
+                bail!("[rig.csv] no force column: set force_x_column (and force_y_column, ...)");
+            }
+            use rig::csv_follow::columns as units;
+            for (key, unit, ok, expected) in [
+                (
+                    "time_unit",
+                    &v.time_unit,
+                    units::TimeUnit::parse(&v.time_unit).is_some(),
+                    units::TIME_UNITS,
+                ),
+                (
+                    "force_unit",
+                    &v.force_unit,
+                    units::ForceUnit::parse(&v.force_unit).is_some(),
+                    units::FORCE_UNITS,
+                ),
+                (
+                    "displacement_unit",
+                    &v.displacement_unit,
+                    units::LengthUnit::parse(&v.displacement_unit).is_some(),
+                    units::LENGTH_UNITS,
+                ),
+            ] {
+                if !unit.is_empty() && !ok {
+                    bail!(
+                        "[rig.csv] {key} = {unit:?}: expected {expected}, or \"\" (the header's)"
+                    );
+                }
+            }
+            if ![",", ";", "tab"].contains(&v.delimiter.as_str()) {
+                bail!(
+                    "[rig.csv] delimiter = {:?}: expected \",\", \";\" or \"tab\"",
+                    v.delimiter
+                );
+            }
+            if !v.offset_s.is_finite() {
+                bail!("[rig.csv] offset_s = {}: expected seconds", v.offset_s);
+            }
+            for (key, a) in [
+                ("section_x_mm2", v.section_x_mm2),
+                ("section_y_mm2", v.section_y_mm2),
+            ] {
+                if !(a.is_finite() && a >= 0.0) {
+                    bail!("[rig.csv] {key} = {a}: expected a section in mm² (0: unknown)");
+                }
+            }
+            if !(v.idle_timeout_s.is_finite() && v.idle_timeout_s > 0.0) {
+                bail!(
+                    "[rig.csv] idle_timeout_s = {}: expected a positive number of seconds",
+                    v.idle_timeout_s
+                );
+            }
+        }
+        Ok(())
     }
 
     /// The campaign the rig runs.
@@ -317,6 +589,7 @@ impl RunConfig {
 
     /// Everything a process would refuse, refused now with the section and key named.
     pub fn validate(&self) -> anyhow::Result<()> {
+        self.validate_sources()?;
         let r = &self.run;
         if r.results_dir.trim().is_empty() {
             bail!("[run] results_dir is empty");
@@ -451,7 +724,22 @@ impl RunConfig {
              # Speckle spot size (FWHM), px; seed of the pattern and the noise.\n\
              speckle_size_px = {:?}\nseed = {}\n\
              # Rendering threads (the correlator wants the cores more).\n\
-             threads = {}\n",
+             threads = {}\n\
+             # Where frames come from: simulated (rendered from the simulated rig, with ground\n\
+             # truth), watch (images another program writes into watch_dir), replay (the\n\
+             # images of replay_files at fps) or genicam (a GenICam camera: a build with the\n\
+             # genicam feature). Real images have no ground truth: no truth columns, no\n\
+             # acceptance. width_px/height_px must then be the images' size.\n\
+             source = {:?}\n\
+             watch_dir = {:?}\nwatch_from_start = {}\n\
+             # 0: the camera never ends by itself.\n\
+             watch_idle_timeout_s = {:?}\nwatch_settle_ms = {}\n\
+             replay_files = {:?}\n\
+             # genicam_id \"\" = the first camera; genicam_exposure_us, genicam_gain_db when set;\n\
+             # pixel format Mono8/10/12/16, roi \"x,y,w,h\", trigger software/hardware/free\n\
+             # (\"\" = as the camera is).\n\
+             genicam_id = {:?}\ngenicam_pixel_format = {:?}\ngenicam_roi = {:?}\n\
+             genicam_trigger = {:?}\n",
             c.width_px,
             c.height_px,
             c.fps,
@@ -459,7 +747,17 @@ impl RunConfig {
             c.mm_per_px,
             c.speckle_size_px,
             c.seed,
-            c.threads
+            c.threads,
+            c.source,
+            c.watch_dir,
+            c.watch_from_start,
+            c.watch_idle_timeout_s,
+            c.watch_settle_ms,
+            c.replay_files,
+            c.genicam_id,
+            c.genicam_pixel_format,
+            c.genicam_roi,
+            c.genicam_trigger
         );
         let k = &d.correlator;
         let _ = writeln!(
@@ -502,8 +800,10 @@ impl RunConfig {
             t,
             "[rig]\n\
              # Simulated time per wall time; rig/state and rig.csv rates, Hz of simulated time.\n\
-             speed = {:?}\npublish_hz = {:?}\nlog_hz = {:?}\nseed = {}\n",
-            g.speed, g.publish_hz, g.log_hz, g.seed
+             speed = {:?}\npublish_hz = {:?}\nlog_hz = {:?}\nseed = {}\n\
+             # simulated (the campaign below) or csv-follow (a test machine's CSV log, [rig.csv]).\n\
+             source = {:?}\n",
+            g.speed, g.publish_hz, g.log_hz, g.seed, g.source
         );
         let _ = writeln!(
             t,
@@ -518,6 +818,44 @@ impl RunConfig {
                 test.kind, test.stretch, test.rate_per_s
             );
         }
+        let v = &g.csv;
+        let _ = writeln!(
+            t,
+            "[rig.csv]\n\
+             # The CSV a test machine's software appends to (waited for if missing; a partial\n\
+             # last line waits for its newline; a malformed line is reported and skipped).\n\
+             file = {:?}\n\
+             # Column names as in the header, without their unit (\"\" = not logged).\n\
+             time_column = {:?}\nforce_x_column = {:?}\nforce_y_column = {:?}\n\
+             force_z_column = {:?}\ndisplacement_x_column = {:?}\n\
+             displacement_y_column = {:?}\ndisplacement_z_column = {:?}\n\
+             # Units: s/ms/min, N/kN, mm/um/m; \"\" = as the header says (`Fx (kN)`).\n\
+             time_unit = {:?}\nforce_unit = {:?}\ndisplacement_unit = {:?}\n\
+             # \",\", \";\" or \"tab\" (with \";\" and tab a decimal comma is read too).\n\
+             delimiter = {:?}\n\
+             # Seconds added to the machine's time to put it on the camera's.\n\
+             offset_s = {:?}\n\
+             # Initial specimen sections normal to X and Y, mm² (stress = force / section).\n\
+             section_x_mm2 = {:?}\nsection_y_mm2 = {:?}\n\
+             # The test is over after this long without a new row.\n\
+             idle_timeout_s = {:?}\n",
+            v.file,
+            v.time_column,
+            v.force_x_column,
+            v.force_y_column,
+            v.force_z_column,
+            v.displacement_x_column,
+            v.displacement_y_column,
+            v.displacement_z_column,
+            v.time_unit,
+            v.force_unit,
+            v.displacement_unit,
+            v.delimiter,
+            v.offset_s,
+            v.section_x_mm2,
+            v.section_y_mm2,
+            v.idle_timeout_s
+        );
         let s = &d.specimen;
         let _ = writeln!(
             t,
@@ -599,5 +937,40 @@ mod tests {
         refuse("[specimen]\nlaw_f = []\n", "law_f");
         refuse("[identifier]\nmodels = \"nope\"\n", "models");
         refuse("[correlator]\nreference = \"sometimes\"\n", "reference");
+        refuse("[camera]\nsource = \"webcam\"\n", "source");
+        refuse("[camera]\nsource = \"watch\"\n", "watch_dir");
+        refuse("[camera]\nsource = \"replay\"\n", "replay_files");
+        refuse(
+            "[camera]\nsource = \"genicam\"\ngenicam_pixel_format = \"RGB8\"\n",
+            "Mono16",
+        );
+        refuse("[camera]\ngenicam_roi = \"1,2,3\"\n", "x,y,w,h");
+        refuse("[rig]\nsource = \"csv\"\n", "csv-follow");
+        refuse("[rig]\nsource = \"csv-follow\"\n", "simulated camera");
+        let real = "[camera]\nsource = \"watch\"\nwatch_dir = \"/tmp/x\"\n[rig]\nsource = \"csv-follow\"\n";
+        refuse(real, "file is empty");
+        refuse(
+            &format!("{real}[rig.csv]\nfile = \"m.csv\"\ntime_column = \"t\"\n"),
+            "no force column",
+        );
+        refuse(
+            &format!(
+                "{real}[rig.csv]\nfile = \"m.csv\"\ntime_column = \"t\"\nforce_x_column = \"F\"\n\
+                 force_unit = \"lbf\"\n"
+            ),
+            "force_unit",
+        );
+        let ok = RunConfig::from_toml(
+            &format!(
+                "{real}[rig.csv]\nfile = \"m.csv\"\ntime_column = \"t\"\nforce_x_column = \"F\"\n"
+            ),
+            "ok.toml",
+        )
+        .unwrap();
+        ok.validate().unwrap();
+        assert_eq!(ok.camera_source(), CameraSource::Watch);
+        assert_eq!(ok.rig_source(), RigSource::CsvFollow);
+        let round = RunConfig::from_toml(&ok.to_toml(), "round").unwrap();
+        assert_eq!(round, ok);
     }
 }

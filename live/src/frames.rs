@@ -52,8 +52,27 @@ pub const COLUMNS: [&str; 40] = [
     "frames_dropped",
 ];
 
+/// The columns that compare with the ground truth: absent (not empty, not zero) from the
+/// `frames.csv` of a real camera, whose frames have none.
+pub const TRUTH_COLUMNS: [&str; 4] = [
+    "disp_error_mean_px",
+    "disp_error_max_px",
+    "log_exx_error",
+    "log_eyy_error",
+];
+
 pub fn csv_header() -> String {
     COLUMNS.join(",")
+}
+
+/// The header with the truth columns, or without them (a camera without ground truth).
+pub fn csv_header_for(truth: bool) -> String {
+    COLUMNS
+        .iter()
+        .filter(|c| truth || !TRUTH_COLUMNS.contains(c))
+        .copied()
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// Recent rig samples by id, bounded: fields name the sample their frame was taken at.
@@ -96,6 +115,13 @@ impl RigHistory {
 
     pub fn latest(&self) -> Option<&RigState> {
         self.samples.back()
+    }
+
+    /// The last sample at or before `t_ns` on the monotonic clock (`t_published_ns`): the rig
+    /// state of a frame that names no rig sample (a real camera's).
+    pub fn at_time(&self, t_ns: u64) -> Option<&RigState> {
+        let after = self.samples.partition_point(|s| s.t_published_ns <= t_ns);
+        after.checked_sub(1).map(|i| &self.samples[i])
     }
 }
 
@@ -248,6 +274,11 @@ impl FrameRow {
 
     /// Appends the CSV line (with its newline) to `out`.
     pub fn write_csv(&self, out: &mut String) {
+        self.write_csv_for(out, true)
+    }
+
+    /// Appends the CSV line, with or without the truth columns ([`csv_header_for`]).
+    pub fn write_csv_for(&self, out: &mut String, truth: bool) {
         fn opt<T: std::fmt::Display>(out: &mut String, v: Option<T>) {
             if let Some(v) = v {
                 let _ = write!(out, "{v}");
@@ -281,8 +312,10 @@ impl FrameRow {
             "{},{},{:.5},{:.5},",
             self.nodes, self.valid_nodes, self.u_mean_px, self.v_mean_px
         );
-        pair(out, self.displacement_error_px);
-        pair(out, self.log_strain_error);
+        if truth {
+            pair(out, self.displacement_error_px);
+            pair(out, self.log_strain_error);
+        }
         let _ = writeln!(
             out,
             "{:.3},{:.3},{:.3},{}",
@@ -384,5 +417,47 @@ mod tests {
         truths.push(1, GroundTruth::IDENTITY);
         truths.push(2, GroundTruth::IDENTITY);
         assert!(truths.get(0).is_none() && truths.get(2).is_some());
+    }
+
+    #[test]
+    fn without_truth_the_truth_columns_are_absent_and_rows_match_the_header() {
+        let header = csv_header_for(false);
+        assert!(!header.contains("disp_error") && !header.contains("log_exx_error"));
+        assert_eq!(
+            header.split(',').count(),
+            COLUMNS.len() - TRUTH_COLUMNS.len()
+        );
+        let field = FieldHeader {
+            rig_sample_id: wire::NO_RIG_SAMPLE,
+            ..FieldHeader::default()
+        };
+        let row = FrameRow::new(&field, &[], None, None, 0, 0);
+        let mut line = String::new();
+        row.write_csv_for(&mut line, false);
+        assert_eq!(
+            line.trim_end().split(',').count(),
+            header.split(',').count()
+        );
+    }
+
+    #[test]
+    fn a_rig_state_is_found_by_time() {
+        let mut rigs = RigHistory::new(8);
+        for k in 0..4u64 {
+            rigs.push(RigState {
+                sample_id: k,
+                t_published_ns: 100 * k,
+                ..RigState::default()
+            });
+        }
+        assert!(rigs.at_time(0).is_some_and(|s| s.sample_id == 0));
+        assert!(rigs.at_time(250).is_some_and(|s| s.sample_id == 2));
+        assert!(rigs.at_time(10_000).is_some_and(|s| s.sample_id == 3));
+        rigs.push(RigState {
+            sample_id: 10,
+            t_published_ns: 1000,
+            ..RigState::default()
+        });
+        assert!(rigs.at_time(999).is_none_or(|s| s.sample_id != 10));
     }
 }

@@ -42,6 +42,9 @@ struct Watch {
 pub struct Liveness {
     stale_after: Duration,
     watches: [Option<Watch>; 4],
+    /// Roles whose silence is not a hang (a real camera, a followed machine log): only their
+    /// stopped state is watched.
+    silence_ignored: [bool; 4],
 }
 
 impl Liveness {
@@ -49,7 +52,13 @@ impl Liveness {
         Liveness {
             stale_after,
             watches: [None; 4],
+            silence_ignored: [false; 4],
         }
+    }
+
+    /// Watches only whether `role` is stopped, not whether it publishes.
+    pub fn ignore_silence(&mut self, role: Role) {
+        self.silence_ignored[role as usize] = true;
     }
 
     /// Starts (or starts again, after a restart) watching `role` from `now`.
@@ -95,6 +104,9 @@ impl Liveness {
             let Some((output, input)) = counts.of(role) else {
                 continue;
             };
+            if self.silence_ignored[role as usize] {
+                continue;
+            }
             if output != watch.output {
                 watch.output = output;
                 watch.output_since = now;
@@ -150,6 +162,26 @@ mod tests {
         let stale = liveness.check(&counts, |_| false, t0 + Duration::from_secs(6));
         assert_eq!(stale.len(), 1);
         assert_eq!(stale[0].0, Role::Rig);
+    }
+
+    #[test]
+    fn a_real_camera_and_a_followed_log_may_be_silent_but_not_stopped() {
+        let t0 = Instant::now();
+        let mut counts = Counts::default();
+        let mut liveness = watching_all(&counts, t0);
+        liveness.ignore_silence(Role::Rig);
+        liveness.ignore_silence(Role::Producer);
+        // Rows come, no image: neither the log nor the camera is stale.
+        counts.rig_states += 100;
+        let later = t0 + Duration::from_secs(60);
+        assert!(liveness.check(&counts, |_| false, later).is_empty());
+        // A stopped camera still is.
+        liveness.check(&counts, |r| r == Role::Producer, later);
+        let stale = liveness.check(&counts, |r| r == Role::Producer, later + STALE);
+        assert_eq!(
+            stale.iter().map(|s| s.0).collect::<Vec<_>>(),
+            [Role::Producer]
+        );
     }
 
     #[test]

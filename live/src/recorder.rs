@@ -17,6 +17,9 @@ const TRUTH_HISTORY: usize = 1024;
 pub struct RecorderSettings {
     pub fields_every: u32,
     pub vtk: bool,
+    /// The camera's frames carry the ground truth (simulated): `frames.csv` has the truth
+    /// columns. A real camera's has none: the columns are absent.
+    pub truth: bool,
 }
 
 pub struct Recorder {
@@ -63,7 +66,10 @@ impl Recorder {
     ) -> Result<Recorder, FileError> {
         assert!(settings.fields_every > 0);
         Ok(Recorder {
-            frames_csv: RowFile::create(&results.frames_csv(), &crate::frames::csv_header())?,
+            frames_csv: RowFile::create(
+                &results.frames_csv(),
+                &crate::frames::csv_header_for(settings.truth),
+            )?,
             results: results.clone(),
             settings,
             t0_ns,
@@ -130,9 +136,11 @@ impl Recorder {
         self.frames_dropped_by_correlator = header.frames_dropped;
         self.latency_field
             .record_ns(header.t_published_ns.saturating_sub(header.t_capture_ns));
-        let rig = (header.rig_sample_id != wire::NO_RIG_SAMPLE)
-            .then(|| self.rigs.get(header.rig_sample_id))
-            .flatten();
+        // A frame without a rig sample (a real camera's): the rig state at its capture time.
+        let rig = match header.rig_sample_id {
+            wire::NO_RIG_SAMPLE => self.rigs.at_time(header.t_capture_ns),
+            id => self.rigs.get(id),
+        };
         let origin = self.truths.get(header.origin_frame_id);
         let row = FrameRow::new(header, nodes, rig, origin, self.t0_ns, seen_ns);
         if let Some(case) = rig.map(|s| s.load_case as usize).filter(|&c| c < 3) {
@@ -142,7 +150,7 @@ impl Recorder {
             }
         }
         self.row.clear();
-        row.write_csv(&mut self.row);
+        row.write_csv_for(&mut self.row, self.settings.truth);
         let line = std::mem::take(&mut self.row);
         let result = self.frames_csv.append(&line);
         self.row = line;

@@ -7,7 +7,7 @@
 
 use crate::acceptance::{accept, Acceptance};
 use crate::children::{Exit, Role, Supervisor};
-use crate::config::RunConfig;
+use crate::config::{CameraSource, RigSource, RunConfig};
 use crate::latency::Percentiles;
 use crate::liveness::{Counts, Liveness};
 use crate::recorder::{Recorder, RecorderSettings};
@@ -95,6 +95,12 @@ pub struct RunReport {
     /// worst node error of the run.
     pub displacement_error_mean_px: Option<f64>,
     pub acceptance: Option<Acceptance>,
+    /// Why there is no acceptance although a law was identified: a real camera or machine
+    /// has no ground truth to compare with.
+    pub acceptance_skipped: Option<String>,
+    /// Where frames and rig samples came from ([camera] source, [rig] source).
+    pub camera_source: String,
+    pub rig_source: String,
     /// What `strain_map.png` shows.
     pub strain_map: Option<StrainMapInfo>,
     /// Files of the instance left once every process had stopped (named, then removed).
@@ -216,12 +222,23 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
         )
         .as_bytes(),
     )?;
-    eprintln!(
-        "run: results in {}, instance {instance_name}, campaign {} (about {:.0} s)",
-        results.root.display(),
-        config.campaign_spec(),
-        config.campaign_wall_s()?
-    );
+    match config.rig_source() {
+        RigSource::Simulated => eprintln!(
+            "run: results in {}, instance {instance_name}, campaign {} (about {:.0} s), camera {}",
+            results.root.display(),
+            config.campaign_spec(),
+            config.campaign_wall_s()?,
+            config.camera.source
+        ),
+        RigSource::CsvFollow => eprintln!(
+            "run: results in {}, instance {instance_name}, camera {}, forces from {} (the test \
+             ends {} s after its last row)",
+            results.root.display(),
+            config.camera.source,
+            config.rig.csv.file,
+            config.rig.csv.idle_timeout_s
+        ),
+    }
     let started = Instant::now();
     let monitor_cpu_at_start_s = crate::children::own_cpu_s();
     let t0_ns = wire::monotonic_ns();
@@ -234,6 +251,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
             RecorderSettings {
                 fields_every: config.run.fields_every,
                 vtk: config.run.vtk,
+                truth: config.camera_source().has_truth(),
             },
             t0_ns,
         )?;
@@ -312,7 +330,25 @@ fn start_children(
             return Ok(false);
         }
         supervisor.spawn(role, child_args(role, config, instance, results, 0))?;
-        if !supervisor.wait_ready(role, READY_TIMEOUT)? {
+        if !waits_for_ready(role, config) {
+            eprintln!(
+                "run: {} started (pid {}); ready at its first image",
+                role.name(),
+                supervisor.pid(role).unwrap_or(0)
+            );
+            continue;
+        }
+        let ready = supervisor.wait_ready(role, READY_TIMEOUT);
+        let ready = match (role, config.camera_source()) {
+            (Role::Producer, CameraSource::Genicam) => ready.map_err(|e| {
+                e.context(
+                    "[camera] source = \"genicam\": the camera could not be opened (a \
+                     dicstream built without `--features genicam` says so above)",
+                )
+            }),
+            _ => ready,
+        };
+        if !ready? {
             return Ok(false);
         }
         eprintln!(
@@ -324,6 +360,13 @@ fn start_children(
     // An exit while a later child was starting is kept by the supervisor: handled first thing
     // by the event loop.
     Ok(true)
+}
+
+/// Whether the run waits for `role` to say it is ready before going on: a watched folder's
+/// camera is ready only at its first image (which sets the frame size), which may come long
+/// after the start; the run goes on at once and handles its exit like any other.
+fn waits_for_ready(role: Role, config: &RunConfig) -> bool {
+    !(role == Role::Producer && config.camera_source() == CameraSource::Watch)
 }
 
 /// What the loop learnt that the end of the run reports.
@@ -395,6 +438,14 @@ fn event_loop(
     let mut phase = Phase::Running;
     let stop_timeout = Duration::from_secs_f64(config.run.stop_timeout_s);
     let mut liveness = Liveness::new(Duration::from_secs_f64(config.run.stale_after_s));
+    // A real camera publishes when images come, a machine's log when rows come: their
+    // silence is the test's pace, not a hang (a stopped process is still caught).
+    if config.camera_source() != CameraSource::Simulated {
+        liveness.ignore_silence(Role::Producer);
+    }
+    if config.rig_source() == RigSource::CsvFollow {
+        liveness.ignore_silence(Role::Rig);
+    }
     for role in Role::ALL {
         liveness.reset(role, &counts(recorder), Instant::now());
     }
@@ -438,6 +489,17 @@ fn event_loop(
             }
             if matches!(phase, Phase::Draining { .. }) && exit.role == Role::Producer {
                 // Stopped on purpose above.
+                continue;
+            }
+            if exit.role == Role::Producer
+                && exit.success
+                && config.camera_source() != CameraSource::Simulated
+            {
+                // A replay at its last image, a watched folder idle for its timeout.
+                eprintln!(
+                    "run: the camera ({}) has no more images; waiting for the rig to finish",
+                    config.camera.source
+                );
                 continue;
             }
             subscriptions.drain(recorder)?;
@@ -548,6 +610,9 @@ fn handle_death(
         Some(code) if code == i32::from(wire::exit::CANNOT_RESUME) => {
             bail!("{report}\n(it could not resume its test safely)");
         }
+        Some(code) if code == i32::from(wire::exit::CONFIG) => {
+            bail!("{report}\n(its configuration does not fit its input: not restarted)");
+        }
         _ => {}
     }
     let count = &mut state.restart_counts[role as usize];
@@ -562,7 +627,7 @@ fn handle_death(
     *count += 1;
     let args = child_args(role, config, instance, results, next_frame_id);
     let pid = supervisor.restart(role, Some(args))?;
-    if !supervisor.wait_ready(role, READY_TIMEOUT)? {
+    if waits_for_ready(role, config) && !supervisor.wait_ready(role, READY_TIMEOUT)? {
         return Ok(());
     }
     let note = format!(
@@ -660,7 +725,19 @@ fn finish(
             }
         }
     }
-    let acceptance = recorder.last_report.map(|report| {
+    let has_truth =
+        config.camera_source().has_truth() && config.rig_source() == RigSource::Simulated;
+    let acceptance_skipped = (!has_truth && recorder.last_report.is_some()).then(|| {
+        format!(
+            "no ground truth with [camera] source = {:?} and [rig] source = {:?}: the \
+             identified law is not compared with [specimen]",
+            config.camera.source, config.rig.source
+        )
+    });
+    if let Some(why) = &acceptance_skipped {
+        eprintln!("run: acceptance skipped: {why}");
+    }
+    let acceptance = recorder.last_report.filter(|_| has_truth).map(|report| {
         let truth = config.law().expect("validated law");
         let tested =
             |case: usize| (recorder.max_stretch[case] > 1.01).then_some(recorder.max_stretch[case]);
@@ -686,6 +763,7 @@ fn finish(
         ending,
         failure,
         acceptance.as_ref(),
+        acceptance_skipped.is_some(),
         frames_lost_to_faults,
         &state,
     );
@@ -724,6 +802,9 @@ fn finish(
         latency_identification_ms: recorder.latency_identification.percentiles(),
         displacement_error_mean_px,
         acceptance,
+        acceptance_skipped,
+        camera_source: config.camera.source.clone(),
+        rig_source: config.rig.source.clone(),
         strain_map,
         leftover_shm_files,
         exit_code,
@@ -747,6 +828,7 @@ fn verdict(
     ending: Ending,
     failure: Option<String>,
     acceptance: Option<&Acceptance>,
+    acceptance_skipped: bool,
     frames_lost_to_faults: u64,
     state: &LoopState,
 ) -> (Option<String>, u8) {
@@ -762,6 +844,7 @@ fn verdict(
         Ending::Completed => {
             let mut doubts = Vec::new();
             match acceptance {
+                None if acceptance_skipped => {}
                 None => doubts.push("nothing was identified".to_string()),
                 Some(a) if !a.passed => doubts.push(format!(
                     "the identified law did not pass the acceptance (tolerance {:.0} %)",

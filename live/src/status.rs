@@ -160,6 +160,7 @@ mod tests {
         let settings = RecorderSettings {
             fields_every: 10,
             vtk: false,
+            truth: true,
         };
         let mut recorder = Recorder::new(&results, settings, 0).unwrap();
         let mut rig = RigState {

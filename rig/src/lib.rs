@@ -10,6 +10,7 @@ pub mod campaign;
 pub mod codes;
 pub mod config;
 pub mod control;
+pub mod csv_follow;
 pub mod hydraulics;
 pub mod ids;
 pub mod journal;

@@ -12,6 +12,7 @@ pub mod producer;
 pub mod producer_genicam;
 pub mod producer_watch;
 pub mod rig;
+pub mod rig_follow_csv;
 pub mod run;
 pub mod synth;
 pub mod tap;

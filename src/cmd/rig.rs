@@ -62,9 +62,14 @@ pub struct RigArgs {
     /// start (exit code 75) if it cannot do so exactly. Created if missing.
     #[arg(long)]
     pub state_dir: Option<PathBuf>,
+    #[command(flatten)]
+    pub follow: super::rig_follow_csv::FollowCsvArgs,
 }
 
 pub fn run(args: RigArgs) -> anyhow::Result<()> {
+    if args.follow.follow_csv.is_some() {
+        return super::rig_follow_csv::run(args.follow, args.instance);
+    }
     let speed = Speed::parse(&args.speed)?;
     let mut config = RigConfig::default();
     let campaign = match (&args.campaign, args.test.as_deref()) {

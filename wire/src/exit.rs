@@ -6,6 +6,9 @@
 pub const OUTPUT_FAILED: u8 = 74;
 /// The rig could not resume its test safely from its journal: it unloaded and stopped.
 pub const CANNOT_RESUME: u8 = 75;
+/// The process's configuration does not fit its input (a followed CSV without the configured
+/// columns): a restart would fail the same way.
+pub const CONFIG: u8 = 78;
 
 /// An error that sets the process's exit code (the binary's `main` looks for it, and for a
 /// [`crate::files::FileError`], in the error's chain).

@@ -43,6 +43,9 @@ pub struct RigState {
     /// Consecutive from 0; frames name the sample they were taken at.
     pub sample_id: u64,
     /// Simulated time since the rig started (s), and when this sample was published (monotonic ns).
+    /// A followed machine log (`rig --follow-csv`) puts there the row's machine time plus the
+    /// configured offset, and the row's instant on the monotonic clock: what a field whose
+    /// frame names no rig sample is paired to by time.
     pub t_sim_s: f64,
     pub t_published_ns: u64,
     pub actuators: [ActuatorState; 6],

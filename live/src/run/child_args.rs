@@ -3,7 +3,7 @@
 //! camera's frame ids start.
 
 use crate::children::Role;
-use crate::config::RunConfig;
+use crate::config::{CameraSource, RigSource, RunConfig};
 use crate::results::ResultsDir;
 use std::path::PathBuf;
 
@@ -33,6 +33,10 @@ pub fn child_args(
     let k = &config.correlator;
     let g = &config.rig;
     let extra: Vec<String> = match role {
+        Role::Rig if config.rig_source() == RigSource::CsvFollow => csv_follow_args(config),
+        Role::Producer if config.camera_source() != CameraSource::Simulated => {
+            real_camera_args(config, results, first_frame_id)
+        }
         Role::Rig => vec![
             "--campaign".into(),
             config.campaign_spec(),
@@ -108,6 +112,105 @@ pub fn child_args(
         ],
     };
     args.extend(extra);
+    args
+}
+
+/// `rig --follow-csv FILE ...`: the machine's log of `[rig.csv]`.
+fn csv_follow_args(config: &RunConfig) -> Vec<String> {
+    let v = &config.rig.csv;
+    let mut args = vec!["--follow-csv".to_string(), v.file.clone()];
+    let mut named = |flag: &str, value: &str| {
+        if !value.trim().is_empty() {
+            args.push(flag.to_string());
+            args.push(value.to_string());
+        }
+    };
+    named("--time-column", &v.time_column);
+    named("--force-x-column", &v.force_x_column);
+    named("--force-y-column", &v.force_y_column);
+    named("--force-z-column", &v.force_z_column);
+    named("--displacement-x-column", &v.displacement_x_column);
+    named("--displacement-y-column", &v.displacement_y_column);
+    named("--displacement-z-column", &v.displacement_z_column);
+    named("--time-unit", &v.time_unit);
+    named("--force-unit", &v.force_unit);
+    named("--displacement-unit", &v.displacement_unit);
+    named("--delimiter", &v.delimiter);
+    args.extend([
+        format!("--offset-s={}", v.offset_s),
+        "--section-x-mm2".into(),
+        v.section_x_mm2.to_string(),
+        "--section-y-mm2".into(),
+        v.section_y_mm2.to_string(),
+        "--idle-timeout-s".into(),
+        v.idle_timeout_s.to_string(),
+    ]);
+    args
+}
+
+/// The producer's options for a watched folder, a replay or a GenICam camera.
+fn real_camera_args(config: &RunConfig, results: &ResultsDir, first_frame_id: u64) -> Vec<String> {
+    let c = &config.camera;
+    let mut args: Vec<String> = match config.camera_source() {
+        CameraSource::Watch => {
+            let mut a = vec![
+                "--watch".to_string(),
+                c.watch_dir.clone(),
+                "--settle-ms".into(),
+                c.watch_settle_ms.to_string(),
+                // Which file each frame is, beside the results.
+                "--log".into(),
+                results
+                    .path("watched_frames.csv")
+                    .to_string_lossy()
+                    .into_owned(),
+            ];
+            if c.watch_from_start {
+                a.push("--from-start".into());
+            }
+            if c.watch_idle_timeout_s > 0.0 {
+                a.extend([
+                    "--idle-timeout-s".into(),
+                    c.watch_idle_timeout_s.to_string(),
+                ]);
+            }
+            a
+        }
+        CameraSource::Replay => vec![
+            "--replay".into(),
+            c.replay_files.clone(),
+            "--fps".into(),
+            c.fps.to_string(),
+        ],
+        CameraSource::Genicam | CameraSource::Simulated => {
+            let mut a = vec![
+                "--camera".to_string(),
+                match c.genicam_id.trim() {
+                    "" => "genicam".to_string(),
+                    id => format!("genicam:{id}"),
+                },
+                "--fps".into(),
+                c.fps.to_string(),
+            ];
+            if let Some(us) = c.genicam_exposure_us {
+                a.extend(["--exposure-us".into(), us.to_string()]);
+            }
+            if let Some(db) = c.genicam_gain_db {
+                a.push(format!("--gain-db={db}"));
+            }
+            for (flag, value) in [
+                ("--pixel-format", &c.genicam_pixel_format),
+                ("--roi", &c.genicam_roi),
+                ("--trigger", &c.genicam_trigger),
+            ] {
+                if !value.is_empty() {
+                    a.extend([flag.to_string(), value.clone()]);
+                }
+            }
+            a
+        }
+    };
+    args.extend(["--first-frame-id".into(), first_frame_id.to_string()]);
     args
 }
 
@@ -216,5 +319,64 @@ mod tests {
             let same = args(role, &config, 0) == args(role, &config, 99);
             assert_eq!(same, role != Role::Producer, "{role:?}");
         }
+    }
+
+    #[test]
+    fn a_csv_follow_rig_gets_its_columns_units_and_offset() {
+        let mut config = RunConfig::default();
+        config.rig.source = "csv-follow".into();
+        let v = &mut config.rig.csv;
+        v.file = "/lab/test.csv".into();
+        v.time_column = "Time".into();
+        v.force_x_column = "Fx".into();
+        v.force_unit = "kN".into();
+        v.offset_s = -0.5;
+        v.section_x_mm2 = 40.0;
+        let args = args(Role::Rig, &config, 0);
+        assert_eq!(value(&args, "--follow-csv"), "/lab/test.csv");
+        assert_eq!(value(&args, "--time-column"), "Time");
+        assert_eq!(value(&args, "--force-x-column"), "Fx");
+        assert_eq!(value(&args, "--force-unit"), "kN");
+        assert!(!args.contains(&"--force-y-column".to_string()), "{args:?}");
+        assert!(args.contains(&"--offset-s=-0.5".to_string()), "{args:?}");
+        assert_eq!(value(&args, "--section-x-mm2"), "40");
+        assert!(!args.contains(&"--campaign".to_string()));
+    }
+
+    #[test]
+    fn real_cameras_get_their_source_options_and_no_rendering_ones() {
+        let mut config = RunConfig::default();
+        config.camera.source = "watch".into();
+        config.camera.watch_dir = "/lab/images".into();
+        config.camera.watch_from_start = true;
+        config.camera.watch_idle_timeout_s = 3.0;
+        let watch = args(Role::Producer, &config, 7);
+        assert_eq!(value(&watch, "--watch"), "/lab/images");
+        assert_eq!(value(&watch, "--idle-timeout-s"), "3");
+        assert_eq!(value(&watch, "--log"), "/results/run/watched_frames.csv");
+        assert_eq!(value(&watch, "--first-frame-id"), "7");
+        assert!(watch.contains(&"--from-start".to_string()));
+        for flag in ["--follow-rig", "--fps", "--max-stretch", "--width"] {
+            assert!(!watch.contains(&flag.to_string()), "{flag} in {watch:?}");
+        }
+        config.camera.source = "replay".into();
+        config.camera.replay_files = "/lab/images/*.tif".into();
+        let replay = args(Role::Producer, &config, 0);
+        assert_eq!(value(&replay, "--replay"), "/lab/images/*.tif");
+        assert_eq!(value(&replay, "--fps"), "10");
+        config.camera.source = "genicam".into();
+        config.camera.genicam_id = "Fake_1".into();
+        config.camera.genicam_exposure_us = Some(2000.0);
+        config.camera.genicam_gain_db = Some(-1.5);
+        config.camera.genicam_pixel_format = "Mono12".into();
+        config.camera.genicam_roi = "0,0,512,512".into();
+        config.camera.genicam_trigger = "software".into();
+        let genicam = args(Role::Producer, &config, 0);
+        assert_eq!(value(&genicam, "--camera"), "genicam:Fake_1");
+        assert_eq!(value(&genicam, "--exposure-us"), "2000");
+        assert!(genicam.contains(&"--gain-db=-1.5".to_string()));
+        assert_eq!(value(&genicam, "--pixel-format"), "Mono12");
+        assert_eq!(value(&genicam, "--roi"), "0,0,512,512");
+        assert_eq!(value(&genicam, "--trigger"), "software");
     }
 }

@@ -1,0 +1,414 @@
+//! Which columns of a machine's CSV hold time, forces and displacements, in which units: the
+//! header names them (`Time (s)`, `Fx [kN]` or plain `Time`), the configuration may state
+//! the units; every value is converted to s, N and mm.
+
+/// Why a follow cannot start (or go on).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CsvError {
+    #[error("column {name:?} is not in the header {header:?}")]
+    MissingColumn { name: String, header: String },
+    #[error("column {name:?} appears {count} times in the header {header:?}")]
+    AmbiguousColumn {
+        name: String,
+        count: usize,
+        header: String,
+    },
+    #[error("the unit of {what} is not stated: name it in the header (`{name} (UNIT)`) or in the configuration ({expected})")]
+    NoUnit {
+        what: &'static str,
+        name: String,
+        expected: &'static str,
+    },
+    #[error("unknown unit {unit:?} for {what}: expected {expected}")]
+    UnknownUnit {
+        what: &'static str,
+        unit: String,
+        expected: &'static str,
+    },
+    #[error("{what}: the header says {header_unit:?}, the configuration {config_unit:?}")]
+    UnitDisagrees {
+        what: String,
+        header_unit: String,
+        config_unit: String,
+    },
+    #[error("{0}")]
+    Spec(String),
+}
+
+/// Seconds, milliseconds or minutes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimeUnit {
+    S,
+    Ms,
+    Min,
+}
+
+/// Newtons or kilonewtons.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ForceUnit {
+    Newton,
+    KiloNewton,
+}
+
+/// Millimetres, micrometres or metres.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LengthUnit {
+    Mm,
+    Um,
+    M,
+}
+
+pub const TIME_UNITS: &str = "s, ms or min";
+pub const FORCE_UNITS: &str = "N or kN";
+pub const LENGTH_UNITS: &str = "mm, um or m";
+
+impl TimeUnit {
+    pub fn parse(text: &str) -> Option<TimeUnit> {
+        match text.trim() {
+            "s" | "sec" => Some(TimeUnit::S),
+            "ms" => Some(TimeUnit::Ms),
+            "min" => Some(TimeUnit::Min),
+            _ => None,
+        }
+    }
+    pub fn to_s(self) -> f64 {
+        match self {
+            TimeUnit::S => 1.0,
+            TimeUnit::Ms => 1e-3,
+            TimeUnit::Min => 60.0,
+        }
+    }
+}
+
+impl ForceUnit {
+    pub fn parse(text: &str) -> Option<ForceUnit> {
+        match text.trim() {
+            "N" => Some(ForceUnit::Newton),
+            "kN" | "KN" => Some(ForceUnit::KiloNewton),
+            _ => None,
+        }
+    }
+    pub fn to_n(self) -> f64 {
+        match self {
+            ForceUnit::Newton => 1.0,
+            ForceUnit::KiloNewton => 1e3,
+        }
+    }
+}
+
+impl LengthUnit {
+    pub fn parse(text: &str) -> Option<LengthUnit> {
+        match text.trim() {
+            "mm" => Some(LengthUnit::Mm),
+            "um" | "µm" => Some(LengthUnit::Um),
+            "m" => Some(LengthUnit::M),
+            _ => None,
+        }
+    }
+    pub fn to_mm(self) -> f64 {
+        match self {
+            LengthUnit::Mm => 1.0,
+            LengthUnit::Um => 1e-3,
+            LengthUnit::M => 1e3,
+        }
+    }
+}
+
+/// One configured column: the name as in the header, without its unit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ColumnSpec {
+    pub name: String,
+    /// The unit the configuration states (None: the header must).
+    pub unit: Option<String>,
+}
+
+impl ColumnSpec {
+    pub fn new(name: &str, unit: Option<&str>) -> ColumnSpec {
+        ColumnSpec {
+            name: name.to_string(),
+            unit: unit.map(str::to_string),
+        }
+    }
+}
+
+/// The columns to follow: time, force per axis X, Y, Z and, if logged, displacement per axis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CsvColumns {
+    pub time: ColumnSpec,
+    pub force: [Option<ColumnSpec>; 3],
+    pub displacement: [Option<ColumnSpec>; 3],
+    /// Units the configuration states (None: each column's header must state it).
+    pub time_unit: Option<TimeUnit>,
+    pub force_unit: Option<ForceUnit>,
+    pub displacement_unit: Option<LengthUnit>,
+    /// `,`, `;` or a tab. With `;` or a tab a decimal comma is read too.
+    pub delimiter: char,
+}
+
+impl CsvColumns {
+    pub fn validate(&self) -> Result<(), CsvError> {
+        if self.time.name.trim().is_empty() {
+            return Err(CsvError::Spec("the time column is not named".into()));
+        }
+        if self.force.iter().all(Option::is_none) {
+            return Err(CsvError::Spec(
+                "no force column is named: name at least one axis's".into(),
+            ));
+        }
+        if ![',', ';', '\t'].contains(&self.delimiter) {
+            return Err(CsvError::Spec(format!(
+                "delimiter {:?}: expected \",\", \";\" or a tab",
+                self.delimiter
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One row, converted: time s, force per axis N, displacement per axis mm.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Row {
+    pub t_s: f64,
+    pub force_n: [Option<f64>; 3],
+    pub displacement_mm: [Option<f64>; 3],
+}
+
+/// Where each configured column is, and its factor to s, N or mm.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layout {
+    delimiter: char,
+    time: (usize, f64),
+    force: [Option<(usize, f64)>; 3],
+    displacement: [Option<(usize, f64)>; 3],
+    /// (cell index, configured name) of every followed column.
+    names: Vec<(usize, String)>,
+}
+
+/// A header cell as (name, unit): `Fx (kN)`, `Fx [kN]` or `Fx`; quotes removed.
+fn split_unit(cell: &str) -> (String, Option<String>) {
+    let cell = cell.trim().trim_matches('"').trim();
+    for (open, close) in [('(', ')'), ('[', ']')] {
+        if let Some(stripped) = cell.strip_suffix(close) {
+            if let Some(at) = stripped.rfind(open) {
+                return (
+                    stripped[..at].trim().to_string(),
+                    Some(stripped[at + 1..].trim().to_string()),
+                );
+            }
+        }
+    }
+    (cell.to_string(), None)
+}
+
+/// The unit factor of a column: from the header, the configuration, both (must agree).
+fn factor<U: Copy + PartialEq>(
+    what: &'static str,
+    spec: &ColumnSpec,
+    header_unit: Option<&str>,
+    config_unit: Option<U>,
+    parse: fn(&str) -> Option<U>,
+    expected: &'static str,
+    to_base: fn(U) -> f64,
+) -> Result<f64, CsvError> {
+    let spec_unit = match &spec.unit {
+        Some(u) => Some(parse(u).ok_or_else(|| CsvError::UnknownUnit {
+            what,
+            unit: u.clone(),
+            expected,
+        })?),
+        None => config_unit,
+    };
+    let header = match header_unit {
+        Some(u) => Some(parse(u).ok_or_else(|| CsvError::UnknownUnit {
+            what,
+            unit: u.to_string(),
+            expected,
+        })?),
+        None => None,
+    };
+    match (header, spec_unit) {
+        (Some(h), Some(c)) if h != c => Err(CsvError::UnitDisagrees {
+            what: format!("{what} column {:?}", spec.name),
+            header_unit: header_unit.unwrap_or_default().to_string(),
+            config_unit: spec.unit.clone().unwrap_or_else(|| expected.to_string()),
+        }),
+        (Some(u), _) | (None, Some(u)) => Ok(to_base(u)),
+        (None, None) => Err(CsvError::NoUnit {
+            what,
+            name: spec.name.clone(),
+            expected,
+        }),
+    }
+}
+
+impl Layout {
+    /// Finds the configured columns in the header line.
+    pub fn from_header(line: &str, spec: &CsvColumns) -> Result<Layout, CsvError> {
+        let cells: Vec<(String, Option<String>)> =
+            line.split(spec.delimiter).map(split_unit).collect();
+        let find = |c: &ColumnSpec| -> Result<(usize, Option<&str>), CsvError> {
+            let at: Vec<usize> = (0..cells.len())
+                .filter(|&i| cells[i].0 == c.name.trim())
+                .collect();
+            match at.as_slice() {
+                [i] => Ok((*i, cells[*i].1.as_deref())),
+                [] => Err(CsvError::MissingColumn {
+                    name: c.name.clone(),
+                    header: line.to_string(),
+                }),
+                _ => Err(CsvError::AmbiguousColumn {
+                    name: c.name.clone(),
+                    count: at.len(),
+                    header: line.to_string(),
+                }),
+            }
+        };
+        let (t_at, t_unit) = find(&spec.time)?;
+        let time = (
+            t_at,
+            factor(
+                "time",
+                &spec.time,
+                t_unit,
+                spec.time_unit,
+                TimeUnit::parse,
+                TIME_UNITS,
+                TimeUnit::to_s,
+            )?,
+        );
+        let mut force = [None; 3];
+        let mut displacement = [None; 3];
+        let mut names = vec![(t_at, spec.time.name.clone())];
+        for axis in 0..3 {
+            if let Some(c) = &spec.force[axis] {
+                let (at, unit) = find(c)?;
+                let f = factor(
+                    "force",
+                    c,
+                    unit,
+                    spec.force_unit,
+                    ForceUnit::parse,
+                    FORCE_UNITS,
+                    ForceUnit::to_n,
+                )?;
+                force[axis] = Some((at, f));
+                names.push((at, c.name.clone()));
+            }
+            if let Some(c) = &spec.displacement[axis] {
+                let (at, unit) = find(c)?;
+                let f = factor(
+                    "displacement",
+                    c,
+                    unit,
+                    spec.displacement_unit,
+                    LengthUnit::parse,
+                    LENGTH_UNITS,
+                    LengthUnit::to_mm,
+                )?;
+                displacement[axis] = Some((at, f));
+                names.push((at, c.name.clone()));
+            }
+        }
+        Ok(Layout {
+            delimiter: spec.delimiter,
+            time,
+            force,
+            displacement,
+            names,
+        })
+    }
+
+    /// Parses one data line (no newline); the error says which cell and why.
+    pub fn parse_row(&self, line: &str) -> Result<Row, String> {
+        let cells: Vec<&str> = line.split(self.delimiter).collect();
+        let decimal_comma = self.delimiter != ',';
+        let value = |(at, f): (usize, f64)| -> Result<f64, String> {
+            let cell = cells.get(at).ok_or_else(|| {
+                format!(
+                    "{} cells, column {} is cell {}",
+                    cells.len(),
+                    self.name_of(at),
+                    at + 1
+                )
+            })?;
+            let text = cell.trim().trim_matches('"').trim();
+            let text = if decimal_comma {
+                text.replace(',', ".")
+            } else {
+                text.to_string()
+            };
+            match text.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v * f),
+                _ => Err(format!("{} = {cell:?} is not a number", self.name_of(at))),
+            }
+        };
+        let mut row = Row {
+            t_s: value(self.time)?,
+            force_n: [None; 3],
+            displacement_mm: [None; 3],
+        };
+        for axis in 0..3 {
+            if let Some(c) = self.force[axis] {
+                row.force_n[axis] = Some(value(c)?);
+            }
+            if let Some(c) = self.displacement[axis] {
+                row.displacement_mm[axis] = Some(value(c)?);
+            }
+        }
+        Ok(row)
+    }
+
+    /// The followed columns and where they are: `Time (cell 1), Fx (cell 3)`.
+    pub fn describe(&self) -> String {
+        self.names
+            .iter()
+            .map(|(at, name)| format!("{name} (cell {})", at + 1))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    fn name_of(&self, at: usize) -> &str {
+        self.names
+            .iter()
+            .find(|(i, _)| *i == at)
+            .map_or("?", |(_, name)| name.as_str())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn header_cells_give_name_and_unit() {
+        assert_eq!(split_unit(" Fx (kN) "), ("Fx".into(), Some("kN".into())));
+        assert_eq!(
+            split_unit("\"Time [s]\""),
+            ("Time".into(), Some("s".into()))
+        );
+        assert_eq!(split_unit("Fx"), ("Fx".into(), None));
+    }
+
+    #[test]
+    fn a_unit_stated_nowhere_or_twice_differently_is_an_error() {
+        let spec = CsvColumns {
+            time: ColumnSpec::new("t", None),
+            force: [Some(ColumnSpec::new("F", None)), None, None],
+            displacement: [None, None, None],
+            time_unit: Some(TimeUnit::S),
+            force_unit: None,
+            displacement_unit: None,
+            delimiter: ';',
+        };
+        let e = Layout::from_header("t;F", &spec).unwrap_err();
+        assert!(matches!(e, CsvError::NoUnit { .. }), "{e}");
+        let e = Layout::from_header("t (ms);F (N)", &spec).unwrap_err();
+        assert!(matches!(e, CsvError::UnitDisagrees { .. }), "{e}");
+        let e = Layout::from_header("t;F (lbf)", &spec).unwrap_err();
+        assert!(e.to_string().contains("lbf"), "{e}");
+        let layout = Layout::from_header("t;F (N)", &spec).unwrap();
+        // Semicolons and decimal commas.
+        let row = layout.parse_row("1,5;2,25").unwrap();
+        assert_eq!((row.t_s, row.force_n[0]), (1.5, Some(2.25)));
+    }
+}
