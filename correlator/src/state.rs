@@ -7,7 +7,7 @@
 //! | offset | size | content |
 //! |---|---|---|
 //! | 0 | 8 | magic `DICSREF1` |
-//! | 8 | 4 | format version (2) |
+//! | 8 | 4 | format version (3) |
 //! | 12 | 8 | width, height (px, u32 each) |
 //! | 20 | 8 | ZOI, step (px, u32 each) |
 //! | 28 | 16 | ROI x, y, width, height (px, u32 each) |
@@ -16,7 +16,7 @@
 //! | 72 | 16 | auto thresholds: displacement fraction, mean score (f64 each; 0 unless auto) |
 //! | 88 | 8 | reference frame id (u64; `u64::MAX` for an image file) |
 //! | 96 | 8 | origin frame id: the frame the mesh is defined in (u64; `u64::MAX`: an image file) |
-//! | 104 | 8 | sequence id (u32), then 0 (u32) |
+//! | 104 | 8 | sequence id (u32), then the sub-pixel method (u32: 0 correli, 1 icgn1, 2 icgn2) |
 //! | 112 | 2 w h | reference pixels, row-major u16 |
 //! | … | 16 nx ny | per-node base displacement u, v (px, f64 each): total displacement when the reference was taken |
 //! | … | 8 | checksum (u64) of every byte before it |
@@ -33,13 +33,17 @@ mod origin;
 
 pub use origin::ORIGIN_FILE;
 
-use crate::settings::{CorrelatorSettings, GuessMode, ReferenceMode, SettingsError, StrainMeasure};
+use crate::settings::{
+    CorrelatorSettings, GuessMode, Method, ReferenceMode, SettingsError, StrainMeasure,
+};
 use crate::Correlator;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"DICSREF1";
-const FORMAT_VERSION: u32 = 2;
+/// 3: the sub-pixel method in the header (a restart with another method is refused, the
+/// difference named; a version 2 file is refused as of another format version).
+const FORMAT_VERSION: u32 = 3;
 const HEADER_BYTES: usize = 112;
 /// Name of the binary state file inside the state folder.
 pub const STATE_FILE: &str = "reference.state";
@@ -110,6 +114,8 @@ struct Layout {
     max_iterations: u32,
     strain_window_nodes: u32,
     auto: [f64; 2],
+    /// 0 correli, 1 icgn1, 2 icgn2.
+    method: u32,
 }
 
 impl Layout {
@@ -148,6 +154,11 @@ impl Layout {
             max_iterations: s.max_iterations,
             strain_window_nodes: s.strain_window_nodes as u32,
             auto,
+            method: match s.method {
+                Method::Correli => 0,
+                Method::Icgn1 => 1,
+                Method::Icgn2 => 2,
+            },
         }
     }
 
@@ -165,7 +176,12 @@ impl Layout {
 
     /// The first difference to `wanted` that makes the state unusable, in words.
     fn difference(&self, wanted: &Layout) -> Option<String> {
-        let pairs: [(&str, String, String); 9] = [
+        let pairs: [(&str, String, String); 10] = [
+            (
+                "method",
+                method_name(self.method).into(),
+                method_name(wanted.method).into(),
+            ),
             (
                 "ZOI",
                 format!("{} px", self.zoi_px),
@@ -226,6 +242,13 @@ fn mode_name(code: u32, auto: [f64; 2]) -> String {
         2 => format!("auto ({} of the ZOI, score {})", auto[0], auto[1]),
         other => format!("code {other}"),
     }
+}
+
+fn method_name(code: u32) -> &'static str {
+    Method::ALL
+        .get(code as usize)
+        .map(|m| m.name())
+        .unwrap_or("?")
 }
 
 fn guess_name(code: u32) -> &'static str {
@@ -489,7 +512,7 @@ fn encode(
     out.extend_from_slice(&ids.reference_frame_id.to_le_bytes());
     out.extend_from_slice(&ids.origin_frame_id.to_le_bytes());
     put_u32(out, ids.sequence_id);
-    put_u32(out, 0);
+    put_u32(out, layout.method);
     debug_assert_eq!(out.len(), HEADER_BYTES);
     for &p in pixels {
         out.extend_from_slice(&p.to_le_bytes());
@@ -535,6 +558,7 @@ fn decode(bytes: &[u8]) -> Result<SavedReference, Corruption> {
         max_iterations: u32_at(64),
         strain_window_nodes: u32_at(68),
         auto: [f64_at(72), f64_at(80)],
+        method: u32_at(108),
     };
     let reference_frame_id = u64_at(88);
     let origin_frame_id = u64_at(96);
@@ -609,7 +633,7 @@ fn summary_json(layout: &Layout, reference_frame_id: u64, saves: u64, out: &mut 
     };
     let _ = write!(
         out,
-        "  \"saves_by_this_process\": {saves},\n  \"image\": [{}, {}],\n  \"zoi\": {},\n  \"step\": {},\n  \"roi\": [{}, {}, {}, {}],\n  \"mesh\": [{}, {}],\n  \"reference_mode\": \"{mode}\",\n  \"auto_displacement_zoi_fraction\": {},\n  \"auto_min_mean_score\": {},\n  \"guess\": \"{}\",\n  \"strain\": \"{}\",\n  \"max_iterations\": {},\n  \"strain_window_nodes\": {}\n}}\n",
+        "  \"saves_by_this_process\": {saves},\n  \"image\": [{}, {}],\n  \"zoi\": {},\n  \"step\": {},\n  \"roi\": [{}, {}, {}, {}],\n  \"mesh\": [{}, {}],\n  \"reference_mode\": \"{mode}\",\n  \"auto_displacement_zoi_fraction\": {},\n  \"auto_min_mean_score\": {},\n  \"method\": \"{}\",\n  \"guess\": \"{}\",\n  \"strain\": \"{}\",\n  \"max_iterations\": {},\n  \"strain_window_nodes\": {}\n}}\n",
         layout.width_px,
         layout.height_px,
         layout.zoi_px,
@@ -622,6 +646,7 @@ fn summary_json(layout: &Layout, reference_frame_id: u64, saves: u64, out: &mut 
         layout.mesh[1],
         layout.auto[0],
         layout.auto[1],
+        method_name(layout.method),
         guess_name(layout.guess),
         strain_name(layout.strain),
         layout.max_iterations,
@@ -708,6 +733,21 @@ mod tests {
             .unwrap()
             .to_string();
         assert!(error.contains("step 16 px there, 8 px now"), "{error}");
+        // Another sub-pixel method: refused, named.
+        let error = saved
+            .restore(
+                CorrelatorSettings {
+                    method: Method::Icgn1,
+                    zoi_px: 33,
+                    ..settings.clone()
+                },
+                state.path(),
+            )
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(error.contains("method correli there, icgn1 now"), "{error}");
+        assert!(summary.contains("\"method\": \"correli\""), "{summary}");
         // A damaged file: refused, not misread.
         let mut bytes = std::fs::read(state.path()).unwrap();
         bytes[HEADER_BYTES + 7] ^= 0x40;
