@@ -261,6 +261,7 @@ fn fake_camera_frames_arrive_intact_consecutive_with_the_camera_pattern_and_time
         "Mono8 values beyond 8 bits"
     );
     assert!(header.t_capture_ns > 0 && header.t_capture_ns <= wire::monotonic_ns());
+    assert!(header.t_camera_ns > 0, "no camera timestamp in the header");
 
     // SIGTERM: a clean end with the counts; the log holds one row per frame, ids consecutive,
     // the camera's timestamps going forward.

@@ -220,14 +220,16 @@ impl Shell {
         &mut self,
         render: impl FnOnce(&mut [u16]) -> Result<Option<FrameInfo>, ProducerError>,
     ) -> Result<Option<FrameHeader>, StreamError> {
-        self.publish_stamped(None, render)
+        self.publish_stamped(None, 0, render)
     }
 
     /// [`Shell::publish`] with the capture time given (a real camera's host receive time,
-    /// [`wire::monotonic_ns`]) instead of read when the slice is loaned.
+    /// [`wire::monotonic_ns`]) instead of read when the slice is loaned, and the camera's own
+    /// timestamp (`FrameHeader::t_camera_ns`, 0 for none).
     fn publish_stamped(
         &mut self,
         t_capture_ns: Option<u64>,
+        t_camera_ns: u64,
         render: impl FnOnce(&mut [u16]) -> Result<Option<FrameInfo>, ProducerError>,
     ) -> Result<Option<FrameHeader>, StreamError> {
         let frame_id = self.first_frame_id + self.report.frames_sent;
@@ -241,6 +243,7 @@ impl Shell {
             *header = FrameHeader {
                 frame_id,
                 t_capture_ns,
+                t_camera_ns,
                 width_px: dims.width,
                 height_px: dims.height,
                 bit_depth: u32::from(dims.bit_depth),

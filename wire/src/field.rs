@@ -90,7 +90,7 @@ impl NodeStatus {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FieldNode.v2")
+    type_name("dicstream.FieldNode.v3")
 )]
 pub struct FieldNode {
     /// ZOI centre in the reference image (px).
@@ -116,7 +116,7 @@ pub struct FieldNode {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.GaugeStrain.v2")
+    type_name("dicstream.GaugeStrain.v3")
 )]
 pub struct GaugeStrain {
     pub exx: f64,
@@ -130,7 +130,7 @@ pub struct GaugeStrain {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FieldHeader.v2")
+    type_name("dicstream.FieldHeader.v3")
 )]
 pub struct FieldHeader {
     pub layout_version: u32,

@@ -13,7 +13,7 @@ use iceoryx2::prelude::ZeroCopySend;
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.GroundTruth.v2")
+    type_name("dicstream.GroundTruth.v3")
 )]
 pub struct GroundTruth {
     /// Deformation gradient, row-major: `[F11, F12, F21, F22]` (dimensionless).
@@ -49,7 +49,7 @@ impl GroundTruth {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FrameHeader.v2")
+    type_name("dicstream.FrameHeader.v3")
 )]
 pub struct FrameHeader {
     /// Always [`crate::LAYOUT_VERSION`]; checked by every reader.
@@ -76,6 +76,10 @@ pub struct FrameHeader {
     pub sequence_id: u32,
     /// Always 0 (keeps the layout a multiple of 8 bytes).
     pub reserved: u32,
+    /// The camera's own timestamp of the frame, ns on the camera's clock (its epoch is the
+    /// camera's, not the host's: use it for intervals between frames, never against
+    /// `t_capture_ns`); 0 when the source has no camera clock (simulated, replayed, watched).
+    pub t_camera_ns: u64,
 }
 
 impl FrameHeader {
@@ -144,6 +148,7 @@ impl Default for FrameHeader {
             pixel_checksum: 0,
             sequence_id: 0,
             reserved: 0,
+            t_camera_ns: 0,
         }
     }
 }

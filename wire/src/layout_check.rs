@@ -12,7 +12,7 @@ use crate::LAYOUT_VERSION;
 use std::mem::{offset_of, size_of};
 
 /// The version the figures below describe.
-const CHECKED_VERSION: u32 = 2;
+const CHECKED_VERSION: u32 = 3;
 
 const _: () = assert!(
     LAYOUT_VERSION == CHECKED_VERSION,
@@ -39,7 +39,7 @@ const _: () = {
 };
 const _: () = {
     assert!(
-        size_of::<FrameHeader>() == 128,
+        size_of::<FrameHeader>() == 136,
         "FrameHeader changed size: bump LAYOUT_VERSION"
     );
     assert!(
@@ -93,6 +93,10 @@ const _: () = {
     assert!(
         offset_of!(FrameHeader, reserved) == 124,
         "FrameHeader::reserved moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(FrameHeader, t_camera_ns) == 128,
+        "FrameHeader::t_camera_ns moved: bump LAYOUT_VERSION"
     );
 };
 const _: () = {

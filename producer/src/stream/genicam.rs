@@ -10,7 +10,8 @@
 //! Clocks: the header's `t_capture_ns` is the host's receive time, [`wire::monotonic_ns`]
 //! taken when the driver hands the complete buffer over, so a consumer's latency is from the
 //! frame's arrival on the host (exposure, readout and transfer come before it). The camera's
-//! own timestamp (its clock, its epoch) goes beside the frame, in [`CameraNote::Frame`].
+//! own timestamp (its clock, its epoch) is the header's `t_camera_ns`, and goes beside the
+//! frame too, in [`CameraNote::Frame`] (the `--log` rows).
 
 use std::time::{Duration, Instant};
 
@@ -178,19 +179,24 @@ pub fn stream_genicam(
                 if publish {
                     let index = report.counts.published - 1;
                     let mut converted = true;
-                    let sent = shell.publish_stamped(Some(host_receive_ns), |pixels| {
-                        if convert_into(format, frame.bytes(), width_px, height_px, pixels).is_err()
-                        {
-                            converted = false;
-                            return Ok(None);
-                        }
-                        Ok(Some(FrameInfo {
-                            index,
-                            truth: None,
-                            rig_sample_id: None,
-                            sequence_id: 0,
-                        }))
-                    })?;
+                    let sent = shell.publish_stamped(
+                        Some(host_receive_ns),
+                        frame.camera_timestamp_ns,
+                        |pixels| {
+                            if convert_into(format, frame.bytes(), width_px, height_px, pixels)
+                                .is_err()
+                            {
+                                converted = false;
+                                return Ok(None);
+                            }
+                            Ok(Some(FrameInfo {
+                                index,
+                                truth: None,
+                                rig_sample_id: None,
+                                sequence_id: 0,
+                            }))
+                        },
+                    )?;
                     match sent {
                         Some(header) => {
                             on_event(StreamEvent::Frame(&header));
