@@ -5,6 +5,7 @@
 //! after the role's name marks the process ready. Exits are noticed as they happen and
 //! reported with the exit status or signal and the last lines the process printed.
 
+use crate::camera_events::{camera_event, CameraEvent};
 use anyhow::Context;
 use crossbeam::channel::{unbounded, Receiver, Sender};
 use std::collections::VecDeque;
@@ -110,6 +111,9 @@ pub struct Supervisor {
     /// Exits noticed but not yet handed out by [`Supervisor::take_exits`]: an exit noticed
     /// while waiting for another child is kept, never lost.
     exited: Vec<Exit>,
+    /// The producer's camera events with their lines, not yet handed out by
+    /// [`Supervisor::take_camera_events`].
+    camera_events: Vec<(CameraEvent, String)>,
     tx: Sender<Event>,
     rx: Receiver<Event>,
 }
@@ -125,6 +129,7 @@ impl Supervisor {
             log_dir: log_dir.to_path_buf(),
             children: Vec::new(),
             exited: Vec::new(),
+            camera_events: Vec::new(),
             tx,
             rx,
         })
@@ -234,6 +239,12 @@ impl Supervisor {
         if line.starts_with(&format!("{}: ready", role.name())) {
             managed.ready = true;
         }
+        if role == Role::Producer {
+            if let Some(event) = camera_event(&line) {
+                self.camera_events.push((event, line.clone()));
+            }
+        }
+        let managed = self.managed(role);
         if managed.last_lines.len() == LAST_LINES {
             managed.last_lines.pop_front();
         }
@@ -325,6 +336,13 @@ impl Supervisor {
             .iter()
             .find(|m| m.role == role)
             .map_or(0.0, |m| m.cpu_s_ended + m.cpu_s_current)
+    }
+
+    /// The producer's camera events (lost, a failed reconnection, back) since the last call,
+    /// each with the line that reported it.
+    pub fn take_camera_events(&mut self) -> Vec<(CameraEvent, String)> {
+        self.drain_lines();
+        std::mem::take(&mut self.camera_events)
     }
 
     /// Children that have ended since the last call, in the order they were noticed

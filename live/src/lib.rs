@@ -8,6 +8,7 @@
 //! ([`children`]) and to shared memory ([`subscriptions`]); [`run`] ties them together.
 
 pub mod acceptance;
+pub mod camera_events;
 pub mod children;
 pub mod config;
 pub mod dashboard_view;

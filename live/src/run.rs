@@ -382,6 +382,8 @@ struct LoopState {
     cpu_s: std::collections::BTreeMap<String, f64>,
     dashboard: Option<dashboard::Dashboard>,
     verbose: bool,
+    /// A real camera reported lost and not yet back (the status line says so).
+    camera_away: bool,
 }
 
 enum Phase {
@@ -475,6 +477,11 @@ fn event_loop(
             }
         }
 
+        for (event, line) in supervisor.take_camera_events() {
+            eprintln!("run: {line}");
+            state.camera_away = event.away();
+        }
+
         for exit in supervisor.take_exits() {
             let campaign_done = exit.role == Role::Rig && exit.success;
             if campaign_done && matches!(phase, Phase::Running) {
@@ -565,10 +572,12 @@ fn event_loop(
                 next_histograms = Instant::now() + HISTOGRAM_EVERY;
             }
             if status {
-                println!(
-                    "{}",
-                    crate::status::line(recorder, started.elapsed().as_secs_f64(), state.verbose)
-                );
+                let line =
+                    crate::status::line(recorder, started.elapsed().as_secs_f64(), state.verbose);
+                match state.camera_away {
+                    true => println!("{line} | CAMERA LOST, reconnecting"),
+                    false => println!("{line}"),
+                }
             }
             next_status += status_every;
             if next_status < Instant::now() {

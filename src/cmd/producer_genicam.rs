@@ -171,6 +171,8 @@ pub fn run(
                     );
                 }
             }
+            // `dicstream run` reads the lost / attempt / reconnected lines below
+            // (`live::camera_events`): keep their beginnings as they are.
             CameraNote::Lost { id, reason } => eprintln!(
                 "producer: camera {id} lost: {reason}; reconnecting (first attempt in {:.1} s, \
                  then backing off up to {} s between attempts); frame ids will go on from {}",
