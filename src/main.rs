@@ -33,7 +33,7 @@ enum Command {
     /// Live dashboard in the browser, attached read-only to a running instance.
     Monitor(cmd::monitor::MonitorArgs),
     /// Camera process: publishes frames (scenario, replay, or following the rig state).
-    Producer(cmd::producer::ProducerArgs),
+    Producer(Box<cmd::producer::ProducerArgs>),
     /// Simulated ASTREE machine: publishes rig/state, answers rig/command, logs rig.csv.
     Rig(Box<cmd::rig::RigArgs>),
     /// The whole simulated bench: rig, camera, correlator, identifier; live status; results.
@@ -80,7 +80,7 @@ fn main() -> std::process::ExitCode {
         Command::Identify(args) => ok(cmd::identify::run(args)),
         Command::Identifier(args) => ok(cmd::identifier::run(args)),
         Command::Monitor(args) => ok(cmd::monitor::run(args)),
-        Command::Producer(args) => ok(cmd::producer::run(args)),
+        Command::Producer(args) => ok(cmd::producer::run(*args)),
         Command::Rig(args) => ok(cmd::rig::run(*args)),
         Command::Run(args) => cmd::run::run(args),
         Command::Synth(args) => ok(cmd::synth::run(args)),
