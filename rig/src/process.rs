@@ -21,6 +21,38 @@ use std::time::{Duration, Instant};
 use wire::files::RowFile;
 use wire::rig::{RigCommandKind, RigReply, RigState};
 
+/// The rig's place on an instance, one for the simulated rig and the CSV follower: the claim
+/// of the `rig` role (a second rig is refused), its node (dead nodes of the instance cleaned,
+/// and said) and the `rig/state` publisher.
+pub(crate) struct StatePort {
+    pub instance: wire::Instance,
+    pub _owner: wire::owner::Owner,
+    pub node: Node<ipc::Service>,
+    pub publisher: wire::pubsub::ValuePublisher<RigState>,
+}
+
+impl StatePort {
+    pub fn open(instance_name: &str) -> Result<StatePort, wire::InstanceError> {
+        let instance = wire::Instance::new(instance_name)?;
+        let _owner = instance.claim("rig")?;
+        let (node, removed) = instance.create_node("rig")?;
+        if removed > 0 {
+            eprintln!(
+                "rig: cleaned {removed} dead node(s) of instance {}",
+                instance.name()
+            );
+        }
+        let publisher =
+            wire::pubsub::ValuePublisher::<RigState>::create(&node, &wire::services::RIG_STATE)?;
+        Ok(StatePort {
+            instance,
+            _owner,
+            node,
+            publisher,
+        })
+    }
+}
+
 /// Why the rig process could not start or stopped early. A file that could not be written and
 /// a journal that cannot be followed are named as the error's `source()` too, so that
 /// `wire::exit::code_of` finds the exit code they ask for.
@@ -231,17 +263,12 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
         Some(path) => resume(&mut session, path, settings)?,
         None => None,
     };
-    let instance = wire::Instance::new(&options.instance)?;
-    let _owner = instance.claim("rig")?;
-    let (node, removed) = instance.create_node("rig")?;
-    if removed > 0 {
-        eprintln!(
-            "rig: cleaned {removed} dead node(s) of instance {}",
-            instance.name()
-        );
-    }
-    let publisher =
-        wire::pubsub::ValuePublisher::<RigState>::create(&node, &wire::services::RIG_STATE)?;
+    let StatePort {
+        instance,
+        _owner,
+        node,
+        publisher,
+    } = StatePort::open(&options.instance)?;
     let service_name = ServiceName::new(wire::services::RIG_COMMAND)
         .map_err(|e| ProcessError::command("service name rig/command", e))?;
     let command_service = node

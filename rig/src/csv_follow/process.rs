@@ -5,9 +5,9 @@
 
 use super::clock::{rig_state, MachineClock};
 use super::{CsvColumns, CsvError, FileTail, Follower, LineEvent, TailRead};
+use crate::process::StatePort;
 use std::path::PathBuf;
 use std::time::{Duration, Instant, SystemTime};
-use wire::rig::RigState;
 
 /// Malformed lines reported one by one; later ones are counted only.
 const MALFORMED_REPORTED: u64 = 20;
@@ -78,17 +78,12 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
     let mut follower =
         Follower::new(options.columns.clone()).map_err(|e| FollowError::columns(&path, e))?;
     let mut tail = FileTail::new(&path);
-    let instance = wire::Instance::new(&options.instance)?;
-    let _owner = instance.claim("rig")?;
-    let (node, removed) = instance.create_node("rig")?;
-    if removed > 0 {
-        eprintln!(
-            "rig: cleaned {removed} dead node(s) of instance {}",
-            instance.name()
-        );
-    }
-    let publisher =
-        wire::pubsub::ValuePublisher::<RigState>::create(&node, &wire::services::RIG_STATE)?;
+    let StatePort {
+        instance,
+        _owner,
+        node: _node,
+        publisher,
+    } = StatePort::open(&options.instance)?;
     let mut clock = MachineClock::new(options.offset_s);
     let mut summary = FollowSummary::default();
     let mut waiting_reported = false;
