@@ -433,18 +433,7 @@ impl Specimen {
             response.kinematics.stretch_y = 1.0;
             return response;
         }
-        // Buckled sheet: no compression along a gripped axis.
-        let (lx, ly) = match self.config.loading {
-            Loading::Equibiaxial => (stretch_x.max(1.0), stretch_y.max(1.0)),
-            Loading::Uniaxial(Axis::Y) => {
-                let l = stretch_y.max(1.0);
-                (1.0 / l.sqrt(), l)
-            }
-            Loading::Uniaxial(_) => {
-                let l = stretch_x.max(1.0);
-                (l, 1.0 / l.sqrt())
-            }
-        };
+        let (lx, ly) = self.loaded_stretches(stretch_x, stretch_y);
         let stress = self.config.law.in_plane_stress(lx, ly);
         let g = &self.config.geometry;
         let cos = m.rotation_deg.to_radians().cos();
@@ -456,11 +445,7 @@ impl Specimen {
         };
         let force_y_n = stress.nominal_stress_mpa[1] * y_reference_mm * g.thickness_mm * cos;
         response.nominal_stress_mpa = stress.nominal_stress_mpa;
-        let (gripped_x, gripped_y) = match self.config.loading {
-            Loading::Equibiaxial => (true, true),
-            Loading::Uniaxial(Axis::Y) => (false, true),
-            Loading::Uniaxial(_) => (true, false),
-        };
+        let (gripped_x, gripped_y) = self.gripped();
         let peak = if gripped_x {
             stress.nominal_stress_mpa[0]
         } else {
