@@ -8,7 +8,8 @@
 //! - positions in f64 (two 4-lane vectors per coordinate), their floor by truncation (the
 //!   positions are checked ≥ 2 first) and fractional parts in f32, the coefficients' index in
 //!   32-bit lanes; a chunk with a sample off the coefficients' fast path sends the whole
-//!   evaluation back to the portable path (which handles the border and `outside_image`);
+//!   evaluation back to the portable path (which handles the border and `outside_image`), as
+//!   does a subset under 9 px (a chunk then crosses more than one row end);
 //! - per sample, the 8-lane weights of the six taps (Horner in 8 lanes, taps in lanes 0..=5,
 //!   lanes 6 and 7 zero), six unaligned 8-value coefficient row loads combined by the y weights
 //!   (FMA), times the x weights; the 8 samples' vectors are summed across their lanes together
@@ -26,12 +27,13 @@ use super::bspline::{Coefficients, MARGIN_HIGH, MARGIN_LOW, TAPS};
 use super::shape::{Order, Warp};
 use super::{Subset, Sums};
 use std::arch::x86_64::{
-    __m256, __m256d, _mm256_add_pd, _mm256_add_ps, _mm256_and_pd, _mm256_broadcast_ss,
-    _mm256_castps256_ps128, _mm256_cmp_pd, _mm256_cvtepi32_pd, _mm256_cvtpd_ps, _mm256_cvtps_pd,
-    _mm256_cvttpd_epi32, _mm256_extractf128_ps, _mm256_fmadd_pd, _mm256_fmadd_ps, _mm256_hadd_ps,
-    _mm256_loadu_ps, _mm256_movemask_pd, _mm256_mul_ps, _mm256_permute2f128_ps, _mm256_set1_pd,
-    _mm256_set1_ps, _mm256_setzero_pd, _mm256_setzero_ps, _mm256_storeu_pd, _mm256_storeu_ps,
-    _mm256_sub_pd, _mm256_sub_ps, _mm_storeu_si128, _CMP_GE_OQ, _CMP_LT_OQ,
+    __m256, __m256d, _mm256_add_pd, _mm256_add_ps, _mm256_and_pd, _mm256_and_ps,
+    _mm256_broadcast_ss, _mm256_castps256_ps128, _mm256_cmp_pd, _mm256_cmp_ps, _mm256_cvtepi32_pd,
+    _mm256_cvtpd_ps, _mm256_cvtps_pd, _mm256_cvttpd_epi32, _mm256_extractf128_ps, _mm256_fmadd_pd,
+    _mm256_fmadd_ps, _mm256_hadd_ps, _mm256_loadu_ps, _mm256_movemask_pd, _mm256_mul_pd,
+    _mm256_mul_ps, _mm256_permute2f128_ps, _mm256_set1_pd, _mm256_set1_ps, _mm256_setr_ps,
+    _mm256_setzero_pd, _mm256_setzero_ps, _mm256_storeu_pd, _mm256_storeu_ps, _mm256_sub_pd,
+    _mm256_sub_ps, _mm_storeu_ps, _mm_storeu_si128, _CMP_GE_OQ, _CMP_LT_OQ,
 };
 
 /// 120 × the weights of the taps −2..=3 (lanes 0..=5; lanes 6 and 7 zero) as polynomials in
@@ -83,11 +85,12 @@ fn weights(t: __m256) -> __m256 {
         // SAFETY: reads the 32 bytes of a [f32; 8].
         unsafe { _mm256_loadu_ps(POLY[p].as_ptr()) }
     };
-    let mut w = row(5);
-    for p in (0..5).rev() {
-        w = _mm256_fmadd_ps(w, t, row(p));
-    }
-    w
+    // Written out: an iterator adapter is not inlined into a target-feature function.
+    let mut w = _mm256_fmadd_ps(row(5), t, row(4));
+    w = _mm256_fmadd_ps(w, t, row(3));
+    w = _mm256_fmadd_ps(w, t, row(2));
+    w = _mm256_fmadd_ps(w, t, row(1));
+    _mm256_fmadd_ps(w, t, row(0))
 }
 
 /// The lane sums of eight vectors, in order.
@@ -126,6 +129,17 @@ fn widen(v: __m256) -> (__m256d, __m256d) {
     )
 }
 
+/// acc[0] += a, acc[1 + m] += a monomials[m].
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn accumulate<const M: usize>(acc: &mut [__m256], a: __m256, monomials: &[__m256; M]) {
+    let acc = &mut acc[..M + 1];
+    acc[0] = _mm256_add_ps(acc[0], a);
+    for m in 0..M {
+        acc[1 + m] = _mm256_fmadd_ps(a, monomials[m], acc[1 + m]);
+    }
+}
+
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 fn run<const SECOND: bool>(subset: &Subset, c: &Coefficients, warp: &Warp) -> Option<Sums> {
@@ -138,6 +152,9 @@ fn run<const SECOND: bool>(subset: &Subset, c: &Coefficients, warp: &Warp) -> Op
     let (cx, cy) = subset.centre_px;
     let (w, h) = (c.width_px, c.height_px);
     let data = &c.data[..];
+    if n < 9 {
+        return None;
+    }
     // The fast path: MARGIN_LOW <= x < w − MARGIN_HIGH, the same for y; every row load then
     // reads data[(iy − 2) w + ix − 2 + r w .. + 8], r < 6, inside the buffer (w h + 8 values).
     assert!(w >= MARGIN_LOW + MARGIN_HIGH + 1 && h >= MARGIN_LOW + MARGIN_HIGH + 1);
@@ -160,41 +177,45 @@ fn run<const SECOND: bool>(subset: &Subset, c: &Coefficients, warp: &Warp) -> Op
     let mut acc = [_mm256_setzero_ps(); SUMS];
     let mut total = [[_mm256_setzero_pd(); 2]; SUMS];
     let terms = if SECOND { 15 } else { 9 };
-    // Offsets of the chunk's samples from the subset centre (lanes past n² sit at the centre,
-    // with a zero mask).
-    let (mut dx, mut dy, mut mask) = ([0.0f32; 8], [0.0f32; 8], [0.0f32; 8]);
-    let (mut column, mut row) = (0usize, 0usize);
+    // Column, row and row-major index of each lane's sample (exact in f32 below 2^24);
+    // lanes past n² are masked (zero bits) and sit at the subset centre.
+    let ps = |v: f32| _mm256_set1_ps(v);
+    let (n_v, nn_v, half_v, eight) = (ps(n as f32), ps(nn as f32), ps(half as f32), ps(8.0));
+    let mut column = _mm256_setr_ps(0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0);
+    let mut row = _mm256_setzero_ps();
+    let mut index = column;
     let chunks = nn.div_ceil(8);
     for chunk in 0..chunks {
         let k = 8 * chunk;
         let count = (nn - k).min(8);
-        for l in 0..8 {
-            if l < count {
-                (dx[l], dy[l], mask[l]) =
-                    (column as f32 - half as f32, row as f32 - half as f32, 1.0);
-                column += 1;
-                if column == n {
-                    (column, row) = (0, row + 1);
-                }
-            } else {
-                (dx[l], dy[l], mask[l]) = (0.0, 0.0, 0.0);
-            }
-        }
-        let (dxv, dyv) = (load8(&dx), load8(&dy));
+        let valid = _mm256_cmp_ps::<_CMP_LT_OQ>(index, nn_v);
+        let dxv = _mm256_and_ps(_mm256_sub_ps(column, half_v), valid);
+        let dyv = _mm256_and_ps(_mm256_sub_ps(row, half_v), valid);
+        // The next chunk: 8 samples on, at most one row end crossed (n >= 9).
+        index = _mm256_add_ps(index, eight);
+        column = _mm256_add_ps(column, eight);
+        let wrap = _mm256_cmp_ps::<_CMP_GE_OQ>(column, n_v);
+        column = _mm256_sub_ps(column, _mm256_and_ps(wrap, n_v));
+        row = _mm256_add_ps(row, _mm256_and_ps(wrap, ps(1.0)));
         let ((dx0, dx1), (dy0, dy1)) = (widen(dxv), widen(dyv));
         let mut ix = [0i32; 8];
         let mut iy = [0i32; 8];
         let mut tx = [0.0f32; 8];
         let mut ty = [0.0f32; 8];
-        for (half_index, (a, b)) in [(dx0, dy0), (dx1, dy1)].into_iter().enumerate() {
+        for half_index in 0..2 {
+            let (a, b) = if half_index == 0 {
+                (dx0, dy0)
+            } else {
+                (dx1, dy1)
+            };
             let mut x = _mm256_fmadd_pd(x_dy, b, _mm256_fmadd_pd(x_dx, a, x0));
             let mut y = _mm256_fmadd_pd(y_dy, b, _mm256_fmadd_pd(y_dx, a, y0));
             if SECOND {
-                let (aa, ab) = (
-                    _mm256_fmadd_pd(a, a, _mm256_setzero_pd()),
-                    _mm256_fmadd_pd(a, b, _mm256_setzero_pd()),
+                let (aa, ab, bb) = (
+                    _mm256_mul_pd(a, a),
+                    _mm256_mul_pd(a, b),
+                    _mm256_mul_pd(b, b),
                 );
-                let bb = _mm256_fmadd_pd(b, b, _mm256_setzero_pd());
                 x = _mm256_fmadd_pd(
                     x_xx,
                     aa,
@@ -231,8 +252,8 @@ fn run<const SECOND: bool>(subset: &Subset, c: &Coefficients, warp: &Warp) -> Op
             unsafe {
                 _mm_storeu_si128(ix[at..at + 4].as_mut_ptr().cast(), fx);
                 _mm_storeu_si128(iy[at..at + 4].as_mut_ptr().cast(), fy);
-                std::arch::x86_64::_mm_storeu_ps(tx[at..at + 4].as_mut_ptr(), fracx);
-                std::arch::x86_64::_mm_storeu_ps(ty[at..at + 4].as_mut_ptr(), fracy);
+                _mm_storeu_ps(tx[at..at + 4].as_mut_ptr(), fracx);
+                _mm_storeu_ps(ty[at..at + 4].as_mut_ptr(), fracy);
             }
         }
         let mut partial = [_mm256_setzero_ps(); 8];
@@ -247,17 +268,19 @@ fn run<const SECOND: bool>(subset: &Subset, c: &Coefficients, warp: &Warp) -> Op
             // SAFETY: start + r w + 8 <= (h − 7) w + w − 6 + 5 w + 8 <= w h + 8 <= data.len()
             // for r < TAPS (the fast-path check and the asserts before the loop).
             let row_at = |r: usize| unsafe { _mm256_loadu_ps(base.add(start + r * w)) };
+            // Written out: an iterator adapter is not inlined into a target-feature function.
             let mut sum = _mm256_mul_ps(_mm256_broadcast_ss(&wy[0]), row_at(0));
-            for (r, weight) in wy.iter().enumerate().take(TAPS).skip(1) {
-                sum = _mm256_fmadd_ps(_mm256_broadcast_ss(weight), row_at(r), sum);
-            }
+            sum = _mm256_fmadd_ps(_mm256_broadcast_ss(&wy[1]), row_at(1), sum);
+            sum = _mm256_fmadd_ps(_mm256_broadcast_ss(&wy[2]), row_at(2), sum);
+            sum = _mm256_fmadd_ps(_mm256_broadcast_ss(&wy[3]), row_at(3), sum);
+            sum = _mm256_fmadd_ps(_mm256_broadcast_ss(&wy[4]), row_at(4), sum);
+            sum = _mm256_fmadd_ps(_mm256_broadcast_ss(&wy[TAPS - 1]), row_at(TAPS - 1), sum);
             partial[l] = _mm256_mul_ps(sum, wx);
         }
-        let mask_v = load8(&mask);
         // g' = g − f_m, zero in the lanes past n².
-        let g = _mm256_mul_ps(
+        let g = _mm256_and_ps(
             _mm256_sub_ps(_mm256_mul_ps(lane_sums(&partial), scale), mean),
-            mask_v,
+            valid,
         );
         let (f, fx, fy) = if count == 8 {
             (load8(&values[k..]), load8(&gx[k..]), load8(&gy[k..]))
@@ -278,27 +301,20 @@ fn run<const SECOND: bool>(subset: &Subset, c: &Coefficients, warp: &Warp) -> Op
             let xx = _mm256_mul_ps(_mm256_mul_ps(dxv, dxv), half_v);
             let xy = _mm256_mul_ps(dxv, dyv);
             let yy = _mm256_mul_ps(_mm256_mul_ps(dyv, dyv), half_v);
-            for (offset, a) in [(3, ax), (9, ay)] {
-                acc[offset] = _mm256_add_ps(acc[offset], a);
-                acc[offset + 1] = _mm256_fmadd_ps(a, dxv, acc[offset + 1]);
-                acc[offset + 2] = _mm256_fmadd_ps(a, dyv, acc[offset + 2]);
-                acc[offset + 3] = _mm256_fmadd_ps(a, xx, acc[offset + 3]);
-                acc[offset + 4] = _mm256_fmadd_ps(a, xy, acc[offset + 4]);
-                acc[offset + 5] = _mm256_fmadd_ps(a, yy, acc[offset + 5]);
-            }
+            let monomials = [dxv, dyv, xx, xy, yy];
+            accumulate(&mut acc[3..9], ax, &monomials);
+            accumulate(&mut acc[9..15], ay, &monomials);
         } else {
-            for (offset, a) in [(3, ax), (6, ay)] {
-                acc[offset] = _mm256_add_ps(acc[offset], a);
-                acc[offset + 1] = _mm256_fmadd_ps(a, dxv, acc[offset + 1]);
-                acc[offset + 2] = _mm256_fmadd_ps(a, dyv, acc[offset + 2]);
-            }
+            let monomials = [dxv, dyv];
+            accumulate(&mut acc[3..6], ax, &monomials);
+            accumulate(&mut acc[6..9], ay, &monomials);
         }
         if (chunk + 1) % FLUSH_CHUNKS == 0 || chunk + 1 == chunks {
-            for (a, t) in acc.iter_mut().zip(total.iter_mut()).take(terms) {
-                let (low, high) = widen(*a);
-                t[0] = _mm256_add_pd(t[0], low);
-                t[1] = _mm256_add_pd(t[1], high);
-                *a = _mm256_setzero_ps();
+            for t in 0..terms {
+                let (low, high) = widen(acc[t]);
+                total[t][0] = _mm256_add_pd(total[t][0], low);
+                total[t][1] = _mm256_add_pd(total[t][1], high);
+                acc[t] = _mm256_setzero_ps();
             }
         }
     }
