@@ -146,6 +146,18 @@ pub fn prepare(
             }
         }
     }
+    // The Gauss-Newton Hessian of the ZNSSD itself: the reference subset's mean and norm move
+    // with Δp too, so its steepest-descent images are K = J − J̄ − f̂ (Σ J f̂) (centred, and
+    // without their component along f̂), and Σ K Kᵀ = Σ J Jᵀ − (Σ J)(Σ J)ᵀ / n² − (Σ J f̂)(Σ J f̂)ᵀ.
+    // Σ J Jᵀ alone overstates the curvature along the parameters these sums are large for (the
+    // gradient terms of a small subset: Σ J f̂ of u_x is about −1/2 whatever the size), which made
+    // the updates too short and the convergence linear (ratio 0.85 to 0.9 per iteration at 9 px).
+    for a in 0..count {
+        for b in a..count {
+            hessian[a * count + b] -=
+                stats.sum_j[a] * stats.sum_j[b] / nn as f64 + stats.sum_jf[a] * stats.sum_jf[b];
+        }
+    }
     for a in 0..count {
         for b in 0..a {
             hessian[a * count + b] = hessian[b * count + a];
