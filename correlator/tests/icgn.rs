@@ -431,8 +431,8 @@ fn independent_images() {
 /// measurable nodes `ok`, how many IC-GN leaves `not_converged`, its median iterations and its
 /// RMS, beside `correli` at 32 px. No case has a wrong node; IC-GN converges on at least 95 %
 /// of the measurable nodes from 21 px and 70 % at 13 px, except on the low-contrast image
-/// (contrast 20 % of full scale, 3 % noise, 8 bit), where the reference subset's noisy
-/// gradients make the iterations converge slowly (see the README).
+/// (contrast 20 % of full scale, 3 % noise, 8 bit: 95 % at 33 px, 60 % at 21 px, printed only
+/// at 13 px, where one subset holds too little signal for its six parameters).
 #[test]
 fn convergence_on_varied_images() {
     use common::independent::{affine_inverse, render as render_independent, IndependentSpeckle};
@@ -553,7 +553,8 @@ fn convergence_on_varied_images() {
                 o.rms_px
             );
             let min_valid = match (name.contains("low contrast"), zoi) {
-                (true, 33) => 0.6,
+                (true, 33) => 0.95,
+                (true, 21) => 0.6,
                 (true, _) => 0.0,
                 (false, 13) => 0.7,
                 (false, _) => 0.95,
