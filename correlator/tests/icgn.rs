@@ -8,7 +8,9 @@
 
 mod common;
 
-use common::{accuracy, command_columns, load, mean_std, render, stretch, translation};
+use common::{
+    accuracy, command_columns, cramer_rao_std_px, load, mean_std, render, stretch, translation,
+};
 use correlator::settings::Method;
 use correlator::{Correlator, CorrelatorSettings, Field, NodeStatus, ReferenceMode, Roi};
 use testkit::shared_data;
@@ -81,6 +83,7 @@ fn sample14_chirp_rms_at_33_px() {
     assert_eq!(columns.len(), w, "command.csv rows");
     println!("| sample 14 RMS(u - command), 150 <= x <= 1900 | L1 | L3 | L5 |");
     let mut worst = 0.0f64;
+    let mut band_lines = Vec::new();
     for method in [Method::Correli, Method::Icgn1, Method::Icgn2] {
         let zoi = zoi_of(method);
         let mut line = format!("| {} @ {zoi} px |", method.name());
@@ -108,11 +111,30 @@ fn sample14_chirp_rms_at_33_px() {
                 .collect();
             let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
             line += &format!(" {rms:.4} |");
+            // Where along x the error sits (the chirp's frequency rises with x): RMS and mean
+            // of u − command per 250 px band.
+            let mut bands = String::new();
+            for band in 0..7 {
+                let x0 = 150.0 + 250.0 * band as f64;
+                let e: Vec<f64> = field
+                    .nodes
+                    .iter()
+                    .filter(|n| n.status == NodeStatus::Ok && (x0..x0 + 250.0).contains(&n.x_px))
+                    .map(|n| n.u_px - interp(n.x_px))
+                    .collect();
+                let (mean, std) = mean_std(&e);
+                bands += &format!(" {:.4} ({mean:+.4}) |", mean.hypot(std));
+            }
+            band_lines.push(format!("| {} {variant} |{bands}", method.name()));
             if method == Method::Icgn1 {
                 assert!(errors.len() > 1000);
                 worst = worst.max(rms);
             }
         }
+        println!("{line}");
+    }
+    println!("| RMS (mean) of u − command per x band | 150-400 | 400-650 | 650-900 | 900-1150 | 1150-1400 | 1400-1650 | 1650-1900 |");
+    for line in &band_lines {
         println!("{line}");
     }
     // The target is 0.011 px; first-order IC-GN at 33 px measures 0.0120, 0.0121 and
@@ -123,39 +145,69 @@ fn sample14_chirp_rms_at_33_px() {
 }
 
 /// Rendered translations 0, 0.1, ..., 1 px (1 % read noise, other noise per image): bias and
-/// standard deviation of u and v over the nodes at every shift.
+/// standard deviation of u and v over the nodes at every shift, beside the Cramér-Rao bound of
+/// one subset of that image and noise.
 #[test]
 fn translation_sweep_bias_curve() {
     let size = 256;
-    let reference = render(size, size, 8.0, translation(0.0, 0.0), 0.01, 100);
-    println!("| shift (px) | method | bias u | bias v | std u | std v |");
-    let (mut worst_bias, mut worst_std) = (0.0f64, 0.0f64);
+    let noise = 0.01;
+    let reference = render(size, size, 8.0, translation(0.0, 0.0), noise, 100);
+    let clean = render(size, size, 8.0, translation(0.0, 0.0), 0.0, 100);
+    let sigma_counts = noise * u16::MAX as f64;
+    println!("| shift (px) | method | bias u | bias v | std u | std v | CRB std u | CRB std v |");
+    let (mut worst_bias, mut worst_std, mut worst_ratio) = (0.0f64, 0.0f64, 0.0f64);
+    // Σ std² and Σ bound² over the shifts and both components (icgn1).
+    let (mut pooled_var, mut pooled_bound, mut count) = (0.0, 0.0, 0.0);
     for method in [Method::Correli, Method::Icgn1] {
         let zoi = zoi_of(method);
         let mut correlator = Correlator::new(settings(method, zoi, 16), size, size).unwrap();
         for step in 0..=10 {
             let shift = 0.1 * step as f64;
-            let deformed = render(size, size, 8.0, translation(shift, 0.5 * shift), 0.01, step);
+            let deformed = render(
+                size,
+                size,
+                8.0,
+                translation(shift, 0.5 * shift),
+                noise,
+                step,
+            );
             correlator.set_reference(&reference).unwrap();
             let field = correlator.correlate(&deformed).unwrap();
             let (mu, su) = mean_std(&ok_values(field, |n| n.u_px));
             let (mv, sv) = mean_std(&ok_values(field, |n| n.v_px));
             let (bu, bv) = (mu - shift, mv - 0.5 * shift);
+            let (cu, cv) = cramer_rao_std_px(&clean, size, size, field, zoi, sigma_counts);
             println!(
-                "| {shift:.1} | {} @ {zoi} | {bu:+.4} | {bv:+.4} | {su:.4} | {sv:.4} |",
+                "| {shift:.1} | {} @ {zoi} | {bu:+.4} | {bv:+.4} | {su:.4} | {sv:.4} | {cu:.4} | {cv:.4} |",
                 method.name()
             );
             assert!(field.valid as f64 >= 0.95 * field.nodes.len() as f64);
             if method == Method::Icgn1 {
                 worst_bias = worst_bias.max(bu.abs()).max(bv.abs());
                 worst_std = worst_std.max(su).max(sv);
+                worst_ratio = worst_ratio.max(su / cu).max(sv / cv);
+                pooled_var += su * su + sv * sv;
+                pooled_bound += cu * cu + cv * cv;
+                count += 2.0;
             }
         }
     }
     assert!(worst_bias <= 0.003, "largest |bias| {worst_bias} px");
-    // The target is 0.005 px at every shift: the std is 0.0049-0.0050 px at shift 0
-    // (no interpolation at all) and 0.0044 to 0.0059 px over the sweep, the scatter of a std
-    // estimated from 169 overlapping subsets. This bound guards what is reached.
+    let (pooled_std, bound) = ((pooled_var / count).sqrt(), (pooled_bound / count).sqrt());
+    println!("icgn1 pooled std {pooled_std:.5} px, Cramér-Rao bound {bound:.5} px");
+    // The target is 0.005 px at every shift. The Cramér-Rao bound of one 33 px subset
+    // of this image at 1 % noise is 0.0050-0.0051 px, and IC-GN's std pooled over the sweep is
+    // at it: no unbiased estimator with this subset size reaches <= 0.005 px at every shift on
+    // this image. A single shift's std, estimated from 169 overlapping subsets, scatters by
+    // about ±10 % around the pooled value (0.0045 to 0.0059 px).
+    assert!(
+        pooled_std <= 1.05 * bound,
+        "pooled std {pooled_std} vs bound {bound}"
+    );
+    assert!(
+        worst_ratio <= 1.25,
+        "std up to {worst_ratio} x the Cramér-Rao bound"
+    );
     assert!(worst_std <= 0.0062, "largest std {worst_std} px");
 }
 
@@ -257,10 +309,11 @@ fn subsets_of_any_size() {
     let reference = render(SIZE, SIZE, 8.0, translation(0.0, 0.0), 0.01, 1);
     let deformed = render(SIZE, SIZE, 8.0, translation(u, v), 0.01, 2);
     println!("| subset (px) | valid | RMS (px) | refused |");
-    // A 9 px subset holds a few speckles: IC-GN does not converge within the cap on a third
-    // of the nodes (`not_converged`, never wrong).
+    // A 9 px subset holds a few speckles: on 7 % of them IC-GN does not converge within the
+    // cap (`not_converged`, never wrong), and the weakly textured ones it does converge on
+    // raise the RMS.
     for (zoi, min_valid, max_rms) in [
-        (9, 0.6, 0.05),
+        (9, 0.85, 0.06),
         (13, 0.9, 0.03),
         (24, 0.95, 0.012),
         (33, 0.95, 0.008),
@@ -370,4 +423,146 @@ fn independent_images() {
             }
         }
     }
+}
+
+/// Convergence on images of varied speckle size, noise (0.5 to 3 %), bit depth (8, 10, 12, 16)
+/// and contrast (the independent generator, and the product's renderer at 1 to 3 % noise),
+/// under a sub-pixel translation and a 10 % stretch, at 13, 21 and 33 px: the share of
+/// measurable nodes `ok`, how many IC-GN leaves `not_converged`, its median iterations and its
+/// RMS, beside `correli` at 32 px. No case has a wrong node; IC-GN converges on at least 95 %
+/// of the measurable nodes from 21 px and 70 % at 13 px, except on the low-contrast image
+/// (contrast 20 % of full scale, 3 % noise, 8 bit: 95 % at 33 px, 60 % at 21 px, printed only
+/// at 13 px, where one subset holds too little signal for its six parameters).
+#[test]
+fn convergence_on_varied_images() {
+    use common::independent::{affine_inverse, render as render_independent, IndependentSpeckle};
+    let c = centre();
+    let base = IndependentSpeckle::default();
+    let patterns = [
+        ("5 px dots, 8 bit, 1 %", base),
+        (
+            "3 px dots, 12 bit, 0.5 %",
+            IndependentSpeckle {
+                dot_diameter_px: 3.0,
+                bit_depth: 12,
+                read_noise: 0.005,
+                seed: 11,
+                ..base
+            },
+        ),
+        (
+            "9 px dots, 16 bit, shot noise",
+            IndependentSpeckle {
+                dot_diameter_px: 9.0,
+                bit_depth: 16,
+                read_noise: 0.002,
+                shot_noise: 1e-4,
+                blur_sigma_px: 1.2,
+                seed: 12,
+                ..base
+            },
+        ),
+        (
+            "5 px dots, 8 bit, low contrast, 3 %",
+            IndependentSpeckle {
+                background: 0.55,
+                dot: 0.35,
+                read_noise: 0.03,
+                seed: 13,
+                ..base
+            },
+        ),
+        (
+            "bright 6 px dots on dark, 10 bit, 2 %",
+            IndependentSpeckle {
+                dot_diameter_px: 6.0,
+                background: 0.1,
+                dot: 0.9,
+                bit_depth: 10,
+                coverage: 0.35,
+                read_noise: 0.02,
+                seed: 14,
+                ..base
+            },
+        ),
+    ];
+    let motions = [
+        ("translation", [[1.0, 0.0], [0.0, 1.0]], [0.43, -0.27]),
+        ("10 % stretch", [[1.1, 0.0], [0.0, 1.0]], [0.0, 0.0]),
+    ];
+    let mut images: Vec<(String, Vec<u16>, Vec<u16>, [[f64; 2]; 2], [f64; 2])> = Vec::new();
+    for (name, pattern) in patterns {
+        let reference = render_independent(&pattern, SIZE, SIZE, &|x| x, 1);
+        for (motion, f, t) in motions {
+            let map = affine_inverse(f, t, c);
+            let deformed = render_independent(&pattern, SIZE, SIZE, &map, 2);
+            images.push((
+                format!("{name}, {motion}"),
+                reference.clone(),
+                deformed,
+                f,
+                t,
+            ));
+        }
+    }
+    for noise in [0.01, 0.02, 0.03] {
+        let reference = render(SIZE, SIZE, 40.0, translation(0.0, 0.0), noise, 1);
+        for (motion, f, t) in motions {
+            let motion_px = producer::Motion::Affine(producer::motion::Affine {
+                f,
+                translation_px: t,
+                centre_px: c,
+            });
+            let deformed = render(SIZE, SIZE, 40.0, motion_px, noise, 2);
+            let name = format!("renderer, {:.0} % noise, {motion}", 100.0 * noise);
+            images.push((name, reference.clone(), deformed, f, t));
+        }
+    }
+    println!("| image, motion | method @ subset | valid | not_converged | median iterations | RMS (px) |");
+    let mut failures = Vec::new();
+    for (name, reference, deformed, f, t) in &images {
+        for (method, zoi) in [
+            (Method::Correli, 32),
+            (Method::Icgn1, 13),
+            (Method::Icgn1, 21),
+            (Method::Icgn1, 33),
+        ] {
+            let mut correlator = Correlator::new(settings(method, zoi, 12), SIZE, SIZE).unwrap();
+            correlator.set_reference(reference).unwrap();
+            let field = correlator.correlate(deformed).unwrap();
+            let o = accuracy(field, zoi, (SIZE, SIZE), |p| {
+                let d = [p[0] - c[0], p[1] - c[1]];
+                [
+                    c[0] + f[0][0] * d[0] + f[0][1] * d[1] + t[0],
+                    c[1] + f[1][0] * d[0] + f[1][1] * d[1] + t[1],
+                ]
+            });
+            let not_converged = field.count(NodeStatus::NotConverged);
+            let mut iterations: Vec<u32> = field
+                .nodes
+                .iter()
+                .filter(|n| n.status == NodeStatus::Ok)
+                .map(|n| n.iterations)
+                .collect();
+            iterations.sort_unstable();
+            let median = iterations.get(iterations.len() / 2).copied().unwrap_or(0);
+            println!(
+                "| {name} | {} @ {zoi} | {:.1} % | {not_converged} | {median} | {:.4} |",
+                method.name(),
+                100.0 * o.valid_fraction(),
+                o.rms_px
+            );
+            let min_valid = match (name.contains("low contrast"), zoi) {
+                (true, 33) => 0.95,
+                (true, 21) => 0.6,
+                (true, _) => 0.0,
+                (false, 13) => 0.7,
+                (false, _) => 0.95,
+            };
+            if method.is_icgn() && (o.false_ok > 0 || o.valid_fraction() < min_valid) {
+                failures.push(format!("{name} @ {zoi}: {o:?}, {}", field.refusals()));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
 }

@@ -159,3 +159,47 @@ pub fn accuracy(
         false_ok,
     }
 }
+
+/// The Cramér-Rao bound of the displacement of one subset under a translation, with white
+/// noise of standard deviation `sigma_counts` in both images: var(u) >= 2 σ² / Σ (∂f/∂x)² and
+/// var(v) >= 2 σ² / Σ (∂f/∂y)² over the subset of side `zoi_px` centred on each node (∂f of
+/// the noise-free reference `clean`, fourth-order central differences). Returns the bound of
+/// the standard deviation of u and of v, each the root of the mean bound variance over the
+/// nodes whose subset lies 2 px inside the image.
+pub fn cramer_rao_std_px(
+    clean: &[u16],
+    width: usize,
+    height: usize,
+    field: &correlator::Field,
+    zoi_px: usize,
+    sigma_counts: f64,
+) -> (f64, f64) {
+    let at = |x: usize, y: usize| clean[y * width + x] as f64;
+    let derivative = |a: [f64; 4]| (a[0] - 8.0 * a[1] + 8.0 * a[2] - a[3]) / 12.0;
+    let half = (zoi_px as f64 - 1.0) / 2.0;
+    let (mut var_u, mut var_v, mut count) = (0.0, 0.0, 0usize);
+    for node in &field.nodes {
+        let (x0, y0) = (node.x_px - half, node.y_px - half);
+        if x0 < 2.0 || y0 < 2.0 || x0 + zoi_px as f64 + 2.0 > width as f64 {
+            continue;
+        }
+        if y0 + zoi_px as f64 + 2.0 > height as f64 {
+            continue;
+        }
+        let (x0, y0) = (x0 as usize, y0 as usize);
+        let (mut sxx, mut syy) = (0.0, 0.0);
+        for y in y0..y0 + zoi_px {
+            for x in x0..x0 + zoi_px {
+                let fx = derivative([at(x - 2, y), at(x - 1, y), at(x + 1, y), at(x + 2, y)]);
+                let fy = derivative([at(x, y - 2), at(x, y - 1), at(x, y + 1), at(x, y + 2)]);
+                sxx += fx * fx;
+                syy += fy * fy;
+            }
+        }
+        var_u += 2.0 * sigma_counts * sigma_counts / sxx;
+        var_v += 2.0 * sigma_counts * sigma_counts / syy;
+        count += 1;
+    }
+    let n = count.max(1) as f64;
+    ((var_u / n).sqrt(), (var_v / n).sqrt())
+}
