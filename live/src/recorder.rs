@@ -235,7 +235,8 @@ pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correla
         Some(wire::NodeStatus::NoGuess) => S::NoGuess,
         Some(wire::NodeStatus::OutsideImage) | None => S::OutsideImage,
     };
-    let nodes: Vec<correlator::Node> = nodes
+    let wire_nodes = nodes;
+    let nodes: Vec<correlator::Node> = wire_nodes
         .iter()
         .map(|n| correlator::Node {
             x_px: f64::from(n.x_px),
@@ -250,6 +251,15 @@ pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correla
             status: status(n.status),
         })
         .collect();
+    let gradients = wire_nodes
+        .iter()
+        .map(|n| {
+            [
+                [f64::from(n.du_dx), f64::from(n.du_dy)],
+                [f64::from(n.dv_dx), f64::from(n.dv_dy)],
+            ]
+        })
+        .collect();
     let (nx, ny) = (header.mesh_cols as usize, header.mesh_rows as usize);
     let (nx, ny) = if nx * ny == nodes.len() {
         (nx, ny)
@@ -261,6 +271,7 @@ pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correla
         ny,
         valid: nodes.iter().filter(|n| n.status == S::Ok).count(),
         nodes,
+        gradients,
         u_mean_px: header.u_mean_px,
         v_mean_px: header.v_mean_px,
         ..correlator::Field::default()
