@@ -206,7 +206,7 @@ fn published_gradient_of_a_stretch_matches_the_truth() {
             "correli",
             "32",
             wire::GradientSource::NeighbourFit,
-            2e-3,
+            5e-4,
             8e-3,
         ),
     ];

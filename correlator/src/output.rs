@@ -232,9 +232,8 @@ mod tests {
         let mut text = String::new();
         field_csv(&f, &mut text);
         assert_eq!(text.lines().count(), 13);
-        assert!(text.starts_with(
-            "x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy\n"
-        ));
+        assert!(text
+            .starts_with("x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy\n"));
         let last = text.lines().last().unwrap();
         assert!(last.ends_with("low_contrast,0.1100000,0.0020000,-0.0030000,0.2500000"));
         let columns = CSV_HEADER.split(',').count();
@@ -243,9 +242,15 @@ mod tests {
         assert!(text.contains("DIMENSIONS 4 3 1"));
         assert!(text.contains("testtitle"));
         assert_eq!(text.matches("LOOKUP_TABLE").count(), 6);
-        let tensors = text.split("TENSORS displacement_gradient double\n").nth(1).unwrap();
+        let tensors = text
+            .split("TENSORS displacement_gradient double\n")
+            .nth(1)
+            .unwrap();
         assert_eq!(tensors.lines().count(), 12);
-        assert_eq!(tensors.lines().nth(1).unwrap(), "0.01 0.002 0 -0.003 0.25 0 0 0 0");
+        assert_eq!(
+            tensors.lines().nth(1).unwrap(),
+            "0.01 0.002 0 -0.003 0.25 0 0 0 0"
+        );
     }
 
     #[test]
@@ -254,7 +259,11 @@ mod tests {
         f.gradients.clear();
         let mut text = String::new();
         field_csv(&f, &mut text);
-        assert!(text.lines().nth(1).unwrap().ends_with(",ok,0.0000000,0.0000000,0.0000000,0.0000000"));
+        assert!(text
+            .lines()
+            .nth(1)
+            .unwrap()
+            .ends_with(",ok,0.0000000,0.0000000,0.0000000,0.0000000"));
     }
 
     #[test]

@@ -33,9 +33,7 @@ pub mod stats;
 pub mod text;
 
 pub use clock::monotonic_ns;
-pub use field::{
-    FieldHeader, FieldNode, GaugeStrain, GradientSource, NodeStatus, StrainMeasure,
-};
+pub use field::{FieldHeader, FieldNode, GaugeStrain, GradientSource, NodeStatus, StrainMeasure};
 pub use frame::{FrameHeader, GroundTruth};
 pub use identification::IdentificationReport;
 #[cfg(feature = "ipc")]
