@@ -277,3 +277,49 @@ pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correla
         ..correlator::Field::default()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The wire's node gradient reaches the field files' gradient columns.
+    #[test]
+    fn wire_gradient_reaches_the_field_csv() {
+        let header = FieldHeader {
+            mesh_cols: 2,
+            mesh_rows: 1,
+            ..FieldHeader::default()
+        };
+        let nodes = [
+            FieldNode {
+                x_px: 10.0,
+                du_dx: 0.125,
+                du_dy: -0.25,
+                dv_dx: 0.5,
+                dv_dy: 0.0625,
+                status: wire::NodeStatus::Ok as u32,
+                ..FieldNode::default()
+            },
+            FieldNode {
+                x_px: 20.0,
+                status: wire::NodeStatus::LowZncc as u32,
+                ..FieldNode::default()
+            },
+        ];
+        let field = to_correlator_field(&header, &nodes);
+        assert_eq!(
+            field.gradients,
+            vec![[[0.125, -0.25], [0.5, 0.0625]], [[0.0; 2]; 2]]
+        );
+        let mut text = String::new();
+        correlator::output::field_csv(&field, &mut text);
+        let rows: Vec<&str> = text.lines().collect();
+        assert!(rows[0].ends_with(",du_dx,du_dy,dv_dx,dv_dy"), "{}", rows[0]);
+        assert!(
+            rows[1].ends_with(",ok,0.1250000,-0.2500000,0.5000000,0.0625000"),
+            "{}",
+            rows[1]
+        );
+        assert!(rows[2].ends_with(",low_zncc,0.0000000,0.0000000,0.0000000,0.0000000"));
+    }
+}
