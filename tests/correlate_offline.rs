@@ -96,16 +96,19 @@ fn fields_and_summary_follow_the_contract() {
         let mut lines = csv.lines();
         assert_eq!(
             lines.next(),
-            Some("x,y,u,v,exx,eyy,exy,score,iterations,status")
+            Some("x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy")
         );
         let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
         assert!(!rows.is_empty());
         let (mut su, mut sv) = (0.0, 0.0);
         for row in &rows {
-            assert_eq!(row.len(), 10, "{row:?}");
+            assert_eq!(row.len(), 14, "{row:?}");
             let numbers: Vec<f64> = row[..9].iter().map(|v| v.parse().unwrap()).collect();
             assert!(numbers.iter().all(|v| v.is_finite()));
             assert_eq!(row[9], "ok", "{row:?}");
+            // A translation: the neighbours' least-squares gradient (correli) is about zero.
+            let gradient: Vec<f64> = row[10..].iter().map(|v| v.parse().unwrap()).collect();
+            assert!(gradient.iter().all(|g| g.abs() < 0.01), "{row:?}");
             su += numbers[2];
             sv += numbers[3];
         }

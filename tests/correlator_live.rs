@@ -194,6 +194,101 @@ fn stretch_against_a_reference_file() {
     bench.finish();
 }
 
+/// The published node gradients (layout 4) of a homogeneous stretch with a little shear
+/// against the exact F − I, with IC-GN (its own gradient) and CORRELI (the neighbours'
+/// least-squares fit), and the header's `gradient_source` naming which.
+#[test]
+fn published_gradient_of_a_stretch_matches_the_truth() {
+    let centre = [(W as f64 - 1.0) / 2.0, (H as f64 - 1.0) / 2.0];
+    let cases = [
+        ("icgn1", "33", wire::GradientSource::Icgn1, 5e-4, 5e-3),
+        (
+            "correli",
+            "32",
+            wire::GradientSource::NeighbourFit,
+            5e-4,
+            8e-3,
+        ),
+    ];
+    eprintln!("method  frame  F-I truth (xx xy yx yy)           mean error (xx xy yx yy)            max |error|  valid");
+    for (method, zoi, source, mean_margin, node_margin) in cases {
+        let mut bench = Bench::new(&format!("gradient_{method}"), W * H);
+        let p = bench.spawn_correlator(&[
+            "--method",
+            method,
+            "--zoi",
+            zoi,
+            "--step",
+            "16",
+            "--threads",
+            "2",
+        ]);
+        bench.proc(p).wait_line("correlator: ready");
+        let stretches = [
+            (0.0, 0.0, 0.0),
+            (0.03, -0.01, 0.01),
+            (0.06, -0.02, 0.02),
+            (0.10, -0.03, 0.03),
+        ];
+        for (id, &(ex, ey, shear)) in stretches.iter().enumerate() {
+            let f = [[1.0 + ex, shear], [0.0, 1.0 + ey]];
+            let (motion, truth) = affine(f, [0.3, -0.2], centre);
+            let pixels = render(W, H, &motion, 700 + id as u64);
+            let header = Bench::header(id as u64, W, H, &pixels, Some(truth));
+            bench.send_frame(header, &pixels);
+            let field = bench.next_field();
+            assert_copied_through(&field, &header);
+            let h = field.header;
+            assert_eq!(h.origin_frame_id, 0);
+            assert_eq!(h.gradient_source, source as u32, "{method}");
+            let exact = [f[0][0] - 1.0, f[0][1], f[1][0], f[1][1] - 1.0];
+            let ok: Vec<_> = field
+                .nodes
+                .iter()
+                .filter(|n| n.status == NodeStatus::Ok as u32)
+                .collect();
+            assert!(
+                ok.len() * 4 >= field.nodes.len() * 3,
+                "{method} frame {id}: {} ok",
+                ok.len()
+            );
+            let (mut mean, mut worst) = ([0.0f64; 4], 0.0f64);
+            for n in &ok {
+                let g = [n.du_dx, n.du_dy, n.dv_dx, n.dv_dy];
+                for c in 0..4 {
+                    let e = f64::from(g[c]) - exact[c];
+                    mean[c] += e / ok.len() as f64;
+                    worst = worst.max(e.abs());
+                }
+            }
+            // Most nodes are ok (at 10 % the border ones left the image); refused nodes carry no
+            // gradient.
+            for n in field
+                .nodes
+                .iter()
+                .filter(|n| n.status != NodeStatus::Ok as u32)
+            {
+                assert_eq!([n.du_dx, n.du_dy, n.dv_dx, n.dv_dy], [0.0; 4]);
+            }
+            eprintln!(
+                "{method:7} {id:5}  {:+.3} {:+.3} {:+.3} {:+.3}   {:+.1e} {:+.1e} {:+.1e} {:+.1e}   {worst:.1e}      {}/{}",
+                exact[0], exact[1], exact[2], exact[3], mean[0], mean[1], mean[2], mean[3],
+                ok.len(),
+                field.nodes.len()
+            );
+            assert!(
+                mean.iter().all(|m| m.abs() <= mean_margin),
+                "{method} frame {id}: mean error {mean:?}"
+            );
+            assert!(
+                worst <= node_margin,
+                "{method} frame {id}: node error {worst}"
+            );
+        }
+        bench.finish();
+    }
+}
+
 /// Frames much faster than the correlator: it always works on the newest, the camera's queue
 /// overflows instead of growing (frames lost), superseded frames are skipped, and every field
 /// says how many frames were dropped so far; the totals agree with the final line.

@@ -5,15 +5,21 @@
 use crate::field::{Field, Node, NodeStatus};
 use std::fmt::Write as _;
 
-/// The CSV contract: header `x,y,u,v,exx,eyy,exy,score,iterations,status`, one row per node
-/// (row-major), x/y the ZOI centre in the reference image (px), u/v in px, status a word.
+/// The CSV contract: header `x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy`,
+/// one row per node (row-major), x/y the ZOI centre in the reference image (px), u/v in px,
+/// status a word, then the node's displacement gradient (dimensionless, `Field::gradients`:
+/// IC-GN's own with `icgn1`/`icgn2`, the least-squares fit of the neighbouring nodes with
+/// `correli`; 0 where the node is not `ok`). The gradient columns come last so that readers of
+/// the first ten columns are unaffected.
 pub fn field_csv(field: &Field, text: &mut String) {
     text.clear();
-    text.push_str("x,y,u,v,exx,eyy,exy,score,iterations,status\n");
-    for n in &field.nodes {
+    text.push_str(CSV_HEADER);
+    text.push('\n');
+    for (k, n) in field.nodes.iter().enumerate() {
+        let g = node_gradient(field, k);
         let _ = writeln!(
             text,
-            "{},{},{:.6},{:.6},{:.7},{:.7},{:.7},{:.5},{},{}",
+            "{},{},{:.6},{:.6},{:.7},{:.7},{:.7},{:.5},{},{},{:.7},{:.7},{:.7},{:.7}",
             n.x_px,
             n.y_px,
             n.u_px,
@@ -23,9 +29,21 @@ pub fn field_csv(field: &Field, text: &mut String) {
             n.exy,
             n.score,
             n.iterations,
-            n.status.word()
+            n.status.word(),
+            g[0][0],
+            g[0][1],
+            g[1][0],
+            g[1][1]
         );
     }
+}
+
+/// The first line of [`field_csv`].
+pub const CSV_HEADER: &str = "x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy";
+
+/// Node `k`'s gradient [[∂u/∂x, ∂u/∂y], [∂v/∂x, ∂v/∂y]], zero when the field carries none.
+fn node_gradient(field: &Field, k: usize) -> [[f64; 2]; 2] {
+    field.gradients.get(k).copied().unwrap_or([[0.0; 2]; 2])
 }
 
 /// Legacy VTK structured grid at the reference node positions (z = 0), titled `title`.
@@ -59,6 +77,16 @@ pub fn field_vtk(field: &Field, title: &str, text: &mut String) {
         for n in &field.nodes {
             let _ = writeln!(text, "{}", get(n));
         }
+    }
+    // ParaView reads a 3x3 row-major tensor: [[du/dx, du/dy, 0], [dv/dx, dv/dy, 0], [0, 0, 0]].
+    let _ = writeln!(text, "TENSORS displacement_gradient double");
+    for k in 0..count {
+        let g = node_gradient(field, k);
+        let _ = writeln!(
+            text,
+            "{} {} 0 {} {} 0 0 0 0",
+            g[0][0], g[0][1], g[1][0], g[1][1]
+        );
     }
 }
 
@@ -186,10 +214,14 @@ mod tests {
                 });
             }
         }
+        let gradients = (0..12)
+            .map(|k| [[0.01 * k as f64, 0.002], [-0.003, 0.25]])
+            .collect();
         Field {
             nx: 4,
             ny: 3,
             nodes,
+            gradients,
             ..Field::default()
         }
     }
@@ -200,12 +232,38 @@ mod tests {
         let mut text = String::new();
         field_csv(&f, &mut text);
         assert_eq!(text.lines().count(), 13);
-        assert!(text.starts_with("x,y,u,v,exx,eyy,exy,score,iterations,status\n"));
-        assert!(text.lines().last().unwrap().ends_with("low_contrast"));
+        assert!(text
+            .starts_with("x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy\n"));
+        let last = text.lines().last().unwrap();
+        assert!(last.ends_with("low_contrast,0.1100000,0.0020000,-0.0030000,0.2500000"));
+        let columns = CSV_HEADER.split(',').count();
+        assert!(text.lines().all(|l| l.split(',').count() == columns));
         field_vtk(&f, "test\ntitle", &mut text);
         assert!(text.contains("DIMENSIONS 4 3 1"));
         assert!(text.contains("testtitle"));
         assert_eq!(text.matches("LOOKUP_TABLE").count(), 6);
+        let tensors = text
+            .split("TENSORS displacement_gradient double\n")
+            .nth(1)
+            .unwrap();
+        assert_eq!(tensors.lines().count(), 12);
+        assert_eq!(
+            tensors.lines().nth(1).unwrap(),
+            "0.01 0.002 0 -0.003 0.25 0 0 0 0"
+        );
+    }
+
+    #[test]
+    fn csv_without_gradients_writes_zeros() {
+        let mut f = field();
+        f.gradients.clear();
+        let mut text = String::new();
+        field_csv(&f, &mut text);
+        assert!(text
+            .lines()
+            .nth(1)
+            .unwrap()
+            .ends_with(",ok,0.0000000,0.0000000,0.0000000,0.0000000"));
     }
 
     #[test]

@@ -18,7 +18,7 @@
 //!   vectors of triggered file descriptors per WaitSet wake-up and a reference-counted state
 //!   per loaned sample; see `tests/process_allocations.rs`.
 
-use crate::settings::{CorrelatorSettings, StrainMeasure};
+use crate::settings::{CorrelatorSettings, Method, StrainMeasure};
 use crate::state::{ReferenceIds, SavedReference, StateDir, REFERENCE_FROM_FILE};
 use crate::{Correlator, Field, NodeStatus};
 use iceoryx2::prelude::*;
@@ -606,6 +606,16 @@ fn wire_status(status: NodeStatus) -> wire::NodeStatus {
     }
 }
 
+/// IC-GN's own gradient with `icgn1`/`icgn2`, the neighbours' least-squares fit with `correli`
+/// (`Field::gradients`).
+fn wire_gradient_source(method: Method) -> wire::GradientSource {
+    match method {
+        Method::Correli => wire::GradientSource::NeighbourFit,
+        Method::Icgn1 => wire::GradientSource::Icgn1,
+        Method::Icgn2 => wire::GradientSource::Icgn2,
+    }
+}
+
 fn wire_measure(measure: StrainMeasure) -> wire::StrainMeasure {
     match measure {
         StrainMeasure::Small => wire::StrainMeasure::Small,
@@ -625,7 +635,8 @@ fn fill_field(
     settings: &CorrelatorSettings,
 ) {
     assert_eq!(nodes.len(), field.nodes.len());
-    for (o, n) in nodes.iter_mut().zip(&field.nodes) {
+    assert_eq!(field.gradients.len(), field.nodes.len());
+    for ((o, n), g) in nodes.iter_mut().zip(&field.nodes).zip(&field.gradients) {
         *o = FieldNode {
             x_px: n.x_px as f32,
             y_px: n.y_px as f32,
@@ -637,6 +648,10 @@ fn fill_field(
             score: n.score as f32,
             iterations: n.iterations,
             status: wire_status(n.status) as u32,
+            du_dx: g[0][0] as f32,
+            du_dy: g[0][1] as f32,
+            dv_dx: g[1][0] as f32,
+            dv_dy: g[1][1] as f32,
         };
     }
     let gauge = |s: crate::Strain2| GaugeStrain {
@@ -674,7 +689,7 @@ fn fill_field(
             gauge(g.log),
         ],
         sequence_id: frame.sequence_id,
-        reserved: 0,
+        gradient_source: wire_gradient_source(settings.method) as u32,
     };
     out.t_published_ns = wire::monotonic_ns();
 }

@@ -2,14 +2,17 @@
 //! spray-paint discs, pixel-area integration in the deformed frame, optical blur, bit depth,
 //! read and shot noise) with dot sizes from 3 to 9 px, 8 to 16 bit, low and high contrast, and
 //! noise from 0.5 to 3 % of full scale, under a sub-pixel translation, a 30° rotation and a
-//! 30 % uniaxial stretch against a fixed reference, with the default settings. Every case:
-//! no `ok` node more than 0.5 px off, most of the measurable nodes `ok`, and a bounded RMS.
+//! 30 % uniaxial stretch against a fixed reference, with the default settings and with
+//! `--method icgn1` (32 px subsets both). Every case: no `ok` node more than 0.5 px off, most
+//! of the measurable nodes `ok`, and a bounded RMS (margins per method, from what was measured:
+//! `cargo test --release -p correlator --test independent_images -- --nocapture --test-threads 1`
+//! prints the table that is in the README).
 
 mod common;
 
 use common::accuracy;
 use common::independent::{affine_inverse, render, rotation, IndependentSpeckle};
-use correlator::{Correlator, CorrelatorSettings};
+use correlator::{Correlator, CorrelatorSettings, Method};
 
 const SIZE: usize = 512;
 
@@ -18,11 +21,61 @@ fn centre() -> [f64; 2] {
     [c, c]
 }
 
+/// What a case must reach with one method: RMS error (px) and fraction of measurable nodes ok.
+#[derive(Clone, Copy)]
+struct Margin {
+    rms_px: f64,
+    valid: f64,
+}
+
+/// One pattern, the margins of `correli` then `icgn1`.
+struct Case {
+    name: &'static str,
+    pattern: IndependentSpeckle,
+    margins: [Margin; 2],
+}
+
+const fn m(rms_px: f64, valid: f64) -> Margin {
+    Margin { rms_px, valid }
+}
+
+/// Correlates one pattern under motion x = c + F (X − c) + t with both methods, prints a
+/// table row per method and checks the outcome; `scale` multiplies the RMS margins.
+fn check_both(motion: &str, case: &Case, f: [[f64; 2]; 2], t: [f64; 2], scale: f64) {
+    for (method, margin) in [Method::Correli, Method::Icgn1]
+        .into_iter()
+        .zip(case.margins)
+    {
+        check(
+            &format!("{motion}, {}", case.name),
+            method,
+            case.pattern,
+            f,
+            t,
+            Margin {
+                rms_px: scale * margin.rms_px,
+                ..margin
+            },
+        );
+    }
+}
+
 /// Correlates one pattern under motion x = c + F (X − c) + t and checks the outcome.
-fn check(name: &str, pattern: IndependentSpeckle, f: [[f64; 2]; 2], t: [f64; 2], max_rms_px: f64) {
+fn check(
+    name: &str,
+    method: Method,
+    pattern: IndependentSpeckle,
+    f: [[f64; 2]; 2],
+    t: [f64; 2],
+    margin: Margin,
+) {
     let reference = render(&pattern, SIZE, SIZE, &|x| x, 1);
     let deformed = render(&pattern, SIZE, SIZE, &affine_inverse(f, t, centre()), 2);
-    let mut correlator = Correlator::new(CorrelatorSettings::default(), SIZE, SIZE).unwrap();
+    let settings = CorrelatorSettings {
+        method,
+        ..CorrelatorSettings::default()
+    };
+    let mut correlator = Correlator::new(settings, SIZE, SIZE).unwrap();
     correlator.set_reference(&reference).unwrap();
     let field = correlator.correlate(&deformed).unwrap();
     let c = centre();
@@ -34,30 +87,37 @@ fn check(name: &str, pattern: IndependentSpeckle, f: [[f64; 2]; 2], t: [f64; 2],
         ]
     };
     let o = accuracy(field, 32, (SIZE, SIZE), forward);
-    o.print(name);
+    let name = format!("{}: {name}", method.name());
+    o.print(&name);
     assert_eq!(o.false_ok, 0, "{name}: wrong nodes reported ok: {o:?}");
-    assert!(o.valid_fraction() >= 0.9, "{name}: {o:?}");
-    assert!(o.rms_px <= max_rms_px, "{name}: {o:?}");
+    assert!(o.valid_fraction() >= margin.valid, "{name}: {o:?}");
+    assert!(o.rms_px <= margin.rms_px, "{name}: {o:?}");
 }
 
-fn patterns() -> Vec<(&'static str, IndependentSpeckle, f64)> {
+fn cases() -> Vec<Case> {
     let base = IndependentSpeckle::default();
+    // Margins `[correli, icgn1]`: RMS about 1.5 to 2 times the measured one (README table);
+    // icgn1 leaves a quarter of the low-contrast 3 % noise nodes `not_converged`.
     vec![
-        ("5 px dots, 8 bit, 1 % noise", base, 0.03),
-        (
-            "3 px dots, 12 bit, 0.5 % noise",
-            IndependentSpeckle {
+        Case {
+            name: "5 px dots, 8 bit, 1 % noise",
+            pattern: base,
+            margins: [m(0.03, 0.9), m(0.015, 0.9)],
+        },
+        Case {
+            name: "3 px dots, 12 bit, 0.5 % noise",
+            pattern: IndependentSpeckle {
                 dot_diameter_px: 3.0,
                 bit_depth: 12,
                 read_noise: 0.005,
                 seed: 11,
                 ..base
             },
-            0.03,
-        ),
-        (
-            "9 px dots, 16 bit, shot noise",
-            IndependentSpeckle {
+            margins: [m(0.03, 0.9), m(0.012, 0.9)],
+        },
+        Case {
+            name: "9 px dots, 16 bit, shot noise",
+            pattern: IndependentSpeckle {
                 dot_diameter_px: 9.0,
                 bit_depth: 16,
                 read_noise: 0.002,
@@ -66,22 +126,22 @@ fn patterns() -> Vec<(&'static str, IndependentSpeckle, f64)> {
                 seed: 12,
                 ..base
             },
-            0.03,
-        ),
-        (
-            "5 px dots, 8 bit, low contrast, 3 % noise",
-            IndependentSpeckle {
+            margins: [m(0.03, 0.9), m(0.012, 0.9)],
+        },
+        Case {
+            name: "5 px dots, 8 bit, low contrast, 3 % noise",
+            pattern: IndependentSpeckle {
                 background: 0.55,
                 dot: 0.35,
                 read_noise: 0.03,
                 seed: 13,
                 ..base
             },
-            0.12,
-        ),
-        (
-            "bright 6 px dots on dark, 10 bit",
-            IndependentSpeckle {
+            margins: [m(0.12, 0.9), m(0.09, 0.7)],
+        },
+        Case {
+            name: "bright 6 px dots on dark, 10 bit",
+            pattern: IndependentSpeckle {
                 dot_diameter_px: 6.0,
                 background: 0.1,
                 dot: 0.9,
@@ -90,47 +150,35 @@ fn patterns() -> Vec<(&'static str, IndependentSpeckle, f64)> {
                 seed: 14,
                 ..base
             },
-            0.03,
-        ),
+            margins: [m(0.03, 0.9), m(0.012, 0.9)],
+        },
     ]
 }
 
 #[test]
 fn translation_on_independent_images() {
-    for (name, pattern, rms) in patterns() {
+    for case in cases() {
         let identity = [[1.0, 0.0], [0.0, 1.0]];
-        check(
-            &format!("translation (3.4, -1.7), {name}"),
-            pattern,
-            identity,
-            [3.4, -1.7],
-            rms,
-        );
+        check_both("translation (3.4, -1.7)", &case, identity, [3.4, -1.7], 1.0);
     }
 }
 
 #[test]
 fn rotation_on_independent_images() {
-    for (name, pattern, rms) in patterns() {
-        check(
-            &format!("rotation 30°, {name}"),
-            pattern,
-            rotation(30.0),
-            [2.0, 1.0],
-            rms,
-        );
+    for case in cases() {
+        check_both("rotation 30°", &case, rotation(30.0), [2.0, 1.0], 1.0);
     }
 }
 
 #[test]
 fn uniaxial_stretch_on_independent_images() {
-    for (name, pattern, rms) in patterns() {
-        check(
-            &format!("uniaxial 30 %, ν 0.3, {name}"),
-            pattern,
+    for case in cases() {
+        check_both(
+            "uniaxial 30 %, ν 0.3",
+            &case,
             [[1.3, 0.0], [0.0, 0.91]],
             [0.0, 0.0],
-            2.0 * rms,
+            2.0,
         );
     }
 }

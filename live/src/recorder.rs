@@ -235,7 +235,8 @@ pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correla
         Some(wire::NodeStatus::NoGuess) => S::NoGuess,
         Some(wire::NodeStatus::OutsideImage) | None => S::OutsideImage,
     };
-    let nodes: Vec<correlator::Node> = nodes
+    let wire_nodes = nodes;
+    let nodes: Vec<correlator::Node> = wire_nodes
         .iter()
         .map(|n| correlator::Node {
             x_px: f64::from(n.x_px),
@@ -250,6 +251,15 @@ pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correla
             status: status(n.status),
         })
         .collect();
+    let gradients = wire_nodes
+        .iter()
+        .map(|n| {
+            [
+                [f64::from(n.du_dx), f64::from(n.du_dy)],
+                [f64::from(n.dv_dx), f64::from(n.dv_dy)],
+            ]
+        })
+        .collect();
     let (nx, ny) = (header.mesh_cols as usize, header.mesh_rows as usize);
     let (nx, ny) = if nx * ny == nodes.len() {
         (nx, ny)
@@ -261,8 +271,55 @@ pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correla
         ny,
         valid: nodes.iter().filter(|n| n.status == S::Ok).count(),
         nodes,
+        gradients,
         u_mean_px: header.u_mean_px,
         v_mean_px: header.v_mean_px,
         ..correlator::Field::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The wire's node gradient reaches the field files' gradient columns.
+    #[test]
+    fn wire_gradient_reaches_the_field_csv() {
+        let header = FieldHeader {
+            mesh_cols: 2,
+            mesh_rows: 1,
+            ..FieldHeader::default()
+        };
+        let nodes = [
+            FieldNode {
+                x_px: 10.0,
+                du_dx: 0.125,
+                du_dy: -0.25,
+                dv_dx: 0.5,
+                dv_dy: 0.0625,
+                status: wire::NodeStatus::Ok as u32,
+                ..FieldNode::default()
+            },
+            FieldNode {
+                x_px: 20.0,
+                status: wire::NodeStatus::LowZncc as u32,
+                ..FieldNode::default()
+            },
+        ];
+        let field = to_correlator_field(&header, &nodes);
+        assert_eq!(
+            field.gradients,
+            vec![[[0.125, -0.25], [0.5, 0.0625]], [[0.0; 2]; 2]]
+        );
+        let mut text = String::new();
+        correlator::output::field_csv(&field, &mut text);
+        let rows: Vec<&str> = text.lines().collect();
+        assert!(rows[0].ends_with(",du_dx,du_dy,dv_dx,dv_dy"), "{}", rows[0]);
+        assert!(
+            rows[1].ends_with(",ok,0.1250000,-0.2500000,0.5000000,0.0625000"),
+            "{}",
+            rows[1]
+        );
+        assert!(rows[2].ends_with(",low_zncc,0.0000000,0.0000000,0.0000000,0.0000000"));
     }
 }

@@ -126,7 +126,10 @@ impl Tap {
                     checksum_ok: None,
                     invalid: header.layout_version != wire::LAYOUT_VERSION
                         || sample.payload().len() != header.node_count(),
-                    last: LastSample::Field { header },
+                    last: LastSample::Field {
+                        header,
+                        mean_gradient: sample::mean_gradient(sample.payload()),
+                    },
                 }
             }),
             Tap::Rig(s) => s.receive()?.map(|state| Observation {

@@ -84,13 +84,45 @@ impl NodeStatus {
     }
 }
 
+/// Where a field's node gradients come from, carried in [`FieldHeader::gradient_source`].
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GradientSource {
+    /// The least-squares fit of the node's neighbouring displacements (method `correli`).
+    NeighbourFit = 0,
+    /// The node's own first-order (affine) IC-GN shape function (method `icgn1`).
+    Icgn1 = 1,
+    /// The first-order part of the node's second-order IC-GN shape function (`icgn2`).
+    Icgn2 = 2,
+}
+
+impl GradientSource {
+    pub const ALL: [GradientSource; 3] = [
+        GradientSource::NeighbourFit,
+        GradientSource::Icgn1,
+        GradientSource::Icgn2,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            GradientSource::NeighbourFit => "neighbour_fit",
+            GradientSource::Icgn1 => "icgn1",
+            GradientSource::Icgn2 => "icgn2",
+        }
+    }
+
+    pub fn from_code(code: u32) -> Option<GradientSource> {
+        GradientSource::ALL.into_iter().find(|g| *g as u32 == code)
+    }
+}
+
 /// One ZOI of the mesh. Strains are of the measure named in the header.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FieldNode.v3")
+    type_name("dicstream.FieldNode.v4")
 )]
 pub struct FieldNode {
     /// ZOI centre in the reference image (px).
@@ -108,6 +140,14 @@ pub struct FieldNode {
     pub iterations: u32,
     /// A [`NodeStatus`] code.
     pub status: u32,
+    /// The node's total displacement gradient against the frame the mesh was defined in
+    /// (`origin_frame_id`), dimensionless: ∂u/∂x, ∂u/∂y, ∂v/∂x, ∂v/∂y, the one its strains
+    /// come from. Where it comes from is the header's `gradient_source`; zero where the node
+    /// is not `ok`.
+    pub du_dx: f32,
+    pub du_dy: f32,
+    pub dv_dx: f32,
+    pub dv_dy: f32,
 }
 
 /// In-plane strain components (dimensionless).
@@ -116,7 +156,7 @@ pub struct FieldNode {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.GaugeStrain.v3")
+    type_name("dicstream.GaugeStrain.v4")
 )]
 pub struct GaugeStrain {
     pub exx: f64,
@@ -130,7 +170,7 @@ pub struct GaugeStrain {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FieldHeader.v3")
+    type_name("dicstream.FieldHeader.v4")
 )]
 pub struct FieldHeader {
     pub layout_version: u32,
@@ -167,8 +207,9 @@ pub struct FieldHeader {
     pub gauge: [GaugeStrain; 4],
     /// The frame's `sequence_id`.
     pub sequence_id: u32,
-    /// Always 0.
-    pub reserved: u32,
+    /// A [`GradientSource`] code: where the nodes' `du_dx`.. `dv_dy` (and so their strains)
+    /// come from.
+    pub gradient_source: u32,
 }
 
 impl FieldHeader {
@@ -206,7 +247,7 @@ impl Default for FieldHeader {
             v_mean_px: 0.0,
             gauge: [GaugeStrain::default(); 4],
             sequence_id: 0,
-            reserved: 0,
+            gradient_source: GradientSource::NeighbourFit as u32,
         }
     }
 }
@@ -225,5 +266,10 @@ mod tests {
         assert_eq!(NodeStatus::from_code(4), Some(NodeStatus::LowZncc));
         assert_eq!(NodeStatus::from_code(7), None);
         assert_eq!(StrainMeasure::Log.name(), "log");
+        for g in GradientSource::ALL {
+            assert_eq!(GradientSource::from_code(g as u32), Some(g));
+        }
+        assert_eq!(GradientSource::from_code(3), None);
+        assert_eq!(GradientSource::NeighbourFit.name(), "neighbour_fit");
     }
 }

@@ -12,7 +12,7 @@ use crate::LAYOUT_VERSION;
 use std::mem::{offset_of, size_of};
 
 /// The version the figures below describe.
-const CHECKED_VERSION: u32 = 3;
+const CHECKED_VERSION: u32 = 4;
 
 const _: () = assert!(
     LAYOUT_VERSION == CHECKED_VERSION,
@@ -101,7 +101,7 @@ const _: () = {
 };
 const _: () = {
     assert!(
-        size_of::<FieldNode>() == 40,
+        size_of::<FieldNode>() == 56,
         "FieldNode changed size: bump LAYOUT_VERSION"
     );
     assert!(
@@ -143,6 +143,22 @@ const _: () = {
     assert!(
         offset_of!(FieldNode, status) == 36,
         "FieldNode::status moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(FieldNode, du_dx) == 40,
+        "FieldNode::du_dx moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(FieldNode, du_dy) == 44,
+        "FieldNode::du_dy moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(FieldNode, dv_dx) == 48,
+        "FieldNode::dv_dx moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(FieldNode, dv_dy) == 52,
+        "FieldNode::dv_dy moved: bump LAYOUT_VERSION"
     );
 };
 const _: () = {
@@ -257,8 +273,8 @@ const _: () = {
         "FieldHeader::sequence_id moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(FieldHeader, reserved) == 284,
-        "FieldHeader::reserved moved: bump LAYOUT_VERSION"
+        offset_of!(FieldHeader, gradient_source) == 284,
+        "FieldHeader::gradient_source moved: bump LAYOUT_VERSION"
     );
 };
 const _: () = {

@@ -15,7 +15,7 @@ pub const AXIS_NAMES: [&str; 3] = ["X", "Y", "Z"];
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.ActuatorState.v3")
+    type_name("dicstream.ActuatorState.v4")
 )]
 pub struct ActuatorState {
     pub position_mm: f64,
@@ -34,7 +34,7 @@ pub struct ActuatorState {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RigState.v3")
+    type_name("dicstream.RigState.v4")
 )]
 pub struct RigState {
     pub layout_version: u32,
@@ -114,7 +114,7 @@ impl RigCommandKind {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RigCommand.v3")
+    type_name("dicstream.RigCommand.v4")
 )]
 pub struct RigCommand {
     pub layout_version: u32,
@@ -148,7 +148,7 @@ impl RigCommand {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RigReply.v3")
+    type_name("dicstream.RigReply.v4")
 )]
 pub struct RigReply {
     pub layout_version: u32,

@@ -1,7 +1,10 @@
 //! The one-line and JSON summaries of the last sample `dicstream tap` saw.
 
 use serde_json::{json, Value};
-use wire::{FieldHeader, FrameHeader, IdentificationReport, RigState, StrainMeasure};
+use wire::{
+    FieldHeader, FieldNode, FrameHeader, GradientSource, IdentificationReport, NodeStatus,
+    RigState, StrainMeasure,
+};
 
 /// The last sample seen, kept to summarise it.
 #[derive(Debug, Clone)]
@@ -12,6 +15,8 @@ pub(super) enum LastSample {
     },
     Field {
         header: FieldHeader,
+        /// Mean displacement gradient of the `ok` nodes: du/dx, du/dy, dv/dx, dv/dy.
+        mean_gradient: [f64; 4],
     },
     Rig {
         state: RigState,
@@ -25,6 +30,24 @@ pub(super) enum LastSample {
 /// Mean of an actuator pair's forces (kN): the axis force, as the identifier reads it.
 pub(super) fn axis_force_kn(state: &RigState, axis: usize) -> f64 {
     0.5 * (state.actuators[2 * axis].force_kn + state.actuators[2 * axis + 1].force_kn)
+}
+
+/// Mean displacement gradient (du/dx, du/dy, dv/dx, dv/dy) of the `ok` nodes (zeros when none).
+pub(super) fn mean_gradient(nodes: &[FieldNode]) -> [f64; 4] {
+    let mut sum = [0.0; 4];
+    let mut count = 0usize;
+    for n in nodes.iter().filter(|n| n.status == NodeStatus::Ok as u32) {
+        for (s, g) in sum.iter_mut().zip([n.du_dx, n.du_dy, n.dv_dx, n.dv_dy]) {
+            *s += f64::from(g);
+        }
+        count += 1;
+    }
+    sum.map(|s| if count > 0 { s / count as f64 } else { 0.0 })
+}
+
+/// The header's gradient source as a word (`unknown` for a code this build does not know).
+fn gradient_source(header: &FieldHeader) -> &'static str {
+    GradientSource::from_code(header.gradient_source).map_or("unknown", GradientSource::name)
 }
 
 pub(super) fn rig_id(id: u64) -> Value {
@@ -67,11 +90,15 @@ impl LastSample {
                 }
                 line
             }
-            LastSample::Field { header } => {
+            LastSample::Field {
+                header,
+                mean_gradient: d,
+            } => {
                 let g = header.gauge_of(StrainMeasure::Log);
                 format!(
                     "field of frame {}: {}/{} valid nodes, u mean {:.4} px, v mean {:.4} px, \
-                     gauge log strain xx {:.3e} yy {:.3e} xy {:.3e}",
+                     gauge log strain xx {:.3e} yy {:.3e} xy {:.3e}, mean gradient ({}) \
+                     du/dx {:.3e} du/dy {:.3e} dv/dx {:.3e} dv/dy {:.3e}",
                     header.frame_id,
                     header.valid_nodes,
                     header.node_count(),
@@ -79,7 +106,12 @@ impl LastSample {
                     header.v_mean_px,
                     g.exx,
                     g.eyy,
-                    g.exy
+                    g.exy,
+                    gradient_source(header),
+                    d[0],
+                    d[1],
+                    d[2],
+                    d[3]
                 )
             }
             LastSample::Rig { state } => format!(
@@ -137,7 +169,10 @@ impl LastSample {
                 "translation_px": header.truth.translation_px,
                 "centre_px": header.truth.centre_px,
             }),
-            LastSample::Field { header } => {
+            LastSample::Field {
+                header,
+                mean_gradient: d,
+            } => {
                 let g = header.gauge_of(StrainMeasure::Log);
                 json!({
                     "frame_id": header.frame_id,
@@ -148,6 +183,8 @@ impl LastSample {
                     "v_mean_px": header.v_mean_px,
                     "gauge_log_strain": {"xx": g.exx, "yy": g.eyy, "xy": g.exy},
                     "correlator_frames_dropped": header.frames_dropped,
+                    "gradient_source": gradient_source(header),
+                    "mean_gradient": {"du_dx": d[0], "du_dy": d[1], "dv_dx": d[2], "dv_dy": d[3]},
                 })
             }
             LastSample::Rig { state } => json!({

@@ -365,13 +365,43 @@ mod tests {
             mesh_rows: 2,
             valid_nodes: 5,
             u_mean_px: 0.25,
+            gradient_source: wire::GradientSource::Icgn1 as u32,
             ..FieldHeader::default()
         };
-        let line = LastSample::Field { header }.line();
+        let ok = |du_dx: f32| wire::FieldNode {
+            du_dx,
+            dv_dy: -0.5,
+            status: wire::NodeStatus::Ok as u32,
+            ..wire::FieldNode::default()
+        };
+        let refused = wire::FieldNode {
+            du_dx: 9.0,
+            status: wire::NodeStatus::LowZncc as u32,
+            ..wire::FieldNode::default()
+        };
+        let mean_gradient = super::super::sample::mean_gradient(&[ok(0.1), ok(0.3), refused]);
+        let expected = [0.2, 0.0, 0.0, -0.5];
         assert!(
-            line.contains("5/6 valid nodes") && line.contains("u mean 0.2500"),
+            mean_gradient
+                .iter()
+                .zip(expected)
+                .all(|(m, e)| (m - e).abs() < 1e-6),
+            "{mean_gradient:?}"
+        );
+        let last = LastSample::Field {
+            header,
+            mean_gradient,
+        };
+        let line = last.line();
+        assert!(
+            line.contains("5/6 valid nodes")
+                && line.contains("u mean 0.2500")
+                && line.contains("mean gradient (icgn1) du/dx 2.000e-1"),
             "{line}"
         );
+        let json = last.json();
+        assert_eq!(json["gradient_source"], "icgn1");
+        assert_eq!(json["mean_gradient"]["dv_dy"], -0.5);
     }
 
     #[test]
