@@ -169,13 +169,10 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         duration_s: args.duration_s,
         exit_when_done: args.exit_when_done,
         state_dir: args.state_dir.clone(),
-        strain: match strain {
-            Some(test) => Some(rig::process::StrainOptions {
-                test,
-                specimen: strain_specimen,
-            }),
-            None => None,
-        },
+        strain: strain.map(|test| rig::process::StrainOptions {
+            test,
+            specimen: strain_specimen,
+        }),
     };
     // The process's messages name their causes; `in_context` keeps the exit code its error
     // asks for (a results file, a journal it cannot follow).
