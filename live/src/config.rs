@@ -927,7 +927,12 @@ impl RunConfig {
             t,
             "# The campaign, in order: each test mounts its specimen (uniaxial: a 100 x 20 x 2 mm\n\
              # strip; equibiaxial: a 100 x 100 x 2 mm cruciform centre), ramps the elongation to\n\
-             # `stretch` at `rate_per_s` in centroid control, holds, unloads."
+             # `stretch` at `rate_per_s` in centroid control, holds, unloads. A test alone may\n\
+             # instead be strain-controlled (the correlator's fields close the loop):\n\
+             # control = \"strain\", kind = uniaxial | equibiaxial | pure_shear | biaxial,\n\
+             # ratio = ln(ly)/ln(lx) (biaxial), stretch = the larger measured stretch,\n\
+             # rate_per_s = log strain rate; stale_s = 0.5, min_valid_nodes = 16,\n\
+             # on_interlock = \"resume\" | \"stop\"."
         );
         for test in &g.tests {
             let _ = writeln!(
