@@ -1019,6 +1019,21 @@ mod tests {
     }
 
     #[test]
+    fn the_example_configs_are_valid_strain_controlled_runs() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/configs");
+        for (name, ratio) in [
+            ("strain_equibiaxial.toml", 1.0),
+            ("strain_biaxial_rho05.toml", 0.5),
+        ] {
+            let text = std::fs::read_to_string(dir.join(name)).unwrap();
+            let config = RunConfig::from_toml(&text, name).unwrap();
+            config.validate().unwrap();
+            let test = config.strain_test().unwrap().expect(name);
+            assert_eq!((test.ratio, test.stretch), (ratio, 1.8), "{name}");
+        }
+    }
+
+    #[test]
     fn strain_controlled_tests_are_checked_and_the_default_is_unchanged() {
         // Displacement control stays the default, and its config file does not change.
         let d = RunConfig::default();
