@@ -75,7 +75,7 @@ pub fn write_csv_row_with(s: &RigSnapshot, control: &ControlColumns, out: &mut S
         k.centre_x_mm,
         k.centre_y_mm,
         u8::from(k.broken),
-        control.mode
+        control.mode.name()
     );
     match control.target_log {
         Some([x, y]) => {

@@ -399,8 +399,13 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
                 session.rig.state().t_s
             )
         }
+        let control = session.control_columns();
+        let target = control.target_log.unwrap_or([f64::NAN; 2]);
         let published = RigState {
             test_index: session.test_index,
+            control_mode: control.mode as u32,
+            target_log_exx: target[0],
+            target_log_eyy: target[1],
             ..to_wire(&session.rig, summary.samples_published)
         };
         publisher.publish(published)?;
@@ -722,6 +727,9 @@ pub fn to_wire(rig: &Rig, sample_id: u64) -> RigState {
         specimen_rotation_rad: s.specimen.rotation_deg.to_radians(),
         specimen_centre_offset_mm: [s.specimen.centre_x_mm, s.specimen.centre_y_mm],
         load_case: codes::load_case(rig.specimen().map(|sp| sp.config().loading)),
+        // Displacement control, no strain target, unless the session says otherwise.
+        target_log_exx: f64::NAN,
+        target_log_eyy: f64::NAN,
         ..RigState::default()
     };
     if let Some(specimen) = rig.specimen() {

@@ -112,16 +112,21 @@ impl Session {
             self.rig.step();
             if let Some(rows) = rows.as_deref_mut() {
                 if self.rig.state().step.is_multiple_of(self.log_every) {
-                    let control = self
-                        .strain
-                        .as_ref()
-                        .map_or(ControlColumns::DISPLACEMENT, StrainRun::columns);
+                    let control = self.control_columns();
                     crate::log::write_csv_row_with(self.rig.state(), &control, rows);
                 }
             }
         }
         self.periods += 1;
         Ok(event)
+    }
+
+    /// What closes the loop now and the strain target (`rig.csv`'s control columns and the
+    /// published `RigState::control_mode` / targets).
+    pub fn control_columns(&self) -> ControlColumns {
+        self.strain
+            .as_ref()
+            .map_or(ControlColumns::DISPLACEMENT, StrainRun::columns)
     }
 
     /// A program or a test is under way (running or held).

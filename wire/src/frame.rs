@@ -13,7 +13,7 @@ use iceoryx2::prelude::ZeroCopySend;
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.GroundTruth.v3")
+    type_name("dicstream.GroundTruth.v4")
 )]
 pub struct GroundTruth {
     /// Deformation gradient, row-major: `[F11, F12, F21, F22]` (dimensionless).
@@ -49,7 +49,7 @@ impl GroundTruth {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FrameHeader.v3")
+    type_name("dicstream.FrameHeader.v4")
 )]
 pub struct FrameHeader {
     /// Always [`crate::LAYOUT_VERSION`]; checked by every reader.

@@ -12,7 +12,7 @@ use crate::LAYOUT_VERSION;
 use std::mem::{offset_of, size_of};
 
 /// The version the figures below describe.
-const CHECKED_VERSION: u32 = 3;
+const CHECKED_VERSION: u32 = 4;
 
 const _: () = assert!(
     LAYOUT_VERSION == CHECKED_VERSION,
@@ -293,7 +293,7 @@ const _: () = {
 };
 const _: () = {
     assert!(
-        size_of::<RigState>() == 392,
+        size_of::<RigState>() == 408,
         "RigState changed size: bump LAYOUT_VERSION"
     );
     assert!(
@@ -365,8 +365,16 @@ const _: () = {
         "RigState::test_index moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(RigState, reserved) == 388,
-        "RigState::reserved moved: bump LAYOUT_VERSION"
+        offset_of!(RigState, control_mode) == 388,
+        "RigState::control_mode moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(RigState, target_log_exx) == 392,
+        "RigState::target_log_exx moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(RigState, target_log_eyy) == 400,
+        "RigState::target_log_eyy moved: bump LAYOUT_VERSION"
     );
 };
 const _: () = {

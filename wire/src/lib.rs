@@ -38,12 +38,12 @@ pub use frame::{FrameHeader, GroundTruth};
 pub use identification::IdentificationReport;
 #[cfg(feature = "ipc")]
 pub use instance::{Instance, InstanceError};
-pub use rig::{ActuatorState, RigCommand, RigCommandKind, RigReply, RigState};
+pub use rig::{ActuatorState, RigCommand, RigCommandKind, RigControl, RigReply, RigState};
 
 /// Version of every layout in this crate. Bump it (and the `#[type_name]` suffixes, which
 /// embed it) whenever a field changes: processes of different versions then refuse to connect
 /// instead of misreading each other.
-pub const LAYOUT_VERSION: u32 = 3;
+pub const LAYOUT_VERSION: u32 = 4;
 
 /// Marks an absent rig sample id (a frame not taken under a rig, e.g. a replayed image).
 pub const NO_RIG_SAMPLE: u64 = u64::MAX;

@@ -20,6 +20,7 @@ use crate::strain::control::{StrainControl, StrainEvent, StrainMode, StrainStart
 use crate::strain::interlock::HoldReason;
 use crate::strain::outer::{GaugeMeasurement, OuterLoopConfig};
 use crate::strain::test::StrainTest;
+use wire::RigControl;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Phase {
@@ -62,15 +63,16 @@ pub enum StrainRunError {
 /// The `rig.csv` control column and the targets of a row.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ControlColumns {
-    /// `displacement`, `strain` or `held`.
-    pub mode: &'static str,
+    /// Displacement, strain or held (its `name()` is the `rig.csv` column, its code the
+    /// published `RigState::control_mode`).
+    pub mode: RigControl,
     /// (ln λx, ln λy) the strain loop aims at; None under displacement control.
     pub target_log: Option<[f64; 2]>,
 }
 
 impl ControlColumns {
     pub const DISPLACEMENT: ControlColumns = ControlColumns {
-        mode: "displacement",
+        mode: RigControl::Displacement,
         target_log: None,
     };
 }
@@ -132,15 +134,15 @@ impl StrainRun {
     pub fn columns(&self) -> ControlColumns {
         match (&self.phase, self.control.mode()) {
             (Phase::Waiting, _) => ControlColumns {
-                mode: "held",
+                mode: RigControl::Held,
                 target_log: None,
             },
             (Phase::Controlling, StrainMode::Strain) => ControlColumns {
-                mode: "strain",
+                mode: RigControl::Strain,
                 target_log: Some(self.control.target()),
             },
             (Phase::Controlling, _) => ControlColumns {
-                mode: "held",
+                mode: RigControl::Held,
                 target_log: Some(self.control.target()),
             },
             _ => ControlColumns::DISPLACEMENT,
@@ -288,7 +290,7 @@ mod tests {
         stop_s: f64,
         restart_s: f64,
         budget_s: f64,
-    ) -> (Rig, StrainRun, Vec<StrainRunEvent>, Vec<&'static str>) {
+    ) -> (Rig, StrainRun, Vec<StrainRunEvent>, Vec<RigControl>) {
         let mut rig = Rig::new(RigConfig::default(), 1).unwrap();
         let mut strain =
             StrainRun::new(&mut rig, test, BuiltinTest::Equibiaxial.specimen()).unwrap();
@@ -351,7 +353,7 @@ mod tests {
             ),
             "{events:?}"
         );
-        assert!(modes.iter().all(|m| *m == "held"));
+        assert!(modes.iter().all(|m| *m == RigControl::Held));
         for axis in 0..2 {
             assert!(rig.state().axes[axis].elongation_mm.abs() < 0.05);
         }
@@ -370,7 +372,7 @@ mod tests {
                 .iter()
                 .position(|e| matches!(e, StrainRunEvent::Held(HoldReason::Stale { .. })))
                 .expect("held on stale fields");
-            assert!(modes.contains(&"held"));
+            assert!(modes.contains(&RigControl::Held));
             if resumes {
                 assert_eq!(events[held + 1], StrainRunEvent::Resumed, "{events:?}");
                 assert!(!strain.was_stopped());
