@@ -45,6 +45,35 @@ fn rig_rows(out: &Path) -> Vec<(f64, String, f64, f64)> {
         .collect()
 }
 
+/// (log_exx, log_eyy, target (ln λx, ln λy) or None) of every `frames.csv` row.
+fn frame_targets(out: &Path) -> Vec<(f64, f64, Option<[f64; 2]>)> {
+    let text = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let at = |name: &str| {
+        header
+            .iter()
+            .position(|c| c == name)
+            .unwrap_or_else(|| panic!("no column {name} in frames.csv"))
+    };
+    let (lx, ly, tx, ty) = (
+        at("log_exx"),
+        at("log_eyy"),
+        at("target_log_exx"),
+        at("target_log_eyy"),
+    );
+    lines
+        .map(|l| {
+            let r: Vec<&str> = l.split(',').collect();
+            let target = match (r[tx], r[ty]) {
+                ("", "") => None,
+                (x, y) => Some([x.parse().unwrap(), y.parse().unwrap()]),
+            };
+            (r[lx].parse().unwrap(), r[ly].parse().unwrap(), target)
+        })
+        .collect()
+}
+
 /// Waits (bounded by the hang guard) until the file at `path` contains `text`.
 fn wait_for_text(path: &Path, text: &str) {
     let give_up = std::time::Instant::now() + common::HANG_GUARD;
@@ -163,6 +192,38 @@ fn kill_correlator_mid_ramp(on_interlock: &str) {
         }
     }
     println!("{on_interlock}: largest X elongation {reached:.2} mm");
+    // frames.csv: the target the rig aimed at when each frame was taken. Empty while waiting
+    // for the first field and after the unloading began (displacement control); equibiaxial
+    // and within the program's range under strain control (or held); the measured log
+    // strains follow it.
+    let frames = frame_targets(&out);
+    let targeted: Vec<_> = frames
+        .iter()
+        .filter_map(|(x, y, t)| t.map(|t| (*x, *y, t)))
+        .collect();
+    assert!(
+        !targeted.is_empty() && targeted.len() < frames.len(),
+        "{} of {} frames with a target",
+        targeted.len(),
+        frames.len()
+    );
+    assert!(
+        frames.first().unwrap().2.is_none(),
+        "a target before the start"
+    );
+    let mut gaps: Vec<f64> = Vec::new();
+    for (x, y, [tx, ty]) in &targeted {
+        assert!((tx - ty).abs() < 1e-6, "not equibiaxial: ({tx}, {ty})");
+        assert!(
+            (-1e-6..=1.3f64.ln() + 1e-6).contains(tx),
+            "target ln λ {tx} outside the program"
+        );
+        gaps.push((x - tx).abs().max((y - ty).abs()));
+    }
+    gaps.sort_by(f64::total_cmp);
+    let median_gap = gaps[gaps.len() / 2];
+    println!("{on_interlock}: median |measured - target| log strain {median_gap:.4}");
+    assert!(median_gap < 0.01, "measured far from target: {median_gap}");
 }
 
 #[test]
