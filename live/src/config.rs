@@ -931,7 +931,7 @@ impl RunConfig {
              # instead be strain-controlled (the correlator's fields close the loop):\n\
              # control = \"strain\", kind = uniaxial | equibiaxial | pure_shear | biaxial,\n\
              # ratio = ln(ly)/ln(lx) (biaxial), stretch = the larger measured stretch,\n\
-             # rate_per_s = log strain rate; stale_s = 0.5, min_valid_nodes = 16,\n\
+             # rate_per_s = log strain rate; stale_s = 1.5, min_valid_nodes = 16,\n\
              # on_interlock = \"resume\" | \"stop\"."
         );
         for test in &g.tests {
