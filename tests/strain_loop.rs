@@ -222,8 +222,8 @@ fn kill_correlator_mid_ramp(on_interlock: &str) {
     }
     gaps.sort_by(f64::total_cmp);
     let median_gap = gaps[gaps.len() / 2];
-    println!("{on_interlock}: median |measured - target| log strain {median_gap:.4}");
-    assert!(median_gap < 0.01, "measured far from target: {median_gap}");
+    println!("{on_interlock}: median |measured - target| log strain {median_gap:.2e}");
+    assert!(median_gap < 0.002, "measured far from target: {median_gap}");
 }
 
 #[test]
