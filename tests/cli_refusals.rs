@@ -144,3 +144,86 @@ fn a_stroke_beyond_the_limit_is_refused_before_ready_and_readable() {
     assert!(stderr.len() < 200, "{stderr}");
     let _ = std::fs::remove_file(&path);
 }
+
+#[test]
+fn bad_strain_control_flags_are_refused_naming_why() {
+    let i = instance();
+    let rig = |extra: &[&str]| {
+        let mut args = vec!["rig", "--instance", &i];
+        args.extend_from_slice(extra);
+        args.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    let check = |extra: &[&str], needles: &[&str]| {
+        let args = rig(extra);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        refused(&args, needles);
+    };
+    check(
+        &[
+            "--control",
+            "strain",
+            "--kind",
+            "uniaxial",
+            "--ratio",
+            "0.5",
+        ],
+        &["--control strain", "only a biaxial"],
+    );
+    check(
+        &["--control", "strain", "--kind", "biaxial", "--ratio", "NaN"],
+        &["ratio NaN"],
+    );
+    check(
+        &[
+            "--control",
+            "strain",
+            "--kind",
+            "equibiaxial",
+            "--stretch",
+            "1",
+        ],
+        &["stretch 1"],
+    );
+    check(&["--control", "strain"], &["needs --kind"]);
+    check(
+        &["--kind", "biaxial", "--ratio", "0.5"],
+        &["add --control strain"],
+    );
+    check(
+        &["--control", "force"],
+        &["expected displacement or strain"],
+    );
+    check(
+        &[
+            "--control",
+            "strain",
+            "--kind",
+            "equibiaxial",
+            "--test",
+            "uniaxial",
+        ],
+        &["no --program, --test or --campaign"],
+    );
+    check(
+        &[
+            "--control",
+            "strain",
+            "--kind",
+            "equibiaxial",
+            "--on-interlock",
+            "pause",
+        ],
+        &["resume or stop"],
+    );
+    check(
+        &[
+            "--control",
+            "strain",
+            "--kind",
+            "equibiaxial",
+            "--speed",
+            "max",
+        ],
+        &["--speed max is refused"],
+    );
+}

@@ -209,6 +209,8 @@ const READ_PAGE: &str = "
         correlator_restarts: text('restarts-correlator'),
         faults: text('processes'),
         mode: text('mode'),
+        rig_control: text('rig-control'),
+        rig_strain: text('rig-strain'),
     };";
 
 fn read_page(browser: &Browser) -> Value {
@@ -319,6 +321,12 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
     browser.goto(&format!("http://{run_addr}/"));
     let run_page = page_live(&browser);
     assert_eq!(run_page["mode"], "dicstream run");
+    // A displacement-controlled test: the mode named, no strain target shown.
+    until("the rig's control mode", || {
+        let p = read_page(&browser);
+        (p["rig_control"] == "displacement").then_some(p)
+    });
+    assert!(read_page(&browser)["rig_strain"].is_null());
     until("the process table", || {
         (read_page(&browser)["correlator_restarts"] == "0").then_some(())
     });

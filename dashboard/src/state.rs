@@ -400,6 +400,8 @@ impl LiveState {
             "axis_centre_mm": s.axis_centre_mm,
             "actuators": actuators,
             "limits_tripped": s.actuators.iter().any(|a| a.limit_flags != 0),
+            "control": s.control().name(),
+            "strain": strain_view(s, self.last_field.as_ref()),
             "history": {
                 "t_sim_s": h.column(0),
                 "stretch_x": h.column(1),
@@ -537,6 +539,25 @@ impl LiveState {
     }
 }
 
+/// Target against measured under strain control (null otherwise): the rig's target log strains
+/// (ln λx, ln λy), the newest field's gauge log strains (null before the first field) and
+/// measured − target per axis. The field is newer than the target it answers by the field
+/// latency, so the difference includes the lag of the loop, not only its error.
+pub fn strain_view(rig: &RigState, field: Option<&FieldHeader>) -> Value {
+    let Some(target) = rig.strain_target() else {
+        return Value::Null;
+    };
+    let measured = field.map(|h| {
+        let g = h.gauge_of(wire::StrainMeasure::Log);
+        [g.exx, g.eyy]
+    });
+    json!({
+        "target_log": target,
+        "measured_log": measured,
+        "error_log": measured.map(|m| [m[0] - target[0], m[1] - target[1]]),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -626,6 +647,39 @@ mod tests {
         s.on_report(&r);
         let snap = s.snapshot(2, 0, &Value::Null);
         assert_eq!(snap["identification"]["g_coefficients"]["values"][2], 7.0e4);
+    }
+
+    #[test]
+    fn strain_control_shows_target_against_measured() {
+        let mut rig = RigState {
+            control_mode: wire::RigControl::Strain as u32,
+            target_log_exx: 0.2,
+            target_log_eyy: 0.1,
+            ..RigState::default()
+        };
+        let mut header = FieldHeader::default();
+        header.gauge[wire::StrainMeasure::Log as usize].exx = 0.19;
+        header.gauge[wire::StrainMeasure::Log as usize].eyy = 0.105;
+        let view = strain_view(&rig, Some(&header));
+        assert_eq!(view["target_log"], json!([0.2, 0.1]));
+        assert_eq!(view["measured_log"], json!([0.19, 0.105]));
+        let error = &view["error_log"];
+        assert!((error[0].as_f64().unwrap() + 0.01).abs() < 1e-12);
+        assert!((error[1].as_f64().unwrap() - 0.005).abs() < 1e-12);
+        // Before any field: the target alone.
+        let alone = strain_view(&rig, None);
+        assert!(alone["measured_log"].is_null() && alone["error_log"].is_null());
+        // Displacement control: nothing to compare.
+        rig.control_mode = wire::RigControl::Displacement as u32;
+        assert!(strain_view(&rig, Some(&header)).is_null());
+        // Through the snapshot, with the mode named.
+        rig.control_mode = wire::RigControl::Held as u32;
+        let mut s = LiveState::new(Settings::new("t", Mode::Run), 0);
+        s.on_field(&header, &[]);
+        s.on_rig(&rig);
+        let snap = s.snapshot(1, 0, &Value::Null);
+        assert_eq!(snap["rig"]["control"], "held");
+        assert_eq!(snap["rig"]["strain"]["measured_log"], json!([0.19, 0.105]));
     }
 
     #[test]

@@ -26,6 +26,10 @@ pub struct Acceptance {
     pub b: Vec<f64>,
     pub uniaxial: Option<CaseComparison>,
     pub equibiaxial: Option<CaseComparison>,
+    /// A strain-controlled path off those two (pure shear, any ρ but 1): both nominal
+    /// stresses along ln λy = ρ ln λx; `max_stretch` and `at_stretch` are of the larger stretch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub strain_path: Option<CaseComparison>,
     pub tolerance: f64,
     pub passed: bool,
 }
@@ -94,6 +98,74 @@ pub fn accept(
         b: b.to_vec(),
         uniaxial,
         equibiaxial,
+        strain_path: None,
+        tolerance: TOLERANCE,
+        passed,
+    }
+}
+
+/// The stretches (λx, λy) of the path ln λy = ρ ln λx where the larger one is `larger`.
+fn path_point(ratio: f64, larger: f64) -> (f64, f64) {
+    let e = larger.ln();
+    if ratio.abs() <= 1.0 {
+        (larger, (ratio * e).exp())
+    } else {
+        ((e / ratio).exp(), larger)
+    }
+}
+
+/// Compares the law against `truth` along a strain-controlled path ρ = ln λy / ln λx up to
+/// the larger stretch `max_stretch`: the worst relative error of either nominal stress (a
+/// stress below 2 % of the larger one, pure shear's lateral near the start, is not a
+/// relative comparison).
+pub fn accept_path(
+    truth: &InvariantLaw,
+    a: &[f64],
+    b: &[f64],
+    ratio: f64,
+    max_stretch: f64,
+) -> Acceptance {
+    let identified = InvariantLaw {
+        f: InvariantFn::ExpPoly(a.to_vec()),
+        g: InvariantFn::ExpPoly(b.to_vec()),
+    };
+    let usable = !a.is_empty() && !b.is_empty() && a.iter().chain(b).all(|c| c.is_finite());
+    let strain_path = (usable && max_stretch > 1.0).then(|| {
+        let mut worst = CaseComparison {
+            max_stretch,
+            max_relative_error: 0.0,
+            at_stretch: 1.0,
+        };
+        for k in 1..=SAMPLES {
+            let larger = 1.0 + (max_stretch - 1.0) * k as f64 / SAMPLES as f64;
+            let (lx, ly) = path_point(ratio, larger);
+            let t = truth.in_plane_stress(lx, ly).nominal_stress_mpa;
+            let p = identified.in_plane_stress(lx, ly).nominal_stress_mpa;
+            let scale = t[0].abs().max(t[1].abs());
+            for i in 0..2 {
+                if t[i].abs() < 0.02 * scale {
+                    continue;
+                }
+                let error = ((p[i] - t[i]) / t[i]).abs();
+                if !error.is_finite() || error > worst.max_relative_error {
+                    worst.max_relative_error = if error.is_finite() {
+                        error
+                    } else {
+                        f64::INFINITY
+                    };
+                    worst.at_stretch = larger;
+                }
+            }
+        }
+        worst
+    });
+    let passed = strain_path.is_some_and(|c| c.max_relative_error <= TOLERANCE);
+    Acceptance {
+        a: a.to_vec(),
+        b: b.to_vec(),
+        uniaxial: None,
+        equibiaxial: None,
+        strain_path,
         tolerance: TOLERANCE,
         passed,
     }
@@ -102,6 +174,32 @@ pub fn accept(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_strain_path_is_compared_on_both_stresses_along_its_ratio() {
+        let truth = InvariantLaw::smactane();
+        let (a, b) = (
+            truth.f.coefficients().to_vec(),
+            truth.g.coefficients().to_vec(),
+        );
+        for ratio in [0.0, 0.5, -0.5, 2.0] {
+            let ok = accept_path(&truth, &a, &b, ratio, 1.8);
+            assert!(ok.passed, "{ok:?}");
+            assert!(ok.strain_path.unwrap().max_relative_error < 1e-12);
+        }
+        assert_eq!(
+            path_point(0.5, 1.8),
+            (1.8, 1.8f64.ln().mul_add(0.5, 0.0).exp())
+        );
+        assert_eq!(path_point(2.0, 1.8).1, 1.8);
+        // f 10 % stiffer: off by more than the tolerance.
+        let mut a_off = a.clone();
+        a_off[0] += 0.1f64.ln_1p();
+        let bad = accept_path(&truth, &a_off, &b, 0.5, 1.8);
+        assert!(!bad.passed);
+        assert!(bad.strain_path.unwrap().max_relative_error > TOLERANCE);
+        assert!(!accept_path(&truth, &[f64::NAN], &b, 0.5, 1.8).passed);
+    }
 
     #[test]
     fn the_true_law_passes_and_a_stiffer_one_fails() {

@@ -206,10 +206,55 @@ pub struct RigSection {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TestSection {
-    /// uniaxial or equibiaxial.
+    /// uniaxial or equibiaxial; under strain control also pure_shear or biaxial.
     pub kind: String,
+    /// Displacement: the final grip stretch; strain: the target of the larger measured stretch.
     pub stretch: f64,
+    /// Displacement: the stretch rate; strain: the rate of the larger log strain (/s).
     pub rate_per_s: f64,
+    /// displacement (the grips follow the program; the default) or strain (the correlator's
+    /// fields close the loop on the gauge zone's log strains; a test alone in its run).
+    #[serde(
+        default = "TestSection::displacement",
+        skip_serializing_if = "TestSection::is_displacement"
+    )]
+    pub control: String,
+    /// Strain control, biaxial: ρ = ln λy / ln λx held along the path.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ratio: Option<f64>,
+    /// Strain control: hold the grips when the newest field is older than this (s) [0.5].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stale_s: Option<f64>,
+    /// Strain control: hold on a field with fewer converged nodes [16].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_valid_nodes: Option<u32>,
+    /// Strain control, once fields are usable again after a hold: resume or stop [resume].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub on_interlock: Option<String>,
+}
+
+impl TestSection {
+    /// A test under displacement control (today's tests).
+    pub fn new(kind: &str, stretch: f64, rate_per_s: f64) -> TestSection {
+        TestSection {
+            kind: kind.into(),
+            stretch,
+            rate_per_s,
+            control: TestSection::displacement(),
+            ratio: None,
+            stale_s: None,
+            min_valid_nodes: None,
+            on_interlock: None,
+        }
+    }
+
+    fn displacement() -> String {
+        "displacement".into()
+    }
+
+    fn is_displacement(control: &String) -> bool {
+        control == "displacement"
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -292,11 +337,7 @@ impl Default for RigSection {
         let tests = rig::Campaign::paper()
             .tests()
             .iter()
-            .map(|t| TestSection {
-                kind: test_kind_name(t.test).into(),
-                stretch: t.stretch,
-                rate_per_s: t.rate_per_s,
-            })
+            .map(|t| TestSection::new(test_kind_name(t.test), t.stretch, t.rate_per_s))
             .collect();
         RigSection {
             speed: 1.0,
@@ -501,12 +542,16 @@ impl RunConfig {
         Ok(campaign.with_law(self.law()?))
     }
 
-    /// `uniaxial:3@0.08,...`, the rig's `--campaign` argument.
+    /// `uniaxial:3@0.08,...`, the rig's `--campaign` argument (a strain-controlled test is
+    /// described as `strain:KIND:STRETCH@RATE`, for messages).
     pub fn campaign_spec(&self) -> String {
         self.rig
             .tests
             .iter()
-            .map(|t| format!("{}:{}@{}", t.kind, t.stretch, t.rate_per_s))
+            .map(|t| match t.control.as_str() {
+                "strain" => format!("strain:{}:{}@{}", t.kind, t.stretch, t.rate_per_s),
+                _ => format!("{}:{}@{}", t.kind, t.stretch, t.rate_per_s),
+            })
             .collect::<Vec<_>>()
             .join(",")
     }
@@ -660,10 +705,12 @@ impl RunConfig {
                 );
             }
         }
-        let campaign = self.campaign()?;
-        campaign
-            .check_against(&rig_config)
-            .map_err(|e| anyhow!("[rig] {e}"))?;
+        if self.strain_test()?.is_none() {
+            let campaign = self.campaign()?;
+            campaign
+                .check_against(&rig_config)
+                .map_err(|e| anyhow!("[rig] {e}"))?;
+        }
         identifier::models::parse_model_list(&self.identifier.models)
             .context("[identifier] models")?;
         Ok(())
@@ -671,7 +718,78 @@ impl RunConfig {
 
     /// Wall-clock length of the campaign (s).
     pub fn campaign_wall_s(&self) -> anyhow::Result<f64> {
+        if let Some(test) = self.strain_test()? {
+            // Hold 1 s, ramp, hold 1 s, unload at 5x the rate, hold 0.5 s (rig::strain::run).
+            let e = test
+                .target_log()
+                .map(f64::abs)
+                .into_iter()
+                .fold(0.0, f64::max);
+            let ramp_s = e / test.rate_log_per_s;
+            let unload_s =
+                (test.stretch - 1.0) / (rig::campaign::UNLOAD_RATE_FACTOR * test.rate_log_per_s);
+            return Ok((2.5 + ramp_s + unload_s) / self.rig.speed);
+        }
         Ok(self.campaign()?.duration_s() / self.rig.speed)
+    }
+
+    /// The strain-controlled test of `[[rig.tests]]` (control = "strain"), None when every test
+    /// is under displacement control; refused with the reason when the combination is not one
+    /// a strain-controlled run can do.
+    pub fn strain_test(&self) -> anyhow::Result<Option<rig::strain::StrainTest>> {
+        let tests = &self.rig.tests;
+        for (k, t) in tests.iter().enumerate() {
+            let at = format!("[[rig.tests]] {} (kind {:?})", k + 1, t.kind);
+            match t.control.as_str() {
+                "displacement" => {
+                    for (key, given) in [
+                        ("ratio", t.ratio.is_some()),
+                        ("stale_s", t.stale_s.is_some()),
+                        ("min_valid_nodes", t.min_valid_nodes.is_some()),
+                        ("on_interlock", t.on_interlock.is_some()),
+                    ] {
+                        if given {
+                            bail!("{at}: {key} applies to control = \"strain\" only");
+                        }
+                    }
+                    if ["pure_shear", "biaxial"].contains(&t.kind.as_str()) {
+                        bail!(
+                            "{at}: a {} path is held on the measured strains: set control = \"strain\"",
+                            t.kind
+                        );
+                    }
+                }
+                "strain" => {}
+                other => bail!("{at}: control = {other:?}: expected displacement or strain"),
+            }
+        }
+        let Some(t) = tests.iter().find(|t| t.control == "strain") else {
+            return Ok(None);
+        };
+        if tests.len() > 1 {
+            bail!(
+                "[[rig.tests]]: a strain-controlled test runs alone in its run ({} tests given); \
+                 run one config per strain path",
+                tests.len()
+            );
+        }
+        if self.rig.source == "csv-follow" {
+            bail!(
+                "[[rig.tests]] control = \"strain\" with [rig] source = \"csv-follow\": strain \
+                 control drives the simulated rig; a followed machine's log cannot be steered"
+            );
+        }
+        let test = rig::strain::StrainTest::new(&t.kind, t.ratio, t.stretch, t.rate_per_s)
+            .and_then(|test| {
+                test.with_interlocks(
+                    t.stale_s.unwrap_or(rig::strain::test::DEFAULT_STALE_S),
+                    t.min_valid_nodes
+                        .unwrap_or(rig::strain::test::DEFAULT_MIN_VALID_NODES),
+                    t.on_interlock.as_deref().unwrap_or("resume"),
+                )
+            })
+            .map_err(|e| anyhow!("[[rig.tests]] 1 (control = \"strain\"): {e}"))?;
+        Ok(Some(test))
     }
 
     /// The defaults as a commented TOML file to start from (`dicstream run --print-config`).
@@ -809,7 +927,12 @@ impl RunConfig {
             t,
             "# The campaign, in order: each test mounts its specimen (uniaxial: a 100 x 20 x 2 mm\n\
              # strip; equibiaxial: a 100 x 100 x 2 mm cruciform centre), ramps the elongation to\n\
-             # `stretch` at `rate_per_s` in centroid control, holds, unloads."
+             # `stretch` at `rate_per_s` in centroid control, holds, unloads. A test alone may\n\
+             # instead be strain-controlled (the correlator's fields close the loop):\n\
+             # control = \"strain\", kind = uniaxial | equibiaxial | pure_shear | biaxial,\n\
+             # ratio = ln(ly)/ln(lx) (biaxial), stretch = the larger measured stretch,\n\
+             # rate_per_s = log strain rate; stale_s = 1.5, min_valid_nodes = 16,\n\
+             # on_interlock = \"resume\" | \"stop\"."
         );
         for test in &g.tests {
             let _ = writeln!(
@@ -893,6 +1016,103 @@ mod tests {
             RunConfig::default().campaign_spec(),
             "uniaxial:3@0.08,equibiaxial:2@0.04"
         );
+    }
+
+    #[test]
+    fn the_example_configs_are_valid_strain_controlled_runs() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/configs");
+        for (name, ratio) in [
+            ("strain_equibiaxial.toml", 1.0),
+            ("strain_biaxial_rho05.toml", 0.5),
+        ] {
+            let text = std::fs::read_to_string(dir.join(name)).unwrap();
+            let config = RunConfig::from_toml(&text, name).unwrap();
+            config.validate().unwrap();
+            let test = config.strain_test().unwrap().expect(name);
+            assert_eq!((test.ratio, test.stretch), (ratio, 1.8), "{name}");
+        }
+    }
+
+    #[test]
+    fn strain_controlled_tests_are_checked_and_the_default_is_unchanged() {
+        // Displacement control stays the default, and its config file does not change.
+        let d = RunConfig::default();
+        assert!(d.strain_test().unwrap().is_none());
+        assert!(!d.to_toml().contains("control"), "{}", d.to_toml());
+        let strain = |body: &str| {
+            RunConfig::from_toml(&format!("[[rig.tests]]\n{body}"), "t.toml")
+                .unwrap()
+                .validate()
+        };
+        strain("kind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.8\nrate_per_s = 0.02\n")
+            .unwrap();
+        strain("kind = \"pure_shear\"\ncontrol = \"strain\"\nstretch = 1.8\nrate_per_s = 0.02\n")
+            .unwrap();
+        let config = RunConfig::from_toml(
+            "[[rig.tests]]\nkind = \"biaxial\"\ncontrol = \"strain\"\nratio = 0.5\nstretch = 1.5\n\
+             rate_per_s = 0.02\nmin_valid_nodes = 50\n",
+            "t.toml",
+        )
+        .unwrap();
+        let test = config.strain_test().unwrap().unwrap();
+        assert_eq!((test.ratio, test.stretch), (0.5, 1.5));
+        assert_eq!(test.limits.min_valid_nodes, 50);
+        assert_eq!(test.limits.stale_s, rig::strain::test::DEFAULT_STALE_S);
+        // Round trip through the results' config.toml.
+        let round = RunConfig::from_toml(&config.to_toml(), "round").unwrap();
+        assert_eq!(round, config);
+        let refused = |body: &str, expected: &str| {
+            let error = format!("{:#}", strain(body).unwrap_err());
+            assert!(error.contains(expected), "{body}: {error}");
+        };
+        refused(
+            "kind = \"uniaxial\"\ncontrol = \"strain\"\nratio = 0.5\nstretch = 1.5\nrate_per_s = 0.02\n",
+            "only a biaxial",
+        );
+        refused(
+            "kind = \"biaxial\"\ncontrol = \"strain\"\nratio = nan\nstretch = 1.5\nrate_per_s = 0.02\n",
+            "ratio NaN",
+        );
+        refused(
+            "kind = \"biaxial\"\ncontrol = \"strain\"\nstretch = 1.5\nrate_per_s = 0.02\n",
+            "needs its ratio",
+        );
+        refused(
+            "kind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.0\nrate_per_s = 0.02\n",
+            "stretch 1",
+        );
+        refused(
+            "kind = \"equibiaxial\"\ncontrol = \"force\"\nstretch = 1.5\nrate_per_s = 0.02\n",
+            "expected displacement or strain",
+        );
+        refused(
+            "kind = \"equibiaxial\"\nratio = 1.0\nstretch = 1.5\nrate_per_s = 0.02\n",
+            "ratio applies to control = \"strain\" only",
+        );
+        refused(
+            "kind = \"pure_shear\"\nstretch = 1.5\nrate_per_s = 0.02\n",
+            "set control = \"strain\"",
+        );
+        refused(
+            "kind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.5\nrate_per_s = 0.02\n\
+             on_interlock = \"pause\"\n",
+            "resume or stop",
+        );
+        refused(
+            "kind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.5\nrate_per_s = 0.02\n\
+             [[rig.tests]]\nkind = \"uniaxial\"\nstretch = 2.0\nrate_per_s = 0.08\n",
+            "runs alone",
+        );
+        let csv = RunConfig::from_toml(
+            "[camera]\nsource = \"watch\"\nwatch_dir = \"/tmp/x\"\n[rig]\nsource = \"csv-follow\"\n\
+             [rig.csv]\nfile = \"m.csv\"\ntime_column = \"t\"\nforce_x_column = \"F\"\n\
+             [[rig.tests]]\nkind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.5\n\
+             rate_per_s = 0.02\n",
+            "t.toml",
+        )
+        .unwrap();
+        let error = format!("{:#}", csv.strain_test().unwrap_err());
+        assert!(error.contains("csv-follow"), "{error}");
     }
 
     #[test]

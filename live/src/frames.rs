@@ -1,6 +1,7 @@
 //! `frames.csv`: one row per correlated frame, everything a test engineer plots afterwards
 //! — ids and times, the gauge strains of the four measures, the stretches and invariants
-//! they give, the rig's forces and Cauchy stresses at the frame's rig sample, the latency,
+//! they give, the rig's forces and Cauchy stresses at the frame's rig sample (and, under strain
+//! control, the log strains the rig aimed at then: empty cells otherwise), the latency,
 //! and, for simulated frames, the correlator's actual error against the ground truth.
 
 use crate::truth;
@@ -9,7 +10,7 @@ use std::fmt::Write as _;
 use wire::{FieldHeader, FieldNode, GroundTruth, RigState, StrainMeasure};
 
 /// Column names, in order.
-pub const COLUMNS: [&str; 40] = [
+pub const COLUMNS: [&str; 42] = [
     "frame_id",
     "reference_frame_id",
     "rig_sample_id",
@@ -38,6 +39,8 @@ pub const COLUMNS: [&str; 40] = [
     "cauchy_y_mpa",
     "rig_stretch_x",
     "rig_stretch_y",
+    "target_log_exx",
+    "target_log_eyy",
     "nodes",
     "valid_nodes",
     "u_mean_px",
@@ -176,6 +179,9 @@ pub struct FrameRow {
     pub force_n: Option<[f64; 2]>,
     pub cauchy_mpa: Option<[f64; 2]>,
     pub rig_stretch: Option<[f64; 2]>,
+    /// The strain program's target (ln λx, ln λy) at the frame's rig sample (also while held by
+    /// an interlock); None under displacement control or without a rig sample.
+    pub target_log: Option<[f64; 2]>,
     pub nodes: usize,
     pub valid_nodes: u32,
     pub u_mean_px: f64,
@@ -259,6 +265,7 @@ impl FrameRow {
             force_n,
             cauchy_mpa,
             rig_stretch: rig.map(|s| [s.specimen_stretch_x, s.specimen_stretch_y]),
+            target_log: rig.and_then(RigState::strain_target),
             nodes: nodes.len(),
             valid_nodes: header.valid_nodes,
             u_mean_px: header.u_mean_px,
@@ -307,6 +314,8 @@ impl FrameRow {
         pair(out, self.force_n);
         pair(out, self.cauchy_mpa);
         pair(out, self.rig_stretch);
+        opt(out, self.target_log.map(|t| format!("{:.7}", t[0])));
+        opt(out, self.target_log.map(|t| format!("{:.7}", t[1])));
         let _ = write!(
             out,
             "{},{},{:.5},{:.5},",
@@ -386,9 +395,28 @@ mod tests {
         assert!((row.log_strain_error.unwrap()[0] - 0.01).abs() < 1e-9);
         assert!((row.latency_field_ms - 50.0).abs() < 1e-9);
         assert!((row.t_capture_s - 1.0).abs() < 1e-12);
+        assert_eq!(row.target_log, None, "displacement control: no target");
         let mut line = String::new();
         row.write_csv(&mut line);
         assert_eq!(line.trim_end().split(',').count(), COLUMNS.len());
+        let cell = |line: &str, name: &str| {
+            let at = COLUMNS.iter().position(|c| *c == name).unwrap();
+            line.trim_end().split(',').nth(at).unwrap().to_string()
+        };
+        assert_eq!(cell(&line, "target_log_exx"), "");
+        assert_eq!(cell(&line, "target_log_eyy"), "");
+        // Under strain control (or held), the rig sample's target fills both cells.
+        rig.control_mode = wire::RigControl::Held as u32;
+        rig.target_log_exx = 0.405_465_1;
+        rig.target_log_eyy = -0.2;
+        let strained = FrameRow::new(&header, &nodes, Some(&rig), None, 0, 0);
+        assert_eq!(strained.target_log, Some([0.405_465_1, -0.2]));
+        line.clear();
+        strained.write_csv(&mut line);
+        assert_eq!(cell(&line, "target_log_exx"), "0.4054651");
+        assert_eq!(cell(&line, "target_log_eyy"), "-0.2000000");
+        line.clear();
+        row.write_csv(&mut line);
         // Without rig sample and truth: empty cells, same count.
         header.has_truth = 0;
         let row = FrameRow::new(&header, &nodes, None, None, 0, 0);

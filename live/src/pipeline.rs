@@ -60,11 +60,7 @@ pub fn trial_config(settings: &PipelineSettings, fps: f64, results_dir: &Path) -
     config.correlator.threads = settings.correlator_threads;
     // Hold 1 s, ramp, hold 1 s, unload at 5x, hold 0.5 s (rig::campaign).
     let ramp_s = ((settings.seconds - 2.5) / 1.2).max(1.0);
-    config.rig.tests = vec![TestSection {
-        kind: "uniaxial".into(),
-        stretch: 2.0,
-        rate_per_s: 1.0 / ramp_s,
-    }];
+    config.rig.tests = vec![TestSection::new("uniaxial", 2.0, 1.0 / ramp_s)];
     config
 }
 

@@ -743,6 +743,13 @@ fn finish(
             config.camera.source, config.rig.source
         )
     });
+    // A strain-controlled path off the uniaxial and equibiaxial curves (pure shear, any ρ but
+    // 1) is compared along its own path, up to the larger stretch the gauge zone reached.
+    let off_path = config
+        .strain_test()
+        .ok()
+        .flatten()
+        .filter(|t| t.kind != rig::strain::StrainKind::Equibiaxial);
     if let Some(why) = &acceptance_skipped {
         eprintln!("run: acceptance skipped: {why}");
     }
@@ -750,6 +757,15 @@ fn finish(
         let truth = config.law().expect("validated law");
         let tested =
             |case: usize| (recorder.max_stretch[case] > 1.01).then_some(recorder.max_stretch[case]);
+        if let Some(test) = &off_path {
+            return crate::acceptance::accept_path(
+                &truth,
+                &report.a[..report.a_count as usize],
+                &report.b[..report.b_count as usize],
+                test.ratio,
+                recorder.max_stretch[2],
+            );
+        }
         accept(
             &truth,
             &report.a[..report.a_count as usize],

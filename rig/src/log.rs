@@ -3,6 +3,7 @@
 
 use crate::ids::{ActuatorId, Axis};
 use crate::snapshot::{ProgramStatus, RigSnapshot};
+use crate::strain::ControlColumns;
 use std::fmt::Write;
 
 pub fn csv_header() -> String {
@@ -18,6 +19,10 @@ pub fn csv_header() -> String {
         let _ = write!(h, ",{n}_centre_mm,{n}_elongation_mm,{n}_force_kn");
     }
     h.push_str(",stretch_x,stretch_y,rotation_deg,centre_x_mm,centre_y_mm,broken");
+    // Who drives the X and Y set-points: displacement (programs, campaigns), strain (the strain
+    // loop on the correlator's fields) or held (strain control held by an interlock or waiting
+    // for its first field); the strain loop's target log strains, empty under displacement.
+    h.push_str(",control,target_log_exx,target_log_eyy");
     h
 }
 
@@ -31,8 +36,13 @@ pub fn program_code(status: ProgramStatus) -> u8 {
     }
 }
 
-/// Appends one row (with its newline) to `out`.
+/// Appends one row (with its newline) to `out`, under displacement control.
 pub fn write_csv_row(s: &RigSnapshot, out: &mut String) {
+    write_csv_row_with(s, &ControlColumns::DISPLACEMENT, out)
+}
+
+/// Appends one row (with its newline) to `out`, with its control columns.
+pub fn write_csv_row_with(s: &RigSnapshot, control: &ControlColumns, out: &mut String) {
     let _ = write!(
         out,
         "{:.6},{},{},{}",
@@ -56,14 +66,21 @@ pub fn write_csv_row(s: &RigSnapshot, out: &mut String) {
         );
     }
     let k = &s.specimen;
-    let _ = writeln!(
+    let _ = write!(
         out,
-        ",{:.6},{:.6},{:.4},{:.6},{:.6},{}",
+        ",{:.6},{:.6},{:.4},{:.6},{:.6},{},{}",
         k.stretch_x,
         k.stretch_y,
         k.rotation_deg,
         k.centre_x_mm,
         k.centre_y_mm,
-        u8::from(k.broken)
+        u8::from(k.broken),
+        control.mode.name()
     );
+    match control.target_log {
+        Some([x, y]) => {
+            let _ = writeln!(out, ",{x:.6},{y:.6}");
+        }
+        None => out.push_str(",,\n"),
+    }
 }

@@ -15,6 +15,8 @@ use crate::program::{Program, ProgramError, StopTransition};
 use crate::refusal::Refusal;
 use crate::rig::{Rig, RigCommand};
 use crate::session::{PeriodEvent, Session, SessionError};
+use crate::specimen::SpecimenConfig;
+use crate::strain::{FieldClock, StrainRunEvent, StrainTest};
 use iceoryx2::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -68,6 +70,12 @@ pub enum ProcessError {
     },
     #[error("a program and a campaign cannot run together: choose one")]
     ProgramAndCampaign,
+    #[error("a strain-controlled test runs alone: no program or campaign with it")]
+    StrainAndProgram,
+    #[error("strain control follows the correlator's fields in real time: --speed max is refused (realtime or a factor)")]
+    StrainAtMaxSpeed,
+    #[error("strain-controlled test: {0}")]
+    Strain(#[from] crate::strain::run::StrainRunError),
     #[error(transparent)]
     Campaign(#[from] CampaignError),
     #[error(transparent)]
@@ -202,6 +210,16 @@ pub struct ProcessOptions {
     /// Folder of the resume journal (`rig.journal`): written as the rig runs, and followed by
     /// a restarted rig of the same settings, which goes on where it was.
     pub state_dir: Option<PathBuf>,
+    /// A strain-controlled test (DIC closes the loop on the `fields` service), exclusive with
+    /// `program` and `campaign`.
+    pub strain: Option<StrainOptions>,
+}
+
+/// A strain-controlled test and the specimen it mounts (a cruciform).
+#[derive(Clone, Debug)]
+pub struct StrainOptions {
+    pub test: StrainTest,
+    pub specimen: SpecimenConfig,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -235,6 +253,14 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
     if options.program.is_some() && options.campaign.is_some() {
         return Err(ProcessError::ProgramAndCampaign);
     }
+    if options.strain.is_some() {
+        if options.program.is_some() || options.campaign.is_some() {
+            return Err(ProcessError::StrainAndProgram);
+        }
+        if options.speed == Speed::Max {
+            return Err(ProcessError::StrainAtMaxSpeed);
+        }
+    }
     if let Some(campaign) = &options.campaign {
         campaign.check_against(&options.config)?;
     }
@@ -260,9 +286,13 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
         })?;
     }
     let resumed = match &journal_path {
+        Some(path) if options.strain.is_some() => refuse_strain_resume(path)?,
         Some(path) => resume(&mut session, path, settings)?,
         None => None,
     };
+    if let Some(strain) = &options.strain {
+        session.start_strain(strain.test, strain.specimen.clone())?;
+    }
     let StatePort {
         instance,
         _owner,
@@ -280,6 +310,16 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
         .server_builder()
         .create()
         .map_err(|e| ProcessError::command("server rig/command", e))?;
+    // The strain channel: the newest field, put on the rig's clock by its rig sample (the
+    // samples of the last 10 s are remembered).
+    let fields = match &options.strain {
+        Some(_) => Some(wire::pubsub::SliceSubscriber::<
+            wire::FieldNode,
+            wire::FieldHeader,
+        >::create(&node, &wire::services::FIELDS)?),
+        None => None,
+    };
+    let mut field_clock = FieldClock::new((10.0 * options.publish_hz).ceil() as usize);
 
     let mut summary = ProcessSummary::default();
     // The log grows by whole rows; a resumed rig goes on after the rows its journal names.
@@ -336,7 +376,18 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
                 .map_err(|e| ProcessError::command("rig/command reply", e))?;
         }
 
+        if let Some(fields) = &fields {
+            fields.clear_events();
+            while let Some(sample) = fields.receive()? {
+                if let Some(m) = field_clock.measurement(sample.user_header()) {
+                    session.newest_field = Some(m);
+                }
+            }
+        }
         let event = session.period(log.is_some().then_some(&mut rows))?;
+        for (t_s, event) in session.strain_events.drain(..) {
+            eprintln!("rig: t = {t_s:.3} s: {}", strain_message(&event));
+        }
         if let PeriodEvent::TestStarted(CampaignEvent::Started { index, test }) = event {
             eprintln!(
                 "rig: campaign test {}/{}: {} to λ {} at {} /s, started at t = {:.1} s",
@@ -348,10 +399,21 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
                 session.rig.state().t_s
             )
         }
-        publisher.publish(RigState {
+        let control = session.control_columns();
+        let target = control.target_log.unwrap_or([f64::NAN; 2]);
+        let published = RigState {
             test_index: session.test_index,
+            control_mode: control.mode as u32,
+            target_log_exx: target[0],
+            target_log_eyy: target[1],
             ..to_wire(&session.rig, summary.samples_published)
-        })?;
+        };
+        publisher.publish(published)?;
+        field_clock.record(
+            published.sample_id,
+            published.t_published_ns,
+            published.t_sim_s,
+        );
         summary.samples_published += 1;
         let done = options.exit_when_done && session.done(options.program.is_some());
         // A termination signal ends the run here too, so its last rows and journal are written
@@ -417,6 +479,8 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
                 t_s: summary.simulated_s,
                 what: if session.campaign.is_some() {
                     "campaign"
+                } else if session.strain.is_some() {
+                    "strain-controlled test"
                 } else {
                     "program"
                 },
@@ -431,7 +495,7 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
 /// log's path, the pacing or the stop conditions).
 fn settings_fingerprint(options: &ProcessOptions) -> u64 {
     crate::journal::fingerprint(&format!(
-        "{:?}|{}|{:?}|{:?}|{}|{}|{}|{}",
+        "{:?}|{}|{:?}|{:?}|{}|{}|{}|{}|{:?}",
         options.config,
         options.seed,
         options.program,
@@ -439,8 +503,51 @@ fn settings_fingerprint(options: &ProcessOptions) -> u64 {
         options.test_rate_per_s,
         options.test_stretch,
         options.publish_hz,
-        options.log_hz
+        options.log_hz,
+        options.strain
     ))
+}
+
+/// What the strain test did, for stderr.
+fn strain_message(event: &StrainRunEvent) -> String {
+    match event {
+        StrainRunEvent::Started { from_log } => format!(
+            "strain control started from ln λ ({:.4}, {:.4})",
+            from_log[0], from_log[1]
+        ),
+        StrainRunEvent::Waiting(reason) => format!(
+            "strain control waits for a usable field, the grips held at rest: {reason}"
+        ),
+        StrainRunEvent::Held(reason) => {
+            format!("strain control HELD, the grips held in displacement: {reason}")
+        }
+        StrainRunEvent::Resumed => "strain control resumed: fields usable again".into(),
+        StrainRunEvent::Unloading { stopped: false } => {
+            "strain program done: unloading in displacement control".into()
+        }
+        StrainRunEvent::Unloading { stopped: true } => {
+            "strain control stopped after the hold (on_interlock = stop): unloading in displacement control".into()
+        }
+        StrainRunEvent::Finished => "strain-controlled test finished (unloaded)".into(),
+    }
+}
+
+/// A strain-controlled rig does not resume: its inputs were the correlator's fields, which a
+/// replay cannot have, so the journal of an earlier rig (if any) ends the restart (exit code
+/// [`wire::exit::CANNOT_RESUME`]) and the specimen stays unloaded. No journal: a fresh start.
+fn refuse_strain_resume(path: &Path) -> Result<Option<Journal>, ProcessError> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    Err(ProcessError::CannotResume(wire::exit::ExitWith {
+        code: wire::exit::CANNOT_RESUME,
+        message: format!(
+            "cannot resume from {}: a strain-controlled test is not replayed (its inputs were \
+             the correlator's fields); the specimen is left unloaded and the rig stopped; start \
+             a new test with a new --state-dir",
+            path.display()
+        ),
+    }))
 }
 
 /// Brings `session` to where the journal at `path` says (None: no journal, a fresh start).
@@ -620,6 +727,9 @@ pub fn to_wire(rig: &Rig, sample_id: u64) -> RigState {
         specimen_rotation_rad: s.specimen.rotation_deg.to_radians(),
         specimen_centre_offset_mm: [s.specimen.centre_x_mm, s.specimen.centre_y_mm],
         load_case: codes::load_case(rig.specimen().map(|sp| sp.config().loading)),
+        // Displacement control, no strain target, unless the session says otherwise.
+        target_log_exx: f64::NAN,
+        target_log_eyy: f64::NAN,
         ..RigState::default()
     };
     if let Some(specimen) = rig.specimen() {

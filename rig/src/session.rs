@@ -9,6 +9,9 @@ use crate::journal::{Journal, Mismatch};
 use crate::refusal::Refusal;
 use crate::rig::{Rig, RigCommand};
 use crate::snapshot::ProgramStatus;
+use crate::specimen::SpecimenConfig;
+use crate::strain::run::StrainRunError;
+use crate::strain::{ControlColumns, GaugeMeasurement, StrainRun, StrainRunEvent, StrainTest};
 use crate::{Program, RigConfig};
 
 /// Why a session could not start, go on, or resume.
@@ -36,6 +39,12 @@ pub struct Session {
     pub periods: u64,
     publish_every: u64,
     log_every: u64,
+    /// A strain-controlled test instead of a program or campaign.
+    pub strain: Option<StrainRun>,
+    /// The newest field on the rig's clock (set by the shell before each period).
+    pub newest_field: Option<GaugeMeasurement>,
+    /// What the strain test did in the periods so far (drained by the shell).
+    pub strain_events: Vec<(f64, StrainRunEvent)>,
 }
 
 /// What happened in a period that the shell reports.
@@ -65,7 +74,20 @@ impl Session {
             periods: 0,
             publish_every: publish_every.max(1),
             log_every: log_every.max(1),
+            strain: None,
+            newest_field: None,
+            strain_events: Vec::new(),
         })
+    }
+
+    /// Runs a strain-controlled test: mounts `specimen` (a cruciform) and waits for fields.
+    pub fn start_strain(
+        &mut self,
+        test: StrainTest,
+        specimen: SpecimenConfig,
+    ) -> Result<(), StrainRunError> {
+        self.strain = Some(StrainRun::new(&mut self.rig, test, specimen)?);
+        Ok(())
     }
 
     /// One publication period; the log rows of its steps are appended to `rows` (if given).
@@ -82,15 +104,29 @@ impl Session {
             }
         }
         for _ in 0..self.publish_every {
+            if let Some(strain) = self.strain.as_mut() {
+                if let Some(e) = strain.before_step(&mut self.rig, self.newest_field.as_ref()) {
+                    self.strain_events.push((self.rig.state().t_s, e));
+                }
+            }
             self.rig.step();
             if let Some(rows) = rows.as_deref_mut() {
                 if self.rig.state().step.is_multiple_of(self.log_every) {
-                    crate::log::write_csv_row(self.rig.state(), rows);
+                    let control = self.control_columns();
+                    crate::log::write_csv_row_with(self.rig.state(), &control, rows);
                 }
             }
         }
         self.periods += 1;
         Ok(event)
+    }
+
+    /// What closes the loop now and the strain target (`rig.csv`'s control columns and the
+    /// published `RigState::control_mode` / targets).
+    pub fn control_columns(&self) -> ControlColumns {
+        self.strain
+            .as_ref()
+            .map_or(ControlColumns::DISPLACEMENT, StrainRun::columns)
     }
 
     /// A program or a test is under way (running or held).
@@ -101,8 +137,11 @@ impl Session {
         )
     }
 
-    /// The campaign (or the started program) has ended.
+    /// The campaign (or the started program, or the strain test) has ended.
     pub fn done(&self, has_program: bool) -> bool {
+        if let Some(strain) = &self.strain {
+            return strain.is_done();
+        }
         match &self.campaign {
             Some(c) => c.is_done(&self.rig),
             None => has_program && !self.program_active(),

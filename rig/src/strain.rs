@@ -10,13 +10,23 @@
 //! - [`interlock`]: what makes a measurement unusable (stale, too few nodes, a jump, NaN).
 //! - [`control`]: [`StrainControl`], which drives the rig's elongation set-points, holds in
 //!   displacement on an interlock and reports why, and hands back bumplessly.
+//! - [`test`]: a strain-controlled test as configured (kind, stretch, ratio, rate, interlocks).
+//! - [`run`]: [`StrainRun`], such a test from mounting through waiting for a field and the
+//!   program to unloading, as the process runs it.
+//! - [`field_clock`]: a field's capture time on the rig's clock (by its rig sample).
 
 pub mod control;
+pub mod field_clock;
 pub mod interlock;
 pub mod outer;
 pub mod path;
+pub mod run;
+pub mod test;
 
 pub use control::{StrainControl, StrainEvent, StrainMode};
+pub use field_clock::FieldClock;
 pub use interlock::{HoldReason, InterlockLimits};
 pub use outer::{GaugeMeasurement, OuterLoop, OuterLoopConfig};
 pub use path::{StrainPath, StrainSegment};
+pub use run::{ControlColumns, StrainRun, StrainRunEvent};
+pub use test::{StrainKind, StrainTest};

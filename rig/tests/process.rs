@@ -42,6 +42,7 @@ fn state_is_published_and_commands_are_answered() {
         duration_s: Some(15.0),
         exit_when_done: false,
         state_dir: None,
+        strain: None,
     };
     let rig_thread = std::thread::spawn(move || run(options).unwrap());
 

@@ -30,12 +30,35 @@ pub struct RigArgs {
     /// ln g(I2) = Σ b_i (I2 − 3)^i, b_0,b_1,... (g in MPa; eq. 25) [default: Smactane, Table 4]
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub law_g: Option<Vec<f64>>,
-    /// Stretch rate of the built-in test (/s).
-    #[arg(long, default_value_t = 1e-3)]
+    /// Stretch rate of the built-in test (/s); under --control strain, the rate of the larger
+    /// log strain (/s).
+    #[arg(long, alias = "rate-per-s", default_value_t = 1e-3)]
     pub rate: f64,
-    /// Final stretch λ of the built-in test.
+    /// Final stretch λ of the built-in test; under --control strain, the target of the larger
+    /// measured stretch.
     #[arg(long, default_value_t = 2.0)]
     pub stretch: f64,
+    /// displacement (the grips follow the program) or strain: the correlator's `fields` close
+    /// the loop on the gauge zone's log strains (a cruciform specimen, --kind, --ratio).
+    #[arg(long, default_value = "displacement")]
+    pub control: String,
+    /// The strain path under --control strain: uniaxial (ρ = −1/2), equibiaxial (ρ = 1),
+    /// pure_shear (ρ = 0) or biaxial (--ratio).
+    #[arg(long)]
+    pub kind: Option<String>,
+    /// ρ = ln λy / ln λx held by a biaxial strain-controlled test.
+    #[arg(long, allow_hyphen_values = true)]
+    pub ratio: Option<f64>,
+    /// Strain control holds the grips when the newest field is older than this (s of rig time).
+    #[arg(long, default_value_t = rig::strain::test::DEFAULT_STALE_S)]
+    pub stale_s: f64,
+    /// Strain control holds on a field with fewer converged nodes.
+    #[arg(long, default_value_t = rig::strain::test::DEFAULT_MIN_VALID_NODES)]
+    pub min_valid_nodes: u32,
+    /// After a hold, once fields are usable again: resume the strain program, or stop
+    /// (unload) there.
+    #[arg(long, default_value = "resume")]
+    pub on_interlock: String,
     /// realtime, a factor N (N× real time) or max.
     #[arg(long, default_value = "realtime")]
     pub speed: String,
@@ -72,6 +95,7 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
     }
     let speed = Speed::parse(&args.speed)?;
     let mut config = RigConfig::default();
+    let strain = strain_test(&args)?;
     let campaign = match (&args.campaign, args.test.as_deref()) {
         (Some(spec), _) => Some(Campaign::parse(spec)?),
         (None, Some("campaign")) => Some(Campaign::paper()),
@@ -100,8 +124,11 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
             })?;
             Some(c.with_law(law))
         }
-        (None, Some(_), _) | (None, _, Some(_)) => {
-            anyhow::bail!("--law-f / --law-g apply to a campaign (--campaign or --test campaign)")
+        (None, Some(_), _) | (None, _, Some(_)) if strain.is_none() => {
+            anyhow::bail!(
+                "--law-f / --law-g apply to a campaign (--campaign or --test campaign) or a \
+                 strain-controlled test (--control strain)"
+            )
         }
         (c, _, _) => c,
     };
@@ -122,6 +149,11 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         }
         (None, None) => None,
     };
+    // The cruciform a strain-controlled test mounts, of --law-f / --law-g if given.
+    let mut strain_specimen = BuiltinTest::Equibiaxial.specimen();
+    if let Some(law) = law_of(&args)? {
+        strain_specimen.law = law;
+    }
     let options = ProcessOptions {
         instance: args.instance,
         config,
@@ -137,6 +169,10 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         duration_s: args.duration_s,
         exit_when_done: args.exit_when_done,
         state_dir: args.state_dir.clone(),
+        strain: strain.map(|test| rig::process::StrainOptions {
+            test,
+            specimen: strain_specimen,
+        }),
     };
     // The process's messages name their causes; `in_context` keeps the exit code its error
     // asks for (a results file, a journal it cannot follow).
@@ -154,4 +190,56 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         summary.limits_tripped
     );
     Ok(())
+}
+
+/// The strain-controlled test of `--control strain`, refused with the flag named.
+fn strain_test(args: &RigArgs) -> anyhow::Result<Option<rig::strain::StrainTest>> {
+    match args.control.as_str() {
+        "displacement" => {
+            if args.kind.is_some() || args.ratio.is_some() {
+                anyhow::bail!("--kind and --ratio describe a strain path: add --control strain");
+            }
+            Ok(None)
+        }
+        "strain" => {
+            if args.program.is_some() || args.test.is_some() || args.campaign.is_some() {
+                anyhow::bail!(
+                    "--control strain runs its own test (--kind, --stretch, --rate-per-s): no \
+                     --program, --test or --campaign with it"
+                );
+            }
+            let kind = args.kind.as_deref().ok_or_else(|| {
+                anyhow::anyhow!(
+                    "--control strain needs --kind: {}",
+                    rig::strain::StrainKind::NAMES
+                )
+            })?;
+            let test = rig::strain::StrainTest::new(kind, args.ratio, args.stretch, args.rate)
+                .and_then(|t| {
+                    t.with_interlocks(args.stale_s, args.min_valid_nodes, &args.on_interlock)
+                })
+                .context("--control strain")?;
+            Ok(Some(test))
+        }
+        other => anyhow::bail!("--control {other:?}: expected displacement or strain"),
+    }
+}
+
+/// The law of --law-f / --law-g (None: the specimen's own).
+fn law_of(args: &RigArgs) -> anyhow::Result<Option<identifier::law::InvariantLaw>> {
+    if args.law_f.is_none() && args.law_g.is_none() {
+        return Ok(None);
+    }
+    let smactane = identifier::law::InvariantLaw::smactane();
+    let a = args
+        .law_f
+        .clone()
+        .unwrap_or_else(|| smactane.f.coefficients().to_vec());
+    let b = args
+        .law_g
+        .clone()
+        .unwrap_or_else(|| smactane.g.coefficients().to_vec());
+    identifier::law::InvariantLaw::exp_poly(&a, &b)
+        .map(Some)
+        .map_err(|e| anyhow::anyhow!("--law-f/--law-g: {e}"))
 }

@@ -309,7 +309,7 @@ const _: () = {
 };
 const _: () = {
     assert!(
-        size_of::<RigState>() == 392,
+        size_of::<RigState>() == 408,
         "RigState changed size: bump LAYOUT_VERSION"
     );
     assert!(
@@ -381,8 +381,16 @@ const _: () = {
         "RigState::test_index moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(RigState, reserved) == 388,
-        "RigState::reserved moved: bump LAYOUT_VERSION"
+        offset_of!(RigState, control_mode) == 388,
+        "RigState::control_mode moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(RigState, target_log_exx) == 392,
+        "RigState::target_log_exx moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(RigState, target_log_eyy) == 400,
+        "RigState::target_log_eyy moved: bump LAYOUT_VERSION"
     );
 };
 const _: () = {

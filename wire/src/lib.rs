@@ -38,7 +38,7 @@ pub use frame::{FrameHeader, GroundTruth};
 pub use identification::IdentificationReport;
 #[cfg(feature = "ipc")]
 pub use instance::{Instance, InstanceError};
-pub use rig::{ActuatorState, RigCommand, RigCommandKind, RigReply, RigState};
+pub use rig::{ActuatorState, RigCommand, RigCommandKind, RigControl, RigReply, RigState};
 
 /// Version of every layout in this crate. Bump it (and the `#[type_name]` suffixes, which
 /// embed it) whenever a field changes: processes of different versions then refuse to connect

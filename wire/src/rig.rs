@@ -67,8 +67,68 @@ pub struct RigState {
     /// Which test of the running campaign (from 0; 0 without a campaign): a camera starts a
     /// new frame sequence when it changes.
     pub test_index: u32,
-    /// Always 0.
-    pub reserved: u32,
+    /// A [`RigControl`] code: what closes the loop of the running test (displacement, the
+    /// correlator's strain, or a strain test held by an interlock).
+    pub control_mode: u32,
+    /// The log strains (ln λx, ln λy) a strain-controlled test aims at this instant (also while
+    /// held: the frozen target). NaN when there is none (displacement control): read them
+    /// through [`RigState::strain_target`].
+    pub target_log_exx: f64,
+    pub target_log_eyy: f64,
+}
+
+impl RigState {
+    /// The strain target (ln λx, ln λy), when a strain-controlled test sets one (its control
+    /// mode is strain or held, and both targets are finite).
+    pub fn strain_target(&self) -> Option<[f64; 2]> {
+        let mode = RigControl::from_code(self.control_mode)?;
+        let target = [self.target_log_exx, self.target_log_eyy];
+        (mode != RigControl::Displacement && target.iter().all(|t| t.is_finite())).then_some(target)
+    }
+
+    /// The control mode, [`RigControl::Displacement`] for an unknown code.
+    pub fn control(&self) -> RigControl {
+        RigControl::from_code(self.control_mode).unwrap_or(RigControl::Displacement)
+    }
+}
+
+/// What closes the loop of the rig's running test ([`RigState::control_mode`]).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum RigControl {
+    /// The grips follow a displacement program (or nothing runs): no strain target.
+    #[default]
+    Displacement = 0,
+    /// The correlator's gauge log strains close the loop on the target.
+    Strain = 1,
+    /// A strain-controlled test held in displacement by an interlock (stale fields, too few
+    /// valid nodes, a strain jump or NaN), or waiting for its first usable field.
+    Held = 2,
+}
+
+impl RigControl {
+    pub const ALL: [RigControl; 3] = [
+        RigControl::Displacement,
+        RigControl::Strain,
+        RigControl::Held,
+    ];
+
+    pub fn from_code(code: u32) -> Option<RigControl> {
+        RigControl::ALL.into_iter().find(|c| *c as u32 == code)
+    }
+
+    /// As in `rig.csv`'s `control` column: `displacement`, `strain`, `held`.
+    pub fn name(self) -> &'static str {
+        match self {
+            RigControl::Displacement => "displacement",
+            RigControl::Strain => "strain",
+            RigControl::Held => "held",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<RigControl> {
+        RigControl::ALL.into_iter().find(|c| c.name() == name)
+    }
 }
 
 /// What a [`RigCommand`] asks for.
@@ -199,5 +259,32 @@ mod tests {
             Some(RigCommandKind::EmergencyStop)
         );
         assert_eq!(RigCommandKind::from_code(99), None);
+    }
+
+    #[test]
+    fn control_mode_codes_and_targets_round_trip() {
+        for mode in RigControl::ALL {
+            assert_eq!(RigControl::from_code(mode as u32), Some(mode));
+            assert_eq!(RigControl::parse(mode.name()), Some(mode));
+        }
+        assert_eq!(RigControl::from_code(3), None);
+        let mut state = RigState {
+            control_mode: RigControl::Strain as u32,
+            target_log_exx: 0.25,
+            target_log_eyy: -0.125,
+            ..RigState::default()
+        };
+        assert_eq!(state.strain_target(), Some([0.25, -0.125]));
+        state.control_mode = RigControl::Held as u32;
+        assert_eq!(state.control(), RigControl::Held);
+        assert_eq!(state.strain_target(), Some([0.25, -0.125]));
+        state.control_mode = RigControl::Displacement as u32;
+        assert_eq!(state.strain_target(), None);
+        state.control_mode = RigControl::Strain as u32;
+        state.target_log_eyy = f64::NAN;
+        assert_eq!(state.strain_target(), None);
+        state.control_mode = 77;
+        assert_eq!(state.control(), RigControl::Displacement);
+        assert_eq!(state.strain_target(), None);
     }
 }

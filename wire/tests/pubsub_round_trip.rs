@@ -50,10 +50,16 @@ fn frame_and_value_round_trip_then_no_leftovers() {
         let state = RigState {
             sample_id: 42,
             t_sim_s: 1.5,
+            control_mode: wire::RigControl::Held as u32,
+            target_log_exx: 0.3,
+            target_log_eyy: -0.02,
             ..RigState::default()
         };
         state_publisher.publish(state).unwrap();
-        assert_eq!(state_subscriber.receive().unwrap(), Some(state));
+        let received = state_subscriber.receive().unwrap().unwrap();
+        assert_eq!(received, state);
+        assert_eq!(received.control(), wire::RigControl::Held);
+        assert_eq!(received.strain_target(), Some([0.3, -0.02]));
         assert!(
             !instance.leftover_files().is_empty(),
             "a live instance has shared-memory files"

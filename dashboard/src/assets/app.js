@@ -305,6 +305,14 @@ function drawInvariantFunctions(id) {
   lineChart($('fg-chart'), series, { xlabel: 'invariant I1 or I2', yZero: true, empty: 'no coefficient identified yet' });
 }
 
+// Strain control: target against the newest field's gauge log strains, per axis.
+function strainText(st) {
+  if (!st) return '';
+  const axis = (k, name) => `ln λ${name} target ${fmt(st.target_log[k], 4)}` +
+    (st.measured_log ? `, measured ${fmt(st.measured_log[k], 4)} (${st.error_log[k] >= 0 ? '+' : ''}${fmt(st.error_log[k], 4)})` : '');
+  return ` <span id="rig-strain">${axis(0, 'x')}; ${axis(1, 'y')}</span>`;
+}
+
 function updateRig(r) {
   const body = $('actuators').tBodies[0];
   if (!r) { setText('rig-info', 'no rig sample yet'); return; }
@@ -317,7 +325,8 @@ function updateRig(r) {
     `hydraulics <b class="${r.hydraulics_on ? 'good' : 'bad'}">${r.hydraulics_on ? 'on' : 'off'}</b>, ` +
     `limits <b class="${r.limits_tripped ? 'bad' : 'good'}">${r.limits_tripped ? 'TRIPPED' : 'none tripped'}</b>; ` +
     `stretch ${fmt(r.stretch[0], 4)} x ${fmt(r.stretch[1], 4)}, rotation ${fmt(r.rotation_deg, 3)}°, ` +
-    `centre drift X/Y/Z ${drift} mm, specimen offset ${fmt(r.centre_offset_mm[0], 3)}, ${fmt(r.centre_offset_mm[1], 3)} mm`;
+    `centre drift X/Y/Z ${drift} mm, specimen offset ${fmt(r.centre_offset_mm[0], 3)}, ${fmt(r.centre_offset_mm[1], 3)} mm; ` +
+    `control <b id="rig-control" class="${r.control === 'held' ? 'bad' : ''}">${esc(r.control)}</b>` + strainText(r.strain);
   const h = r.history;
   lineChart($('rig-chart'), [
     { x: h.t_sim_s, y: h.stretch_x, color: SERIES_COLORS[0], label: 'λx' },

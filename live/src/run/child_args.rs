@@ -18,6 +18,35 @@ fn fmt_list(values: &[f64]) -> String {
         .join(",")
 }
 
+/// The rig's arguments of a strain-controlled test (in place of `--campaign`).
+fn strain_args(test: &rig::strain::StrainTest) -> Vec<String> {
+    let mut args = vec![
+        "--control".to_string(),
+        "strain".into(),
+        "--kind".into(),
+        test.kind.name().into(),
+    ];
+    if test.kind == rig::strain::StrainKind::Biaxial {
+        args.push(format!("--ratio={}", test.ratio));
+    }
+    args.extend([
+        "--stretch".into(),
+        test.stretch.to_string(),
+        "--rate-per-s".into(),
+        test.rate_log_per_s.to_string(),
+        "--stale-s".into(),
+        test.limits.stale_s.to_string(),
+        "--min-valid-nodes".into(),
+        test.limits.min_valid_nodes.to_string(),
+        "--on-interlock".into(),
+        match test.on_interlock {
+            rig::strain::control::OnRestore::Resume => "resume".into(),
+            rig::strain::control::OnRestore::Stop => "stop".into(),
+        },
+    ]);
+    args
+}
+
 /// The command line of each child. `first_frame_id` is where the camera's frame ids start
 /// (past the last id seen when a camera is restarted, so ids never go back).
 pub fn child_args(
@@ -37,25 +66,30 @@ pub fn child_args(
         Role::Producer if config.camera_source() != CameraSource::Simulated => {
             real_camera_args(config, results, first_frame_id)
         }
-        Role::Rig => vec![
-            "--campaign".into(),
-            config.campaign_spec(),
-            format!("--law-f={}", fmt_list(&config.specimen.law_f)),
-            format!("--law-g={}", fmt_list(&config.specimen.law_g)),
-            "--speed".into(),
-            g.speed.to_string(),
-            "--publish-hz".into(),
-            g.publish_hz.to_string(),
-            "--log".into(),
-            path(results.rig_csv()),
-            "--log-hz".into(),
-            g.log_hz.to_string(),
-            "--seed".into(),
-            g.seed.to_string(),
-            "--state-dir".into(),
-            path(results.rig_state()),
-            "--exit-when-done".into(),
-        ],
+        Role::Rig => [
+            match config.strain_test() {
+                Ok(Some(test)) => strain_args(&test),
+                _ => vec!["--campaign".into(), config.campaign_spec()],
+            },
+            vec![
+                format!("--law-f={}", fmt_list(&config.specimen.law_f)),
+                format!("--law-g={}", fmt_list(&config.specimen.law_g)),
+                "--speed".into(),
+                g.speed.to_string(),
+                "--publish-hz".into(),
+                g.publish_hz.to_string(),
+                "--log".into(),
+                path(results.rig_csv()),
+                "--log-hz".into(),
+                g.log_hz.to_string(),
+                "--seed".into(),
+                g.seed.to_string(),
+                "--state-dir".into(),
+                path(results.rig_state()),
+                "--exit-when-done".into(),
+            ],
+        ]
+        .concat(),
         Role::Producer => vec![
             "--follow-rig".into(),
             "--fps".into(),
@@ -261,6 +295,29 @@ mod tests {
         assert_eq!(value(&args, "--speed"), "4");
         assert_eq!(value(&args, "--seed"), "11");
         assert_eq!(value(&args, "--log"), "/results/run/rig.csv");
+        assert_eq!(value(&args, "--state-dir"), "/results/run/rig_state");
+        assert_eq!(args.last().map(String::as_str), Some("--exit-when-done"));
+    }
+
+    #[test]
+    fn a_strain_controlled_test_gives_the_rig_its_strain_flags_instead_of_a_campaign() {
+        let config = RunConfig::from_toml(
+            "[[rig.tests]]\nkind = \"biaxial\"\ncontrol = \"strain\"\nratio = 0.5\n\
+             stretch = 1.6\nrate_per_s = 0.02\non_interlock = \"stop\"\nstale_s = 0.8\n",
+            "t.toml",
+        )
+        .unwrap();
+        config.validate().unwrap();
+        let args = args(Role::Rig, &config, 0);
+        assert!(!args.contains(&"--campaign".to_string()), "{args:?}");
+        assert_eq!(value(&args, "--control"), "strain");
+        assert_eq!(value(&args, "--kind"), "biaxial");
+        assert!(args.contains(&"--ratio=0.5".to_string()), "{args:?}");
+        assert_eq!(value(&args, "--stretch"), "1.6");
+        assert_eq!(value(&args, "--rate-per-s"), "0.02");
+        assert_eq!(value(&args, "--stale-s"), "0.8");
+        assert_eq!(value(&args, "--min-valid-nodes"), "16");
+        assert_eq!(value(&args, "--on-interlock"), "stop");
         assert_eq!(value(&args, "--state-dir"), "/results/run/rig_state");
         assert_eq!(args.last().map(String::as_str), Some("--exit-when-done"));
     }

@@ -69,6 +69,10 @@ pub fn rig_state(
         specimen_section_x_mm2: sections_mm2[0],
         specimen_section_y_mm2: sections_mm2[1],
         hydraulics_on: 1,
+        // A followed machine log is displacement data: no strain target.
+        control_mode: wire::RigControl::Displacement as u32,
+        target_log_exx: f64::NAN,
+        target_log_eyy: f64::NAN,
         ..RigState::default()
     };
     for axis in 0..3 {
@@ -116,5 +120,8 @@ mod tests {
         assert_eq!((s.sample_id, s.t_sim_s, s.t_published_ns), (7, 2.5, 42));
         assert_eq!(s.axis_elongation_mm[0], 3.0);
         assert_eq!(s.specimen_section_x_mm2, 40.0);
+        assert_eq!(s.control(), wire::RigControl::Displacement);
+        assert_eq!(s.strain_target(), None);
+        assert!(s.target_log_exx.is_nan() && s.target_log_eyy.is_nan());
     }
 }

@@ -280,8 +280,19 @@ impl StrainControl {
                             }
                             OnRestore::Resume => {
                                 if self.outer.reset_to(m) {
-                                    // Bumpless: the model now gives the held position; the
-                                    // target walks on from where it was held.
+                                    // Bumpless: the model now gives the held position, and
+                                    // the program goes on from the point of its path nearest
+                                    // the state now (the re-anchored model at the present
+                                    // elongations: `m` may predate the freeze by a latency),
+                                    // not from the target frozen at the hold, a latency of
+                                    // travel ahead, that the grips would lurch to. On the
+                                    // path, so a constant-ratio test keeps its ratio.
+                                    let now_u = self.outer.nominal_log_strain(elongations(rig));
+                                    let state = self.outer.predict(now_u);
+                                    self.program_t_s =
+                                        self.path.time_nearest(self.start, self.program_t_s, state);
+                                    self.target = self.path.target(self.start, self.program_t_s);
+                                    self.setpoint_mm = elongations(rig);
                                     self.mode = StrainMode::Strain;
                                     return Some(StrainEvent::Resumed);
                                 }

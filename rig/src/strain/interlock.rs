@@ -16,7 +16,7 @@ pub struct InterlockLimits {
 impl Default for InterlockLimits {
     fn default() -> Self {
         InterlockLimits {
-            stale_s: 0.5,
+            stale_s: crate::strain::test::DEFAULT_STALE_S,
             min_valid_nodes: 16,
             jump_log: 0.03,
         }

@@ -159,14 +159,16 @@ impl OuterLoop {
     }
 
     /// Bumpless (re)start: b such that the model gives the measurement at its capture; the
-    /// gains learnt so far are kept.
+    /// gains learnt so far are kept, and enter b (g k̂ u, as [`OuterLoop::predict`] has it: a
+    /// re-anchor after a hold mid-ramp, with g ≠ 1 learnt, must not shift the model by
+    /// (g − 1) k̂ u).
     pub fn reset_to(&mut self, m: &GaugeMeasurement) -> bool {
         let Some(u) = self.nominal_at(m.t_capture_s) else {
             return false;
         };
         for i in 0..2 {
             self.offset[i] = m.log_strain[i]
-                - self.config.model_fraction[i] * u[i]
+                - self.gain[i] * self.config.model_fraction[i] * u[i]
                 - self.config.model_cross * u[1 - i];
         }
         true

@@ -127,6 +127,38 @@ impl StrainPath {
         total
     }
 
+    /// The program time, in the segment under way at `t_s` (from `start`), whose target is
+    /// nearest to `state`: where the program stands for a specimen at `state`. A ramp is
+    /// projected onto (clamped to its ends); a hold keeps `t_s`. A resume goes on from there,
+    /// on the path (its ratio kept) and at the state reached, not at a target frozen ahead.
+    pub fn time_nearest(&self, start: [f64; 2], t_s: f64, state: [f64; 2]) -> f64 {
+        let mut at = start;
+        let mut begin_s = 0.0;
+        let t = t_s.max(0.0);
+        for s in &self.segments {
+            let d = segment_duration_s(s, at);
+            if t < begin_s + d {
+                return match *s {
+                    StrainSegment::Ramp { to_log, .. } => {
+                        let dir = [to_log[0] - at[0], to_log[1] - at[1]];
+                        let norm = dir[0] * dir[0] + dir[1] * dir[1];
+                        if norm <= 0.0 {
+                            return t;
+                        }
+                        let f = ((state[0] - at[0]) * dir[0] + (state[1] - at[1]) * dir[1]) / norm;
+                        begin_s + f.clamp(0.0, 1.0) * d
+                    }
+                    StrainSegment::Hold { .. } => t,
+                };
+            }
+            if let StrainSegment::Ramp { to_log, .. } = *s {
+                at = to_log;
+            }
+            begin_s += d;
+        }
+        t
+    }
+
     /// Target (ln λx, ln λy) at program time `t_s` from `start`; after the end, the last one.
     pub fn target(&self, start: [f64; 2], t_s: f64) -> [f64; 2] {
         let mut at = start;
@@ -169,6 +201,22 @@ fn segment_duration_s(s: &StrainSegment, from: [f64; 2]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_state_is_placed_on_the_path_by_projection() {
+        let path = StrainPath::ratio_path(1.0, 1.5, 0.02).unwrap();
+        let start = [0.0, 0.0];
+        // In the first hold: the time stays.
+        assert_eq!(path.time_nearest(start, 0.25, [0.3, 0.3]), 0.25);
+        // On the ramp, held at t = 6 s (target 0.1): a state behind (0.094, 0.096) projects
+        // to 0.095, 0.25 s earlier; one off the line keeps the ratio of the path.
+        let t = path.time_nearest(start, 6.0, [0.094, 0.096]);
+        assert!((t - (1.0 + 0.095 / 0.02)).abs() < 1e-9, "{t}");
+        let target = path.target(start, t);
+        assert_eq!(target[0], target[1]);
+        // Clamped to the ramp's ends.
+        assert_eq!(path.time_nearest(start, 6.0, [-1.0, -1.0]), 1.0);
+    }
 
     #[test]
     fn a_ratio_path_keeps_its_ratio_and_ends_at_the_stretch() {

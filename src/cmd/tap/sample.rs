@@ -114,15 +114,22 @@ impl LastSample {
                     d[3]
                 )
             }
-            LastSample::Rig { state } => format!(
-                "rig sample {}: t_sim {:.3} s, stretch x {:.4} y {:.4}, force X {:.4} kN Y {:.4} kN",
-                state.sample_id,
-                state.t_sim_s,
-                state.specimen_stretch_x,
-                state.specimen_stretch_y,
-                axis_force_kn(state, 0),
-                axis_force_kn(state, 1)
-            ),
+            LastSample::Rig { state } => {
+                let mut line = format!(
+                    "rig sample {}: t_sim {:.3} s, stretch x {:.4} y {:.4}, force X {:.4} kN Y {:.4} kN, control {}",
+                    state.sample_id,
+                    state.t_sim_s,
+                    state.specimen_stretch_x,
+                    state.specimen_stretch_y,
+                    axis_force_kn(state, 0),
+                    axis_force_kn(state, 1),
+                    state.control().name()
+                );
+                if let Some([x, y]) = state.strain_target() {
+                    line.push_str(&format!(", target ln λ x {x:.4} y {y:.4}"));
+                }
+                line
+            }
             LastSample::Identification { report } => {
                 let coefficients = |values: &[f64], count: u32| {
                     values[..(count as usize).min(values.len())]
@@ -194,6 +201,9 @@ impl LastSample {
                 "stretch_y": state.specimen_stretch_y,
                 "force_x_kn": axis_force_kn(state, 0),
                 "force_y_kn": axis_force_kn(state, 1),
+                "control": state.control().name(),
+                // null under displacement control.
+                "target_log": state.strain_target(),
             }),
             LastSample::Identification { report } => json!({
                 "frame_id": report.frame_id,
@@ -203,5 +213,41 @@ impl LastSample {
                 "rms_mpa": report.rms_mpa,
             }),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_rig_sample_shows_its_control_mode_and_strain_target() {
+        let displacement = LastSample::Rig {
+            state: RigState {
+                target_log_exx: f64::NAN,
+                target_log_eyy: f64::NAN,
+                ..RigState::default()
+            },
+        };
+        assert!(displacement.line().ends_with(", control displacement"));
+        let json = displacement.json();
+        assert_eq!(json["control"], "displacement");
+        assert!(json["target_log"].is_null());
+        let strain = LastSample::Rig {
+            state: RigState {
+                control_mode: wire::RigControl::Strain as u32,
+                target_log_exx: 0.25,
+                target_log_eyy: 0.125,
+                ..RigState::default()
+            },
+        };
+        assert!(
+            strain
+                .line()
+                .ends_with(", control strain, target ln λ x 0.2500 y 0.1250"),
+            "{}",
+            strain.line()
+        );
+        assert_eq!(strain.json()["target_log"], json!([0.25, 0.125]));
     }
 }
