@@ -425,6 +425,9 @@ fn independent_images() {
     }
 }
 
+/// A case's name, reference and deformed pixels, and the affine motion (F, t) between them.
+type ImagePair = (String, Vec<u16>, Vec<u16>, [[f64; 2]; 2], [f64; 2]);
+
 /// Convergence on images of varied speckle size, noise (0.5 to 3 %), bit depth (8, 10, 12, 16)
 /// and contrast (the independent generator, and the product's renderer at 1 to 3 % noise),
 /// under a sub-pixel translation and a 10 % stretch, at 13, 21 and 33 px: the share of
@@ -490,7 +493,7 @@ fn convergence_on_varied_images() {
         ("translation", [[1.0, 0.0], [0.0, 1.0]], [0.43, -0.27]),
         ("10 % stretch", [[1.1, 0.0], [0.0, 1.0]], [0.0, 0.0]),
     ];
-    let mut images: Vec<(String, Vec<u16>, Vec<u16>, [[f64; 2]; 2], [f64; 2])> = Vec::new();
+    let mut images: Vec<ImagePair> = Vec::new();
     for (name, pattern) in patterns {
         let reference = render_independent(&pattern, SIZE, SIZE, &|x| x, 1);
         for (motion, f, t) in motions {
