@@ -20,7 +20,10 @@
 //! Loading branch only: states are grouped into paths by their direction in the log-strain
 //! plane, θ = atan2(ln λy, ln λx), a state joining the nearest path within
 //! [`OnlineConfig::path_tolerance_rad`] of the path's newest state (or opening a new one, at most
-//! [`OnlineConfig::max_paths`]); it is kept when its larger stretch exceeds the last kept one of
+//! [`OnlineConfig::max_paths`]); a state whose largest |ln λ| is below
+//! [`OnlineConfig::min_log_strain`] is not a loading point (`NotStretched`): its direction is
+//! the gauge's noise, and such states at rest, before each test, used to open a path each
+//! until no path was left for the next test's real one. A state is kept when its larger stretch exceeds the last kept one of
 //! its path by [`OnlineConfig::min_stretch_increment`] (unloading and reloading below the
 //! maximum reached are skipped, as the Mullins effect makes them another material).
 //!
@@ -74,6 +77,9 @@ pub struct OnlineConfig {
     pub path_tolerance_rad: f64,
     /// Paths kept at most (a state opening one more is refused, counted).
     pub max_paths: usize,
+    /// Largest |ln λ| below which a state is not a loading point (its direction in the
+    /// log-strain plane would be the gauge's noise).
+    pub min_log_strain: f64,
     pub min_stretch_increment: f64,
     /// States per path kept at most (later ones are refused, counted).
     pub max_points_per_path: usize,
@@ -91,6 +97,7 @@ impl Default for OnlineConfig {
             classify_tolerance: 0.15,
             path_tolerance_rad: 0.05,
             max_paths: 8,
+            min_log_strain: 5e-3,
             min_stretch_increment: 2e-3,
             max_points_per_path: 2000,
             models: vec![
@@ -361,6 +368,10 @@ impl OnlineIdentifier {
         if state.check().is_err() {
             return Err(SkipReason::BadSection);
         }
+        let largest_log_strain = state.stretch1.ln().abs().max(state.stretch2.ln().abs());
+        if largest_log_strain < self.config.min_log_strain {
+            return Err(SkipReason::NotStretched);
+        }
         let Some(ratio) = state.path_ratio() else {
             return Err(SkipReason::NotStretched);
         };
@@ -542,6 +553,43 @@ mod tests {
             sample_id += 1;
         }
         sample_id
+    }
+
+    /// Fields at rest before each test (the gauge's noise, |ln λ| ~ 1e-5 in every direction)
+    /// open no path: the equibiaxial test after a uniaxial one still has its path (they used
+    /// to open one each, until `max_paths` refused the equibiaxial states).
+    #[test]
+    fn noise_at_rest_opens_no_path() {
+        let mut id = OnlineIdentifier::new(OnlineConfig::default());
+        let mut sample_id = 1;
+        let at_rest = |id: &mut OnlineIdentifier, sample_id: &mut u64| {
+            for k in 0..20 {
+                let angle = k as f64 * 2.4;
+                id.push_rig(RigSample {
+                    sample_id: *sample_id,
+                    t_ns: *sample_id * 1000,
+                    force_x_n: 0.1,
+                    force_y_n: 0.1,
+                    section_x_mm2: 40.0,
+                    section_y_mm2: 40.0,
+                });
+                let outcome = id.push_field(FieldSample {
+                    frame_id: *sample_id,
+                    rig_sample_id: *sample_id,
+                    t_capture_ns: *sample_id * 1000,
+                    log_strain_xx: 2e-5 * angle.cos(),
+                    log_strain_yy: 2e-5 * angle.sin(),
+                });
+                assert_eq!(outcome, FieldOutcome::Skipped(SkipReason::NotStretched));
+                *sample_id += 1;
+            }
+        };
+        at_rest(&mut id, &mut sample_id);
+        sample_id = simulate(&mut id, LoadCase::Uniaxial, 2.0, sample_id);
+        at_rest(&mut id, &mut sample_id);
+        simulate(&mut id, LoadCase::Equibiaxial, 1.8, sample_id);
+        assert_eq!(id.point_counts(), [40, 40, 0]);
+        assert_eq!(id.counters.skipped, 40);
     }
 
     #[test]
