@@ -309,20 +309,10 @@ impl OnlineIdentifier {
         let outcome = match (found, newest) {
             (Some(rig), _) => self.accept(field, rig),
             (None, Some(newest)) if field.rig_sample_id > newest => {
-                if self.pending.len() == self.config.pending_fields {
-                    self.pending.pop_front();
-                    self.counters.dropped += 1;
-                }
-                self.pending.push_back(field);
-                return FieldOutcome::Pending;
+                return self.queue(field);
             }
             (None, None) => {
-                if self.pending.len() == self.config.pending_fields {
-                    self.pending.pop_front();
-                    self.counters.dropped += 1;
-                }
-                self.pending.push_back(field);
-                return FieldOutcome::Pending;
+                return self.queue(field);
             }
             (None, Some(_)) => FieldOutcome::Dropped,
         };
