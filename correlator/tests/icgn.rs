@@ -72,7 +72,9 @@ fn sample5_bias_and_std_at_33_px() {
     }
 }
 
-/// RMS of u − command over 150 <= x <= 1900 for L1, L3, L5 (step 8 px over the whole image).
+/// RMS of u − command over 150 <= x <= 1900 for L1, L3, L5 (step 8 px over the whole image),
+/// beside the noise floor of the images (the same subsets measuring no motion through noise of
+/// the images' own variance).
 #[test]
 fn sample14_chirp_rms_at_33_px() {
     let Some(dir) = shared_data("dic-challenge/sample14") else {
@@ -137,10 +139,70 @@ fn sample14_chirp_rms_at_33_px() {
     for line in &band_lines {
         println!("{line}");
     }
-    // The target is 0.011 px; first-order IC-GN at 33 px measures 0.0120, 0.0121 and
-    // 0.0128 px here (as OpenCorr's IC-GN does: 0.0122 to 0.0139 px): the random error of one
-    // subset of this size on these images, which neither the interpolation (cubic, OMOMS,
-    // quintic) nor a Gaussian pre-filter lowered. This bound guards what is reached.
+    // The floor of the images' noise: the chirp starts at x = 100, so left of it the deformed
+    // image differs from the reference by its noise alone. The reference plus white noise of
+    // that variance, correlated at zero displacement, has the random error of one subset of
+    // this size on this speckle and noise, with no displacement to follow.
+    let variance = |deformed: &[u16]| {
+        let d: Vec<f64> = (0..h)
+            .flat_map(|y| (8..92).map(move |x| y * w + x))
+            .map(|i| deformed[i] as f64 - reference[i] as f64)
+            .collect();
+        let (_, std) = mean_std(&d);
+        std * std
+    };
+    let noise_variance = ["L1", "L3", "L5"]
+        .iter()
+        .map(|v| variance(&load(dir.join(format!("Sample14 {v} Amp0.1b.tif"))).0))
+        .sum::<f64>()
+        / 3.0;
+    let noisy = common::independent::with_white_noise(&reference, noise_variance.sqrt(), 255, 5);
+    let s = CorrelatorSettings {
+        roi: Some(Roi {
+            x_px: 0,
+            y_px: 0,
+            width_px: w,
+            height_px: h,
+        }),
+        ..settings(Method::Icgn1, 33, 8)
+    };
+    let mut correlator = Correlator::new(s, w, h).unwrap();
+    correlator.set_reference(&reference).unwrap();
+    let field = correlator.correlate(&noisy).unwrap();
+    let band_rms = |x0: f64, x1: f64| {
+        let e: Vec<f64> = field
+            .nodes
+            .iter()
+            .filter(|n| n.status == NodeStatus::Ok && (x0..=x1).contains(&n.x_px))
+            .map(|n| n.u_px)
+            .collect();
+        (e.iter().map(|e| e * e).sum::<f64>() / e.len().max(1) as f64).sqrt()
+    };
+    let floor = band_rms(150.0, 1900.0);
+    let bands: Vec<String> = (0..7)
+        .map(|b| {
+            format!(
+                " {:.4} |",
+                band_rms(150.0 + 250.0 * b as f64, 399.999 + 250.0 * b as f64)
+            )
+        })
+        .collect();
+    println!(
+        "| noise floor: reference + white noise of var(g - f, x < 92) = {noise_variance:.2} counts², no motion, icgn1 @ 33 | {floor:.4} |"
+    );
+    println!("| noise floor per band |{}", bands.concat());
+    // The target is 0.011 px; first-order IC-GN at 33 px measures 0.0119 to 0.0129 px
+    // here (OpenCorr's IC-GN: 0.0122 to 0.0139 px). That is the noise floor of one subset of
+    // this size on these images (about 0.012 px, printed above, rising from 0.010 px on the
+    // left to 0.015 px on the right, where the speckle's contrast is lower): no subset of 33 px
+    // follows the chirp better than it measures no motion at all. Neither the interpolation
+    // (cubic, OMOMS, quintic) nor a Gaussian pre-filter lowered it. The test guards that IC-GN
+    // stays within 10 % of that floor.
+    assert!(floor > 0.0 && floor.is_finite(), "floor {floor}");
+    assert!(
+        worst <= 1.1 * floor,
+        "largest RMS {worst} px, floor {floor} px"
+    );
     assert!(worst <= 0.013, "largest RMS {worst} px");
 }
 
@@ -381,13 +443,7 @@ fn independent_images() {
         ("5 px dots, 8 bit, 1 %", IndependentSpeckle::default()),
         (
             "3 px dots, 12 bit, 0.5 %",
-            IndependentSpeckle {
-                dot_diameter_px: 3.0,
-                bit_depth: 12,
-                read_noise: 0.005,
-                seed: 11,
-                ..IndependentSpeckle::default()
-            },
+            IndependentSpeckle::fine_12_bit(),
         ),
     ] {
         let reference = render_independent(&pattern, SIZE, SIZE, &|x| x, 1);
@@ -445,48 +501,19 @@ fn convergence_on_varied_images() {
         ("5 px dots, 8 bit, 1 %", base),
         (
             "3 px dots, 12 bit, 0.5 %",
-            IndependentSpeckle {
-                dot_diameter_px: 3.0,
-                bit_depth: 12,
-                read_noise: 0.005,
-                seed: 11,
-                ..base
-            },
+            IndependentSpeckle::fine_12_bit(),
         ),
         (
             "9 px dots, 16 bit, shot noise",
-            IndependentSpeckle {
-                dot_diameter_px: 9.0,
-                bit_depth: 16,
-                read_noise: 0.002,
-                shot_noise: 1e-4,
-                blur_sigma_px: 1.2,
-                seed: 12,
-                ..base
-            },
+            IndependentSpeckle::coarse_16_bit_shot_noise(),
         ),
         (
             "5 px dots, 8 bit, low contrast, 3 %",
-            IndependentSpeckle {
-                background: 0.55,
-                dot: 0.35,
-                read_noise: 0.03,
-                seed: 13,
-                ..base
-            },
+            IndependentSpeckle::low_contrast_8_bit(),
         ),
         (
             "bright 6 px dots on dark, 10 bit, 2 %",
-            IndependentSpeckle {
-                dot_diameter_px: 6.0,
-                background: 0.1,
-                dot: 0.9,
-                bit_depth: 10,
-                coverage: 0.35,
-                read_noise: 0.02,
-                seed: 14,
-                ..base
-            },
+            IndependentSpeckle::bright_on_dark_10_bit(0.02),
         ),
     ];
     let motions = [

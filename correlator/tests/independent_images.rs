@@ -106,50 +106,22 @@ fn cases() -> Vec<Case> {
         },
         Case {
             name: "3 px dots, 12 bit, 0.5 % noise",
-            pattern: IndependentSpeckle {
-                dot_diameter_px: 3.0,
-                bit_depth: 12,
-                read_noise: 0.005,
-                seed: 11,
-                ..base
-            },
+            pattern: IndependentSpeckle::fine_12_bit(),
             margins: [m(0.03, 0.9), m(0.012, 0.9)],
         },
         Case {
             name: "9 px dots, 16 bit, shot noise",
-            pattern: IndependentSpeckle {
-                dot_diameter_px: 9.0,
-                bit_depth: 16,
-                read_noise: 0.002,
-                shot_noise: 1e-4,
-                blur_sigma_px: 1.2,
-                seed: 12,
-                ..base
-            },
+            pattern: IndependentSpeckle::coarse_16_bit_shot_noise(),
             margins: [m(0.03, 0.9), m(0.012, 0.9)],
         },
         Case {
             name: "5 px dots, 8 bit, low contrast, 3 % noise",
-            pattern: IndependentSpeckle {
-                background: 0.55,
-                dot: 0.35,
-                read_noise: 0.03,
-                seed: 13,
-                ..base
-            },
+            pattern: IndependentSpeckle::low_contrast_8_bit(),
             margins: [m(0.12, 0.9), m(0.09, 0.7)],
         },
         Case {
             name: "bright 6 px dots on dark, 10 bit",
-            pattern: IndependentSpeckle {
-                dot_diameter_px: 6.0,
-                background: 0.1,
-                dot: 0.9,
-                bit_depth: 10,
-                coverage: 0.35,
-                seed: 14,
-                ..base
-            },
+            pattern: IndependentSpeckle::bright_on_dark_10_bit(base.read_noise),
             margins: [m(0.03, 0.9), m(0.012, 0.9)],
         },
     ]

@@ -91,6 +91,59 @@ impl IndependentSpeckle {
     }
 }
 
+/// The varied patterns the accuracy tests share, beside the default (5 px dark dots on a
+/// bright background, 8 bit, 1 % read noise).
+impl IndependentSpeckle {
+    /// 3 px dots, 12 bit, 0.5 % read noise.
+    pub fn fine_12_bit() -> Self {
+        Self {
+            dot_diameter_px: 3.0,
+            bit_depth: 12,
+            read_noise: 0.005,
+            seed: 11,
+            ..Self::default()
+        }
+    }
+
+    /// 9 px dots seen through a 1.2 px blur, 16 bit, shot noise.
+    pub fn coarse_16_bit_shot_noise() -> Self {
+        Self {
+            dot_diameter_px: 9.0,
+            bit_depth: 16,
+            read_noise: 0.002,
+            shot_noise: 1e-4,
+            blur_sigma_px: 1.2,
+            seed: 12,
+            ..Self::default()
+        }
+    }
+
+    /// 5 px dots, 8 bit, contrast 20 % of full scale, 3 % read noise.
+    pub fn low_contrast_8_bit() -> Self {
+        Self {
+            background: 0.55,
+            dot: 0.35,
+            read_noise: 0.03,
+            seed: 13,
+            ..Self::default()
+        }
+    }
+
+    /// Bright 6 px dots on a dark background (35 % coverage), 10 bit, `read_noise`.
+    pub fn bright_on_dark_10_bit(read_noise: f64) -> Self {
+        Self {
+            dot_diameter_px: 6.0,
+            background: 0.1,
+            dot: 0.9,
+            bit_depth: 10,
+            coverage: 0.35,
+            read_noise,
+            seed: 14,
+            ..Self::default()
+        }
+    }
+}
+
 /// Sub-squares per pixel side for the area integration (a power of two).
 pub const SUBSAMPLES: usize = 8;
 const _: () = assert!(SUBSAMPLES.is_power_of_two());
@@ -654,4 +707,18 @@ impl SplitMix {
         let (u, v) = (self.uniform(), self.uniform());
         (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
     }
+}
+
+/// `pixels` plus white Gaussian noise of standard deviation `sigma_counts`, rounded and clipped
+/// to `0..=full_scale`: the noise of this generator, for images it did not render.
+pub fn with_white_noise(pixels: &[u16], sigma_counts: f64, full_scale: u16, seed: u64) -> Vec<u16> {
+    pixels
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            let mut rng = SplitMix(mix(seed ^ mix(i as u64)));
+            let g = p as f64 + sigma_counts * rng.normal();
+            g.round().clamp(0.0, full_scale as f64) as u16
+        })
+        .collect()
 }
