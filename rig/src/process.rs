@@ -100,17 +100,15 @@ pub enum ProcessError {
     Command { port: &'static str, detail: String },
     #[error("{0}")]
     File(#[from] wire::files::FileError),
-    #[error(
-        "stopped by {signal} at t = {t_s:.3} s, before the {what} finished{}",
-        .journal.as_ref().map(|path| format!(" (a restart resumes from {})", path.display())).unwrap_or_default()
-    )]
+    #[error("stopped by {signal} at t = {t_s:.3} s, before the {what} finished{restart}")]
     Stopped {
         /// The signal's name (SIGTERM, ...).
         signal: String,
         t_s: f64,
-        /// `campaign` or `program`.
+        /// `campaign`, `program` or `strain-controlled test`.
         what: &'static str,
-        journal: Option<PathBuf>,
+        /// What a restart does, in parentheses (empty without a journal).
+        restart: String,
     },
 }
 
@@ -474,17 +472,18 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
     if let Some(signal) = stopped_by {
         if options.exit_when_done && !session.done(options.program.is_some()) {
             // Not "done": a supervisor must not read this stop as the end of the campaign.
+            let strain = session.campaign.is_none() && session.strain.is_some();
             return Err(ProcessError::Stopped {
                 signal: wire::signals::name(signal),
                 t_s: summary.simulated_s,
                 what: if session.campaign.is_some() {
                     "campaign"
-                } else if session.strain.is_some() {
+                } else if strain {
                     "strain-controlled test"
                 } else {
                     "program"
                 },
-                journal: journal_path,
+                restart: restart_note(journal_path.as_deref(), strain),
             });
         }
     }
@@ -506,6 +505,20 @@ fn settings_fingerprint(options: &ProcessOptions) -> u64 {
         options.log_hz,
         options.strain
     ))
+}
+
+/// What a restart after a stop does, for the stop's message: a campaign or program resumes from
+/// its journal; a strain-controlled test is never resumed ([`refuse_strain_resume`]).
+fn restart_note(journal: Option<&Path>, strain: bool) -> String {
+    match journal {
+        None => String::new(),
+        Some(path) if strain => format!(
+            " (a restart with {} is refused: a strain-controlled test is not replayed; start a \
+             new test with a new --state-dir)",
+            path.display()
+        ),
+        Some(path) => format!(" (a restart resumes from {})", path.display()),
+    }
 }
 
 /// What the strain test did, for stderr.
@@ -758,4 +771,23 @@ pub fn to_wire(rig: &Rig, sample_id: u64) -> RigState {
         state.axis_elongation_mm[axis.index()] = s.axes[axis.index()].elongation_mm;
     }
     state
+}
+
+#[cfg(test)]
+mod tests {
+    use super::restart_note;
+    use std::path::Path;
+
+    #[test]
+    fn a_stop_says_what_a_restart_does() {
+        let journal = Path::new("/r/rig.journal");
+        assert_eq!(restart_note(None, false), "");
+        assert_eq!(
+            restart_note(Some(journal), false),
+            " (a restart resumes from /r/rig.journal)"
+        );
+        let strain = restart_note(Some(journal), true);
+        assert!(strain.contains("is refused"), "{strain}");
+        assert!(!strain.contains("resumes"), "{strain}");
+    }
 }
