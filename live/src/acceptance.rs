@@ -245,17 +245,24 @@ impl Acceptance {
     }
 }
 
+/// The specimen's law and its coefficients (ln f, ln g): an identification that found it.
+#[cfg(test)]
+pub(crate) fn true_law() -> (InvariantLaw, Vec<f64>, Vec<f64>) {
+    let truth = InvariantLaw::smactane();
+    let (a, b) = (
+        truth.f.coefficients().to_vec(),
+        truth.g.coefficients().to_vec(),
+    );
+    (truth, a, b)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn a_strain_path_is_compared_on_both_stresses_along_its_ratio() {
-        let truth = InvariantLaw::smactane();
-        let (a, b) = (
-            truth.f.coefficients().to_vec(),
-            truth.g.coefficients().to_vec(),
-        );
+        let (truth, a, b) = true_law();
         for ratio in [0.0, 0.5, -0.5, 2.0] {
             let ok = accept_path(&truth, &a, &b, "biaxial", ratio, 1.8);
             assert!(ok.passed, "{ok:?}");
@@ -277,11 +284,7 @@ mod tests {
 
     #[test]
     fn the_verdict_line_names_what_was_compared_and_the_limit() {
-        let truth = InvariantLaw::smactane();
-        let (a, b) = (
-            truth.f.coefficients().to_vec(),
-            truth.g.coefficients().to_vec(),
-        );
+        let (truth, a, b) = true_law();
         // A pure-shear path: named with its ratio, no "not tested" uniaxial/equibiaxial.
         let ok = accept_path(&truth, &a, &b, "pure_shear", 0.0, 1.5);
         let line = ok.verdict_line();
@@ -344,9 +347,7 @@ mod tests {
 
     #[test]
     fn the_true_law_passes_and_a_stiffer_one_fails() {
-        let truth = InvariantLaw::smactane();
-        let a = truth.f.coefficients().to_vec();
-        let b = truth.g.coefficients().to_vec();
+        let (truth, a, b) = true_law();
         let ok = accept(&truth, &a, &b, Some(3.0), Some(2.0));
         assert!(ok.passed, "{ok:?}");
         assert!(ok.uniaxial.unwrap().max_relative_error < 1e-12);

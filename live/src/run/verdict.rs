@@ -57,8 +57,7 @@ pub(super) fn verdict(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::acceptance::{accept, accept_path};
-    use identifier::law::InvariantLaw;
+    use crate::acceptance::{accept, accept_path, true_law};
 
     fn completed(acceptance: Option<&Acceptance>, skipped: bool) -> (Option<String>, u8) {
         verdict(Ending::Completed, None, acceptance, skipped, 0, None, &[])
@@ -66,11 +65,7 @@ mod tests {
 
     #[test]
     fn a_strain_path_decides_a_completed_run() {
-        let truth = InvariantLaw::smactane();
-        let (a, b) = (
-            truth.f.coefficients().to_vec(),
-            truth.g.coefficients().to_vec(),
-        );
+        let (truth, a, b) = true_law();
         let ok = accept_path(&truth, &a, &b, "pure_shear", 0.0, 1.5);
         assert_eq!(completed(Some(&ok), false), (None, exit_code::PASSED));
         // f 10 % stiffer: the path's error is past the tolerance, the run is doubtful.
@@ -84,11 +79,7 @@ mod tests {
 
     #[test]
     fn an_acceptance_that_tested_nothing_is_said_and_doubtful() {
-        let truth = InvariantLaw::smactane();
-        let (a, b) = (
-            truth.f.coefficients().to_vec(),
-            truth.g.coefficients().to_vec(),
-        );
+        let (truth, a, b) = true_law();
         for nothing in [
             accept(&truth, &a, &b, None, None),
             accept_path(&truth, &a, &b, "biaxial", 0.5, 1.0),
