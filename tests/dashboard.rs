@@ -352,10 +352,20 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
         (fields(&monitor_addr).as_u64() > seen.as_u64()).then_some(())
     });
     // The identified law appears (f's coefficients only: the test is uniaxial), on enough
-    // points for a meaningful screenshot.
+    // points for a meaningful screenshot: 40 stretch increments of 0.002 of a ramp to 1.5 at
+    // 0.01 /s, reached whatever the machine's speed as long as the ramp runs (a run whose
+    // campaign ended first fails here at once, naming the page's counts, not at the guard).
     let coefficients = until("an identification on 40 points on the page", || {
+        let run = bench.child("run");
+        assert!(
+            run.is_running(),
+            "the run ended before the page showed 40 uniaxial points (identification {}):\n{}",
+            browser.eval("return (dash.last && dash.last.identification || {}).points;"),
+            run.stderr()
+        );
         let c = browser.eval(
-            "return dash.last.identification.points.uniaxial >= 40 \
+            "const id = dash.last && dash.last.identification; \
+             return !!id && id.points.uniaxial >= 40 \
              && document.getElementById('coefficients').textContent;",
         );
         let c = c.as_str()?.to_string();

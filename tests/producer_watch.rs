@@ -17,7 +17,7 @@ use std::io::{Cursor, Write};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use common::{Proc, Run, HANG_GUARD};
+use common::{Proc, Run};
 use iceoryx2::prelude::*;
 use image::{ImageBuffer, ImageFormat, Luma};
 use wire::pubsub::SliceSubscriber;
@@ -51,7 +51,6 @@ struct Received<T, H> {
 struct Consumer<T: Debug + ZeroCopySend + Copy + 'static, H: Debug + ZeroCopySend + 'static> {
     _node: Node<ipc::Service>,
     subscriber: SliceSubscriber<T, H>,
-    waitset: WaitSet<ipc::Service>,
     received: Vec<Received<T, H>>,
 }
 
@@ -63,11 +62,9 @@ where
     fn new(instance: &Instance, spec: &ServiceSpec) -> Self {
         let (node, _) = instance.create_node("test").expect("test node");
         let subscriber = SliceSubscriber::create(&node, spec).expect("subscriber");
-        let waitset = WaitSetBuilder::new().create::<ipc::Service>().unwrap();
         Consumer {
             _node: node,
             subscriber,
-            waitset,
             received: Vec::new(),
         }
     }
@@ -76,29 +73,13 @@ where
     fn receive_until(&mut self, mut until: impl FnMut(&[Received<T, H>]) -> bool) {
         let Consumer {
             subscriber,
-            waitset,
             received,
             ..
         } = self;
-        let _guard = waitset.attach_notification(subscriber.listener()).unwrap();
-        let give_up = Instant::now() + HANG_GUARD;
-        loop {
+        common::notified::wait_notified(subscriber.listener(), || {
             drain(subscriber, received);
-            if until(received) {
-                break;
-            }
-            assert!(
-                Instant::now() < give_up,
-                "hang guard: {} samples received",
-                received.len()
-            );
-            waitset
-                .wait_and_process_once_with_timeout(
-                    |_| CallbackProgression::Continue,
-                    Duration::from_millis(100),
-                )
-                .unwrap();
-        }
+            (!until(received)).then(|| format!("{} samples received", received.len()))
+        });
         drain(subscriber, received);
     }
 }

@@ -9,11 +9,10 @@
 mod common;
 
 use common::bench_run::{rows, start_run, summary};
-use common::{Run, HANG_GUARD};
-use iceoryx2::prelude::*;
+use common::Run;
 use std::io::Write;
 use std::path::Path;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use wire::pubsub::ValueSubscriber;
 use wire::{services, Instance, RigState};
 
@@ -92,27 +91,14 @@ fn rows_appended_at_100_hz_are_published_once_in_order_converted_and_shifted() {
             std::thread::sleep(Duration::from_millis(5));
         }
     });
-    let waitset = WaitSetBuilder::new().create::<ipc::Service>().unwrap();
-    let _guard = waitset.attach_notification(subscriber.listener()).unwrap();
     let mut received: Vec<RigState> = Vec::new();
-    let give_up = Instant::now() + HANG_GUARD;
-    while (received.len() as u64) < ROWS {
-        assert!(
-            Instant::now() < give_up,
-            "hang guard: {} rows",
-            received.len()
-        );
-        waitset
-            .wait_and_process_once_with_timeout(
-                |_| CallbackProgression::Continue,
-                Duration::from_millis(100),
-            )
-            .unwrap();
+    common::notified::wait_notified(subscriber.listener(), || {
         subscriber.clear_events();
         while let Some(state) = subscriber.receive().unwrap() {
             received.push(state);
         }
-    }
+        ((received.len() as u64) < ROWS).then(|| format!("{} rows", received.len()))
+    });
     writer.join().unwrap();
     // Idle: the follower ends by itself, with its summary.
     let (status, _, stderr) = run.child("rig").wait();

@@ -118,10 +118,32 @@ fn kill_correlator_mid_ramp(on_interlock: &str) {
     signal(pid, libc::SIGSTOP);
     wait_for_text(&out.join("logs/rig.log"), "strain control HELD");
     signal(pid, libc::SIGKILL);
-    let (status, _, stderr) = run.child("run").wait();
+    let (status, stdout, stderr) = run.child("run").wait();
     let s = summary(&out);
     println!("{on_interlock}: {status:?}, summary {s}");
     assert_eq!(s["ending"], "completed", "{s}\n{stderr}");
+    // The acceptance line names what was compared (the equibiaxial curve this test ran) and
+    // agrees with summary.json and the exit code.
+    if s["acceptance"].is_null() {
+        assert!(stdout.contains("run: nothing identified"), "{stdout}");
+        assert_eq!(status.code(), Some(2), "{stderr}");
+    } else {
+        let verdict = stdout
+            .lines()
+            .find(|l| l.contains(" -> PASSED") || l.contains(" -> NOT PASSED"))
+            .unwrap_or_else(|| panic!("no acceptance line:\n{stdout}"));
+        println!("{verdict}");
+        let passed = s["acceptance"]["passed"].as_bool().unwrap();
+        assert!(
+            verdict.starts_with("run: uniaxial: not tested; equibiaxial to λ")
+                || verdict.starts_with("run: acceptance tested nothing"),
+            "{verdict}"
+        );
+        assert_eq!(verdict.contains("-> PASSED"), passed, "{verdict}\n{s}");
+        if !passed {
+            assert_eq!(status.code(), Some(2), "{verdict}\n{stderr}");
+        }
+    }
     assert!(
         s["faults"].as_array().unwrap().iter().any(|f| f
             .as_str()

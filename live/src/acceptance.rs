@@ -30,6 +30,12 @@ pub struct Acceptance {
     /// stresses along ln λy = ρ ln λx; `max_stretch` and `at_stretch` are of the larger stretch.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub strain_path: Option<CaseComparison>,
+    /// The strain path's kind (`pure_shear`, `biaxial`, `uniaxial`) and ρ = ln λy / ln λx,
+    /// when the acceptance was along a path.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub strain_path_kind: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub strain_path_ratio: Option<f64>,
     pub tolerance: f64,
     pub passed: bool,
 }
@@ -99,6 +105,8 @@ pub fn accept(
         uniaxial,
         equibiaxial,
         strain_path: None,
+        strain_path_kind: None,
+        strain_path_ratio: None,
         tolerance: TOLERANCE,
         passed,
     }
@@ -117,11 +125,12 @@ fn path_point(ratio: f64, larger: f64) -> (f64, f64) {
 /// Compares the law against `truth` along a strain-controlled path ρ = ln λy / ln λx up to
 /// the larger stretch `max_stretch`: the worst relative error of either nominal stress (a
 /// stress below 2 % of the larger one, pure shear's lateral near the start, is not a
-/// relative comparison).
+/// relative comparison). `kind` names the path (`pure_shear`, `biaxial`, ...).
 pub fn accept_path(
     truth: &InvariantLaw,
     a: &[f64],
     b: &[f64],
+    kind: &str,
     ratio: f64,
     max_stretch: f64,
 ) -> Acceptance {
@@ -166,9 +175,85 @@ pub fn accept_path(
         uniaxial: None,
         equibiaxial: None,
         strain_path,
+        strain_path_kind: Some(kind.to_string()),
+        strain_path_ratio: Some(ratio),
         tolerance: TOLERANCE,
         passed,
     }
+}
+
+impl Acceptance {
+    /// No case was compared: no usable law, or no test stretched the specimen. Such an
+    /// acceptance is not passed.
+    pub fn tested_nothing(&self) -> bool {
+        self.uniaxial.is_none() && self.equibiaxial.is_none() && self.strain_path.is_none()
+    }
+
+    /// Why nothing was compared (meaningful when [`Acceptance::tested_nothing`]).
+    pub fn why_nothing_tested(&self) -> &'static str {
+        let usable = !self.a.is_empty()
+            && !self.b.is_empty()
+            && self.a.iter().chain(&self.b).all(|c| c.is_finite());
+        if usable {
+            "no test stretched the specimen"
+        } else {
+            "the identified law has no usable coefficients"
+        }
+    }
+
+    /// One line naming what was compared, its worst error against the limit, and the verdict:
+    /// `pure_shear strain path (ρ 0.00) to λ 1.50: worst stress error 0.36 % at λ 1.42 ->
+    /// PASSED (limit 3 %)`.
+    pub fn verdict_line(&self) -> String {
+        let verdict = if self.passed { "PASSED" } else { "NOT PASSED" };
+        let limit = format!("limit {:.0} %", 100.0 * self.tolerance);
+        if self.tested_nothing() {
+            return format!(
+                "acceptance tested nothing ({}) -> {verdict} ({limit})",
+                self.why_nothing_tested()
+            );
+        }
+        let describe = |name: &str, c: CaseComparison| {
+            format!(
+                "{name} to λ {:.2}: worst stress error {:.2} % at λ {:.2}",
+                c.max_stretch,
+                100.0 * c.max_relative_error,
+                c.at_stretch
+            )
+        };
+        let cases = match (&self.strain_path_kind, self.strain_path) {
+            (Some(kind), Some(c)) => describe(
+                &format!(
+                    "{kind} strain path (ρ {:.2})",
+                    self.strain_path_ratio.unwrap_or(f64::NAN)
+                ),
+                c,
+            ),
+            _ => [
+                ("uniaxial", self.uniaxial),
+                ("equibiaxial", self.equibiaxial),
+            ]
+            .into_iter()
+            .map(|(name, c)| match c {
+                Some(c) => describe(name, c),
+                None => format!("{name}: not tested"),
+            })
+            .collect::<Vec<_>>()
+            .join("; "),
+        };
+        format!("{cases} -> {verdict} ({limit})")
+    }
+}
+
+/// The specimen's law and its coefficients (ln f, ln g): an identification that found it.
+#[cfg(test)]
+pub(crate) fn true_law() -> (InvariantLaw, Vec<f64>, Vec<f64>) {
+    let truth = InvariantLaw::smactane();
+    let (a, b) = (
+        truth.f.coefficients().to_vec(),
+        truth.g.coefficients().to_vec(),
+    );
+    (truth, a, b)
 }
 
 #[cfg(test)]
@@ -177,13 +262,9 @@ mod tests {
 
     #[test]
     fn a_strain_path_is_compared_on_both_stresses_along_its_ratio() {
-        let truth = InvariantLaw::smactane();
-        let (a, b) = (
-            truth.f.coefficients().to_vec(),
-            truth.g.coefficients().to_vec(),
-        );
+        let (truth, a, b) = true_law();
         for ratio in [0.0, 0.5, -0.5, 2.0] {
-            let ok = accept_path(&truth, &a, &b, ratio, 1.8);
+            let ok = accept_path(&truth, &a, &b, "biaxial", ratio, 1.8);
             assert!(ok.passed, "{ok:?}");
             assert!(ok.strain_path.unwrap().max_relative_error < 1e-12);
         }
@@ -195,17 +276,78 @@ mod tests {
         // f 10 % stiffer: off by more than the tolerance.
         let mut a_off = a.clone();
         a_off[0] += 0.1f64.ln_1p();
-        let bad = accept_path(&truth, &a_off, &b, 0.5, 1.8);
+        let bad = accept_path(&truth, &a_off, &b, "biaxial", 0.5, 1.8);
         assert!(!bad.passed);
         assert!(bad.strain_path.unwrap().max_relative_error > TOLERANCE);
-        assert!(!accept_path(&truth, &[f64::NAN], &b, 0.5, 1.8).passed);
+        assert!(!accept_path(&truth, &[f64::NAN], &b, "biaxial", 0.5, 1.8).passed);
+    }
+
+    #[test]
+    fn the_verdict_line_names_what_was_compared_and_the_limit() {
+        let (truth, a, b) = true_law();
+        // A pure-shear path: named with its ratio, no "not tested" uniaxial/equibiaxial.
+        let ok = accept_path(&truth, &a, &b, "pure_shear", 0.0, 1.5);
+        let line = ok.verdict_line();
+        assert!(
+            line.starts_with(
+                "pure_shear strain path (ρ 0.00) to λ 1.50: worst stress error 0.00 %"
+            ),
+            "{line}"
+        );
+        assert!(line.ends_with("-> PASSED (limit 3 %)"), "{line}");
+        assert!(!line.contains("not tested"), "{line}");
+        // The path's error decides: f 10 % stiffer fails, and the line says by how much.
+        let mut a_off = a.clone();
+        a_off[0] += 0.1f64.ln_1p();
+        let bad = accept_path(&truth, &a_off, &b, "pure_shear", 0.0, 1.5);
+        let error = bad.strain_path.unwrap().max_relative_error;
+        assert!(!bad.passed && error > TOLERANCE);
+        let line = bad.verdict_line();
+        assert!(
+            line.contains(&format!("worst stress error {:.2} %", 100.0 * error)),
+            "{line}"
+        );
+        assert!(line.ends_with("-> NOT PASSED (limit 3 %)"), "{line}");
+        // The uniaxial and equibiaxial curves: the untested one is said.
+        let line = accept(&truth, &a, &b, Some(3.0), None).verdict_line();
+        assert!(
+            line.starts_with("uniaxial to λ 3.00: worst stress error 0.00 %"),
+            "{line}"
+        );
+        assert!(
+            line.contains("; equibiaxial: not tested -> PASSED"),
+            "{line}"
+        );
+        // Nothing compared: said, and not passed.
+        for (nothing, why) in [
+            (
+                accept_path(&truth, &a, &b, "pure_shear", 0.0, 1.0),
+                "no test stretched the specimen",
+            ),
+            (
+                accept(&truth, &a, &b, None, None),
+                "no test stretched the specimen",
+            ),
+            (
+                accept(&truth, &[], &[], Some(3.0), None),
+                "the identified law has no usable coefficients",
+            ),
+            (
+                accept_path(&truth, &[f64::NAN], &b, "biaxial", 0.5, 1.8),
+                "the identified law has no usable coefficients",
+            ),
+        ] {
+            assert!(nothing.tested_nothing() && !nothing.passed, "{nothing:?}");
+            assert_eq!(
+                nothing.verdict_line(),
+                format!("acceptance tested nothing ({why}) -> NOT PASSED (limit 3 %)")
+            );
+        }
     }
 
     #[test]
     fn the_true_law_passes_and_a_stiffer_one_fails() {
-        let truth = InvariantLaw::smactane();
-        let a = truth.f.coefficients().to_vec();
-        let b = truth.g.coefficients().to_vec();
+        let (truth, a, b) = true_law();
         let ok = accept(&truth, &a, &b, Some(3.0), Some(2.0));
         assert!(ok.passed, "{ok:?}");
         assert!(ok.uniaxial.unwrap().max_relative_error < 1e-12);

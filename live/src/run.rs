@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 mod child_args;
+mod verdict;
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -762,6 +763,7 @@ fn finish(
                 &truth,
                 &report.a[..report.a_count as usize],
                 &report.b[..report.b_count as usize],
+                test.kind.name(),
                 test.ratio,
                 recorder.max_stretch[2],
             );
@@ -784,13 +786,14 @@ fn finish(
     } else {
         frames_not_correlated.saturating_sub(recorder.frames_dropped_by_correlators())
     };
-    let (mut failure, mut exit_code) = verdict(
+    let (mut failure, mut exit_code) = verdict::verdict(
         ending,
         failure,
         acceptance.as_ref(),
         acceptance_skipped.is_some(),
         frames_lost_to_faults,
-        &state,
+        state.signal,
+        &state.faults,
     );
     let mut ending = ending;
     if !notes.is_empty() && ending != Ending::Interrupted {
@@ -846,49 +849,6 @@ fn finish(
         serde_json::to_string_pretty(&json)?.as_bytes(),
     )?;
     Ok(report)
-}
-
-/// What makes the results doubtful or the run failed, and the exit code of `dicstream run`.
-fn verdict(
-    ending: Ending,
-    failure: Option<String>,
-    acceptance: Option<&Acceptance>,
-    acceptance_skipped: bool,
-    frames_lost_to_faults: u64,
-    state: &LoopState,
-) -> (Option<String>, u8) {
-    match ending {
-        Ending::Failed => (failure, exit_code::FAILED),
-        Ending::Interrupted => {
-            let signal = state.signal.unwrap_or(libc::SIGINT);
-            (
-                Some(format!("interrupted by {}", wire::signals::name(signal))),
-                exit_code::SIGNAL_BASE.saturating_add(signal as u8),
-            )
-        }
-        Ending::Completed => {
-            let mut doubts = Vec::new();
-            match acceptance {
-                None if acceptance_skipped => {}
-                None => doubts.push("nothing was identified".to_string()),
-                Some(a) if !a.passed => doubts.push(format!(
-                    "the identified law did not pass the acceptance (tolerance {:.0} %)",
-                    100.0 * a.tolerance
-                )),
-                Some(_) => {}
-            }
-            if frames_lost_to_faults > 0 {
-                doubts.push(format!(
-                    "{frames_lost_to_faults} frame(s) were lost to faults ({})",
-                    state.faults.join("; ")
-                ));
-            }
-            match doubts.is_empty() {
-                true => (None, exit_code::PASSED),
-                false => (Some(doubts.join("; ")), exit_code::DOUBTFUL),
-            }
-        }
-    }
 }
 
 /// `latency.hgrm` (capture to field) and `latency_identification.hgrm`.

@@ -1,9 +1,10 @@
 //! The process shell over iceoryx2: rig/state is published, rig/command answers accepted or
 //! refused with a reason. Runs under its own instance prefix and removes its files.
 
+mod common;
+
 use iceoryx2::prelude::*;
 use rig::process::{run, ProcessOptions, Speed};
-use rig::RigConfig;
 use std::time::{Duration, Instant};
 use wire::rig::{RigCommandKind, RigReply, RigState};
 
@@ -28,21 +29,9 @@ fn state_is_published_and_commands_are_answered() {
     let test_instance = testkit::TestInstance::new("rig_process");
     let name = test_instance.name().to_string();
     let options = ProcessOptions {
-        instance: name.clone(),
-        config: RigConfig::default(),
-        seed: 1,
-        program: None,
-        campaign: None,
-        test_rate_per_s: 1e-3,
-        test_stretch: 2.0,
         speed: Speed::Factor(5.0),
-        publish_hz: 500.0,
-        log_path: None,
-        log_hz: 100.0,
         duration_s: Some(15.0),
-        exit_when_done: false,
-        state_dir: None,
-        strain: None,
+        ..common::rig_options(&name)
     };
     let rig_thread = std::thread::spawn(move || run(options).unwrap());
 

@@ -4,9 +4,10 @@
 //! pause mid-ramp: the rig holds (rig.csv `held`, the grips still) and resumes when they come
 //! back; the test ends unloaded. Runs under its own instance prefix and removes its files.
 
-use rig::process::{run, ProcessOptions, Speed, StrainOptions};
+mod common;
+
+use rig::process::{run, ProcessOptions, StrainOptions};
 use rig::strain::StrainTest;
-use rig::RigConfig;
 use std::time::{Duration, Instant};
 use wire::pubsub::{SlicePublisher, ValueSubscriber};
 use wire::{FieldHeader, FieldNode, RigState, StrainMeasure};
@@ -30,15 +31,6 @@ fn a_strain_controlled_rig_follows_fields_holds_while_they_stop_and_resumes() {
         .with_interlocks(0.3, 16, "resume")
         .unwrap();
     let options = ProcessOptions {
-        instance: name.clone(),
-        config: RigConfig::default(),
-        seed: 1,
-        program: None,
-        campaign: None,
-        test_rate_per_s: 1e-3,
-        test_stretch: 2.0,
-        speed: Speed::Realtime,
-        publish_hz: 500.0,
         log_path: Some(log.clone()),
         log_hz: 50.0,
         duration_s: Some(60.0),
@@ -48,6 +40,7 @@ fn a_strain_controlled_rig_follows_fields_holds_while_they_stop_and_resumes() {
             test,
             specimen: rig::builtin::BuiltinTest::Equibiaxial.specimen(),
         }),
+        ..common::rig_options(&name)
     };
     let rig_options = options.clone();
     let rig_thread = std::thread::spawn(move || run(rig_options));

@@ -92,26 +92,12 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
         println!("run: mean displacement error against the ground truth {error:.4} px");
     }
     match &report.acceptance {
-        Some(a) => {
-            let describe = |name: &str, c: Option<live::acceptance::CaseComparison>| match c {
-                Some(c) => format!(
-                    "{name} to λ {:.2}: worst stress error {:.2} % at λ {:.2}",
-                    c.max_stretch,
-                    100.0 * c.max_relative_error,
-                    c.at_stretch
-                ),
-                None => format!("{name}: not tested"),
-            };
-            println!(
-                "run: identified a = {:?}, b = {:?}\nrun: {}; {} -> {} (tolerance {:.0} %)",
-                a.a,
-                a.b,
-                describe("uniaxial", a.uniaxial),
-                describe("equibiaxial", a.equibiaxial),
-                if a.passed { "PASSED" } else { "NOT PASSED" },
-                100.0 * a.tolerance
-            );
-        }
+        Some(a) => println!(
+            "run: identified a = {:?}, b = {:?}\nrun: {}",
+            a.a,
+            a.b,
+            a.verdict_line()
+        ),
         None => println!("run: nothing identified"),
     }
     println!("run: results in {}", report.results.display());
