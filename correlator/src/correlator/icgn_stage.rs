@@ -185,11 +185,16 @@ impl Correlator {
             let (u, v) = (result.u_px, result.v_px);
             let mut score = 0.0;
             if result.status == NodeStatus::Ok {
-                // Through the node's own gradient, or the guess's (smoother than a noisy
-                // subset's own, as the check of the other results falls back to).
-                let check = |g| verify::zncc(reference, top_left, n, image, (u, v), g);
-                score = check(result.warp_gradient).unwrap_or(0.0);
+                // IC-GN's own ZNCC of the whole subset (B-spline samples) through the warp of
+                // its last evaluation: an `ok` subset stopped because the update from that
+                // warp to the final one moves no subset point by more than
+                // `icgn::CONVERGED_PX`, so it is the subset's ZNCC through the final warp
+                // within what a 0.001 px move changes. Below `min_zncc`, the check through the
+                // guess's gradient (smoother than a noisy subset's own, as the check of the
+                // other results falls back to).
+                score = outcome.zncc;
                 if score < min_zncc {
+                    let check = |g| verify::zncc(reference, top_left, n, image, (u, v), g);
                     score = score.max(check(entry.gradient).unwrap_or(0.0));
                 }
                 if score < min_zncc {
