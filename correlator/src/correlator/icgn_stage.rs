@@ -2,10 +2,11 @@
 //! coefficients (once per frame, on the pool), the reference subsets (once per reference), and
 //! the refinement of every node whose guess verified: IC-GN from the guess's displacement and
 //! gradient (the node's gradient in the previous frame on a followed mesh, else the
-//! least-squares gradient of its neighbours' guesses), then the same final check as every
-//! result. What IC-GN finds replaces the guess: its displacement, its gradient (the node's
-//! `warp_gradient`), its iterations, and its status (`outside_image` when a sample leaves the
-//! image, `not_converged` at the iteration cap, `low_zncc` when the final check fails).
+//! least-squares gradient of its neighbours' guesses), then the final check against
+//! `min_zncc`, on IC-GN's own ZNCC of the subset (see `refine_icgn`). What IC-GN finds
+//! replaces the guess: its displacement, its gradient (the node's `warp_gradient`), its
+//! iterations, and its status (`outside_image` when a sample leaves the image,
+//! `not_converged` at the iteration cap, `low_zncc` when the final check fails).
 
 use super::{Correlator, Entry};
 use crate::field::NodeStatus;
