@@ -798,3 +798,32 @@ fn fft_iterations(settings: &CorrelatorSettings) -> SubpixelIterations {
         SubpixelIterations::paper(settings.max_iterations)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::settings::Method;
+    use crate::zoi::{ICGN_GUESS_ITERATIONS, ICGN_GUESS_NOT_CONVERGED_STEP_PX};
+
+    /// `correli` keeps the paper's iterations; the IC-GN methods' guess stops at its own cap
+    /// (or the settings' when lower) with its own not-converged bound.
+    #[test]
+    fn the_icgn_guess_has_its_own_iteration_cap_and_correli_the_papers() {
+        let with = |method, max_iterations| CorrelatorSettings {
+            method,
+            zoi_px: if method == Method::Correli { 32 } else { 33 },
+            max_iterations,
+            ..CorrelatorSettings::default()
+        };
+        assert_eq!(
+            fft_iterations(&with(Method::Correli, 10)),
+            SubpixelIterations::paper(10)
+        );
+        for method in [Method::Icgn1, Method::Icgn2] {
+            let cap = fft_iterations(&with(method, 10));
+            assert_eq!(cap.max, ICGN_GUESS_ITERATIONS);
+            assert_eq!(cap.not_converged_step_px, ICGN_GUESS_NOT_CONVERGED_STEP_PX);
+            assert_eq!(fft_iterations(&with(method, 1)).max, 1);
+        }
+    }
+}
