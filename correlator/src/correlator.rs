@@ -19,7 +19,9 @@ use crate::mesh::Mesh;
 use crate::pool::{Pool, SharedSlice};
 use crate::settings::{CorrelatorSettings, GuessMode, Roi, SettingsError};
 use crate::strain::{gauge, node_strains_and_gradients, strains_from_gradients, AffineSums};
-use crate::zoi::{spectrum_len, GradientSensitivity, Image, TimeSplit, ZoiResult};
+use crate::zoi::{
+    spectrum_len, GradientSensitivity, Image, SubpixelIterations, TimeSplit, ZoiResult,
+};
 use rustfft::num_complex::Complex32;
 
 /// Per-node state of the current reference image.
@@ -238,6 +240,8 @@ pub struct Correlator {
     /// Results of the returned nodes measured against the origin (scratch, capacity: every
     /// node).
     reanchored: Vec<(ZoiResult, f64)>,
+    /// The FFT stage's sub-pixel iterations (the guess's, with IC-GN).
+    fft_iterations: SubpixelIterations,
 }
 
 impl Correlator {
@@ -279,6 +283,7 @@ impl Correlator {
             })
             .collect();
         Ok(Self {
+            fft_iterations: fft_iterations(&settings),
             pool: Pool::new(settings.threads, fft_px, subset_values),
             fft_px,
             fft_pad_px: (settings.zoi_px - fft_px) / 2,
@@ -774,6 +779,51 @@ impl Correlator {
             let mut engine = self.pool.engine(i);
             engine.profile = on;
             engine.split = TimeSplit::default();
+        }
+    }
+}
+
+/// The FFT stage's sub-pixel iterations: the paper's with the settings' cap for `correli`;
+/// for the IC-GN methods, whose every guess IC-GN refines, at most
+/// [`crate::zoi::ICGN_GUESS_ITERATIONS`] with [`crate::zoi::ICGN_GUESS_NOT_CONVERGED_STEP_PX`].
+fn fft_iterations(settings: &CorrelatorSettings) -> SubpixelIterations {
+    if settings.method.is_icgn() {
+        SubpixelIterations {
+            max: settings
+                .max_iterations
+                .min(crate::zoi::ICGN_GUESS_ITERATIONS),
+            not_converged_step_px: crate::zoi::ICGN_GUESS_NOT_CONVERGED_STEP_PX,
+        }
+    } else {
+        SubpixelIterations::paper(settings.max_iterations)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::settings::Method;
+    use crate::zoi::{ICGN_GUESS_ITERATIONS, ICGN_GUESS_NOT_CONVERGED_STEP_PX};
+
+    /// `correli` keeps the paper's iterations; the IC-GN methods' guess stops at its own cap
+    /// (or the settings' when lower) with its own not-converged bound.
+    #[test]
+    fn the_icgn_guess_has_its_own_iteration_cap_and_correli_the_papers() {
+        let with = |method, max_iterations| CorrelatorSettings {
+            method,
+            zoi_px: if method == Method::Correli { 32 } else { 33 },
+            max_iterations,
+            ..CorrelatorSettings::default()
+        };
+        assert_eq!(
+            fft_iterations(&with(Method::Correli, 10)),
+            SubpixelIterations::paper(10)
+        );
+        for method in [Method::Icgn1, Method::Icgn2] {
+            let cap = fft_iterations(&with(method, 10));
+            assert_eq!(cap.max, ICGN_GUESS_ITERATIONS);
+            assert_eq!(cap.not_converged_step_px, ICGN_GUESS_NOT_CONVERGED_STEP_PX);
+            assert_eq!(fft_iterations(&with(method, 1)).max, 1);
         }
     }
 }

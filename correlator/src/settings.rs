@@ -189,8 +189,9 @@ pub struct CorrelatorSettings {
     pub guess: GuessMode,
     /// Worker threads including the calling thread (1 ..= 64).
     pub threads: usize,
-    /// Cap of the sub-pixel iterations per ZOI (1 ..= 100): Fourier-shift iterations (also
-    /// those of IC-GN's FFT guess) and Gauss-Newton iterations.
+    /// Cap of the sub-pixel iterations per ZOI (1 ..= 100): Fourier-shift iterations (those of
+    /// IC-GN's FFT guess stop at `zoi::ICGN_GUESS_ITERATIONS` below it) and Gauss-Newton
+    /// iterations.
     pub max_iterations: u32,
     /// Half-width, in nodes, of the least-squares window of the displacement gradient
     /// (1 = 3x3 nodes).

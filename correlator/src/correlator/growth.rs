@@ -241,7 +241,7 @@ impl Correlator {
         let n = self.settings.zoi_px;
         let (fft, pad) = (self.fft_px, self.fft_pad_px);
         let n2 = spectrum_len(fft);
-        let max_iterations = self.settings.max_iterations;
+        let iterations = self.fft_iterations;
         let min_zncc = self.settings.min_zncc;
         let reference = Image {
             pixels: &self.reference_pixels,
@@ -268,7 +268,7 @@ impl Correlator {
                 r.top_left.1 + pad,
                 entry.guess_px,
                 Some(entry.gradient),
-                max_iterations,
+                iterations,
             );
             let mut score = 0.0;
             if result.status == NodeStatus::Ok {

@@ -2,10 +2,11 @@
 //! coefficients (once per frame, on the pool), the reference subsets (once per reference), and
 //! the refinement of every node whose guess verified: IC-GN from the guess's displacement and
 //! gradient (the node's gradient in the previous frame on a followed mesh, else the
-//! least-squares gradient of its neighbours' guesses), then the same final check as every
-//! result. What IC-GN finds replaces the guess: its displacement, its gradient (the node's
-//! `warp_gradient`), its iterations, and its status (`outside_image` when a sample leaves the
-//! image, `not_converged` at the iteration cap, `low_zncc` when the final check fails).
+//! least-squares gradient of its neighbours' guesses), then the final check against
+//! `min_zncc`, on IC-GN's own ZNCC of the subset (see `refine_icgn`). What IC-GN finds
+//! replaces the guess: its displacement, its gradient (the node's `warp_gradient`), its
+//! iterations, and its status (`outside_image` when a sample leaves the image,
+//! `not_converged` at the iteration cap, `low_zncc` when the final check fails).
 
 use super::{Correlator, Entry};
 use crate::field::NodeStatus;
@@ -185,11 +186,16 @@ impl Correlator {
             let (u, v) = (result.u_px, result.v_px);
             let mut score = 0.0;
             if result.status == NodeStatus::Ok {
-                // Through the node's own gradient, or the guess's (smoother than a noisy
-                // subset's own, as the check of the other results falls back to).
-                let check = |g| verify::zncc(reference, top_left, n, image, (u, v), g);
-                score = check(result.warp_gradient).unwrap_or(0.0);
+                // IC-GN's own ZNCC of the whole subset (B-spline samples) through the warp of
+                // its last evaluation: an `ok` subset stopped because the update from that
+                // warp to the final one moves no subset point by more than
+                // `icgn::CONVERGED_PX`, so it is the subset's ZNCC through the final warp
+                // within what a 0.001 px move changes. Below `min_zncc`, the check through the
+                // guess's gradient (smoother than a noisy subset's own, as the check of the
+                // other results falls back to).
+                score = outcome.zncc;
                 if score < min_zncc {
+                    let check = |g| verify::zncc(reference, top_left, n, image, (u, v), g);
                     score = score.max(check(entry.gradient).unwrap_or(0.0));
                 }
                 if score < min_zncc {

@@ -101,7 +101,8 @@ impl Correlator {
     fn measure_against_origin(&mut self, image: Image) {
         let (n, pad) = (self.settings.zoi_px, self.fft_pad_px);
         let offset = (n - self.fft_px) as f64 / 2.0 - pad as f64;
-        let max_iterations = self.settings.max_iterations;
+        // A measurement, not a guess, when IC-GN has no origin coefficients: the paper's iterations.
+        let iterations = crate::zoi::SubpixelIterations::paper(self.settings.max_iterations);
         let origin = Image {
             pixels: &self.origin_pixels,
             width_px: self.width_px,
@@ -145,7 +146,7 @@ impl Correlator {
                 image,
                 entry.guess_px,
                 Some(entry.gradient),
-                max_iterations,
+                iterations,
             );
             // The FFT ZOI's centre is `offset` px from the node's when an odd subset holds an
             // even FFT ZOI: the node's own displacement is the gradient's step from there.
