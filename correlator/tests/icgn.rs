@@ -72,6 +72,28 @@ fn sample5_bias_and_std_at_33_px() {
     }
 }
 
+/// The field of `deformed` against `reference` over the whole image (step 8 px).
+fn whole_image_field(
+    method: Method,
+    zoi_px: usize,
+    reference: &[u16],
+    deformed: &[u16],
+    (width_px, height_px): (usize, usize),
+) -> Field {
+    let s = CorrelatorSettings {
+        roi: Some(Roi {
+            x_px: 0,
+            y_px: 0,
+            width_px,
+            height_px,
+        }),
+        ..settings(method, zoi_px, 8)
+    };
+    let mut correlator = Correlator::new(s, width_px, height_px).unwrap();
+    correlator.set_reference(reference).unwrap();
+    correlator.correlate(deformed).unwrap().clone()
+}
+
 /// RMS of u − command over 150 <= x <= 1900 for L1, L3, L5 (step 8 px over the whole image),
 /// beside the noise floor of the images (the same subsets measuring no motion through noise of
 /// the images' own variance).
@@ -93,18 +115,7 @@ fn sample14_chirp_rms_at_33_px() {
             let (deformed, _, _) = load(dir.join(format!("Sample14 {variant} Amp0.1b.tif")));
             let u_command: Vec<f64> = columns.iter().map(|c| c[column]).collect();
             let interp = |x: f64| common::linear(&u_command, x);
-            let s = CorrelatorSettings {
-                roi: Some(Roi {
-                    x_px: 0,
-                    y_px: 0,
-                    width_px: w,
-                    height_px: h,
-                }),
-                ..settings(method, zoi, 8)
-            };
-            let mut correlator = Correlator::new(s, w, h).unwrap();
-            correlator.set_reference(&reference).unwrap();
-            let field = correlator.correlate(&deformed).unwrap();
+            let field = whole_image_field(method, zoi, &reference, &deformed, (w, h));
             let errors: Vec<f64> = field
                 .nodes
                 .iter()
@@ -157,18 +168,7 @@ fn sample14_chirp_rms_at_33_px() {
         .sum::<f64>()
         / 3.0;
     let noisy = common::independent::with_white_noise(&reference, noise_variance.sqrt(), 255, 5);
-    let s = CorrelatorSettings {
-        roi: Some(Roi {
-            x_px: 0,
-            y_px: 0,
-            width_px: w,
-            height_px: h,
-        }),
-        ..settings(Method::Icgn1, 33, 8)
-    };
-    let mut correlator = Correlator::new(s, w, h).unwrap();
-    correlator.set_reference(&reference).unwrap();
-    let field = correlator.correlate(&noisy).unwrap();
+    let field = whole_image_field(Method::Icgn1, 33, &reference, &noisy, (w, h));
     let band_rms = |x0: f64, x1: f64| {
         let e: Vec<f64> = field
             .nodes
