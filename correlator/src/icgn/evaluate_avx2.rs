@@ -338,8 +338,8 @@ fn run<const SECOND: bool>(subset: &Subset, c: &Coefficients, warp: &Warp) -> Op
 
 #[cfg(test)]
 mod tests {
-    use super::super::subset::{self, SubsetStats, PLANES};
-    use super::super::{evaluate_portable, Subset, Sums};
+    use super::super::subset::test_support::{coefficients, Prepared};
+    use super::super::{evaluate_portable, Sums};
     use super::*;
     use crate::verify::tests::texture;
     use crate::zoi::Image;
@@ -377,12 +377,10 @@ mod tests {
                 (0.9 * texture((i % size) as f64 - 0.37, (i / size) as f64 + 0.21) + 700.0) as u16
             })
             .collect();
-        let coefficients = |pixels: &[u16]| {
-            let mut c = Coefficients::new(size, size);
-            c.prefilter(pixels);
-            c
-        };
-        let (cr, cd) = (coefficients(&reference), coefficients(&deformed));
+        let (cr, cd) = (
+            coefficients(&reference, size),
+            coefficients(&deformed, size),
+        );
         let image = Image {
             pixels: &reference,
             width_px: size,
@@ -393,24 +391,8 @@ mod tests {
         for order in [Order::First, Order::Second] {
             for n in [9usize, 10, 24, 33, 41] {
                 let top_left = (40usize, 37usize);
-                let mut planes = vec![0.0; PLANES * n * n];
-                let mut stats = SubsetStats::default();
-                assert!(subset::prepare(
-                    image,
-                    &cr,
-                    top_left,
-                    n,
-                    order,
-                    &mut planes,
-                    &mut stats
-                ));
-                let half = (n as f64 - 1.0) / 2.0;
-                let subset = Subset {
-                    planes: &planes,
-                    stats: &stats,
-                    n,
-                    centre_px: (top_left.0 as f64 + half, top_left.1 as f64 + half),
-                };
+                let prepared = Prepared::new(image, &cr, top_left, n, order);
+                let subset = prepared.subset();
                 for case in 0..12 {
                     let s = case as f64;
                     let mut warp = Warp::affine(

@@ -285,6 +285,7 @@ pub fn solve(
 mod tests {
     use super::*;
     use crate::zoi::Image;
+    use subset::test_support::{coefficients, Prepared};
 
     use crate::verify::tests::texture;
 
@@ -309,12 +310,10 @@ mod tests {
                 (0.8 * texture(px, py) + 1500.0) as u16
             })
             .collect();
-        let image = |p: &[u16]| {
-            let mut c = Coefficients::new(size, size);
-            c.prefilter(p);
-            c
-        };
-        let (cr, cd) = (image(&reference), image(&deformed));
+        let (cr, cd) = (
+            coefficients(&reference, size),
+            coefficients(&deformed, size),
+        );
         let reference_image = Image {
             pixels: &reference,
             width_px: size,
@@ -326,29 +325,14 @@ mod tests {
             (Order::First, 24),
         ] {
             let top_left = (30usize, 32usize);
-            let mut planes = vec![0.0; PLANES * n * n];
-            let mut stats = SubsetStats::default();
-            assert!(subset::prepare(
-                reference_image,
-                &cr,
-                top_left,
-                n,
-                order,
-                &mut planes,
-                &mut stats
-            ));
+            let prepared = Prepared::new(reference_image, &cr, top_left, n, order);
+            let subset = prepared.subset();
             let half = (n as f64 - 1.0) / 2.0;
-            let centre = (top_left.0 as f64 + half, top_left.1 as f64 + half);
+            let centre = subset.centre_px;
             let truth = (
                 t.0 + g[0][0] * centre.0 + g[0][1] * centre.1,
                 t.1 + g[1][0] * centre.0 + g[1][1] * centre.1,
             );
-            let subset = Subset {
-                planes: &planes,
-                stats: &stats,
-                n,
-                centre_px: centre,
-            };
             let guess = Warp::affine(
                 (truth.0.round() + 0.4, truth.1.round() - 0.2),
                 [[0.0; 2]; 2],

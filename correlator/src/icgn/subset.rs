@@ -214,3 +214,65 @@ fn invert<const P: usize>(h: &[f64; 144]) -> Option<[f64; 144]> {
     }
     out.iter().all(|v| v.is_finite()).then_some(out)
 }
+
+/// For the IC-GN tests: images of one size with their B-spline coefficients, and reference
+/// subsets prepared from them.
+#[cfg(test)]
+pub(crate) mod test_support {
+    use super::*;
+    use crate::icgn::Subset;
+
+    /// The B-spline coefficients of a `size` x `size` image.
+    pub fn coefficients(pixels: &[u16], size: usize) -> Coefficients {
+        let mut c = Coefficients::new(size, size);
+        c.prefilter(pixels);
+        c
+    }
+
+    /// A reference subset's planes and statistics, owned.
+    pub struct Prepared {
+        planes: Vec<f32>,
+        stats: SubsetStats,
+        n: usize,
+        centre_px: (f64, f64),
+    }
+
+    impl Prepared {
+        /// The subset of side `n` at `top_left` of `reference`; panics if it cannot be prepared.
+        pub fn new(
+            reference: Image,
+            coefficients: &Coefficients,
+            top_left: (usize, usize),
+            n: usize,
+            order: Order,
+        ) -> Self {
+            let mut planes = vec![0.0; PLANES * n * n];
+            let mut stats = SubsetStats::default();
+            assert!(prepare(
+                reference,
+                coefficients,
+                top_left,
+                n,
+                order,
+                &mut planes,
+                &mut stats
+            ));
+            let half = (n as f64 - 1.0) / 2.0;
+            Self {
+                planes,
+                stats,
+                n,
+                centre_px: (top_left.0 as f64 + half, top_left.1 as f64 + half),
+            }
+        }
+
+        pub fn subset(&self) -> Subset<'_> {
+            Subset {
+                planes: &self.planes,
+                stats: &self.stats,
+                n: self.n,
+                centre_px: self.centre_px,
+            }
+        }
+    }
+}
