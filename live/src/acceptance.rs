@@ -20,6 +20,30 @@ pub struct CaseComparison {
     pub at_stretch: f64,
 }
 
+impl CaseComparison {
+    /// No error yet, up to `max_stretch`.
+    fn up_to(max_stretch: f64) -> Self {
+        Self {
+            max_stretch,
+            max_relative_error: 0.0,
+            at_stretch: 1.0,
+        }
+    }
+
+    /// Keeps `error` at `stretch` when it is the largest so far; a non-finite error counts as
+    /// infinite and always takes the place.
+    fn record(&mut self, error: f64, stretch: f64) {
+        if !error.is_finite() || error > self.max_relative_error {
+            self.max_relative_error = if error.is_finite() {
+                error
+            } else {
+                f64::INFINITY
+            };
+            self.at_stretch = stretch;
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Acceptance {
     pub a: Vec<f64>,
@@ -45,23 +69,11 @@ fn compare(
     predicted: impl Fn(f64) -> f64,
     max_stretch: f64,
 ) -> CaseComparison {
-    let mut worst = CaseComparison {
-        max_stretch,
-        max_relative_error: 0.0,
-        at_stretch: 1.0,
-    };
+    let mut worst = CaseComparison::up_to(max_stretch);
     for k in 1..=SAMPLES {
         let stretch = 1.0 + (max_stretch - 1.0) * k as f64 / SAMPLES as f64;
         let t = truth(stretch);
-        let error = ((predicted(stretch) - t) / t).abs();
-        if !error.is_finite() || error > worst.max_relative_error {
-            worst.max_relative_error = if error.is_finite() {
-                error
-            } else {
-                f64::INFINITY
-            };
-            worst.at_stretch = stretch;
-        }
+        worst.record(((predicted(stretch) - t) / t).abs(), stretch);
     }
     worst
 }
@@ -140,11 +152,7 @@ pub fn accept_path(
     };
     let usable = !a.is_empty() && !b.is_empty() && a.iter().chain(b).all(|c| c.is_finite());
     let strain_path = (usable && max_stretch > 1.0).then(|| {
-        let mut worst = CaseComparison {
-            max_stretch,
-            max_relative_error: 0.0,
-            at_stretch: 1.0,
-        };
+        let mut worst = CaseComparison::up_to(max_stretch);
         for k in 1..=SAMPLES {
             let larger = 1.0 + (max_stretch - 1.0) * k as f64 / SAMPLES as f64;
             let (lx, ly) = path_point(ratio, larger);
@@ -155,15 +163,7 @@ pub fn accept_path(
                 if t[i].abs() < 0.02 * scale {
                     continue;
                 }
-                let error = ((p[i] - t[i]) / t[i]).abs();
-                if !error.is_finite() || error > worst.max_relative_error {
-                    worst.max_relative_error = if error.is_finite() {
-                        error
-                    } else {
-                        f64::INFINITY
-                    };
-                    worst.at_stretch = larger;
-                }
+                worst.record(((p[i] - t[i]) / t[i]).abs(), larger);
             }
         }
         worst
