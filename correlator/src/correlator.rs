@@ -240,8 +240,6 @@ pub struct Correlator {
     /// Results of the returned nodes measured against the origin (scratch, capacity: every
     /// node).
     reanchored: Vec<(ZoiResult, f64)>,
-    /// The FFT stage's sub-pixel iterations (the guess's, with IC-GN).
-    fft_iterations: SubpixelIterations,
 }
 
 impl Correlator {
@@ -283,7 +281,6 @@ impl Correlator {
             })
             .collect();
         Ok(Self {
-            fft_iterations: fft_iterations(&settings),
             pool: Pool::new(settings.threads, fft_px, subset_values),
             fft_px,
             fft_pad_px: (settings.zoi_px - fft_px) / 2,

@@ -241,7 +241,7 @@ impl Correlator {
         let n = self.settings.zoi_px;
         let (fft, pad) = (self.fft_px, self.fft_pad_px);
         let n2 = spectrum_len(fft);
-        let iterations = self.fft_iterations;
+        let iterations = super::fft_iterations(&self.settings);
         let min_zncc = self.settings.min_zncc;
         let reference = Image {
             pixels: &self.reference_pixels,

@@ -19,7 +19,7 @@ impl Correlator {
     pub(super) fn run_zois(&mut self, image: Image) {
         let (n, pad) = (self.fft_px, self.fft_pad_px);
         let n2 = spectrum_len(n);
-        let iterations = self.fft_iterations;
+        let iterations = super::fft_iterations(&self.settings);
         let use_previous = self.settings.guess != GuessMode::Correli && self.has_previous;
         let whole_mesh = if use_previous && self.previous.iter().any(|p| p.is_none()) {
             self.affine_fit_around(None, 0)
