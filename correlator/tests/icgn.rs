@@ -105,17 +105,24 @@ fn sample14_chirp_rms_at_33_px() {
     let (reference, w, h) = load(dir.join("Sample14 Reference.tif"));
     let columns = command_columns(dir.join("command.csv"));
     assert_eq!(columns.len(), w, "command.csv rows");
+    // Each variant's deformed image and its column of u in command.csv.
+    let variants: Vec<(&str, usize, Vec<u16>)> = [("L1", 1), ("L3", 3), ("L5", 5)]
+        .into_iter()
+        .map(|(variant, column)| {
+            let (deformed, _, _) = load(dir.join(format!("Sample14 {variant} Amp0.1b.tif")));
+            (variant, column, deformed)
+        })
+        .collect();
     println!("| sample 14 RMS(u - command), 150 <= x <= 1900 | L1 | L3 | L5 |");
     let mut worst = 0.0f64;
     let mut band_lines = Vec::new();
     for method in [Method::Correli, Method::Icgn1, Method::Icgn2] {
         let zoi = zoi_of(method);
         let mut line = format!("| {} @ {zoi} px |", method.name());
-        for (variant, column) in [("L1", 1), ("L3", 3), ("L5", 5)] {
-            let (deformed, _, _) = load(dir.join(format!("Sample14 {variant} Amp0.1b.tif")));
-            let u_command: Vec<f64> = columns.iter().map(|c| c[column]).collect();
+        for (variant, column, deformed) in &variants {
+            let u_command: Vec<f64> = columns.iter().map(|c| c[*column]).collect();
             let interp = |x: f64| common::linear(&u_command, x);
-            let field = whole_image_field(method, zoi, &reference, &deformed, (w, h));
+            let field = whole_image_field(method, zoi, &reference, deformed, (w, h));
             let errors: Vec<f64> = field
                 .nodes
                 .iter()
@@ -162,11 +169,11 @@ fn sample14_chirp_rms_at_33_px() {
         let (_, std) = mean_std(&d);
         std * std
     };
-    let noise_variance = ["L1", "L3", "L5"]
+    let noise_variance = variants
         .iter()
-        .map(|v| variance(&load(dir.join(format!("Sample14 {v} Amp0.1b.tif"))).0))
+        .map(|(_, _, deformed)| variance(deformed))
         .sum::<f64>()
-        / 3.0;
+        / variants.len() as f64;
     let noisy = common::independent::with_white_noise(&reference, noise_variance.sqrt(), 255, 5);
     let field = whole_image_field(Method::Icgn1, 33, &reference, &noisy, (w, h));
     let band_rms = |x0: f64, x1: f64| {
