@@ -64,6 +64,11 @@ pub struct Acceptance {
     pub passed: bool,
 }
 
+/// A law can be compared: both series have coefficients, all finite.
+fn usable_law(a: &[f64], b: &[f64]) -> bool {
+    !a.is_empty() && !b.is_empty() && a.iter().chain(b).all(|c| c.is_finite())
+}
+
 fn compare(
     truth: impl Fn(f64) -> f64,
     predicted: impl Fn(f64) -> f64,
@@ -91,7 +96,7 @@ pub fn accept(
         f: InvariantFn::ExpPoly(a.to_vec()),
         g: InvariantFn::ExpPoly(b.to_vec()),
     };
-    let usable = !a.is_empty() && !b.is_empty() && a.iter().chain(b).all(|c| c.is_finite());
+    let usable = usable_law(a, b);
     let uniaxial = uniaxial_max_stretch.filter(|_| usable).map(|max| {
         compare(
             |l| truth.uniaxial_nominal_stress_mpa(l),
@@ -150,7 +155,7 @@ pub fn accept_path(
         f: InvariantFn::ExpPoly(a.to_vec()),
         g: InvariantFn::ExpPoly(b.to_vec()),
     };
-    let usable = !a.is_empty() && !b.is_empty() && a.iter().chain(b).all(|c| c.is_finite());
+    let usable = usable_law(a, b);
     let strain_path = (usable && max_stretch > 1.0).then(|| {
         let mut worst = CaseComparison::up_to(max_stretch);
         for k in 1..=SAMPLES {
@@ -191,9 +196,7 @@ impl Acceptance {
 
     /// Why nothing was compared (meaningful when [`Acceptance::tested_nothing`]).
     pub fn why_nothing_tested(&self) -> &'static str {
-        let usable = !self.a.is_empty()
-            && !self.b.is_empty()
-            && self.a.iter().chain(&self.b).all(|c| c.is_finite());
+        let usable = usable_law(&self.a, &self.b);
         if usable {
             "no test stretched the specimen"
         } else {
