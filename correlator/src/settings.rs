@@ -36,23 +36,9 @@ pub enum StrainMeasure {
     Log,
 }
 
-impl StrainMeasure {
-    pub const ALL: [StrainMeasure; 4] = [Self::Small, Self::Green, Self::Nominal, Self::Log];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Small => "small",
-            Self::Green => "green",
-            Self::Nominal => "nominal",
-            Self::Log => "log",
-        }
-    }
-
-    /// The measure called `name` (`small`, `green`, `nominal`, `log`).
-    pub fn from_name(name: &str) -> Option<StrainMeasure> {
-        Self::ALL.into_iter().find(|m| m.name() == name)
-    }
-}
+wire::named!(StrainMeasure, "strain measure", {
+    Small => "small", Green => "green", Nominal => "nominal", Log => "log",
+});
 
 /// Which image the deformed images are compared with.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -78,33 +64,38 @@ impl ReferenceMode {
         min_mean_score: 0.5,
     };
 
-    /// `fixed`, `incremental` or `auto` (with the default thresholds).
-    pub fn from_name(name: &str) -> Option<ReferenceMode> {
-        match name {
-            "fixed" => Some(ReferenceMode::Fixed),
-            "incremental" => Some(ReferenceMode::Incremental),
-            "auto" => Some(ReferenceMode::AUTO_DEFAULT),
-            _ => None,
+    /// The mode of a kind (`auto` with the default thresholds).
+    pub fn of_kind(kind: ReferenceKind) -> ReferenceMode {
+        match kind {
+            ReferenceKind::Fixed => ReferenceMode::Fixed,
+            ReferenceKind::Incremental => ReferenceMode::Incremental,
+            ReferenceKind::Auto => ReferenceMode::AUTO_DEFAULT,
         }
     }
-}
 
-impl GuessMode {
-    pub const ALL: [GuessMode; 3] = [GuessMode::Auto, GuessMode::Correli, GuessMode::Predict];
-
-    pub fn name(self) -> &'static str {
+    pub fn kind(self) -> ReferenceKind {
         match self {
-            GuessMode::Auto => "auto",
-            GuessMode::Correli => "correli",
-            GuessMode::Predict => "predict",
+            ReferenceMode::Fixed => ReferenceKind::Fixed,
+            ReferenceMode::Incremental => ReferenceKind::Incremental,
+            ReferenceMode::Auto { .. } => ReferenceKind::Auto,
         }
     }
-
-    /// `auto`, `correli` or `predict`.
-    pub fn from_name(name: &str) -> Option<GuessMode> {
-        Self::ALL.into_iter().find(|m| m.name() == name)
-    }
 }
+
+/// A [`ReferenceMode`] as a user chooses it: by its name, `auto` with its default thresholds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ReferenceKind {
+    #[default]
+    Fixed,
+    Incremental,
+    Auto,
+}
+
+wire::named!(ReferenceKind, "reference", {
+    Fixed => "fixed", Incremental => "incremental", Auto => "auto",
+});
+
+wire::named!(GuessMode, "guess", { Auto => "auto", Correli => "correli", Predict => "predict" });
 
 /// Initial guess of each ZOI before its integer FFT correlation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -142,22 +133,9 @@ pub enum Method {
     Icgn2,
 }
 
+wire::named!(Method, "method", { Correli => "correli", Icgn1 => "icgn1", Icgn2 => "icgn2" });
+
 impl Method {
-    pub const ALL: [Method; 3] = [Method::Correli, Method::Icgn1, Method::Icgn2];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Correli => "correli",
-            Method::Icgn1 => "icgn1",
-            Method::Icgn2 => "icgn2",
-        }
-    }
-
-    /// `correli`, `icgn1` or `icgn2`.
-    pub fn from_name(name: &str) -> Option<Method> {
-        Self::ALL.into_iter().find(|m| m.name() == name)
-    }
-
     pub fn is_icgn(self) -> bool {
         self != Method::Correli
     }

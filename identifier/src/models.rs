@@ -398,6 +398,26 @@ pub fn parse_model_list(list: &str) -> Result<Vec<Model>, ModelError> {
     names.iter().map(|n| Model::parse(n)).collect()
 }
 
+/// The models a fit ranks, as a user lists them (`yeoh,gent`, `ogden:3`, or `all`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelList(pub Vec<Model>);
+
+impl std::str::FromStr for ModelList {
+    type Err = ModelError;
+
+    fn from_str(list: &str) -> Result<ModelList, ModelError> {
+        parse_model_list(list).map(ModelList)
+    }
+}
+
+/// The names, comma-separated, as [`parse_model_list`] reads them back.
+impl std::fmt::Display for ModelList {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let names: Vec<String> = self.0.iter().map(Model::name).collect();
+        f.write_str(&names.join(","))
+    }
+}
+
 /// Inverse Langevin function L⁻¹(x), |x| < 1, by safeguarded Newton (≤ 100 iterations).
 pub fn inverse_langevin(x: f64) -> Option<f64> {
     if x.is_nan() || x.abs() >= 1.0 {

@@ -25,14 +25,13 @@ pub fn journal_curves(journal: &Path) -> anyhow::Result<Vec<Curve>> {
 pub fn identification_figures(
     dir: &Path,
     journal: &Path,
-    models: &str,
+    models: &[identifier::models::Model],
 ) -> anyhow::Result<Vec<PathBuf>> {
     let curves = journal_curves(journal)?;
     if curves.is_empty() {
         return Ok(Vec::new());
     }
-    let models = identifier::models::parse_model_list(models)?;
-    let (fits, _failures) = fit_ranked(&models, &curves, &FitOptions::default());
+    let (fits, _failures) = fit_ranked(models, &curves, &FitOptions::default());
     // Without both cases the route cannot run: the f(I1) and g(I2) plots show the fits only.
     let route = identifier::route::paper_route(&curves, 2, 2).ok();
     Ok(identifier::plot::write_plots(

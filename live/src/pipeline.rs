@@ -49,7 +49,7 @@ const BISECTIONS: usize = 3;
 /// The run configuration of a trial: a uniaxial test to λ 2 lasting about `seconds`.
 pub fn trial_config(settings: &PipelineSettings, fps: f64, results_dir: &Path) -> RunConfig {
     let mut config = RunConfig::default();
-    config.run.results_dir = results_dir.to_string_lossy().into_owned();
+    config.run.results_dir = results_dir.to_path_buf();
     config.run.restart = false;
     config.run.fields_every = u32::MAX;
     config.camera.width_px = settings.width_px;
@@ -60,7 +60,11 @@ pub fn trial_config(settings: &PipelineSettings, fps: f64, results_dir: &Path) -
     config.correlator.threads = settings.correlator_threads;
     // Hold 1 s, ramp, hold 1 s, unload at 5x, hold 0.5 s (rig::campaign).
     let ramp_s = ((settings.seconds - 2.5) / 1.2).max(1.0);
-    config.rig.tests = vec![TestSection::new("uniaxial", 2.0, 1.0 / ramp_s)];
+    config.rig.tests = vec![TestSection::new(
+        rig::strain::StrainKind::Uniaxial,
+        2.0,
+        1.0 / ramp_s,
+    )];
     config
 }
 

@@ -100,8 +100,8 @@ pub struct RunReport {
     /// has no ground truth to compare with.
     pub acceptance_skipped: Option<String>,
     /// Where frames and rig samples came from ([camera] source, [rig] source).
-    pub camera_source: String,
-    pub rig_source: String,
+    pub camera_source: CameraSource,
+    pub rig_source: RigSource,
     /// What `strain_map.png` shows.
     pub strain_map: Option<StrainMapInfo>,
     /// Files of the instance left once every process had stopped (named, then removed).
@@ -223,7 +223,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
         )
         .as_bytes(),
     )?;
-    match config.rig_source() {
+    match config.rig.source {
         RigSource::Simulated => eprintln!(
             "run: results in {}, instance {instance_name}, campaign {} (about {:.0} s), camera {}",
             results.root.display(),
@@ -236,7 +236,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
              ends {} s after its last row)",
             results.root.display(),
             config.camera.source,
-            config.rig.csv.file,
+            config.rig.csv.file.display(),
             config.rig.csv.idle_timeout_s
         ),
     }
@@ -252,7 +252,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
             RecorderSettings {
                 fields_every: config.run.fields_every,
                 vtk: config.run.vtk,
-                truth: config.camera_source().has_truth(),
+                truth: config.camera.source.has_truth(),
             },
             t0_ns,
         )?;
@@ -340,7 +340,7 @@ fn start_children(
             continue;
         }
         let ready = supervisor.wait_ready(role, READY_TIMEOUT);
-        let ready = match (role, config.camera_source()) {
+        let ready = match (role, config.camera.source) {
             (Role::Producer, CameraSource::Genicam) => ready.map_err(|e| {
                 e.context(
                     "[camera] source = \"genicam\": the camera could not be opened (a \
@@ -367,7 +367,7 @@ fn start_children(
 /// camera is ready only at its first image (which sets the frame size), which may come long
 /// after the start; the run goes on at once and handles its exit like any other.
 fn waits_for_ready(role: Role, config: &RunConfig) -> bool {
-    !(role == Role::Producer && config.camera_source() == CameraSource::Watch)
+    !(role == Role::Producer && config.camera.source == CameraSource::Watch)
 }
 
 /// What the loop learnt that the end of the run reports.
@@ -443,10 +443,10 @@ fn event_loop(
     let mut liveness = Liveness::new(Duration::from_secs_f64(config.run.stale_after_s));
     // A real camera publishes when images come, a machine's log when rows come: their
     // silence is the test's pace, not a hang (a stopped process is still caught).
-    if config.camera_source() != CameraSource::Simulated {
+    if config.camera.source != CameraSource::Simulated {
         liveness.ignore_silence(Role::Producer);
     }
-    if config.rig_source() == RigSource::CsvFollow {
+    if config.rig.source == RigSource::CsvFollow {
         liveness.ignore_silence(Role::Rig);
     }
     for role in Role::ALL {
@@ -501,7 +501,7 @@ fn event_loop(
             }
             if exit.role == Role::Producer
                 && exit.success
-                && config.camera_source() != CameraSource::Simulated
+                && config.camera.source != CameraSource::Simulated
             {
                 // A replay at its last image, a watched folder idle for its timeout.
                 eprintln!(
@@ -704,7 +704,7 @@ fn finish(
         crate::figures::identification_figures(
             &results.root,
             &results.journal(),
-            &config.identifier.models,
+            &config.identifier.models.0,
         )
         .map(|_| ()),
     );
@@ -735,8 +735,7 @@ fn finish(
             }
         }
     }
-    let has_truth =
-        config.camera_source().has_truth() && config.rig_source() == RigSource::Simulated;
+    let has_truth = config.camera.source.has_truth() && config.rig.source == RigSource::Simulated;
     let acceptance_skipped = (!has_truth && recorder.last_report.is_some()).then(|| {
         format!(
             "no ground truth with [camera] source = {:?} and [rig] source = {:?}: the \
@@ -831,8 +830,8 @@ fn finish(
         displacement_error_mean_px,
         acceptance,
         acceptance_skipped,
-        camera_source: config.camera.source.clone(),
-        rig_source: config.rig.source.clone(),
+        camera_source: config.camera.source,
+        rig_source: config.rig.source,
         strain_map,
         leftover_shm_files,
         exit_code,

@@ -11,13 +11,12 @@ mod link;
 mod pixels;
 mod roi;
 
-use std::fmt;
 use std::str::FromStr;
 
 pub use link::{
     BufferCounts, BufferStatus, Link, LinkState, FIRST_RETRY, MAX_RETRY, SILENCE, SILENT_PERIODS,
 };
-pub use pixels::{convert_into, ConvertError, PixelFormat, PIXEL_FORMATS};
+pub use pixels::{convert_into, ConvertError, PixelFormat};
 pub use roi::{Roi, RoiError, RoiLimits};
 
 /// When the camera takes a frame.
@@ -36,36 +35,9 @@ pub enum Trigger {
     Hardware,
 }
 
-impl Trigger {
-    pub fn name(self) -> &'static str {
-        match self {
-            Trigger::Free => "free",
-            Trigger::Software => "software",
-            Trigger::Hardware => "hardware",
-        }
-    }
-}
-
-impl fmt::Display for Trigger {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Trigger {
-    type Err = String;
-
-    fn from_str(text: &str) -> Result<Self, Self::Err> {
-        match text.trim().to_ascii_lowercase().as_str() {
-            "free" => Ok(Trigger::Free),
-            "software" => Ok(Trigger::Software),
-            "hardware" => Ok(Trigger::Hardware),
-            _ => Err(format!(
-                "unknown trigger {text:?}: expected free, software or hardware"
-            )),
-        }
-    }
-}
+wire::named!(Trigger, "trigger", ignore_case, {
+    Free => "free", Software => "software", Hardware => "hardware",
+});
 
 /// Which camera `--camera` names: `genicam` (the first found) or `genicam:ID` (an Aravis
 /// device id such as `Basler-21234567`, a serial number, or an address).
@@ -170,6 +142,7 @@ mod tests {
         assert!("line1"
             .parse::<Trigger>()
             .unwrap_err()
+            .to_string()
             .contains("free, software or hardware"));
 
         assert_eq!(CameraSettings::default().check(), Ok(()));

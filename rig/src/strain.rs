@@ -29,4 +29,4 @@ pub use interlock::{HoldReason, InterlockLimits};
 pub use outer::{GaugeMeasurement, OuterLoop, OuterLoopConfig};
 pub use path::{StrainPath, StrainSegment};
 pub use run::{ControlColumns, StrainRun, StrainRunEvent};
-pub use test::{StrainKind, StrainTest};
+pub use test::{StrainKind, StrainTest, TestControl};

@@ -26,9 +26,9 @@ fn a_strain_controlled_rig_follows_fields_holds_while_they_stop_and_resumes() {
     let dir = std::env::temp_dir().join(format!("{name}_out"));
     std::fs::create_dir_all(&dir).unwrap();
     let log = dir.join("rig.csv");
-    let test = StrainTest::new("pure_shear", None, 1.15, 0.05)
+    let test = StrainTest::new(rig::strain::StrainKind::PureShear, None, 1.15, 0.05)
         .unwrap()
-        .with_interlocks(0.3, 16, "resume")
+        .with_interlocks(0.3, 16, rig::strain::control::OnRestore::Resume)
         .unwrap();
     let options = ProcessOptions {
         log_path: Some(log.clone()),

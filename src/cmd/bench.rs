@@ -1,7 +1,9 @@
 //! `dicstream bench ...`: speed figures a user can reproduce on their machine. One subcommand
 //! per benchmark (`BenchCommand`); `correlate` measures the correlator on rendered speckle.
 
+use super::named_arg::named;
 use anyhow::{bail, Context, Result};
+use correlator::settings::{GuessMode, Method};
 use correlator::{Correlator, CorrelatorSettings};
 use producer::motion::Affine;
 use producer::{CameraModel, FastRenderer, Motion, Speckle, SpeckleParams};
@@ -36,8 +38,8 @@ pub struct CorrelateBenchArgs {
     #[arg(long, default_value_t = 1024)]
     pub height: usize,
     /// Sub-pixel method: icgn1, icgn2 or correli.
-    #[arg(long, value_enum, default_value = super::correlate::MethodArg::default_name())]
-    pub method: super::correlate::MethodArg,
+    #[arg(long, value_parser = named::<Method>(), default_value_t = Method::default())]
+    pub method: Method,
     /// ZOI (subset) side in px (a power of two for correli).
     #[arg(long, default_value_t = 32)]
     pub zoi: usize,
@@ -56,8 +58,8 @@ pub struct CorrelateBenchArgs {
     pub frames: usize,
     /// Initial guess: auto (the default), predict (the live path without growth or
     /// keypoints) or correli (the paper's).
-    #[arg(long, value_enum, default_value = "auto")]
-    pub guess: super::correlate::GuessArg,
+    #[arg(long, value_parser = named::<GuessMode>(), default_value_t = GuessMode::default())]
+    pub guess: GuessMode,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -160,8 +162,8 @@ fn correlate(args: CorrelateBenchArgs) -> Result<()> {
         width_px: w,
         height_px: h,
     });
-    let guess = args.guess.mode();
-    let method = args.method.method();
+    let guess = args.guess;
+    let method = args.method;
     let settings_with = |method, zoi_px, threads| CorrelatorSettings {
         method,
         zoi_px,

@@ -6,8 +6,9 @@
 //! structured grid and colour maps of |u| and exx over the reference image. Every file is
 //! written atomically (temporary sibling, then rename). Images are read by `producer::read_image`.
 
+use super::named_arg::named;
 use anyhow::{anyhow, bail, Context, Result};
-use correlator::settings::Method;
+use correlator::settings::{Method, ReferenceKind};
 use correlator::{
     Correlator, CorrelatorSettings, Field, GaugeStrains, GuessMode, ReferenceMode, Roi,
     StrainMeasure,
@@ -16,79 +17,9 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-pub enum StrainArg {
-    Log,
-    Green,
-    Nominal,
-    Small,
-}
-
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-pub enum ReferenceArg {
-    Fixed,
-    Incremental,
-    Auto,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum MethodArg {
-    Correli,
-    Icgn1,
-    Icgn2,
-}
-
-impl MethodArg {
-    pub fn method(self) -> Method {
-        match self {
-            MethodArg::Correli => Method::Correli,
-            MethodArg::Icgn1 => Method::Icgn1,
-            MethodArg::Icgn2 => Method::Icgn2,
-        }
-    }
-
-    /// The library's default method, as the CLI default.
-    pub fn default_name() -> &'static str {
-        Method::default().name()
-    }
-}
-
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-pub enum GuessArg {
-    Auto,
-    Correli,
-    Predict,
-}
-
-impl StrainArg {
-    pub fn measure(self) -> StrainMeasure {
-        match self {
-            StrainArg::Log => StrainMeasure::Log,
-            StrainArg::Green => StrainMeasure::Green,
-            StrainArg::Nominal => StrainMeasure::Nominal,
-            StrainArg::Small => StrainMeasure::Small,
-        }
-    }
-}
-
-impl ReferenceArg {
-    pub fn mode(self) -> ReferenceMode {
-        match self {
-            ReferenceArg::Fixed => ReferenceMode::Fixed,
-            ReferenceArg::Incremental => ReferenceMode::Incremental,
-            ReferenceArg::Auto => ReferenceMode::AUTO_DEFAULT,
-        }
-    }
-}
-
-impl GuessArg {
-    pub fn mode(self) -> GuessMode {
-        match self {
-            GuessArg::Auto => GuessMode::Auto,
-            GuessArg::Correli => GuessMode::Correli,
-            GuessArg::Predict => GuessMode::Predict,
-        }
-    }
+/// The library's defaults, the command line's defaults.
+fn defaults() -> CorrelatorSettings {
+    CorrelatorSettings::default()
 }
 
 /// The correlation settings of both `correlate` and `correlator` (their reference-mode flags
@@ -100,54 +31,54 @@ pub struct CorrelationArgs {
     /// icgn1: inverse compositional Gauss-Newton, first-order (affine) shape function, ZNSSD,
     /// quintic B-spline (about 1.5 times less noise, any subset size from 9 px); icgn2: the same
     /// with a second-order shape function. See the README.
-    #[arg(long, value_enum, default_value = MethodArg::default_name())]
-    pub method: MethodArg,
+    #[arg(long, value_parser = named::<Method>(), default_value_t = defaults().method)]
+    pub method: Method,
     /// ZOI (subset) side in px: any size from 9 px for icgn1/icgn2 (odd or even), a power of
     /// two (2^s) for correli.
-    #[arg(long, default_value_t = 32)]
+    #[arg(long, default_value_t = defaults().zoi_px)]
     pub zoi: usize,
     /// Distance between ZOI centres in px (1 ..= ZOI).
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = defaults().step_px)]
     pub step: usize,
     /// Region of interest x,y,w,h in px (default: the largest centred 2^p square).
     #[arg(long, value_parser = parse_roi)]
     pub roi: Option<Roi>,
     /// Strain measure of the node strains (the gauge is given in all four).
-    #[arg(long, value_enum, default_value = "log")]
-    pub strain: StrainArg,
+    #[arg(long, value_parser = named::<StrainMeasure>(), default_value_t = defaults().strain)]
+    pub strain: StrainMeasure,
     /// Initial guess per ZOI. auto: the cheapest guess that passes the final check (previous
     /// field, significant global (U0, V0)), failed nodes grown from verified neighbours,
     /// keypoints (rotation- and scale-invariant) when too few verify. correli: the paper's
     /// global (U0, V0). predict: previous field, or grown from the centre.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub guess: GuessArg,
+    #[arg(long, value_parser = named::<GuessMode>(), default_value_t = defaults().guess)]
+    pub guess: GuessMode,
     /// A node is ok only when the ZNCC of its reference ZOI with the deformed image, sampled
     /// at its displacement and local gradient, reaches this (0 < value < 1).
-    #[arg(long, default_value_t = correlator::DEFAULT_MIN_ZNCC)]
+    #[arg(long, default_value_t = defaults().min_zncc)]
     pub min_zncc: f64,
     /// Remove, to first order, the rigid ZOI's bias under a displacement gradient (beyond the
     /// paper; false = CORRELI-GD as published).
-    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    #[arg(long, default_value_t = defaults().gradient_correction, action = clap::ArgAction::Set)]
     pub gradient_correction: bool,
     /// Worker threads.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = defaults().threads)]
     pub threads: usize,
     /// Cap of the sub-pixel iterations per ZOI (Gauss-Newton for IC-GN, Fourier-shift for
     /// correli); an IC-GN node that has not converged at the cap is not_converged.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = defaults().max_iterations)]
     pub max_iterations: u32,
 }
 
 impl CorrelationArgs {
-    pub fn settings(&self, reference: ReferenceMode) -> CorrelatorSettings {
+    pub fn settings(&self, reference: ReferenceKind) -> CorrelatorSettings {
         CorrelatorSettings {
             zoi_px: self.zoi,
-            method: self.method.method(),
+            method: self.method,
             step_px: self.step,
             roi: self.roi,
-            strain: self.strain.measure(),
-            reference,
-            guess: self.guess.mode(),
+            strain: self.strain,
+            reference: ReferenceMode::of_kind(reference),
+            guess: self.guess,
             min_zncc: self.min_zncc,
             gradient_correction: self.gradient_correction,
             threads: self.threads,
@@ -165,8 +96,8 @@ pub struct CorrelateArgs {
     #[arg(required = true)]
     pub deformed: Vec<PathBuf>,
     /// Reference mode: fixed, incremental (consecutive images) or auto update.
-    #[arg(long = "reference", value_enum, default_value = "fixed")]
-    pub reference_mode: ReferenceArg,
+    #[arg(long = "reference", value_parser = named::<ReferenceKind>(), default_value_t = ReferenceKind::Fixed)]
+    pub reference_mode: ReferenceKind,
     #[command(flatten)]
     pub correlation: CorrelationArgs,
     /// Output folder (created if missing).
@@ -202,7 +133,7 @@ pub(crate) fn parse_roi(text: &str) -> Result<Roi> {
 
 impl CorrelateArgs {
     fn settings(&self) -> CorrelatorSettings {
-        self.correlation.settings(self.reference_mode.mode())
+        self.correlation.settings(self.reference_mode)
     }
 }
 
@@ -330,8 +261,8 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
     }
     if frames_with_valid_nodes == 0 {
         let hint = match args.correlation.guess {
-            GuessArg::Auto => "unrelated or flat images?",
-            GuessArg::Correli | GuessArg::Predict => {
+            GuessMode::Auto => "unrelated or flat images?",
+            GuessMode::Correli | GuessMode::Predict => {
                 "unrelated or flat images, or a motion beyond this guess (--guess auto also tries keypoints)?"
             }
         };
@@ -372,7 +303,7 @@ fn settings_json(args: &CorrelateArgs, correlator: &Correlator) -> serde_json::V
         "roi": [roi.x_px, roi.y_px, roi.width_px, roi.height_px],
         "mesh": [nx, ny],
         "strain": correlator.settings().strain.name(),
-        "reference_mode": format!("{:?}", args.reference_mode).to_lowercase(),
+        "reference_mode": args.reference_mode.name(),
         "guess": format!("{:?}", args.correlation.guess).to_lowercase(),
         "gradient_correction": args.correlation.gradient_correction,
         "min_zncc": args.correlation.min_zncc,

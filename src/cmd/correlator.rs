@@ -1,9 +1,11 @@
 //! `dicstream correlator`: the live correlation process (subscribes to `frames`, publishes
 //! `fields`, saves its reference to `--state-dir` to survive a restart).
 
-use super::correlate::{CorrelationArgs, ReferenceArg};
+use super::correlate::CorrelationArgs;
+use super::named_arg::named;
 use anyhow::{bail, Context, Result};
 use correlator::process::{run as run_process, ProcessConfig, ReferenceImage};
+use correlator::settings::ReferenceKind;
 use correlator::CorrelatorSettings;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -17,8 +19,8 @@ pub struct CorrelatorArgs {
     #[arg(long)]
     pub reference: Option<PathBuf>,
     /// Reference mode: fixed, incremental (previous frame) or auto update.
-    #[arg(long, value_enum, default_value = "fixed")]
-    pub reference_mode: ReferenceArg,
+    #[arg(long, value_parser = named::<ReferenceKind>(), default_value_t = ReferenceKind::Fixed)]
+    pub reference_mode: ReferenceKind,
     #[command(flatten)]
     pub correlation: CorrelationArgs,
     /// Folder for the reference and what is needed to resume after a restart (created if
@@ -35,7 +37,7 @@ pub struct CorrelatorArgs {
 
 impl CorrelatorArgs {
     fn settings(&self) -> CorrelatorSettings {
-        self.correlation.settings(self.reference_mode.mode())
+        self.correlation.settings(self.reference_mode)
     }
 }
 

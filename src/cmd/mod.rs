@@ -8,6 +8,7 @@ pub mod correlator;
 pub mod identifier;
 pub mod identify;
 pub mod monitor;
+pub mod named_arg;
 pub mod producer;
 pub mod producer_genicam;
 pub mod producer_watch;

@@ -4,6 +4,8 @@
 use anyhow::Context;
 use rig::builtin::BuiltinTest;
 use rig::process::{run as run_process, ProcessOptions, Speed};
+use rig::strain::control::OnRestore;
+use rig::strain::{StrainKind, TestControl};
 use rig::{Campaign, Program, RigConfig};
 use std::path::PathBuf;
 
@@ -40,12 +42,12 @@ pub struct RigArgs {
     pub stretch: f64,
     /// displacement (the grips follow the program) or strain: the correlator's `fields` close
     /// the loop on the gauge zone's log strains (a cruciform specimen, --kind, --ratio).
-    #[arg(long, default_value = "displacement")]
-    pub control: String,
+    #[arg(long, default_value_t = TestControl::Displacement)]
+    pub control: TestControl,
     /// The strain path under --control strain: uniaxial (ρ = −1/2), equibiaxial (ρ = 1),
     /// pure_shear (ρ = 0) or biaxial (--ratio).
     #[arg(long)]
-    pub kind: Option<String>,
+    pub kind: Option<StrainKind>,
     /// ρ = ln λy / ln λx held by a biaxial strain-controlled test.
     #[arg(long, allow_hyphen_values = true)]
     pub ratio: Option<f64>,
@@ -57,8 +59,8 @@ pub struct RigArgs {
     pub min_valid_nodes: u32,
     /// After a hold, once fields are usable again: resume the strain program, or stop
     /// (unload) there.
-    #[arg(long, default_value = "resume")]
-    pub on_interlock: String,
+    #[arg(long, default_value_t = OnRestore::Resume)]
+    pub on_interlock: OnRestore,
     /// realtime, a factor N (N× real time) or max.
     #[arg(long, default_value = "realtime")]
     pub speed: String,
@@ -194,34 +196,33 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
 
 /// The strain-controlled test of `--control strain`, refused with the flag named.
 fn strain_test(args: &RigArgs) -> anyhow::Result<Option<rig::strain::StrainTest>> {
-    match args.control.as_str() {
-        "displacement" => {
+    match args.control {
+        TestControl::Displacement => {
             if args.kind.is_some() || args.ratio.is_some() {
                 anyhow::bail!("--kind and --ratio describe a strain path: add --control strain");
             }
             Ok(None)
         }
-        "strain" => {
+        TestControl::Strain => {
             if args.program.is_some() || args.test.is_some() || args.campaign.is_some() {
                 anyhow::bail!(
                     "--control strain runs its own test (--kind, --stretch, --rate-per-s): no \
                      --program, --test or --campaign with it"
                 );
             }
-            let kind = args.kind.as_deref().ok_or_else(|| {
+            let kind = args.kind.ok_or_else(|| {
                 anyhow::anyhow!(
                     "--control strain needs --kind: {}",
-                    rig::strain::StrainKind::NAMES
+                    <StrainKind as wire::names::Named>::expected()
                 )
             })?;
             let test = rig::strain::StrainTest::new(kind, args.ratio, args.stretch, args.rate)
                 .and_then(|t| {
-                    t.with_interlocks(args.stale_s, args.min_valid_nodes, &args.on_interlock)
+                    t.with_interlocks(args.stale_s, args.min_valid_nodes, args.on_interlock)
                 })
                 .context("--control strain")?;
             Ok(Some(test))
         }
-        other => anyhow::bail!("--control {other:?}: expected displacement or strain"),
     }
 }
 

@@ -2,9 +2,8 @@
 //! log a real test machine's software appends to, and publish its rows on `rig/state` in the
 //! simulated rig's layout (see `rig::csv_follow`).
 
-use rig::csv_follow::columns::{
-    ForceUnit, LengthUnit, TimeUnit, FORCE_UNITS, LENGTH_UNITS, TIME_UNITS,
-};
+use rig::csv_follow::columns::{ForceUnit, LengthUnit, TimeUnit};
+use rig::csv_follow::delimiter::Delimiter;
 use rig::csv_follow::process::{run as follow, FollowOptions};
 use rig::csv_follow::{ColumnSpec, CsvColumns};
 use std::path::PathBuf;
@@ -35,16 +34,16 @@ pub struct FollowCsvArgs {
     pub displacement_z_column: Option<String>,
     /// Unit of the time column: s, ms or min [default: as its header says, `Time (s)`]
     #[arg(long, requires = "follow_csv")]
-    pub time_unit: Option<String>,
+    pub time_unit: Option<TimeUnit>,
     /// Unit of the force columns: N or kN [default: as their headers say]
     #[arg(long, requires = "follow_csv")]
-    pub force_unit: Option<String>,
+    pub force_unit: Option<ForceUnit>,
     /// Unit of the displacement columns: mm, um or m [default: as their headers say]
     #[arg(long, requires = "follow_csv")]
-    pub displacement_unit: Option<String>,
+    pub displacement_unit: Option<LengthUnit>,
     /// Cell delimiter: ",", ";" or "tab" (with ";" and tab a decimal comma is read too)
-    #[arg(long, default_value = ",", requires = "follow_csv")]
-    pub delimiter: String,
+    #[arg(long, default_value_t = Delimiter::Comma, requires = "follow_csv")]
+    pub delimiter: Delimiter,
     /// Seconds added to the machine's time to put it on the camera's (camera − machine)
     #[arg(
         long,
@@ -67,26 +66,10 @@ pub struct FollowCsvArgs {
     pub idle_timeout_s: Option<f64>,
 }
 
-fn unit<U>(
-    text: &Option<String>,
-    flag: &str,
-    parse: fn(&str) -> Option<U>,
-    expected: &str,
-) -> anyhow::Result<Option<U>> {
-    text.as_deref()
-        .map(|t| parse(t).ok_or_else(|| anyhow::anyhow!("{flag} {t:?}: expected {expected}")))
-        .transpose()
-}
-
 /// The columns to follow, checked (names, units, delimiter) before anything starts.
 pub fn columns(args: &FollowCsvArgs) -> anyhow::Result<CsvColumns> {
     let spec = |name: &Option<String>| name.as_deref().map(|n| ColumnSpec::new(n, None));
-    let delimiter = match args.delimiter.as_str() {
-        "tab" | "\t" => '\t',
-        "," => ',',
-        ";" => ';',
-        other => anyhow::bail!("--delimiter {other:?}: expected \",\", \";\" or tab"),
-    };
+    let delimiter = args.delimiter.as_char();
     let columns = CsvColumns {
         time: ColumnSpec::new(
             args.time_column
@@ -104,19 +87,9 @@ pub fn columns(args: &FollowCsvArgs) -> anyhow::Result<CsvColumns> {
             spec(&args.displacement_y_column),
             spec(&args.displacement_z_column),
         ],
-        time_unit: unit(&args.time_unit, "--time-unit", TimeUnit::parse, TIME_UNITS)?,
-        force_unit: unit(
-            &args.force_unit,
-            "--force-unit",
-            ForceUnit::parse,
-            FORCE_UNITS,
-        )?,
-        displacement_unit: unit(
-            &args.displacement_unit,
-            "--displacement-unit",
-            LengthUnit::parse,
-            LENGTH_UNITS,
-        )?,
+        time_unit: args.time_unit,
+        force_unit: args.force_unit,
+        displacement_unit: args.displacement_unit,
         delimiter,
     };
     columns

@@ -2,6 +2,7 @@
 //! processes), live status, results folder. See the `live` crate.
 
 use anyhow::Context;
+use live::config::DashboardListen;
 use live::{Ending, RunConfig, RunOptions};
 use std::path::PathBuf;
 
@@ -31,7 +32,7 @@ pub struct RunArgs {
     /// Serve the live dashboard at ADDR:PORT [default: the configuration's `dashboard`,
     /// 127.0.0.1:8421]; a non-loopback address serves other machines too, with a warning.
     #[arg(long, conflicts_with = "no_dashboard")]
-    pub dashboard: Option<String>,
+    pub dashboard: Option<DashboardListen>,
     /// No live dashboard.
     #[arg(long)]
     pub no_dashboard: bool,
@@ -56,7 +57,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
         config.run.dashboard = address;
     }
     if args.no_dashboard {
-        config.run.dashboard = "off".into();
+        config.run.dashboard = DashboardListen::Off;
     }
     config.validate().context("configuration refused")?;
     let exe = std::env::current_exe().context("cannot find the dicstream binary")?;

@@ -21,6 +21,7 @@ pub mod identification;
 #[cfg(feature = "ipc")]
 pub mod instance;
 mod layout_check;
+pub mod names;
 pub mod owner;
 #[cfg(feature = "ipc")]
 pub mod pubsub;

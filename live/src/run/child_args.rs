@@ -62,8 +62,8 @@ pub fn child_args(
     let k = &config.correlator;
     let g = &config.rig;
     let extra: Vec<String> = match role {
-        Role::Rig if config.rig_source() == RigSource::CsvFollow => csv_follow_args(config),
-        Role::Producer if config.camera_source() != CameraSource::Simulated => {
+        Role::Rig if config.rig.source == RigSource::CsvFollow => csv_follow_args(config),
+        Role::Producer if config.camera.source != CameraSource::Simulated => {
             real_camera_args(config, results, first_frame_id)
         }
         Role::Rig => [
@@ -116,7 +116,7 @@ pub fn child_args(
         ],
         Role::Correlator => vec![
             "--method".into(),
-            k.method.clone(),
+            k.method.to_string(),
             "--zoi".into(),
             k.zoi_px.to_string(),
             "--step".into(),
@@ -124,11 +124,11 @@ pub fn child_args(
             "--threads".into(),
             k.threads.to_string(),
             "--strain".into(),
-            k.strain.clone(),
+            k.strain.to_string(),
             "--reference-mode".into(),
-            k.reference.clone(),
+            k.reference.to_string(),
             "--guess".into(),
-            k.guess.clone(),
+            k.guess.to_string(),
             "--min-zncc".into(),
             k.min_zncc.to_string(),
             "--gradient-correction".into(),
@@ -142,7 +142,7 @@ pub fn child_args(
             "--journal".into(),
             path(results.journal()),
             "--model".into(),
-            config.identifier.models.clone(),
+            config.identifier.models.to_string(),
         ],
     };
     args.extend(extra);
@@ -152,7 +152,8 @@ pub fn child_args(
 /// `rig --follow-csv FILE ...`: the machine's log of `[rig.csv]`.
 fn csv_follow_args(config: &RunConfig) -> Vec<String> {
     let v = &config.rig.csv;
-    let mut args = vec!["--follow-csv".to_string(), v.file.clone()];
+    let path = |p: &PathBuf| p.to_string_lossy().into_owned();
+    let mut args = vec!["--follow-csv".to_string(), path(&v.file)];
     let mut named = |flag: &str, value: &str| {
         if !value.trim().is_empty() {
             args.push(flag.to_string());
@@ -166,10 +167,14 @@ fn csv_follow_args(config: &RunConfig) -> Vec<String> {
     named("--displacement-x-column", &v.displacement_x_column);
     named("--displacement-y-column", &v.displacement_y_column);
     named("--displacement-z-column", &v.displacement_z_column);
-    named("--time-unit", &v.time_unit);
-    named("--force-unit", &v.force_unit);
-    named("--displacement-unit", &v.displacement_unit);
-    named("--delimiter", &v.delimiter);
+    let unit = |u: Option<&str>| u.unwrap_or("").to_string();
+    named("--time-unit", &unit(v.time_unit.map(|u| u.name())));
+    named("--force-unit", &unit(v.force_unit.map(|u| u.name())));
+    named(
+        "--displacement-unit",
+        &unit(v.displacement_unit.map(|u| u.name())),
+    );
+    named("--delimiter", v.delimiter.name());
     args.extend([
         format!("--offset-s={}", v.offset_s),
         "--section-x-mm2".into(),
@@ -185,11 +190,11 @@ fn csv_follow_args(config: &RunConfig) -> Vec<String> {
 /// The producer's options for a watched folder, a replay or a GenICam camera.
 fn real_camera_args(config: &RunConfig, results: &ResultsDir, first_frame_id: u64) -> Vec<String> {
     let c = &config.camera;
-    let mut args: Vec<String> = match config.camera_source() {
+    let mut args: Vec<String> = match config.camera.source {
         CameraSource::Watch => {
             let mut a = vec![
                 "--watch".to_string(),
-                c.watch_dir.clone(),
+                c.watch_dir.to_string_lossy().into_owned(),
                 "--settle-ms".into(),
                 c.watch_settle_ms.to_string(),
                 // Which file each frame is, beside the results.
@@ -233,12 +238,15 @@ fn real_camera_args(config: &RunConfig, results: &ResultsDir, first_frame_id: u6
                 a.push(format!("--gain-db={db}"));
             }
             for (flag, value) in [
-                ("--pixel-format", &c.genicam_pixel_format),
-                ("--roi", &c.genicam_roi),
-                ("--trigger", &c.genicam_trigger),
+                (
+                    "--pixel-format",
+                    c.genicam_pixel_format.map(|f| f.to_string()),
+                ),
+                ("--roi", c.genicam_roi.map(|r| r.to_string())),
+                ("--trigger", c.genicam_trigger.map(|t| t.to_string())),
             ] {
-                if !value.is_empty() {
-                    a.extend([flag.to_string(), value.clone()]);
+                if let Some(value) = value {
+                    a.extend([flag.to_string(), value]);
                 }
             }
             a
@@ -339,7 +347,7 @@ mod tests {
     #[test]
     fn the_correlator_gets_its_method_threads_and_state_folder() {
         let mut config = RunConfig::default();
-        config.correlator.method = "icgn2".into();
+        config.correlator.method = "icgn2".parse().unwrap();
         config.correlator.threads = 5;
         config.correlator.zoi_px = 31;
         config.correlator.gradient_correction = false;
@@ -350,16 +358,16 @@ mod tests {
         assert_eq!(value(&args, "--gradient-correction"), "false");
         assert_eq!(
             value(&args, "--reference-mode"),
-            config.correlator.reference
+            config.correlator.reference.name()
         );
-        assert_eq!(value(&args, "--guess"), config.correlator.guess);
+        assert_eq!(value(&args, "--guess"), config.correlator.guess.name());
         assert_eq!(value(&args, "--state-dir"), "/results/run/correlator_state");
     }
 
     #[test]
     fn the_identifier_writes_and_journals_in_the_results() {
         let mut config = RunConfig::default();
-        config.identifier.models = "yeoh,gent".into();
+        config.identifier.models = "yeoh,gent".parse().unwrap();
         let args = args(Role::Identifier, &config, 0);
         assert_eq!(value(&args, "--output"), "/results/run/identification.json");
         assert_eq!(
@@ -381,12 +389,12 @@ mod tests {
     #[test]
     fn a_csv_follow_rig_gets_its_columns_units_and_offset() {
         let mut config = RunConfig::default();
-        config.rig.source = "csv-follow".into();
+        config.rig.source = "csv-follow".parse().unwrap();
         let v = &mut config.rig.csv;
         v.file = "/lab/test.csv".into();
         v.time_column = "Time".into();
         v.force_x_column = "Fx".into();
-        v.force_unit = "kN".into();
+        v.force_unit = Some("kN".parse().unwrap());
         v.offset_s = -0.5;
         v.section_x_mm2 = 40.0;
         let args = args(Role::Rig, &config, 0);
@@ -403,7 +411,7 @@ mod tests {
     #[test]
     fn real_cameras_get_their_source_options_and_no_rendering_ones() {
         let mut config = RunConfig::default();
-        config.camera.source = "watch".into();
+        config.camera.source = "watch".parse().unwrap();
         config.camera.watch_dir = "/lab/images".into();
         config.camera.watch_from_start = true;
         config.camera.watch_idle_timeout_s = 3.0;
@@ -416,18 +424,18 @@ mod tests {
         for flag in ["--follow-rig", "--fps", "--max-stretch", "--width"] {
             assert!(!watch.contains(&flag.to_string()), "{flag} in {watch:?}");
         }
-        config.camera.source = "replay".into();
+        config.camera.source = "replay".parse().unwrap();
         config.camera.replay_files = "/lab/images/*.tif".into();
         let replay = args(Role::Producer, &config, 0);
         assert_eq!(value(&replay, "--replay"), "/lab/images/*.tif");
         assert_eq!(value(&replay, "--fps"), "10");
-        config.camera.source = "genicam".into();
+        config.camera.source = "genicam".parse().unwrap();
         config.camera.genicam_id = "Fake_1".into();
         config.camera.genicam_exposure_us = Some(2000.0);
         config.camera.genicam_gain_db = Some(-1.5);
-        config.camera.genicam_pixel_format = "Mono12".into();
-        config.camera.genicam_roi = "0,0,512,512".into();
-        config.camera.genicam_trigger = "software".into();
+        config.camera.genicam_pixel_format = Some("Mono12".parse().unwrap());
+        config.camera.genicam_roi = Some("0,0,512,512".parse().unwrap());
+        config.camera.genicam_trigger = Some("software".parse().unwrap());
         let genicam = args(Role::Producer, &config, 0);
         assert_eq!(value(&genicam, "--camera"), "genicam:Fake_1");
         assert_eq!(value(&genicam, "--exposure-us"), "2000");

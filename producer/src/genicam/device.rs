@@ -13,8 +13,8 @@ use std::time::Duration;
 use aravis::prelude::*;
 use aravis::{AcquisitionMode, Auto, Buffer, Camera, Stream};
 
+use super::Trigger;
 use super::{BufferStatus, CameraSettings, CameraSpec, PixelFormat, RoiError, RoiLimits};
-use super::{Trigger, PIXEL_FORMATS};
 
 /// Buffers queued to the driver: the camera keeps streaming while the producer publishes one.
 const QUEUED_BUFFERS: usize = 10;
@@ -26,7 +26,7 @@ pub enum GenicamError {
     NotFound { id: Option<String>, found: String },
     #[error("opening camera {id}: {detail}")]
     Open { id: String, detail: String },
-    #[error("camera {id} does not offer pixel format {asked} (it offers {offered}); dicstream publishes {}", PIXEL_FORMATS.map(PixelFormat::name).join(", "))]
+    #[error("camera {id} does not offer pixel format {asked} (it offers {offered}); dicstream publishes {}", <PixelFormat as wire::names::Named>::expected())]
     PixelFormat {
         id: String,
         asked: String,

@@ -4,9 +4,6 @@
 //!
 //! Codes are the GenICam PFNC values (the `PixelFormat` feature's integer values).
 
-use std::fmt;
-use std::str::FromStr;
-
 /// A monochrome pixel format dicstream can publish.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum PixelFormat {
@@ -27,31 +24,12 @@ pub enum PixelFormat {
     Mono12Packed,
 }
 
-/// The formats, in the order they are listed to a user.
-pub const PIXEL_FORMATS: [PixelFormat; 7] = [
-    PixelFormat::Mono8,
-    PixelFormat::Mono10,
-    PixelFormat::Mono12,
-    PixelFormat::Mono16,
-    PixelFormat::Mono10p,
-    PixelFormat::Mono12p,
-    PixelFormat::Mono12Packed,
-];
+wire::named!(PixelFormat, "pixel format", ignore_case, {
+    Mono8 => "Mono8", Mono10 => "Mono10", Mono12 => "Mono12", Mono16 => "Mono16",
+    Mono10p => "Mono10p", Mono12p => "Mono12p", Mono12Packed => "Mono12Packed",
+});
 
 impl PixelFormat {
-    /// The GenICam name (the `PixelFormat` enumeration entry).
-    pub fn name(self) -> &'static str {
-        match self {
-            PixelFormat::Mono8 => "Mono8",
-            PixelFormat::Mono10 => "Mono10",
-            PixelFormat::Mono12 => "Mono12",
-            PixelFormat::Mono16 => "Mono16",
-            PixelFormat::Mono10p => "Mono10p",
-            PixelFormat::Mono12p => "Mono12p",
-            PixelFormat::Mono12Packed => "Mono12Packed",
-        }
-    }
-
     /// The PFNC code.
     pub fn code(self) -> u32 {
         match self {
@@ -67,7 +45,7 @@ impl PixelFormat {
 
     /// The format of a PFNC code, if dicstream can publish it.
     pub fn from_code(code: u32) -> Option<PixelFormat> {
-        PIXEL_FORMATS.into_iter().find(|f| f.code() == code)
+        Self::ALL.iter().copied().find(|f| f.code() == code)
     }
 
     /// Significant bits per pixel (the frame header's bit depth).
@@ -89,28 +67,6 @@ impl PixelFormat {
             PixelFormat::Mono10p => (pixels * 10).div_ceil(8),
             PixelFormat::Mono12p | PixelFormat::Mono12Packed => (pixels * 12).div_ceil(8),
         }
-    }
-}
-
-impl fmt::Display for PixelFormat {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for PixelFormat {
-    type Err = String;
-
-    fn from_str(text: &str) -> Result<Self, Self::Err> {
-        PIXEL_FORMATS
-            .into_iter()
-            .find(|f| f.name().eq_ignore_ascii_case(text.trim()))
-            .ok_or_else(|| {
-                format!(
-                    "unknown pixel format {text:?}: expected one of {} (monochrome only)",
-                    PIXEL_FORMATS.map(PixelFormat::name).join(", ")
-                )
-            })
     }
 }
 
@@ -232,12 +188,12 @@ mod tests {
 
     #[test]
     fn names_and_codes_round_trip_and_unknown_names_are_refused_clearly() {
-        for f in PIXEL_FORMATS {
+        for &f in PixelFormat::ALL {
             assert_eq!(f.name().parse::<PixelFormat>(), Ok(f));
             assert_eq!(PixelFormat::from_code(f.code()), Some(f));
         }
         assert_eq!("mono12".parse::<PixelFormat>(), Ok(PixelFormat::Mono12));
-        let err = "RGB8".parse::<PixelFormat>().unwrap_err();
+        let err = "RGB8".parse::<PixelFormat>().unwrap_err().to_string();
         assert!(
             err.contains("\"RGB8\"") && err.contains("Mono8, Mono10"),
             "{err}"

@@ -62,14 +62,11 @@ pub const TIME_UNITS: &str = "s, ms or min";
 pub const FORCE_UNITS: &str = "N or kN";
 pub const LENGTH_UNITS: &str = "mm, um or m";
 
+wire::named!(TimeUnit, "time unit", { S => "s" | "sec", Ms => "ms", Min => "min" });
+
 impl TimeUnit {
     pub fn parse(text: &str) -> Option<TimeUnit> {
-        match text.trim() {
-            "s" | "sec" => Some(TimeUnit::S),
-            "ms" => Some(TimeUnit::Ms),
-            "min" => Some(TimeUnit::Min),
-            _ => None,
-        }
+        text.parse().ok()
     }
     pub fn to_s(self) -> f64 {
         match self {
@@ -80,13 +77,11 @@ impl TimeUnit {
     }
 }
 
+wire::named!(ForceUnit, "force unit", { Newton => "N", KiloNewton => "kN" | "KN" });
+
 impl ForceUnit {
     pub fn parse(text: &str) -> Option<ForceUnit> {
-        match text.trim() {
-            "N" => Some(ForceUnit::Newton),
-            "kN" | "KN" => Some(ForceUnit::KiloNewton),
-            _ => None,
-        }
+        text.parse().ok()
     }
     pub fn to_n(self) -> f64 {
         match self {
@@ -96,14 +91,11 @@ impl ForceUnit {
     }
 }
 
+wire::named!(LengthUnit, "displacement unit", { Mm => "mm", Um => "um" | "µm", M => "m" });
+
 impl LengthUnit {
     pub fn parse(text: &str) -> Option<LengthUnit> {
-        match text.trim() {
-            "mm" => Some(LengthUnit::Mm),
-            "um" | "µm" => Some(LengthUnit::Um),
-            "m" => Some(LengthUnit::M),
-            _ => None,
-        }
+        text.parse().ok()
     }
     pub fn to_mm(self) -> f64 {
         match self {

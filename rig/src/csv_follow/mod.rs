@@ -8,6 +8,7 @@
 
 pub mod clock;
 pub mod columns;
+pub mod delimiter;
 pub mod lines;
 #[cfg(feature = "process")]
 pub mod process;

@@ -25,11 +25,14 @@ use crate::strain::path::StrainPath;
 pub const RESUME_AFTER_FIELDS: u32 = 3;
 
 /// What strain control does once fields are usable again after an interlock.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum OnRestore {
+    #[default]
     Resume,
     Stop,
 }
+
+wire::named!(OnRestore, "on_interlock", { Resume => "resume", Stop => "stop" });
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum StrainMode {

@@ -282,6 +282,8 @@ impl StrainRun {
 mod tests {
     use super::*;
     use crate::builtin::BuiltinTest;
+    use crate::strain::control::OnRestore;
+    use crate::strain::StrainKind;
     use crate::RigConfig;
 
     /// The gauge truth as a field captured at 20 Hz and delivered 0.1 s later, until `stop_s`.
@@ -330,7 +332,7 @@ mod tests {
 
     #[test]
     fn a_pure_shear_run_starts_on_a_field_holds_its_path_and_unloads() {
-        let test = StrainTest::new("pure_shear", None, 1.3, 0.05).unwrap();
+        let test = StrainTest::new(StrainKind::PureShear, None, 1.3, 0.05).unwrap();
         let (rig, strain, events, _) = run(test, f64::INFINITY, 0.0, 30.0);
         assert!(strain.is_done(), "{events:?}");
         assert!(matches!(events[0], StrainRunEvent::Started { .. }));
@@ -343,7 +345,7 @@ mod tests {
 
     #[test]
     fn without_fields_nothing_moves_and_the_wait_is_reported() {
-        let test = StrainTest::new("equibiaxial", None, 1.5, 0.05).unwrap();
+        let test = StrainTest::new(StrainKind::Equibiaxial, None, 1.5, 0.05).unwrap();
         let (rig, strain, events, modes) = run(test, 0.0, f64::INFINITY, 3.0);
         assert_eq!(strain.phase(), &Phase::Waiting);
         assert!(
@@ -361,8 +363,8 @@ mod tests {
 
     #[test]
     fn fields_stopped_mid_ramp_hold_then_resume_or_stop_as_configured() {
-        for (on, resumes) in [("resume", true), ("stop", false)] {
-            let test = StrainTest::new("equibiaxial", None, 1.4, 0.05)
+        for (on, resumes) in [(OnRestore::Resume, true), (OnRestore::Stop, false)] {
+            let test = StrainTest::new(StrainKind::Equibiaxial, None, 1.4, 0.05)
                 .unwrap()
                 .with_interlocks(0.5, 16, on)
                 .unwrap();

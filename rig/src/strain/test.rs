@@ -20,28 +20,24 @@ pub enum StrainKind {
     Biaxial,
 }
 
+/// How a test drives the grips.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TestControl {
+    /// The grips follow the program (centroid control).
+    #[default]
+    Displacement,
+    /// The correlator's fields close the loop on the gauge zone's log strains.
+    Strain,
+}
+
+wire::named!(TestControl, "control", { Displacement => "displacement", Strain => "strain" });
+
+wire::named!(StrainKind, "kind", {
+    Uniaxial => "uniaxial", Equibiaxial => "equibiaxial", PureShear => "pure_shear",
+    Biaxial => "biaxial",
+});
+
 impl StrainKind {
-    pub const NAMES: &'static str = "uniaxial, equibiaxial, pure_shear or biaxial";
-
-    pub fn parse(text: &str) -> Option<StrainKind> {
-        match text {
-            "uniaxial" => Some(StrainKind::Uniaxial),
-            "equibiaxial" => Some(StrainKind::Equibiaxial),
-            "pure_shear" => Some(StrainKind::PureShear),
-            "biaxial" => Some(StrainKind::Biaxial),
-            _ => None,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            StrainKind::Uniaxial => "uniaxial",
-            StrainKind::Equibiaxial => "equibiaxial",
-            StrainKind::PureShear => "pure_shear",
-            StrainKind::Biaxial => "biaxial",
-        }
-    }
-
     /// The kind's own ratio (None: biaxial, given by the user).
     pub fn fixed_ratio(self) -> Option<f64> {
         match self {
@@ -80,14 +76,10 @@ pub struct StrainTest {
 /// Why a strain-controlled test was refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum StrainTestError {
-    #[error("kind {kind:?}: expected {}", StrainKind::NAMES)]
-    Kind { kind: String },
     #[error("ratio {ratio} given with kind {kind}: only a biaxial test takes a ratio (uniaxial is −0.5, equibiaxial 1, pure_shear 0)")]
     RatioNotTaken { kind: &'static str, ratio: f64 },
     #[error("a biaxial test needs its ratio (ln λy / ln λx)")]
     RatioMissing,
-    #[error("on_interlock {text:?}: expected resume or stop")]
-    OnInterlock { text: String },
     #[error("stale limit {stale_s} s: expected a positive number of seconds")]
     Stale { stale_s: f64 },
     #[error(transparent)]
@@ -95,16 +87,13 @@ pub enum StrainTestError {
 }
 
 impl StrainTest {
-    /// `kind` by name; `ratio` only for a biaxial test; `stretch` > 1; `rate_log_per_s` > 0.
+    /// `ratio` only for a biaxial test; `stretch` > 1; `rate_log_per_s` > 0.
     pub fn new(
-        kind: &str,
+        kind: StrainKind,
         ratio: Option<f64>,
         stretch: f64,
         rate_log_per_s: f64,
     ) -> Result<StrainTest, StrainTestError> {
-        let kind = StrainKind::parse(kind).ok_or_else(|| StrainTestError::Kind {
-            kind: kind.to_string(),
-        })?;
         let ratio = match (kind.fixed_ratio(), ratio) {
             (Some(_), Some(ratio)) => {
                 return Err(StrainTestError::RatioNotTaken {
@@ -132,19 +121,19 @@ impl StrainTest {
         Ok(test)
     }
 
-    /// The interlocks: the stale limit (s), the fewest valid nodes, and `resume` or `stop`.
+    /// The interlocks: the stale limit (s), the fewest valid nodes, and what follows a hold.
     pub fn with_interlocks(
         mut self,
         stale_s: f64,
         min_valid_nodes: u32,
-        on_interlock: &str,
+        on_interlock: OnRestore,
     ) -> Result<StrainTest, StrainTestError> {
         if !(stale_s.is_finite() && stale_s > 0.0) {
             return Err(StrainTestError::Stale { stale_s });
         }
         self.limits.stale_s = stale_s;
         self.limits.min_valid_nodes = min_valid_nodes;
-        self.on_interlock = parse_on_interlock(on_interlock)?;
+        self.on_interlock = on_interlock;
         Ok(self)
     }
 
@@ -159,59 +148,57 @@ impl StrainTest {
     }
 }
 
-pub fn parse_on_interlock(text: &str) -> Result<OnRestore, StrainTestError> {
-    match text {
-        "resume" => Ok(OnRestore::Resume),
-        "stop" => Ok(OnRestore::Stop),
-        _ => Err(StrainTestError::OnInterlock { text: text.into() }),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn kinds_give_their_ratio_and_bad_combinations_are_refused_with_reasons() {
-        let t = StrainTest::new("equibiaxial", None, 1.8, 0.02).unwrap();
+        let t = StrainTest::new(StrainKind::Equibiaxial, None, 1.8, 0.02).unwrap();
         assert_eq!(t.ratio, 1.0);
         assert_eq!(t.target_log(), [1.8f64.ln(); 2]);
         assert_eq!(
-            StrainTest::new("pure_shear", None, 1.5, 0.02)
+            StrainTest::new(StrainKind::PureShear, None, 1.5, 0.02)
                 .unwrap()
                 .target_log(),
             [1.5f64.ln(), 0.0]
         );
         assert_eq!(
-            StrainTest::new("uniaxial", None, 1.5, 0.02).unwrap().ratio,
+            StrainTest::new(StrainKind::Uniaxial, None, 1.5, 0.02)
+                .unwrap()
+                .ratio,
             -0.5
         );
-        let b = StrainTest::new("biaxial", Some(0.5), 1.5, 0.02).unwrap();
+        let b = StrainTest::new(StrainKind::Biaxial, Some(0.5), 1.5, 0.02).unwrap();
         assert_eq!(b.target_log(), [1.5f64.ln(), 0.5 * 1.5f64.ln()]);
         let refused = |kind, ratio, stretch, rate| {
             StrainTest::new(kind, ratio, stretch, rate)
                 .unwrap_err()
                 .to_string()
         };
-        assert!(refused("uniaxial", Some(0.5), 1.5, 0.02).contains("only a biaxial"));
-        assert!(refused("biaxial", None, 1.5, 0.02).contains("needs its ratio"));
-        assert!(refused("biaxial", Some(f64::NAN), 1.5, 0.02).contains("ratio NaN"));
-        assert!(refused("equibiaxial", None, 1.0, 0.02).contains("stretch 1"));
-        assert!(refused("equibiaxial", None, 0.8, 0.02).contains("stretch"));
-        assert!(refused("equibiaxial", None, 1.5, 0.0).contains("rate"));
-        assert!(refused("shear", None, 1.5, 0.02).contains("pure_shear"));
-        let t = StrainTest::new("equibiaxial", None, 1.8, 0.02).unwrap();
+        assert!(refused(StrainKind::Uniaxial, Some(0.5), 1.5, 0.02).contains("only a biaxial"));
+        assert!(refused(StrainKind::Biaxial, None, 1.5, 0.02).contains("needs its ratio"));
+        assert!(refused(StrainKind::Biaxial, Some(f64::NAN), 1.5, 0.02).contains("ratio NaN"));
+        assert!(refused(StrainKind::Equibiaxial, None, 1.0, 0.02).contains("stretch 1"));
+        assert!(refused(StrainKind::Equibiaxial, None, 0.8, 0.02).contains("stretch"));
+        assert!(refused(StrainKind::Equibiaxial, None, 1.5, 0.0).contains("rate"));
+        assert!("shear"
+            .parse::<StrainKind>()
+            .unwrap_err()
+            .to_string()
+            .contains("pure_shear or biaxial"));
+        let t = StrainTest::new(StrainKind::Equibiaxial, None, 1.8, 0.02).unwrap();
         assert!(t
-            .with_interlocks(0.0, 16, "resume")
+            .with_interlocks(0.0, 16, OnRestore::Resume)
             .unwrap_err()
             .to_string()
             .contains("stale limit"));
-        assert!(t
-            .with_interlocks(0.5, 16, "pause")
+        assert!("pause"
+            .parse::<OnRestore>()
             .unwrap_err()
             .to_string()
             .contains("resume or stop"));
-        let t = t.with_interlocks(1.5, 40, "stop").unwrap();
+        let t = t.with_interlocks(1.5, 40, OnRestore::Stop).unwrap();
         assert_eq!(t.limits.stale_s, 1.5);
         assert_eq!(t.limits.min_valid_nodes, 40);
         assert_eq!(t.on_interlock, OnRestore::Stop);

@@ -1,0 +1,173 @@
+//! `dicstream run --print-config`: the defaults, written by the configuration's own types (so
+//! a key, its spelling and its default cannot drift from what is read), with the comment of
+//! each key from [`COMMENTS`]. A test checks that every key written has its comment and every
+//! comment its key.
+
+use super::RunConfig;
+use std::fmt::Write as _;
+
+/// The comment written above a key (`section.key`) or a table (`[section]`).
+const COMMENTS: &[(&str, &str)] = &[
+    ("[run]", ""),
+    ("run.results_dir", "Parent folder of the per-run results folders (<results_dir>/<date-time>/)."),
+    ("run.restart", "Restart a process that dies (at most max_restarts times each)."),
+    ("run.max_restarts", ""),
+    ("run.fields_every", "Keep the field of every Nth correlated frame (fields/field_<frame>.csv, and .vtk)."),
+    ("run.vtk", ""),
+    ("run.status_interval_s", "Seconds between two status lines, and given to a process to stop before SIGKILL."),
+    ("run.stop_timeout_s", ""),
+    ("run.stale_after_s", "Seconds after which a stopped (SIGSTOP) or silent process is killed as hung."),
+    ("run.dashboard", "The live dashboard (ADDR:PORT, or \"off\"); a non-loopback address serves other\nmachines too."),
+    ("[camera]", "The simulated camera renders the specimen as the rig deforms it."),
+    ("camera.width_px", ""),
+    ("camera.height_px", ""),
+    ("camera.fps", ""),
+    ("camera.bit_depth", "8, 10, 12 or 16 bit."),
+    ("camera.mm_per_px", "Image scale of the specimen, mm per px."),
+    ("camera.speckle_size_px", "Speckle spot size (FWHM), px; seed of the pattern and the noise."),
+    ("camera.seed", ""),
+    ("camera.threads", "Rendering threads (the correlator wants the cores more)."),
+    ("camera.source", "Where frames come from: simulated (rendered from the simulated rig, with ground\ntruth), watch (images another program writes into watch_dir), replay (the\nimages of replay_files at fps) or genicam (a GenICam camera: a build with the\ngenicam feature). Real images have no ground truth: no truth columns, no\nacceptance. width_px/height_px must then be the images' size."),
+    ("camera.watch_dir", ""),
+    ("camera.watch_from_start", ""),
+    ("camera.watch_idle_timeout_s", "0: the camera never ends by itself."),
+    ("camera.watch_settle_ms", ""),
+    ("camera.replay_files", ""),
+    ("camera.genicam_id", "genicam_id \"\" = the first camera; genicam_exposure_us, genicam_gain_db when set;\npixel format Mono8/10/12/16 (or packed Mono10p/Mono12p/Mono12Packed), roi\n\"x,y,w,h\", trigger software/hardware/free (\"\" = as the camera is)."),
+    ("camera.genicam_pixel_format", ""),
+    ("camera.genicam_roi", ""),
+    ("camera.genicam_trigger", ""),
+    ("[correlator]", ""),
+    ("correlator.method", "Sub-pixel method: correli (the paper; the default, the fastest), icgn1 (inverse\ncompositional Gauss-Newton, affine subsets: less noise, several times slower)\nor icgn2 (second-order subsets)."),
+    ("correlator.zoi_px", "ZOI (subset) side px (any size from 9 for icgn1/icgn2, 2^s for correli) and\ndistance between ZOI centres px (paper section 3.b)."),
+    ("correlator.step_px", ""),
+    ("correlator.threads", ""),
+    ("correlator.strain", "Node strain measure: log (m = 0), green (m = 1), nominal (m = 1/2) or small."),
+    ("correlator.reference", "Reference: fixed, incremental (consecutive frames) or auto (renewed when the\ndisplacement or the score call for it, mesh followed)."),
+    ("correlator.guess", "Initial guess per ZOI: auto (previous field or significant global (U0, V0),\nfailed nodes grown from verified neighbours, keypoints when too few verify),\npredict (previous field, neighbours) or correli (paper)."),
+    ("correlator.min_zncc", "A node is ok only when the ZNCC of its reference ZOI with the frame, sampled at\nits displacement and local gradient, reaches this (0 < min_zncc < 1)."),
+    ("correlator.gradient_correction", "Remove, to first order, the rigid ZOI's bias under a displacement gradient\n(beyond the paper; false = CORRELI-GD as published)."),
+    ("[rig]", ""),
+    ("rig.speed", "Simulated time per wall time; rig/state and rig.csv rates, Hz of simulated time."),
+    ("rig.publish_hz", ""),
+    ("rig.log_hz", ""),
+    ("rig.seed", ""),
+    ("rig.source", "simulated (the campaign below) or csv-follow (a test machine's CSV log, [rig.csv])."),
+    ("[[rig.tests]]", "The campaign, in order: each test mounts its specimen (uniaxial: a 100 x 20 x 2 mm\nstrip; equibiaxial: a 100 x 100 x 2 mm cruciform centre), ramps the elongation to\n`stretch` at `rate_per_s` in centroid control, holds, unloads. A test alone may\ninstead be strain-controlled (the correlator's fields close the loop):\ncontrol = \"strain\", kind = uniaxial | equibiaxial | pure_shear | biaxial,\nratio = ln(ly)/ln(lx) (biaxial), stretch = the larger measured stretch,\nrate_per_s = log strain rate; stale_s = 1.5, min_valid_nodes = 16,\non_interlock = \"resume\" | \"stop\"."),
+    ("rig.tests.kind", ""),
+    ("rig.tests.stretch", ""),
+    ("rig.tests.rate_per_s", ""),
+    ("[rig.csv]", ""),
+    ("rig.csv.file", "The CSV a test machine's software appends to (waited for if missing; a partial\nlast line waits for its newline; a malformed line is reported and skipped)."),
+    ("rig.csv.time_column", "Column names as in the header, without their unit (\"\" = not logged)."),
+    ("rig.csv.force_x_column", ""),
+    ("rig.csv.force_y_column", ""),
+    ("rig.csv.force_z_column", ""),
+    ("rig.csv.displacement_x_column", ""),
+    ("rig.csv.displacement_y_column", ""),
+    ("rig.csv.displacement_z_column", ""),
+    ("rig.csv.time_unit", "Units: s/ms/min, N/kN, mm/um/m; \"\" = as the header says (`Fx (kN)`)."),
+    ("rig.csv.force_unit", ""),
+    ("rig.csv.displacement_unit", ""),
+    ("rig.csv.delimiter", "\",\", \";\" or \"tab\" (with \";\" and tab a decimal comma is read too)."),
+    ("rig.csv.offset_s", "Seconds added to the machine's time to put it on the camera's."),
+    ("rig.csv.section_x_mm2", "Initial specimen sections normal to X and Y, mm² (stress = force / section)."),
+    ("rig.csv.section_y_mm2", ""),
+    ("rig.csv.idle_timeout_s", "The test is over after this long without a new row."),
+    ("[specimen]", ""),
+    ("specimen.law_f", "Material of the specimens: ln f(I1) = sum a_i (I1 - 3)^i and\nln g(I2) = sum b_i (I2 - 3)^i (eqs. 22, 25; f, g in MPa). Default: Smactane,\nTables 3 and 4 (n = 2). A virtual test must give them back."),
+    ("specimen.law_g", ""),
+    ("[identifier]", ""),
+    ("identifier.models", "Models ranked at each refit (see `dicstream identify --help`), or all."),
+];
+
+const PREAMBLE: &str =
+    "# dicstream run configuration. Every key is optional: a missing key takes the value\n\
+                        # shown here. Unknown keys are refused.\n";
+
+/// What a line of the written TOML opens: a table (`[rig.csv]`, `[[rig.tests]]`) or a key
+/// (`rig.csv.file`), with the table it is in.
+fn entry_of(line: &str, table: &str) -> Option<String> {
+    let line = line.trim();
+    if line.starts_with('[') {
+        return Some(line.to_string());
+    }
+    let key = line.split_once(" = ")?.0.trim();
+    Some(format!("{table}.{key}"))
+}
+
+/// The table a header line names (`[[rig.tests]]` → `rig.tests`).
+fn table_of(header: &str) -> String {
+    header.trim_matches(|c| c == '[' || c == ']').to_string()
+}
+
+fn comment(entry: &str) -> Option<&'static str> {
+    COMMENTS.iter().find(|(e, _)| *e == entry).map(|(_, c)| *c)
+}
+
+impl RunConfig {
+    /// The defaults as a commented TOML file to start from. Each comment is written once, above
+    /// the first occurrence of its key or table.
+    pub fn commented_defaults() -> String {
+        let mut out = String::from(PREAMBLE);
+        let mut table = String::new();
+        let mut said: Vec<String> = Vec::new();
+        for line in RunConfig::default().to_toml().lines() {
+            if let Some(entry) = entry_of(line, &table) {
+                if line.trim_start().starts_with('[') {
+                    table = table_of(line);
+                    let _ = writeln!(out);
+                }
+                if !said.contains(&entry) {
+                    for text in comment(&entry).unwrap_or("").lines() {
+                        let _ = writeln!(out, "# {text}");
+                    }
+                    said.push(entry);
+                }
+            }
+            let _ = writeln!(out, "{line}");
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every entry the types write (with every optional key given, so none is skipped).
+    fn written_entries() -> Vec<String> {
+        let mut table = String::new();
+        let mut entries = Vec::new();
+        for line in RunConfig::default().to_toml().lines() {
+            if let Some(entry) = entry_of(line, &table) {
+                if line.trim_start().starts_with('[') {
+                    table = table_of(line);
+                }
+                if !entries.contains(&entry) {
+                    entries.push(entry);
+                }
+            }
+        }
+        entries
+    }
+
+    #[test]
+    fn every_key_written_has_its_comment_and_every_comment_its_key() {
+        let written = written_entries();
+        for entry in &written {
+            assert!(comment(entry).is_some(), "no comment for {entry}");
+        }
+        for (entry, _) in COMMENTS {
+            assert!(written.iter().any(|w| w == entry), "{entry} is not a key");
+        }
+    }
+
+    #[test]
+    fn the_commented_defaults_parse_back_to_the_defaults() {
+        let text = RunConfig::commented_defaults();
+        assert!(text.contains("# Sub-pixel method: correli"), "{text}");
+        let parsed = RunConfig::from_toml(&text, "defaults").unwrap();
+        assert_eq!(parsed, RunConfig::default());
+    }
+}

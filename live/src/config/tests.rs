@@ -1,0 +1,191 @@
+//! The configuration's refusals and round trips.
+
+use super::*;
+
+#[test]
+fn defaults_round_trip_and_validate() {
+    RunConfig::default().validate().unwrap();
+    let round = RunConfig::from_toml(&RunConfig::default().to_toml(), "round").unwrap();
+    assert_eq!(round, RunConfig::default());
+    assert_eq!(
+        RunConfig::default().campaign_spec(),
+        "uniaxial:3@0.08,equibiaxial:2@0.04"
+    );
+}
+
+#[test]
+fn the_example_configs_are_valid_strain_controlled_runs() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/configs");
+    for (name, ratio) in [
+        ("strain_equibiaxial.toml", 1.0),
+        ("strain_biaxial_rho05.toml", 0.5),
+    ] {
+        let text = std::fs::read_to_string(dir.join(name)).unwrap();
+        let config = RunConfig::from_toml(&text, name).unwrap();
+        config.validate().unwrap();
+        let test = config.strain_test().unwrap().expect(name);
+        assert_eq!((test.ratio, test.stretch), (ratio, 1.8), "{name}");
+    }
+}
+
+#[test]
+fn strain_controlled_tests_are_checked_and_the_default_is_unchanged() {
+    // Displacement control stays the default, and its config file does not change.
+    let d = RunConfig::default();
+    assert!(d.strain_test().unwrap().is_none());
+    assert!(!d.to_toml().contains("control"), "{}", d.to_toml());
+    let strain = |body: &str| {
+        RunConfig::from_toml(&format!("[[rig.tests]]\n{body}"), "t.toml")
+            .and_then(|config| config.validate())
+    };
+    strain("kind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.8\nrate_per_s = 0.02\n")
+        .unwrap();
+    strain("kind = \"pure_shear\"\ncontrol = \"strain\"\nstretch = 1.8\nrate_per_s = 0.02\n")
+        .unwrap();
+    let config = RunConfig::from_toml(
+        "[[rig.tests]]\nkind = \"biaxial\"\ncontrol = \"strain\"\nratio = 0.5\nstretch = 1.5\n\
+         rate_per_s = 0.02\nmin_valid_nodes = 50\n",
+        "t.toml",
+    )
+    .unwrap();
+    let test = config.strain_test().unwrap().unwrap();
+    assert_eq!((test.ratio, test.stretch), (0.5, 1.5));
+    assert_eq!(test.limits.min_valid_nodes, 50);
+    assert_eq!(test.limits.stale_s, rig::strain::test::DEFAULT_STALE_S);
+    // Round trip through the results' config.toml.
+    let round = RunConfig::from_toml(&config.to_toml(), "round").unwrap();
+    assert_eq!(round, config);
+    let refused = |body: &str, expected: &str| {
+        let error = format!("{:#}", strain(body).unwrap_err());
+        assert!(error.contains(expected), "{body}: {error}");
+    };
+    refused(
+        "kind = \"uniaxial\"\ncontrol = \"strain\"\nratio = 0.5\nstretch = 1.5\nrate_per_s = 0.02\n",
+        "only a biaxial",
+    );
+    refused(
+        "kind = \"biaxial\"\ncontrol = \"strain\"\nratio = nan\nstretch = 1.5\nrate_per_s = 0.02\n",
+        "ratio NaN",
+    );
+    refused(
+        "kind = \"biaxial\"\ncontrol = \"strain\"\nstretch = 1.5\nrate_per_s = 0.02\n",
+        "needs its ratio",
+    );
+    refused(
+        "kind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.0\nrate_per_s = 0.02\n",
+        "stretch 1",
+    );
+    refused(
+        "kind = \"equibiaxial\"\ncontrol = \"force\"\nstretch = 1.5\nrate_per_s = 0.02\n",
+        "expected displacement or strain",
+    );
+    refused(
+        "kind = \"equibiaxial\"\nratio = 1.0\nstretch = 1.5\nrate_per_s = 0.02\n",
+        "ratio applies to control = \"strain\" only",
+    );
+    refused(
+        "kind = \"pure_shear\"\nstretch = 1.5\nrate_per_s = 0.02\n",
+        "set control = \"strain\"",
+    );
+    refused(
+        "kind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.5\nrate_per_s = 0.02\n\
+         on_interlock = \"pause\"\n",
+        "resume or stop",
+    );
+    refused(
+        "kind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.5\nrate_per_s = 0.02\n\
+         [[rig.tests]]\nkind = \"uniaxial\"\nstretch = 2.0\nrate_per_s = 0.08\n",
+        "runs alone",
+    );
+    let csv = RunConfig::from_toml(
+        "[camera]\nsource = \"watch\"\nwatch_dir = \"/tmp/x\"\n[rig]\nsource = \"csv-follow\"\n\
+         [rig.csv]\nfile = \"m.csv\"\ntime_column = \"t\"\nforce_x_column = \"F\"\n\
+         [[rig.tests]]\nkind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.5\n\
+         rate_per_s = 0.02\n",
+        "t.toml",
+    )
+    .unwrap();
+    let error = format!("{:#}", csv.strain_test().unwrap_err());
+    assert!(error.contains("csv-follow"), "{error}");
+}
+
+#[test]
+fn bad_configurations_are_refused_with_the_key_named() {
+    let unknown = RunConfig::from_toml("[camera]\nwidht_px = 512\n", "my.toml").unwrap_err();
+    let unknown = format!("{unknown:#}");
+    assert!(
+        unknown.contains("my.toml") && unknown.contains("widht_px"),
+        "{unknown}"
+    );
+    // A word that names no choice is refused as the file is read, the rest by `validate`.
+    let refuse = |toml: &str, expected: &str| {
+        let checked = RunConfig::from_toml(toml, "t.toml").and_then(|config| config.validate());
+        let error = format!("{:#}", checked.unwrap_err());
+        assert!(error.contains(expected), "{toml}: {error}");
+    };
+    refuse(
+        "[camera]\nwidth_px = 128\nheight_px = 128\n[correlator]\nzoi_px = 256\n",
+        "larger than the ROI",
+    );
+    refuse(
+        "[correlator]\nmethod = \"correli\"\nzoi_px = 48\n",
+        "power of two",
+    );
+    refuse("[correlator]\nmethod = \"icgn1\"\nzoi_px = 8\n", "9 to 256");
+    refuse("[correlator]\nmethod = \"icgn3\"\n", "method");
+    refuse(
+        "[[rig.tests]]\nkind = \"uniaxial\"\nstretch = 7.0\nrate_per_s = 0.08\n",
+        "stroke",
+    );
+    refuse(
+        "[[rig.tests]]\nkind = \"equibiaxial\"\nstretch = 1.5\nrate_per_s = 50.0\n",
+        "rate",
+    );
+    refuse(
+        "[[rig.tests]]\nkind = \"shear\"\nstretch = 1.5\nrate_per_s = 0.1\n",
+        "kind \"shear\": expected uniaxial, equibiaxial, pure_shear or biaxial",
+    );
+    refuse("[rig]\ntests = []\n", "at least one");
+    refuse("[rig]\nspeed = 1000.0\n", "speed");
+    refuse("[camera]\nfps = -1.0\n", "fps");
+    refuse("[camera]\nbit_depth = 9\n", "bit_depth");
+    refuse("[specimen]\nlaw_f = []\n", "law_f");
+    refuse("[identifier]\nmodels = \"nope\"\n", "models");
+    refuse("[correlator]\nreference = \"sometimes\"\n", "reference");
+    refuse("[camera]\nsource = \"webcam\"\n", "source");
+    refuse("[camera]\nsource = \"watch\"\n", "watch_dir");
+    refuse("[camera]\nsource = \"replay\"\n", "replay_files");
+    refuse(
+        "[camera]\nsource = \"genicam\"\ngenicam_pixel_format = \"RGB8\"\n",
+        "Mono16",
+    );
+    refuse("[camera]\ngenicam_roi = \"1,2,3\"\n", "x,y,w,h");
+    refuse("[rig]\nsource = \"csv\"\n", "csv-follow");
+    refuse("[rig]\nsource = \"csv-follow\"\n", "simulated camera");
+    let real =
+        "[camera]\nsource = \"watch\"\nwatch_dir = \"/tmp/x\"\n[rig]\nsource = \"csv-follow\"\n";
+    refuse(real, "file is empty");
+    refuse(
+        &format!("{real}[rig.csv]\nfile = \"m.csv\"\ntime_column = \"t\"\n"),
+        "no force column",
+    );
+    refuse(
+        &format!(
+            "{real}[rig.csv]\nfile = \"m.csv\"\ntime_column = \"t\"\nforce_x_column = \"F\"\n\
+             force_unit = \"lbf\"\n"
+        ),
+        "force_unit",
+    );
+    let ok = RunConfig::from_toml(
+        &format!(
+            "{real}[rig.csv]\nfile = \"m.csv\"\ntime_column = \"t\"\nforce_x_column = \"F\"\n"
+        ),
+        "ok.toml",
+    )
+    .unwrap();
+    ok.validate().unwrap();
+    assert_eq!(ok.camera.source, CameraSource::Watch);
+    assert_eq!(ok.rig.source, RigSource::CsvFollow);
+    let round = RunConfig::from_toml(&ok.to_toml(), "round").unwrap();
+    assert_eq!(round, ok);
+}
