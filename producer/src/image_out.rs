@@ -6,7 +6,7 @@ use std::path::Path;
 use crate::error::ProducerError;
 
 /// Output image formats.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ImageFormatOut {
     /// 8-bit grayscale PNG (frames of bit depth 8 only).
     Png8,
@@ -15,6 +15,8 @@ pub enum ImageFormatOut {
     /// TIFF, 8-bit for 8-bit frames, 16-bit otherwise (values as they are).
     Tiff,
 }
+
+wire::named!(ImageFormatOut, "image format", { Png8 => "png8", Png16 => "png16", Tiff => "tiff" });
 
 impl ImageFormatOut {
     /// File extension.

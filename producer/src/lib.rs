@@ -10,7 +10,6 @@
 #![cfg_attr(feature = "genicam", deny(unsafe_code))]
 
 pub mod camera;
-mod cli;
 mod error;
 pub mod genicam;
 mod image_io;
@@ -31,7 +30,6 @@ pub mod stream;
 mod watch;
 
 pub use camera::{CameraModel, BIT_DEPTHS};
-pub use cli::{RendererArg, SimArgs};
 pub use error::ProducerError;
 pub use image_io::{decode_into, read_image, read_shape, Image16, ImageShape};
 pub use image_out::{write_atomic, write_frame, ImageFormatOut};
@@ -47,8 +45,8 @@ pub use rig_follow::{
 };
 pub use scenario::{Scenario, ScenarioKind, SCENARIO_NAMES};
 pub use simulated::{
-    motion_reach_px, MotionSource, RendererKind, ScenarioTimeline, SimulatedCamera,
-    SimulatedConfig, MAX_SIDE_PX,
+    check_frame_size, motion_reach_px, MotionSource, RendererKind, ScenarioTimeline,
+    SimulatedCamera, SimulatedConfig, MAX_SIDE_PX,
 };
 pub use source::{FrameDims, FrameInfo, FrameSource, Truth};
 pub use speckle::{Speckle, SpeckleParams};

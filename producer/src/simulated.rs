@@ -94,6 +94,8 @@ pub enum RendererKind {
     Exact,
 }
 
+wire::named!(RendererKind, "renderer", { Fast => "fast", Exact => "exact" });
+
 /// Settings of a simulated camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimulatedConfig {

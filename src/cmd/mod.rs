@@ -15,5 +15,6 @@ pub mod producer_watch;
 pub mod rig;
 pub mod rig_follow_csv;
 pub mod run;
+pub mod sim_args;
 pub mod synth;
 pub mod tap;

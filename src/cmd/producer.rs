@@ -5,6 +5,7 @@
 //! `producer_genicam.rs`, feature `genicam`). Says "ready" on stderr once the publisher exists
 //! and prints one final line on stdout (also after SIGINT/SIGTERM, then exits 0).
 
+use super::sim_args::SimArgs;
 use std::path::PathBuf;
 
 use anyhow::Context;
@@ -12,7 +13,7 @@ use producer::stream::{
     check_shm_for_frames, stream, stream_following_rig, StreamEvent, StreamReport, StreamSettings,
 };
 use producer::{
-    FrameSource, Replay, RigCamera, RigEnvelope, RigFollowConfig, SimArgs, DEFAULT_MAX_OFFSET_MM,
+    FrameSource, Replay, RigCamera, RigEnvelope, RigFollowConfig, DEFAULT_MAX_OFFSET_MM,
     DEFAULT_MAX_ROTATION_DEG, DEFAULT_MAX_STRETCH, DEFAULT_MM_PER_PX,
 };
 

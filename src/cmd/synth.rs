@@ -6,11 +6,13 @@
 //! displacement at the centre; the displacement at any reference point X comes from the library:
 //! `producer::Scenario::parse(spec, width, height)?.motion_at(frame, frames).displacement(X)`.
 
+use super::named_arg::named;
+use super::sim_args::SimArgs;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::Context;
-use producer::{write_atomic, write_frame, FrameSource, ImageFormatOut, SimArgs};
+use producer::{write_atomic, write_frame, FrameSource, ImageFormatOut};
 
 /// Options of `dicstream synth`.
 #[derive(Debug, clap::Args)]
@@ -24,7 +26,7 @@ pub struct SynthArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Image format [default: png8 for 8-bit cameras, png16 otherwise]
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = named::<ImageFormatOut>())]
     pub format: Option<ImageFormatOut>,
 }
 

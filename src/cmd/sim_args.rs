@@ -1,20 +1,11 @@
 //! The command-line options of the simulated camera, shared by `dicstream synth` and
-//! `dicstream producer` (`#[command(flatten)]`).
+//! `dicstream producer` (`#[command(flatten)]`), turned into the producer's settings.
 
-use crate::camera::CameraModel;
-use crate::error::ProducerError;
-use crate::scenario::Scenario;
-use crate::simulated::{RendererKind, ScenarioTimeline, SimulatedCamera, SimulatedConfig};
-use crate::speckle::SpeckleParams;
-
-/// Renderer choice on the command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum RendererArg {
-    /// Oversampled texture + bicubic (live).
-    Fast,
-    /// Analytic pattern + pixel integration (ground truth, slow).
-    Exact,
-}
+use super::named_arg::named;
+use producer::{
+    check_frame_size, CameraModel, ProducerError, RendererKind, Scenario, ScenarioTimeline,
+    SimulatedCamera, SimulatedConfig, SpeckleParams,
+};
 
 /// Scenario, pattern and camera options.
 #[derive(Clone, Debug, clap::Args)]
@@ -65,9 +56,10 @@ pub struct SimArgs {
     /// Gaussian blur sigma of the optics, px (0: none)
     #[arg(long, default_value_t = 0.0)]
     pub blur_px: f64,
-    /// Renderer
-    #[arg(long, value_enum, default_value_t = RendererArg::Fast)]
-    pub renderer: RendererArg,
+    /// Renderer: fast (oversampled texture + bicubic, live) or exact (analytic pattern + pixel
+    /// integration: ground truth, slow)
+    #[arg(long, value_parser = named::<RendererKind>(), default_value_t = RendererKind::Fast)]
+    pub renderer: RendererKind,
     /// Texels per px of the fast renderer (2, 4, 6, 8)
     #[arg(long, default_value_t = 4)]
     pub oversample: usize,
@@ -93,7 +85,7 @@ impl SimArgs {
 
     /// The parsed scenario (for a frame size within the limits).
     pub fn scenario(&self) -> Result<Scenario, ProducerError> {
-        crate::simulated::check_frame_size(self.width, self.height)?;
+        check_frame_size(self.width, self.height)?;
         Scenario::parse(&self.scenario_spec(), self.width, self.height)
     }
 
@@ -127,10 +119,7 @@ impl SimArgs {
         camera.seed = self.seed;
         camera.validate()?;
         config.camera = camera;
-        config.renderer = match self.renderer {
-            RendererArg::Fast => RendererKind::Fast,
-            RendererArg::Exact => RendererKind::Exact,
-        };
+        config.renderer = self.renderer;
         config.oversample = self.oversample;
         if let Some(threads) = self.threads {
             config.threads = threads.max(1);
