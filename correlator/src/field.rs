@@ -2,52 +2,7 @@
 
 use crate::settings::StrainMeasure;
 
-/// What happened at one node. Never NaN: a node that could not be measured says why.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum NodeStatus {
-    /// Converged: displacement and score are meaningful.
-    Ok,
-    /// The integer search did not settle, the sub-pixel iterations hit the cap, or the
-    /// correlation peak is far below the frame's median (a match on other material).
-    NotConverged,
-    /// The reference or deformed ZOI has (almost) no grey-level variation.
-    LowContrast,
-    /// The deformed ZOI left the image.
-    #[default]
-    OutsideImage,
-    /// The final check failed: the reference ZOI against the deformed image sampled through
-    /// the node's displacement and local gradient has a ZNCC below `min_zncc`.
-    LowZncc,
-    /// Further than 2 px from the affine fit of its neighbours.
-    Inconsistent,
-    /// No guess could be trusted for this node (the global correlation peak was not
-    /// significant and no other guess verified), so it was not measured.
-    NoGuess,
-}
-
-impl NodeStatus {
-    pub const ALL: [NodeStatus; 7] = [
-        Self::Ok,
-        Self::NotConverged,
-        Self::LowContrast,
-        Self::OutsideImage,
-        Self::LowZncc,
-        Self::Inconsistent,
-        Self::NoGuess,
-    ];
-
-    pub fn word(self) -> &'static str {
-        match self {
-            Self::Ok => "ok",
-            Self::NotConverged => "not_converged",
-            Self::LowContrast => "low_contrast",
-            Self::OutsideImage => "outside_image",
-            Self::LowZncc => "low_zncc",
-            Self::Inconsistent => "inconsistent",
-            Self::NoGuess => "no_guess",
-        }
-    }
-}
+pub use wire::NodeStatus;
 
 /// In-plane strain components (engineering strain, dimensionless; exy is the tensor component).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -145,7 +100,7 @@ impl Field {
             .iter()
             .map(|&s| (s, self.count(s)))
             .filter(|&(_, c)| c > 0)
-            .map(|(s, c)| format!("{} {c}", s.word()))
+            .map(|(s, c)| format!("{} {c}", s.name()))
             .collect::<Vec<_>>()
             .join(", ")
     }

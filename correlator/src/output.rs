@@ -29,7 +29,7 @@ pub fn field_csv(field: &Field, text: &mut String) {
             n.exy,
             n.score,
             n.iterations,
-            n.status.word(),
+            n.status.name(),
             g[0][0],
             g[0][1],
             g[1][0],

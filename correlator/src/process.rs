@@ -18,9 +18,9 @@
 //!   vectors of triggered file descriptors per WaitSet wake-up and a reference-counted state
 //!   per loaned sample; see `tests/process_allocations.rs`.
 
-use crate::settings::{CorrelatorSettings, Method, StrainMeasure};
+use crate::settings::{CorrelatorSettings, Method};
 use crate::state::{ReferenceIds, SavedReference, StateDir, REFERENCE_FROM_FILE};
-use crate::{Correlator, Field, NodeStatus};
+use crate::{Correlator, Field};
 use iceoryx2::prelude::*;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -594,18 +594,6 @@ struct FieldTimes {
     frames_dropped: u64,
 }
 
-fn wire_status(status: NodeStatus) -> wire::NodeStatus {
-    match status {
-        NodeStatus::Ok => wire::NodeStatus::Ok,
-        NodeStatus::NotConverged => wire::NodeStatus::NotConverged,
-        NodeStatus::LowContrast => wire::NodeStatus::LowContrast,
-        NodeStatus::OutsideImage => wire::NodeStatus::OutsideImage,
-        NodeStatus::LowZncc => wire::NodeStatus::LowZncc,
-        NodeStatus::Inconsistent => wire::NodeStatus::Inconsistent,
-        NodeStatus::NoGuess => wire::NodeStatus::NoGuess,
-    }
-}
-
 /// IC-GN's own gradient with `icgn1`/`icgn2`, the neighbours' least-squares fit with `correli`
 /// (`Field::gradients`).
 fn wire_gradient_source(method: Method) -> wire::GradientSource {
@@ -613,15 +601,6 @@ fn wire_gradient_source(method: Method) -> wire::GradientSource {
         Method::Correli => wire::GradientSource::NeighbourFit,
         Method::Icgn1 => wire::GradientSource::Icgn1,
         Method::Icgn2 => wire::GradientSource::Icgn2,
-    }
-}
-
-fn wire_measure(measure: StrainMeasure) -> wire::StrainMeasure {
-    match measure {
-        StrainMeasure::Small => wire::StrainMeasure::Small,
-        StrainMeasure::Green => wire::StrainMeasure::Green,
-        StrainMeasure::Nominal => wire::StrainMeasure::Nominal,
-        StrainMeasure::Log => wire::StrainMeasure::Log,
     }
 }
 
@@ -647,7 +626,7 @@ fn fill_field(
             exy: n.exy as f32,
             score: n.score as f32,
             iterations: n.iterations,
-            status: wire_status(n.status) as u32,
+            status: n.status as u32,
             du_dx: g[0][0] as f32,
             du_dy: g[0][1] as f32,
             dv_dx: g[1][0] as f32,
@@ -662,7 +641,7 @@ fn fill_field(
     let g = &field.gauge;
     *out = FieldHeader {
         layout_version: wire::LAYOUT_VERSION,
-        strain_measure: wire_measure(settings.strain) as u32,
+        strain_measure: settings.strain as u32,
         frame_id: frame.frame_id,
         reference_frame_id: times.reference_frame_id,
         origin_frame_id: times.origin_frame_id,

@@ -22,23 +22,9 @@ impl std::fmt::Display for Roi {
     }
 }
 
-/// Strain measure of the per-node strains (the gauge gives all four).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum StrainMeasure {
-    /// Infinitesimal strain, sym(grad u).
-    Small,
-    /// Green-Lagrange, eq. (13) with m = 1.
-    Green,
-    /// Nominal (Biot), eq. (13) with m = 1/2.
-    Nominal,
-    /// Logarithmic (Hencky), eq. (13) with m = 0: the paper's default.
-    #[default]
-    Log,
-}
-
-wire::named!(StrainMeasure, "strain measure", {
-    Small => "small", Green => "green", Nominal => "nominal", Log => "log",
-});
+/// Strain measure of the per-node strains (the gauge gives all four): wire's, the one the
+/// `fields` header names.
+pub use wire::StrainMeasure;
 
 /// Which image the deformed images are compared with.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]

@@ -29,7 +29,7 @@ fn five_degree_rotation() {
         correlator.set_reference(&reference).unwrap();
         let field = correlator.correlate(&deformed).unwrap().clone();
         let mut means = Vec::new();
-        for &measure in StrainMeasure::ALL {
+        for measure in StrainMeasure::ALL {
             let mut nodes = field.nodes.clone();
             node_strains(&mut nodes, field.nx, field.ny, 1, measure);
             let ok: Vec<_> = nodes

@@ -281,7 +281,7 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
 fn status_json(field: &Field) -> serde_json::Value {
     correlator::NodeStatus::ALL
         .iter()
-        .map(|&s| (s.word().to_owned(), field.count(s).into()))
+        .map(|&s| (s.name().to_owned(), field.count(s).into()))
         .collect::<serde_json::Map<_, _>>()
         .into()
 }

@@ -6,7 +6,7 @@ use iceoryx2::prelude::ZeroCopySend;
 
 /// Strain measures of the paper's eq. (13), plus the infinitesimal strain.
 #[repr(u32)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum StrainMeasure {
     /// ε = sym(∇u).
     Small = 0,
@@ -15,72 +15,56 @@ pub enum StrainMeasure {
     /// m = 1/2: E = C^(1/2) − 1 (ΔL/L0 in uniaxial elongation).
     Nominal = 2,
     /// m = 0: E = ln(C)/2, the default.
+    #[default]
     Log = 3,
 }
 
+crate::named!(StrainMeasure, "strain measure", {
+    Small => "small", Green => "green", Nominal => "nominal", Log => "log",
+});
+
 impl StrainMeasure {
-    pub const ALL: [StrainMeasure; 4] = [
-        StrainMeasure::Small,
-        StrainMeasure::Green,
-        StrainMeasure::Nominal,
-        StrainMeasure::Log,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            StrainMeasure::Small => "small",
-            StrainMeasure::Green => "green",
-            StrainMeasure::Nominal => "nominal",
-            StrainMeasure::Log => "log",
-        }
-    }
-
     pub fn from_code(code: u32) -> Option<StrainMeasure> {
-        StrainMeasure::ALL.into_iter().find(|m| *m as u32 == code)
+        StrainMeasure::ALL
+            .iter()
+            .copied()
+            .find(|m| *m as u32 == code)
     }
 }
 
-/// Outcome of one ZOI, carried in [`FieldNode::status`].
+/// Outcome of one ZOI (the correlator's and [`FieldNode::status`]'s code).
 #[repr(u32)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum NodeStatus {
+    /// Converged: displacement and score are meaningful.
     Ok = 0,
+    /// The integer search did not settle, the sub-pixel iterations hit the cap, or the
+    /// correlation peak is far below the frame's median (a match on other material).
     NotConverged = 1,
+    /// The reference or deformed ZOI has (almost) no grey-level variation.
     LowContrast = 2,
+    /// The deformed ZOI left the image.
+    #[default]
     OutsideImage = 3,
-    /// The final ZNCC check failed.
+    /// The final check failed: the reference ZOI against the deformed image sampled through
+    /// the node's displacement and local gradient has a ZNCC below `min_zncc`.
     LowZncc = 4,
-    /// Far from the affine fit of its neighbours.
+    /// Further than 2 px from the affine fit of its neighbours.
     Inconsistent = 5,
-    /// No trustworthy guess: not measured.
+    /// No guess could be trusted for this node (the global correlation peak was not
+    /// significant and no other guess verified), so it was not measured.
     NoGuess = 6,
 }
 
-impl NodeStatus {
-    pub fn name(self) -> &'static str {
-        match self {
-            NodeStatus::Ok => "ok",
-            NodeStatus::NotConverged => "not_converged",
-            NodeStatus::LowContrast => "low_contrast",
-            NodeStatus::OutsideImage => "outside_image",
-            NodeStatus::LowZncc => "low_zncc",
-            NodeStatus::Inconsistent => "inconsistent",
-            NodeStatus::NoGuess => "no_guess",
-        }
-    }
+crate::named!(NodeStatus, "node status", {
+    Ok => "ok", NotConverged => "not_converged", LowContrast => "low_contrast",
+    OutsideImage => "outside_image", LowZncc => "low_zncc", Inconsistent => "inconsistent",
+    NoGuess => "no_guess",
+});
 
+impl NodeStatus {
     pub fn from_code(code: u32) -> Option<NodeStatus> {
-        [
-            NodeStatus::Ok,
-            NodeStatus::NotConverged,
-            NodeStatus::LowContrast,
-            NodeStatus::OutsideImage,
-            NodeStatus::LowZncc,
-            NodeStatus::Inconsistent,
-            NodeStatus::NoGuess,
-        ]
-        .into_iter()
-        .find(|s| *s as u32 == code)
+        NodeStatus::ALL.iter().copied().find(|s| *s as u32 == code)
     }
 }
 

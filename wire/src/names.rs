@@ -79,12 +79,13 @@ macro_rules! named {
     ($t:ty, $what:literal, { $($body:tt)* }) => {
         $crate::named!(@impl $t, $what, false, { $($body)* });
     };
+    (@unit $v:ident) => { () };
     (@impl $t:ty, $what:literal, $ignore_case:literal,
      { $($v:ident => $name:literal $(| $alias:literal)*),+ $(,)? }) => {
         impl $crate::names::Named for $t {
             const WHAT: &'static str = $what;
             const IGNORE_CASE: bool = $ignore_case;
-            const ALL: &'static [Self] = &[$(<$t>::$v),+];
+            const ALL: &'static [Self] = &<$t>::ALL;
             fn name(self) -> &'static str {
                 match self { $(<$t>::$v => $name),+ }
             }
@@ -95,7 +96,7 @@ macro_rules! named {
         impl $t {
             /// Every value, in the order they are listed to a user.
             #[allow(dead_code)]
-            pub const ALL: &'static [Self] = <$t as $crate::names::Named>::ALL;
+            pub const ALL: [Self; <[()]>::len(&[$($crate::named!(@unit $v)),+])] = [$(<$t>::$v),+];
             /// The name a value is written as.
             #[allow(dead_code)]
             pub fn name(self) -> &'static str {

@@ -188,7 +188,7 @@ mod tests {
 
     #[test]
     fn names_and_codes_round_trip_and_unknown_names_are_refused_clearly() {
-        for &f in PixelFormat::ALL {
+        for f in PixelFormat::ALL {
             assert_eq!(f.name().parse::<PixelFormat>(), Ok(f));
             assert_eq!(PixelFormat::from_code(f.code()), Some(f));
         }
