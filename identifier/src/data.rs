@@ -146,8 +146,8 @@ impl BiaxialState {
         (large > 1.0).then(|| small.ln() / large.ln())
     }
 
-    /// Checks positivity and finiteness; the message says what is wrong.
-    pub fn check(&self) -> Result<(), String> {
+    /// Checks positivity and finiteness; the error says what is wrong.
+    pub fn check(&self) -> Result<(), StateError> {
         let values = [
             ("lambda1", self.stretch1),
             ("lambda2", self.stretch2),
@@ -156,16 +156,25 @@ impl BiaxialState {
         ];
         for (name, v) in values {
             if !v.is_finite() {
-                return Err(format!("{name} {v} is not a finite number"));
+                return Err(StateError::NotFinite { name, value: v });
             }
         }
         for (name, v) in &values[..2] {
             if *v <= 0.0 {
-                return Err(format!("{name} {v} must be > 0"));
+                return Err(StateError::NotPositive { name, value: *v });
             }
         }
         Ok(())
     }
+}
+
+/// A biaxial state that is not one.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StateError {
+    #[error("{name} {value} is not a finite number")]
+    NotFinite { name: &'static str, value: f64 },
+    #[error("{name} {value} must be > 0")]
+    NotPositive { name: &'static str, value: f64 },
 }
 
 /// The states that are canonical cases (path ratio within `tolerance`, see

@@ -46,15 +46,30 @@ pub struct CameraSpec {
     pub id: Option<String>,
 }
 
+/// Camera options refused before anything is sent to a camera.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CameraArgError {
+    #[error(
+        "--camera {text:?}: expected genicam (the first camera found) or genicam:ID (an id \
+         from `dicstream cameras`)"
+    )]
+    Spec { text: String },
+    #[error("{flag} {value}: expected a finite number{}", if *positive { " above 0" } else { "" })]
+    Number {
+        flag: &'static str,
+        value: f64,
+        positive: bool,
+    },
+    #[error("--trigger software needs --fps (the rate the producer triggers at)")]
+    SoftwareTriggerWithoutFps,
+}
+
 impl FromStr for CameraSpec {
-    type Err = String;
+    type Err = CameraArgError;
 
     fn from_str(text: &str) -> Result<Self, Self::Err> {
-        let bad = || {
-            format!(
-                "--camera {text:?}: expected genicam (the first camera found) or genicam:ID (an \
-                 id from `dicstream cameras`)"
-            )
+        let bad = || CameraArgError::Spec {
+            text: text.to_string(),
         };
         let rest = text.strip_prefix("genicam").ok_or_else(bad)?;
         match rest.strip_prefix(':') {
@@ -82,7 +97,7 @@ pub struct CameraSettings {
 
 impl CameraSettings {
     /// Checks the numbers before anything is sent to a camera.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), CameraArgError> {
         for (name, value, min) in [
             ("--exposure-us", self.exposure_us, f64::MIN_POSITIVE),
             ("--fps", self.fps, f64::MIN_POSITIVE),
@@ -90,17 +105,16 @@ impl CameraSettings {
         ] {
             if let Some(v) = value {
                 if !v.is_finite() || v < min {
-                    return Err(format!(
-                        "{name} {v}: expected a finite number{}",
-                        if min > 0.0 { " above 0" } else { "" }
-                    ));
+                    return Err(CameraArgError::Number {
+                        flag: name,
+                        value: v,
+                        positive: min > 0.0,
+                    });
                 }
             }
         }
         if self.trigger == Trigger::Software && self.fps.is_none() {
-            return Err(
-                "--trigger software needs --fps (the rate the producer triggers at)".into(),
-            );
+            return Err(CameraArgError::SoftwareTriggerWithoutFps);
         }
         Ok(())
     }
@@ -134,6 +148,7 @@ mod tests {
             assert!(
                 bad.parse::<CameraSpec>()
                     .unwrap_err()
+                    .to_string()
                     .contains("genicam:ID"),
                 "{bad}"
             );
@@ -150,7 +165,11 @@ mod tests {
             trigger: Trigger::Software,
             ..CameraSettings::default()
         };
-        assert!(software.check().unwrap_err().contains("needs --fps"));
+        assert!(software
+            .check()
+            .unwrap_err()
+            .to_string()
+            .contains("needs --fps"));
         let bad_exposure = CameraSettings {
             exposure_us: Some(0.0),
             ..CameraSettings::default()
@@ -158,6 +177,7 @@ mod tests {
         assert!(bad_exposure
             .check()
             .unwrap_err()
+            .to_string()
             .contains("--exposure-us 0"));
         let negative_gain = CameraSettings {
             gain_db: Some(-3.0),

@@ -5,6 +5,7 @@
 #![forbid(unsafe_code)]
 
 pub mod actuator;
+pub mod bad_setting;
 pub mod builtin;
 pub mod campaign;
 pub mod codes;

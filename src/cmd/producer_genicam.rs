@@ -94,7 +94,7 @@ pub fn run(
         roi: args.roi,
         trigger: args.trigger,
     };
-    camera.check().map_err(anyhow::Error::msg)?;
+    camera.check()?;
     let mut rows = match log {
         Some(path) => Some(
             RowFile::create(path, LOG_HEADER)

@@ -25,11 +25,11 @@ impl fmt::Display for Roi {
 }
 
 impl FromStr for Roi {
-    type Err = String;
+    type Err = RoiError;
 
     fn from_str(text: &str) -> Result<Self, Self::Err> {
-        let bad = || {
-            format!("--roi {text:?}: expected x,y,w,h in px (four whole numbers, w and h above 0), e.g. 0,0,1024,1024")
+        let bad = || RoiError::Text {
+            text: text.to_string(),
         };
         let parts: Vec<u32> = text
             .split(',')
@@ -70,6 +70,8 @@ pub struct RoiLimits {
 /// Why a region does not fit the camera.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum RoiError {
+    #[error("--roi {text:?}: expected x,y,w,h in px (four whole numbers, w and h above 0), e.g. 0,0,1024,1024")]
+    Text { text: String },
     #[error("--roi {roi}: reaches beyond the {sensor_width_px}x{sensor_height_px} px sensor")]
     Outside {
         roi: Roi,
@@ -176,7 +178,7 @@ mod tests {
             "0,0,0,10",
             "-1,0,10,10",
         ] {
-            let err = bad.parse::<Roi>().unwrap_err();
+            let err = bad.parse::<Roi>().unwrap_err().to_string();
             assert!(err.contains("expected x,y,w,h"), "{bad}: {err}");
         }
     }

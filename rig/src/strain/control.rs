@@ -88,7 +88,7 @@ pub enum StrainStartError {
     #[error("strain control needs a usable field to start from: {0}")]
     Measurement(HoldReason),
     #[error("interlock limits: {0}")]
-    Limits(String),
+    Limits(crate::bad_setting::BadSetting),
     #[error("the rig refused: {0}")]
     Rig(#[from] Refusal),
     #[error("strain control needs a specimen mounted")]
@@ -96,7 +96,7 @@ pub enum StrainStartError {
     #[error("strain control drives the X and Y pairs: it needs a cruciform (equibiaxial loading) specimen")]
     NotCruciform,
     #[error("strain loop model: {0}")]
-    Model(String),
+    Model(crate::bad_setting::BadSetting),
 }
 
 fn rig_setpoint(rig: &Rig, axis: Axis) -> f64 {

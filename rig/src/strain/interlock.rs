@@ -1,6 +1,7 @@
 //! Interlocks of strain control: what makes the strain channel unusable. Any of them puts the
 //! rig on a displacement hold at its present position and is reported with its reason.
 
+use crate::bad_setting::BadSetting;
 use crate::strain::outer::GaugeMeasurement;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,17 +78,19 @@ impl std::fmt::Display for HoldReason {
 }
 
 impl InterlockLimits {
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), BadSetting> {
         if !(self.stale_s.is_finite() && self.stale_s > 0.0) {
-            return Err(format!(
-                "stale_s {}: expected a positive number",
-                self.stale_s
+            return Err(BadSetting::new(
+                "stale_s",
+                self.stale_s,
+                "a positive number",
             ));
         }
         if !(self.jump_log.is_finite() && self.jump_log > 0.0) {
-            return Err(format!(
-                "jump_log {}: expected a positive number",
-                self.jump_log
+            return Err(BadSetting::new(
+                "jump_log",
+                self.jump_log,
+                "a positive number",
             ));
         }
         Ok(())

@@ -20,6 +20,7 @@
 //! The residual error is the model's curvature over one latency of travel, far below the
 //! measurement noise at the rates. Pure arithmetic: no IPC, no clock of its own.
 
+use crate::bad_setting::BadSetting;
 use std::collections::VecDeque;
 
 /// A field sample as the strain loop uses it: mean gauge log strains, capture time in rig
@@ -207,34 +208,38 @@ impl OuterLoop {
     }
 
     /// Checks the configuration: a model the loop can invert, gains it can use.
-    pub fn validate(config: &OuterLoopConfig) -> Result<(), String> {
+    pub fn validate(config: &OuterLoopConfig) -> Result<(), BadSetting> {
         let c = config;
         if !c
             .model_fraction
             .iter()
             .all(|k| k.is_finite() && *k >= 0.2 && *k <= 1.5)
         {
-            return Err(format!(
-                "model_fraction {:?}: expected values in [0.2, 1.5]",
-                c.model_fraction
+            return Err(BadSetting::new(
+                "model_fraction",
+                c.model_fraction,
+                "values in [0.2, 1.5]",
             ));
         }
         if !(c.model_cross.is_finite() && c.model_cross.abs() <= 0.1) {
-            return Err(format!(
-                "model_cross {}: expected a value in [−0.1, 0.1]",
-                c.model_cross
+            return Err(BadSetting::new(
+                "model_cross",
+                c.model_cross,
+                "a value in [−0.1, 0.1]",
             ));
         }
         if !(c.adaptation_gain > 0.0 && c.adaptation_gain <= 1.0) {
-            return Err(format!(
-                "adaptation_gain {}: expected (0, 1]",
-                c.adaptation_gain
+            return Err(BadSetting::new(
+                "adaptation_gain",
+                c.adaptation_gain,
+                "(0, 1]",
             ));
         }
         if !(c.offset_scale.is_finite() && c.offset_scale > 0.0) {
-            return Err(format!(
-                "offset_scale {}: expected a positive number",
-                c.offset_scale
+            return Err(BadSetting::new(
+                "offset_scale",
+                c.offset_scale,
+                "a positive number",
             ));
         }
         if !(c.gain_range[0] >= 0.5
@@ -242,18 +247,20 @@ impl OuterLoop {
             && c.gain_range[1] >= 1.0
             && c.gain_range[1] <= 2.0)
         {
-            return Err(format!(
-                "gain_range {:?}: expected [≥ 0.5, ≤ 2] around 1",
-                c.gain_range
+            return Err(BadSetting::new(
+                "gain_range",
+                c.gain_range,
+                "[≥ 0.5, ≤ 2] around 1",
             ));
         }
         if !(c.history_s.is_finite() && c.history_s > 0.0 && c.history_s <= 60.0) {
-            return Err(format!("history_s {}: expected (0, 60] s", c.history_s));
+            return Err(BadSetting::new("history_s", c.history_s, "(0, 60] s"));
         }
         if !(c.max_elongation_rate_mm_s.is_finite() && c.max_elongation_rate_mm_s > 0.0) {
-            return Err(format!(
-                "max_elongation_rate_mm_s {}: expected a positive number",
-                c.max_elongation_rate_mm_s
+            return Err(BadSetting::new(
+                "max_elongation_rate_mm_s",
+                c.max_elongation_rate_mm_s,
+                "a positive number",
             ));
         }
         Ok(())
