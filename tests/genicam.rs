@@ -7,7 +7,8 @@
 //! consumers (a `dicstream tap`, the test's own subscriber) stay on the host: iceoryx2's data
 //! is in /dev/shm and its events are pathname unix sockets under /tmp, neither of which a
 //! network namespace separates, so a frame crossing is itself part of the check. Where no
-//! namespace can be made (not root, no user namespaces), each test says so and is skipped.
+//! namespace can be made (not root, no user namespaces), each test says so and is skipped, except
+//! under CI (`CI` set), where that is a failure (as the dashboard test without chromium).
 
 #![cfg(feature = "genicam")]
 
@@ -37,6 +38,12 @@ impl Netns {
     fn new(test: &str) -> Option<Netns> {
         let probe = Command::new("unshare").args(["-n", "true"]).output();
         if !probe.as_ref().is_ok_and(|o| o.status.success()) {
+            // CI (`CI` set) runs as root, where a namespace can always be made: there a
+            // failure is one, not a skip.
+            assert!(
+                std::env::var_os("CI").is_none(),
+                "{test}: cannot create a network namespace (`unshare -n` failed: {probe:?})"
+            );
             eprintln!(
                 "SKIPPED {test}: cannot create a network namespace here (`unshare -n` failed: \
                  {probe:?}); the GenICam tests never run on the host's network"
