@@ -2,8 +2,9 @@
 //! or a fault left: a log cut mid-row or deleted (the missing rows written again from the
 //! replay, the log then byte for byte that of a run never stopped), another run's log
 //! (refused untouched), a journal that cannot be read or whose figures no run could have
-//! written (refused at once, exit 75), and a long replay stopped by SIGTERM. Real processes on
-//! a unique instance; timeouts only guard against a hang.
+//! written (refused at once, exit 75), a long replay stopped by SIGTERM, and a full `/dev/shm`
+//! (refused before anything is created). Real processes on a unique instance; timeouts only
+//! guard against a hang.
 
 mod common;
 
@@ -199,4 +200,25 @@ fn an_absurd_periods_count_is_refused_at_once_and_a_long_replay_ends_on_sigterm(
         "{stderr}"
     );
     assert_eq!(journal_text(&state), consistent, "the journal untouched");
+}
+
+/// `/dev/shm` a one-page tmpfs (in a mount namespace of the test's own): the restarted rig
+/// refuses before creating a service, naming `/dev/shm`, instead of dying of SIGBUS.
+#[test]
+fn a_restart_without_room_in_dev_shm_is_refused() {
+    let mut run = Run::new("rig_resume_shm");
+    let (state, _) = stopped_at(&mut run, "shm", "0.2", false);
+    let script = format!(
+        "mount -t tmpfs -o size=4k tmpfs /dev/shm && exec {exe} rig --instance {instance} \
+         --campaign {CAMPAIGN} --speed max --exit-when-done --state-dir {state}",
+        exe = env!("CARGO_BIN_EXE_dicstream"),
+        instance = run.name(),
+        state = state.display(),
+    );
+    let Some(outcome) = common::namespace::run_in_mount_namespace(&script) else {
+        return;
+    };
+    let stderr = String::from_utf8_lossy(&outcome.stderr);
+    assert_eq!(outcome.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("/dev/shm has"), "{stderr}");
 }

@@ -304,6 +304,8 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
     if let Some(strain) = &options.strain {
         session.start_strain(strain.test, strain.specimen.clone())?;
     }
+    // Room in /dev/shm for the services, or a clear refusal (not a SIGBUS mid-run).
+    wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes())?;
     let StatePort {
         instance,
         _owner,
@@ -499,6 +501,12 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
         }
     }
     Ok(summary)
+}
+
+/// Shared memory the rig's services need (bytes): `rig/state`, and `rig/command`, whose
+/// requests and replies are small (a MiB covers iceoryx2's default clients and queues).
+fn shm_needed_bytes() -> u64 {
+    wire::services::RIG_STATE.shm_bytes(0, std::mem::size_of::<RigState>()) + (1 << 20)
 }
 
 /// The settings that make the simulation what it is, as a fingerprint (not the instance, the
