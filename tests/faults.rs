@@ -398,8 +398,6 @@ fn a_full_disk_stops_the_run_naming_the_file() {
     let small = run.dir.join("small");
     std::fs::create_dir_all(&small).unwrap();
     let out = small.join("out");
-    // SAFETY: geteuid has no preconditions.
-    let root = unsafe { libc::geteuid() } == 0;
     // The tmpfs goes with the namespace: what the run left is copied out before.
     let copy = run.dir.join("copy");
     let script = format!(
@@ -412,22 +410,9 @@ fn a_full_disk_stops_the_run_naming_the_file() {
         out = out.display(),
         copy = copy.display(),
     );
-    let namespace = if root { "-m" } else { "-rm" };
-    let probe = std::process::Command::new("unshare")
-        .args([namespace, "true"])
-        .status();
-    if !probe.is_ok_and(|s| s.success()) {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI must be able to mount a small tmpfs (unshare {namespace})"
-        );
-        eprintln!("skipped: cannot make a mount namespace here (unshare {namespace})");
+    let Some(outcome) = common::namespace::run_in_mount_namespace(&script) else {
         return;
-    }
-    let outcome = std::process::Command::new("unshare")
-        .args([namespace, "sh", "-c", &script])
-        .output()
-        .unwrap();
+    };
     let stderr = String::from_utf8_lossy(&outcome.stderr);
     let stdout = String::from_utf8_lossy(&outcome.stdout);
     assert_eq!(outcome.status.code(), Some(1), "{stdout}\n{stderr}");

@@ -10,15 +10,45 @@
 
 use crate::snapshot::RigSnapshot;
 
-/// Why a journal's text could not be read.
+/// Why a journal could not be read, or holds figures no run of the rig could have written.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum JournalError {
+    #[error("not UTF-8 text (byte {valid_up_to})")]
+    NotText { valid_up_to: usize },
     #[error("no {key}")]
     Missing { key: &'static str },
     #[error("{key} = {value:?} is not a count")]
     NotACount { key: &'static str, value: String },
     #[error("{key} = {value:?} is not hexadecimal")]
     NotHexadecimal { key: &'static str, value: String },
+    #[error("step = {step} is not periods = {periods} times the {steps_per_period} control steps of a period")]
+    StepsPerPeriod {
+        periods: u64,
+        step: u64,
+        steps_per_period: u64,
+    },
+    #[error("t_s = {t_s} s is not step = {step} times the control period")]
+    Time { t_s: f64, step: u64 },
+    #[error("{count} actuator positions, not {expected} finite ones")]
+    Positions { count: usize, expected: usize },
+    #[error("rows_logged = {rows_logged} is not step = {step} / {log_every} (one row every {log_every} control steps)")]
+    RowsLogged {
+        rows_logged: u64,
+        step: u64,
+        log_every: u64,
+    },
+}
+
+/// How a run of the rig counts, which every journal it writes fits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cadence {
+    /// Control steps per publication period.
+    pub steps_per_period: u64,
+    /// Control steps per log row.
+    pub log_every: u64,
+    /// The control period (s).
+    pub dt_s: f64,
+    pub actuators: usize,
 }
 
 /// How a replay differs from where the journal says the rig was.
@@ -88,6 +118,14 @@ impl Journal {
         )
     }
 
+    /// [`Journal::parse`] of a file's bytes, which must be UTF-8 text.
+    pub fn parse_bytes(bytes: &[u8]) -> Result<Journal, JournalError> {
+        let text = std::str::from_utf8(bytes).map_err(|e| JournalError::NotText {
+            valid_up_to: e.valid_up_to(),
+        })?;
+        Journal::parse(text)
+    }
+
     pub fn parse(text: &str) -> Result<Journal, JournalError> {
         let value = |key: &'static str| -> Result<&str, JournalError> {
             text.lines()
@@ -123,6 +161,47 @@ impl Journal {
             log_bytes: int(value("log_bytes")?, "log_bytes")?,
             commands_accepted: int(value("commands_accepted")?, "commands_accepted")?,
         })
+    }
+
+    /// Checks that the journal's figures fit together as a run of `cadence` writes them (a
+    /// corrupt or edited figure, such as an absurd `periods`, is refused before any replay).
+    pub fn check(&self, cadence: &Cadence) -> Result<(), JournalError> {
+        if self.periods.checked_mul(cadence.steps_per_period) != Some(self.step) {
+            return Err(JournalError::StepsPerPeriod {
+                periods: self.periods,
+                step: self.step,
+                steps_per_period: cadence.steps_per_period,
+            });
+        }
+        // The rig's own time: step × dt, bit for bit.
+        if self.t_s.to_bits() != (self.step as f64 * cadence.dt_s).to_bits() {
+            return Err(JournalError::Time {
+                t_s: self.t_s,
+                step: self.step,
+            });
+        }
+        if self.positions_mm.len() != cadence.actuators
+            || !self.positions_mm.iter().all(|p| p.is_finite())
+        {
+            return Err(JournalError::Positions {
+                count: self.positions_mm.len(),
+                expected: cadence.actuators,
+            });
+        }
+        // A journal without a log (log_bytes 0) counts no rows.
+        let rows = if self.log_bytes == 0 {
+            0
+        } else {
+            self.step / cadence.log_every.max(1)
+        };
+        if self.rows_logged != rows {
+            return Err(JournalError::RowsLogged {
+                rows_logged: self.rows_logged,
+                step: self.step,
+                log_every: cadence.log_every,
+            });
+        }
+        Ok(())
     }
 
     /// Why a replay that reached `snapshot` after `self.periods` periods is not where the

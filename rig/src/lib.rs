@@ -17,6 +17,7 @@ pub mod ids;
 pub mod journal;
 pub mod limits;
 pub mod log;
+pub mod log_check;
 pub mod params;
 pub mod pidf;
 #[cfg(feature = "process")]

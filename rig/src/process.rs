@@ -9,7 +9,6 @@ use crate::codes;
 use crate::config::RigConfig;
 use crate::control::{AxisControl, ControlMode};
 use crate::ids::{ActuatorId, Axis};
-use crate::journal::Journal;
 use crate::limits::LimitKind;
 use crate::program::{Program, ProgramError, StopTransition};
 use crate::refusal::Refusal;
@@ -22,6 +21,8 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use wire::files::RowFile;
 use wire::rig::{RigCommandKind, RigReply, RigState};
+
+mod resume;
 
 /// The rig's place on an instance, one for the simulated rig and the CSV follower: the claim
 /// of the `rig` role (a second rig is refused), its node (dead nodes of the instance cleaned,
@@ -85,10 +86,13 @@ pub enum ProcessError {
         path: PathBuf,
         reason: std::io::Error,
     },
-    #[error("cannot read {}: {reason}", .path.display())]
-    ReadJournal {
-        path: PathBuf,
-        reason: std::io::Error,
+    #[error("stopped by {signal} while replaying {} (period {periods} of {of}): nothing was published or written", .journal.display())]
+    ReplayStopped {
+        /// The signal's name (SIGTERM, ...).
+        signal: String,
+        journal: PathBuf,
+        periods: u64,
+        of: u64,
     },
     /// The journal cannot be followed safely: exit code [`wire::exit::CANNOT_RESUME`].
     #[error("{0}")]
@@ -284,13 +288,24 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
         })?;
     }
     let resumed = match &journal_path {
-        Some(path) if options.strain.is_some() => refuse_strain_resume(path)?,
-        Some(path) => resume(&mut session, path, settings)?,
+        Some(path) if options.strain.is_some() => {
+            refuse_strain_resume(path)?;
+            None
+        }
+        Some(path) => resume::resume(
+            &mut session,
+            path,
+            settings,
+            options.log_path.as_deref(),
+            options.exit_when_done.then_some(options.program.is_some()),
+        )?,
         None => None,
     };
     if let Some(strain) = &options.strain {
         session.start_strain(strain.test, strain.specimen.clone())?;
     }
+    // Room in /dev/shm for the services, or a clear refusal (not a SIGBUS mid-run).
+    wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes())?;
     let StatePort {
         instance,
         _owner,
@@ -321,14 +336,18 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
 
     let mut summary = ProcessSummary::default();
     // The log grows by whole rows; a resumed rig goes on after the rows its journal names.
-    let mut log = match (&options.log_path, &resumed) {
-        (Some(path), Some(journal)) => {
-            summary.rows_logged = journal.rows_logged;
-            Some(RowFile::resume(
-                path,
-                &crate::log::csv_header(),
-                journal.log_bytes,
-            )?)
+    // Only now, the role claimed: a second rig refused at the claim has written nothing.
+    let (resumed, log_finding) = match resumed {
+        Some(r) => (
+            Some(r.journal),
+            r.log.map(|finding| (finding, r.rows_logged)),
+        ),
+        None => (None, None),
+    };
+    let mut log = match (&options.log_path, log_finding) {
+        (Some(path), Some((finding, rows_logged))) => {
+            summary.rows_logged = rows_logged;
+            Some(resume::reopen_log(path, finding)?)
         }
         (Some(path), None) => Some(RowFile::create(path, &crate::log::csv_header())?),
         (None, _) => None,
@@ -476,18 +495,18 @@ pub fn run(options: ProcessOptions) -> Result<ProcessSummary, ProcessError> {
             return Err(ProcessError::Stopped {
                 signal: wire::signals::name(signal),
                 t_s: summary.simulated_s,
-                what: if session.campaign.is_some() {
-                    "campaign"
-                } else if strain {
-                    "strain-controlled test"
-                } else {
-                    "program"
-                },
+                what: session.what(),
                 restart: restart_note(journal_path.as_deref(), strain),
             });
         }
     }
     Ok(summary)
+}
+
+/// Shared memory the rig's services need (bytes): `rig/state`, and `rig/command`, whose
+/// requests and replies are small (a MiB covers iceoryx2's default clients and queues).
+fn shm_needed_bytes() -> u64 {
+    wire::services::RIG_STATE.shm_bytes(0, std::mem::size_of::<RigState>()) + (1 << 20)
 }
 
 /// The settings that make the simulation what it is, as a fingerprint (not the instance, the
@@ -548,9 +567,9 @@ fn strain_message(event: &StrainRunEvent) -> String {
 /// A strain-controlled rig does not resume: its inputs were the correlator's fields, which a
 /// replay cannot have, so the journal of an earlier rig (if any) ends the restart (exit code
 /// [`wire::exit::CANNOT_RESUME`]) and the specimen stays unloaded. No journal: a fresh start.
-fn refuse_strain_resume(path: &Path) -> Result<Option<Journal>, ProcessError> {
+fn refuse_strain_resume(path: &Path) -> Result<(), ProcessError> {
     if !path.exists() {
-        return Ok(None);
+        return Ok(());
     }
     Err(ProcessError::CannotResume(wire::exit::ExitWith {
         code: wire::exit::CANNOT_RESUME,
@@ -561,44 +580,6 @@ fn refuse_strain_resume(path: &Path) -> Result<Option<Journal>, ProcessError> {
             path.display()
         ),
     }))
-}
-
-/// Brings `session` to where the journal at `path` says (None: no journal, a fresh start).
-/// A journal that cannot be followed safely leaves the machine unloaded and stopped: the
-/// error asks for exit code [`wire::exit::CANNOT_RESUME`].
-fn resume(
-    session: &mut Session,
-    path: &Path,
-    settings: u64,
-) -> Result<Option<Journal>, ProcessError> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(reason) => {
-            return Err(ProcessError::ReadJournal {
-                path: path.to_path_buf(),
-                reason,
-            })
-        }
-    };
-    let refuse = |why: &dyn std::fmt::Display| {
-        ProcessError::CannotResume(wire::exit::ExitWith {
-            code: wire::exit::CANNOT_RESUME,
-            message: format!(
-                "cannot resume from {}: {why}; the specimen is left unloaded and the rig stopped",
-                path.display()
-            ),
-        })
-    };
-    let journal =
-        Journal::parse(&text).map_err(|e| refuse(&format_args!("unreadable journal: {e}")))?;
-    if journal.settings != settings {
-        return Err(refuse(
-            &"it was written by a rig with other settings (campaign, material, seed or rates)",
-        ));
-    }
-    session.resume(&journal).map_err(|e| refuse(&e))?;
-    Ok(Some(journal))
 }
 
 /// A `wire::RigCommand` to a core command, refused with a reason when malformed or refused.

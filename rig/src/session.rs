@@ -5,7 +5,7 @@
 //! both times, so the replay is exact.
 
 use crate::campaign::{Campaign, CampaignEvent};
-use crate::journal::{Journal, Mismatch};
+use crate::journal::{Cadence, Journal, JournalError, Mismatch};
 use crate::refusal::Refusal;
 use crate::rig::{Rig, RigCommand};
 use crate::snapshot::ProgramStatus;
@@ -28,6 +28,17 @@ pub enum SessionError {
     CommandsTaken { count: u64 },
     #[error(transparent)]
     Mismatch(Mismatch),
+    #[error("the journal cannot be followed: {0}")]
+    Journal(JournalError),
+    #[error("the replay ended the {what} after {periods} periods (t = {t_s:.3} s), the journal says {journal_periods} (t = {journal_t_s:.3} s): a rig that ends when done cannot have run on")]
+    BeyondTheEnd {
+        /// `campaign`, `program` or `strain-controlled test`.
+        what: &'static str,
+        periods: u64,
+        t_s: f64,
+        journal_periods: u64,
+        journal_t_s: f64,
+    },
 }
 
 pub struct Session {
@@ -148,19 +159,69 @@ impl Session {
         }
     }
 
+    /// How this session counts periods, steps and log rows (what its journals fit).
+    pub fn cadence(&self) -> Cadence {
+        Cadence {
+            steps_per_period: self.publish_every,
+            log_every: self.log_every,
+            dt_s: self.rig.dt_s(),
+            actuators: self.rig.state().actuators.len(),
+        }
+    }
+
+    /// What the session runs, for messages: `campaign`, `program` or `strain-controlled test`.
+    pub fn what(&self) -> &'static str {
+        if self.campaign.is_some() {
+            "campaign"
+        } else if self.strain.is_some() {
+            "strain-controlled test"
+        } else {
+            "program"
+        }
+    }
+
     /// Runs `journal.periods` periods at once and checks that the machine is where the journal
-    /// says it was, bit for bit; refused (with why) otherwise, or when commands were accepted.
-    pub fn resume(&mut self, journal: &Journal) -> Result<(), SessionError> {
+    /// says it was, bit for bit; refused (with why) otherwise, when commands were accepted, or
+    /// when the journal's figures do not fit together. `ends_when_done` is `Some(has_program)`
+    /// for a rig that stops once done (`--exit-when-done`): a journal beyond that end is
+    /// refused as soon as the replay gets there. `after_period` is handed each period's log
+    /// rows (they are what the log holds, from its header on); its error ends the replay (a
+    /// termination request).
+    pub fn resume<E: From<SessionError>>(
+        &mut self,
+        journal: &Journal,
+        ends_when_done: Option<bool>,
+        mut after_period: impl FnMut(&str) -> Result<(), E>,
+    ) -> Result<(), E> {
         if journal.commands_accepted > 0 {
             return Err(SessionError::CommandsTaken {
                 count: journal.commands_accepted,
-            });
+            }
+            .into());
         }
+        journal
+            .check(&self.cadence())
+            .map_err(SessionError::Journal)?;
+        let mut rows = String::new();
         while self.periods < journal.periods {
-            self.period(None)?;
+            if let Some(has_program) = ends_when_done {
+                if self.done(has_program) {
+                    return Err(SessionError::BeyondTheEnd {
+                        what: self.what(),
+                        periods: self.periods,
+                        t_s: self.rig.state().t_s,
+                        journal_periods: journal.periods,
+                        journal_t_s: journal.t_s,
+                    }
+                    .into());
+                }
+            }
+            rows.clear();
+            self.period(Some(&mut rows))?;
+            after_period(&rows)?;
         }
         match journal.mismatch(self.rig.state()) {
-            Some(why) => Err(SessionError::Mismatch(why)),
+            Some(why) => Err(SessionError::Mismatch(why).into()),
             None => Ok(()),
         }
     }
@@ -206,7 +267,15 @@ mod tests {
         assert!(live.program_active());
         let journal = live.journal(1, 0, 0, 0);
         let mut again = session();
-        again.resume(&journal).unwrap();
+        let mut replayed_rows = String::new();
+        again
+            .resume(&journal, None, |r: &str| {
+                replayed_rows.push_str(r);
+                Ok::<(), SessionError>(())
+            })
+            .unwrap();
+        // The replay gives the very rows the live session logged.
+        assert_eq!(replayed_rows, rows);
         assert_eq!(again.rig.state().t_s, live.rig.state().t_s);
         assert_eq!(again.test_index, live.test_index);
         // The two go on identically.
@@ -227,14 +296,111 @@ mod tests {
         )
         .unwrap();
         other.campaign = Some(Campaign::parse("uniaxial:1.3@0.2").unwrap());
-        let refused = other.resume(&journal);
-        assert!(refused.is_err());
+        let refused = other.resume(&journal, None, no_rows);
+        assert!(
+            matches!(refused, Err(SessionError::Mismatch(_))),
+            "{refused:?}"
+        );
         // A rig that took commands cannot resume.
         let mut commanded = journal.clone();
         commanded.commands_accepted = 1;
         assert_eq!(
-            session().resume(&commanded),
+            session().resume(&commanded, None, no_rows),
             Err(SessionError::CommandsTaken { count: 1 })
         );
+    }
+
+    fn no_rows(_: &str) -> Result<(), SessionError> {
+        Ok(())
+    }
+
+    #[test]
+    fn a_journal_whose_figures_do_not_fit_is_refused_before_any_replay() {
+        let mut live = session();
+        for _ in 0..20 {
+            live.period(None).unwrap();
+        }
+        let journal = live.journal(1, 0, 0, 0);
+        // An edited periods count (10^12 would replay for years): refused at once.
+        let absurd = Journal {
+            periods: 1_000_000_000_000,
+            ..journal.clone()
+        };
+        let mut fresh = session();
+        let refused = fresh.resume(&absurd, None, no_rows).unwrap_err();
+        assert!(
+            matches!(
+                refused,
+                SessionError::Journal(JournalError::StepsPerPeriod { .. })
+            ),
+            "{refused:?}"
+        );
+        assert_eq!(fresh.periods, 0, "nothing replayed");
+        let late = Journal {
+            t_s: journal.t_s + 1.0,
+            ..journal.clone()
+        };
+        assert!(matches!(
+            session().resume(&late, None, no_rows),
+            Err(SessionError::Journal(JournalError::Time { .. }))
+        ));
+        let nan = Journal {
+            positions_mm: vec![f64::NAN; 6],
+            ..journal.clone()
+        };
+        assert!(matches!(
+            session().resume(&nan, None, no_rows),
+            Err(SessionError::Journal(JournalError::Positions { .. }))
+        ));
+        let rows = Journal {
+            rows_logged: 3,
+            log_bytes: 1000,
+            ..journal.clone()
+        };
+        assert!(matches!(
+            session().resume(&rows, None, no_rows),
+            Err(SessionError::Journal(JournalError::RowsLogged { .. }))
+        ));
+        session().resume(&journal, None, no_rows).unwrap();
+    }
+
+    #[test]
+    fn a_journal_beyond_the_end_of_a_campaign_that_ends_when_done_is_refused() {
+        let campaign = Campaign::parse("uniaxial:1.02@0.2").unwrap();
+        let new = || {
+            Session::new(
+                &RigConfig::default(),
+                7,
+                None,
+                Some(campaign.clone()),
+                10,
+                50,
+            )
+        };
+        let mut live = new().unwrap();
+        for _ in 0..100_000 {
+            if live.done(false) {
+                break;
+            }
+            live.period(None).unwrap();
+        }
+        assert!(live.done(false), "the campaign ended");
+        let end = live.journal(1, 0, 0, 0);
+        // The end itself resumes (a finished campaign restarted).
+        new().unwrap().resume(&end, Some(false), no_rows).unwrap();
+        // Ten periods on: a rig that ends when done cannot have written it.
+        for _ in 0..10 {
+            live.period(None).unwrap();
+        }
+        let beyond = live.journal(1, 0, 0, 0);
+        let mut replay = new().unwrap();
+        let refused = replay.resume(&beyond, Some(false), no_rows).unwrap_err();
+        assert!(
+            matches!(refused, SessionError::BeyondTheEnd { periods, .. } if periods == end.periods),
+            "{refused:?}"
+        );
+        assert!(refused.to_string().contains("campaign"), "{refused}");
+        // A rig that runs on once done may have.
+        new().unwrap().resume(&beyond, None, no_rows).unwrap();
     }
 }

@@ -83,8 +83,9 @@ pub struct RigArgs {
     #[arg(long)]
     pub exit_when_done: bool,
     /// Folder of the resume journal: a rig restarted with the same settings and folder goes
-    /// on where it was (same time, test and position; its --log continued), or refuses to
-    /// start (exit code 75) if it cannot do so exactly. Created if missing.
+    /// on where it was (same time, test and position; its --log continued, rows it lacks
+    /// written again from the replay), or refuses to start (exit code 75) if it cannot do so
+    /// exactly. Created if missing.
     #[arg(long)]
     pub state_dir: Option<PathBuf>,
     #[command(flatten)]

@@ -2,12 +2,13 @@
 //! (`testkit`: child processes, readiness, signals, the hang guard, test instances): [`Run`]
 //! is a `testkit::Run` whose children run the binary under test; `bench_run` drives
 //! `dicstream run`; `camera` makes the test itself the camera and the field reader of a live
-//! correlator; `notified` waits on a subscriber's notifications under the hang guard.
+//! correlator; `namespace` runs a script in a mount namespace (a small tmpfs); `notified` waits on a subscriber's notifications under the hang guard.
 
 #![allow(dead_code)]
 
 pub mod bench_run;
 pub mod camera;
+pub mod namespace;
 pub mod notified;
 
 pub use testkit::{Proc, HANG_GUARD};
