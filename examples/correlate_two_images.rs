@@ -4,7 +4,7 @@
 //! cargo run --release --example correlate_two_images -- REFERENCE DEFORMED
 //! ```
 //! Without arguments it reads the DIC Challenge sample 14 (reference and L1) from
-//! `../shared/data`. Prints the mean displacement, the valid nodes and the gauge strain.
+//! `testdata/`. Prints the mean displacement, the valid nodes and the gauge strain.
 
 use anyhow::Context;
 use correlator::{Correlator, CorrelatorSettings};
@@ -17,7 +17,7 @@ fn read_gray16(path: &str) -> anyhow::Result<(Vec<u16>, usize, usize)> {
 }
 
 fn main() -> anyhow::Result<()> {
-    let sample = "../shared/data/dic-challenge/sample14";
+    let sample = "testdata/dic-challenge/sample14";
     let args: Vec<String> = std::env::args().skip(1).collect();
     let (reference_path, deformed_path) = match args.as_slice() {
         [r, d] => (r.clone(), d.clone()),

@@ -331,7 +331,7 @@ fn files_present_at_start_are_ignored_and_sigint_stops_the_watch_cleanly() {
     assert!(!stderr.contains("old_1"), "{stderr}");
 }
 
-/// The DIC Challenge's sample 5 (../shared/data), 512 x 512, 8 bit: reference, u = v = 0,
+/// The DIC Challenge's sample 5 (testdata/), 512 x 512, 8 bit: reference, u = v = 0,
 /// u = v = +0.1 px (another noise realisation and contrast each).
 const SAMPLE5: [&str; 3] = [
     "Sample5 Reference.tif",

@@ -3,7 +3,7 @@
 //! exit), one hang guard ([`HANG_GUARD`]), a test's own instance whose shared-memory files are
 //! removed even when the test fails ([`TestInstance`]), a test's instance, children and scratch
 //! folder together ([`Run`]), unique instance names, polling for a condition no line announces
-//! ([`until`]), and the path to `../shared/data` ([`shared_data`]: skipped with a message, or a
+//! ([`until`]), and the path to the reference data `testdata/` ([`shared_data`]: skipped with a message, or a
 //! failure under `DICSTREAM_REQUIRE_SHARED=1`).
 //!
 //! Timeouts here only guard against a hang (a test that would otherwise never end); no test

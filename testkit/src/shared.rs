@@ -1,20 +1,20 @@
-//! The shared reference data (`../shared/data` next to the workspace: DIC Challenge images,
-//! Treloar's curves), which a clone may not have.
+//! The reference data the tests read (DIC Challenge samples 5 and 14 with their imposed
+//! displacements, Treloar's curves): `testdata/` in the repository (5.6 MB, copied from the
+//! project's shared data folder with its READMEs), so a clone has it.
 
 use std::path::PathBuf;
 
-/// Environment variable: when `1`, a missing shared data folder fails the test (CI sets it,
+/// Environment variable: when `1`, a missing data folder fails the test (CI sets it,
 /// `.ci/run`); otherwise the test is skipped with a message on stderr.
 pub const REQUIRE_SHARED_VAR: &str = "DICSTREAM_REQUIRE_SHARED";
 
-/// Environment variable: another location of the shared data folder (default
-/// `<workspace>/../shared/data`).
+/// Environment variable: another location of the data folder (default `<workspace>/testdata`).
 pub const SHARED_DATA_VAR: &str = "DICSTREAM_SHARED_DATA";
 
 fn data_root() -> PathBuf {
     match std::env::var_os(SHARED_DATA_VAR) {
         Some(dir) => PathBuf::from(dir),
-        None => PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data")),
+        None => PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../testdata")),
     }
 }
 
@@ -39,7 +39,7 @@ fn resolve(root: &std::path::Path, relative: &str, required: bool) -> Option<Pat
     if required {
         panic!(
             "shared data {shown} not found, and {REQUIRE_SHARED_VAR}=1 requires it: put the \
-             shared folder next to the workspace (../shared/data) or point {SHARED_DATA_VAR} at it"
+             repository's testdata/ back (git checkout testdata) or point {SHARED_DATA_VAR} at a copy"
         );
     }
     eprintln!(

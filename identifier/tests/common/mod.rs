@@ -1,4 +1,4 @@
-//! Shared by the integration tests: Treloar's (1944) three load cases from `../shared/data`.
+//! Shared by the integration tests: Treloar's (1944) three load cases from `testdata/`.
 
 use identifier::data::{read_curve_csv, Curve, LoadCase};
 
