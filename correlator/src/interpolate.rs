@@ -4,7 +4,7 @@
 //! smoothing), and the small affine helpers both use. Positions are in px, x = column,
 //! y = row, pixel centres on integers.
 
-use crate::zoi::Image;
+use crate::image::Image;
 
 /// A 2x2 matrix, row-major: `[[a11, a12], [a21, a22]]`.
 pub type Mat2 = [[f64; 2]; 2];

@@ -29,6 +29,7 @@ mod fft2d;
 pub mod field;
 mod global;
 mod icgn;
+mod image;
 mod interpolate;
 pub mod keypoints;
 mod mesh;

@@ -9,6 +9,7 @@
 //! G_w conj(F_w) gives at d, without the forward and inverse transforms.
 
 use crate::field::NodeStatus;
+pub use crate::image::Image;
 use crate::interpolate::{apply, bicubic, bicubic_clamped, block_inside, identity_plus, Mat2};
 use crate::peak::quadratic_peak_3x3;
 use crate::real_fft2d::RealFft2d;
@@ -53,22 +54,6 @@ impl SubpixelIterations {
 
 /// The sub-pixel shift may not wander further than this from the integer position (px).
 const MAX_SUBPIXEL_DRIFT_PX: f64 = 2.0;
-
-/// A grey-level image borrowed as row-major u16.
-#[derive(Clone, Copy)]
-pub struct Image<'a> {
-    pub pixels: &'a [u16],
-    pub width_px: usize,
-    pub height_px: usize,
-}
-
-impl Image<'_> {
-    /// True when the n x n block with top-left (x0, y0) lies inside the image.
-    #[inline]
-    pub fn contains_block(&self, x0: i64, y0: i64, n: usize) -> bool {
-        x0 >= 0 && y0 >= 0 && x0 as usize + n <= self.width_px && y0 as usize + n <= self.height_px
-    }
-}
 
 /// The per-node reference data, cached while the reference is fixed.
 pub struct ReferenceSpectra<'a> {

@@ -22,6 +22,7 @@ pub mod data;
 pub mod fit;
 pub mod gradient;
 pub mod journal;
+pub mod kinematics;
 /// The law lives in its own crate (`material`), shared with the rig; re-exported here.
 pub use material as law;
 pub mod lsq;

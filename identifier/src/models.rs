@@ -344,7 +344,7 @@ impl Model {
         case: crate::data::LoadCase,
         stretch: f64,
     ) -> Option<f64> {
-        self.nominal_stress_at(p, &crate::gradient::Kinematics::of(case, stretch), None)
+        self.nominal_stress_at(p, &crate::kinematics::Kinematics::of(case, stretch), None)
     }
 }
 

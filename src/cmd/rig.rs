@@ -52,10 +52,10 @@ pub struct RigArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub ratio: Option<f64>,
     /// Strain control holds the grips when the newest field is older than this (s of rig time).
-    #[arg(long, default_value_t = rig::strain::test::DEFAULT_STALE_S)]
+    #[arg(long, default_value_t = rig::strain::interlock::DEFAULT_STALE_S)]
     pub stale_s: f64,
     /// Strain control holds on a field with fewer converged nodes.
-    #[arg(long, default_value_t = rig::strain::test::DEFAULT_MIN_VALID_NODES)]
+    #[arg(long, default_value_t = rig::strain::interlock::DEFAULT_MIN_VALID_NODES)]
     pub min_valid_nodes: u32,
     /// After a hold, once fields are usable again: resume the strain program, or stop
     /// (unload) there.

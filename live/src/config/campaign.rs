@@ -113,9 +113,9 @@ impl RunConfig {
         let test = rig::strain::StrainTest::new(t.kind, t.ratio, t.stretch, t.rate_per_s)
             .and_then(|test| {
                 test.with_interlocks(
-                    t.stale_s.unwrap_or(rig::strain::test::DEFAULT_STALE_S),
+                    t.stale_s.unwrap_or(rig::strain::interlock::DEFAULT_STALE_S),
                     t.min_valid_nodes
-                        .unwrap_or(rig::strain::test::DEFAULT_MIN_VALID_NODES),
+                        .unwrap_or(rig::strain::interlock::DEFAULT_MIN_VALID_NODES),
                     t.on_interlock.unwrap_or_default(),
                 )
             })

@@ -51,7 +51,7 @@ fn strain_controlled_tests_are_checked_and_the_default_is_unchanged() {
     let test = config.strain_test().unwrap().unwrap();
     assert_eq!((test.ratio, test.stretch), (0.5, 1.5));
     assert_eq!(test.limits.min_valid_nodes, 50);
-    assert_eq!(test.limits.stale_s, rig::strain::test::DEFAULT_STALE_S);
+    assert_eq!(test.limits.stale_s, rig::strain::interlock::DEFAULT_STALE_S);
     // Round trip through the results' config.toml.
     let round = RunConfig::from_toml(&config.to_toml(), "round").unwrap();
     assert_eq!(round, config);

@@ -4,7 +4,7 @@
 //! the reasons a user reads; [`StrainTest::path`] is its strain program.
 
 use crate::strain::control::OnRestore;
-use crate::strain::interlock::InterlockLimits;
+use crate::strain::interlock::{InterlockLimits, DEFAULT_MIN_VALID_NODES, DEFAULT_STALE_S};
 use crate::strain::path::{StrainPath, StrainPathError};
 
 /// The path a strain-controlled test holds on the cruciform specimen.
@@ -48,16 +48,6 @@ impl StrainKind {
         }
     }
 }
-
-/// Defaults of the interlocks as a user configures them. The stale limit is the field latency
-/// a loaded bench really has, not a wish: on the 2-core bench under load (issue 16) a field's
-/// latency was 310 ms median and 1.2 s at p99, and 0.5 s held and resumed the test dozens of
-/// times per ramp on ordinary jitter (each resume costing accuracy). 1.5 s = that p99 plus
-/// three frame periods at 10 frames/s: a hold means the fields stopped, not that one was late.
-/// While held the grips stand still, so a longer limit only lets the ramp run 1.5 s on the
-/// model's feed-forward (at 0.02–0.03 /s, ≤ 0.045 log strain, which the model follows).
-pub const DEFAULT_STALE_S: f64 = 1.5;
-pub const DEFAULT_MIN_VALID_NODES: u32 = 16;
 
 /// A checked strain-controlled test.
 #[derive(Clone, Copy, Debug, PartialEq)]
