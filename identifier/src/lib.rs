@@ -9,6 +9,9 @@
 //! - [`residuals`]: the fit's residuals, cost and normal equations in one pass (blocked, threaded).
 //! - [`fit`]: fitting a model to any combination of load cases, statistics, ranking by AIC.
 //! - [`stability`]: Drucker stability along the load paths.
+//! - [`field_stress`]: a measured node's stress from its in-plane F and a law (section 4.c).
+//! - [`section_cut`]: the force through a band across an arm, the paper's section cut as a
+//!   virtual field.
 //! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
 //! - [`plot`]: PNG plots of the data, fits, f(I1) and g(I2) (plotters, bitmap backend).
 //! - [`online`]: pairing strains with rig forces, accumulating the load path, refitting (no IPC).
@@ -19,6 +22,7 @@
 #![forbid(unsafe_code)]
 
 pub mod data;
+pub mod field_stress;
 pub mod fit;
 pub mod gradient;
 pub mod journal;
@@ -34,5 +38,6 @@ pub mod process;
 pub mod report;
 pub mod residuals;
 pub mod route;
+pub mod section_cut;
 pub mod stability;
 pub mod subsample;
