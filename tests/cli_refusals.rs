@@ -19,9 +19,19 @@ fn instance() -> String {
 
 /// Exit status 1, the message holds every needle, nothing started.
 fn refused(args: &[&str], needles: &[&str]) -> String {
+    refused_with(1, args, needles)
+}
+
+/// A word that names no choice of a flag is refused by the command line itself: clap's usage
+/// error, exit status 2, with the choice's own message.
+fn refused_as_usage(args: &[&str], needles: &[&str]) -> String {
+    refused_with(2, args, needles)
+}
+
+fn refused_with(code: i32, args: &[&str], needles: &[&str]) -> String {
     let output = dicstream(args);
     let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
-    assert_eq!(output.status.code(), Some(1), "{args:?}: {stderr}");
+    assert_eq!(output.status.code(), Some(code), "{args:?}: {stderr}");
     for needle in needles {
         assert!(stderr.contains(needle), "{needle:?} not in {stderr}");
     }
@@ -189,9 +199,17 @@ fn bad_strain_control_flags_are_refused_naming_why() {
         &["--kind", "biaxial", "--ratio", "0.5"],
         &["add --control strain"],
     );
-    check(
+    let words = |extra: &[&str], needles: &[&str]| {
+        let args = rig(extra);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        refused_as_usage(&args, needles);
+    };
+    words(
         &["--control", "force"],
-        &["expected displacement or strain"],
+        &[
+            "--control <CONTROL>",
+            "control \"force\": expected displacement or strain",
+        ],
     );
     check(
         &[
@@ -204,7 +222,7 @@ fn bad_strain_control_flags_are_refused_naming_why() {
         ],
         &["no --program, --test or --campaign"],
     );
-    check(
+    words(
         &[
             "--control",
             "strain",
@@ -213,7 +231,11 @@ fn bad_strain_control_flags_are_refused_naming_why() {
             "--on-interlock",
             "pause",
         ],
-        &["resume or stop"],
+        &["on_interlock \"pause\": expected resume or stop"],
+    );
+    words(
+        &["--control", "strain", "--kind", "shear"],
+        &["expected uniaxial, equibiaxial"],
     );
     check(
         &[
