@@ -107,6 +107,7 @@ fn accept(listener: TcpListener, hub: &Arc<Hub>, limits: Arc<Limits>) {
             return;
         }
         let Ok(stream) = stream else {
+            // Out of file descriptors, say: a pause lets connections end.
             std::thread::sleep(ACCEPT_RETRY);
             continue;
         };

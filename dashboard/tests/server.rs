@@ -105,6 +105,22 @@ fn a_huge_request_head_is_refused_without_being_read() {
 }
 
 #[test]
+fn a_head_not_finished_before_the_deadline_is_answered_408() {
+    let hub = Arc::new(Hub::default());
+    let limits = Limits {
+        head_timeout: Duration::from_millis(300),
+        ..Limits::default()
+    };
+    let (_server, addr) = serve(&hub, limits);
+    let mut stream = send_request(&addr, "GET / HTTP/1.1\r\nHo");
+    let mut answer = Vec::new();
+    stream.read_to_end(&mut answer).unwrap();
+    let answer = String::from_utf8_lossy(&answer);
+    assert!(answer.starts_with("HTTP/1.1 408 "), "{answer}");
+    assert!(answer.contains("Connection: close\r\n"), "{answer}");
+}
+
+#[test]
 fn a_stalled_event_viewer_is_dropped_while_another_keeps_receiving() {
     let hub = Arc::new(Hub::default());
     let limits = Limits {

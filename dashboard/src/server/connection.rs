@@ -21,8 +21,9 @@ pub fn serve(stream: TcpStream, hub: &Hub, limits: &Limits) {
             break;
         }
         reader.get_mut().renew(limits.head_timeout);
+        let request = head::read(&mut reader, limits.max_head_bytes);
         let mut out = Timed::new(&stream, limits.write_timeout);
-        let request = match head::read(&mut reader, limits.max_head_bytes) {
+        let request = match request {
             Ok(request) => request,
             Err(no) => {
                 if let Some(reply) = refusal(&no, limits) {
@@ -31,7 +32,6 @@ pub fn serve(stream: TcpStream, hub: &Hub, limits: &Limits) {
                 break;
             }
         };
-        out.renew(limits.write_timeout);
         let head_only = request.method == "HEAD";
         let keep_open = !request.close && answered < limits.requests_per_connection;
         let reply = match route(&request.method, &request.path, hub) {

@@ -10,12 +10,17 @@ use std::net::TcpStream;
 
 const HEAD: &str = "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\n\
                     Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n\
-                    Connection: close\r\nX-Accel-Buffering: no\r\n\r\nretry: 1000\n\n";
+                    Connection: close\r\nX-Accel-Buffering: no\r\n\r\n";
+/// The browser reconnects 1 s after the stream ends.
+const RETRY: &str = "retry: 1000\n\n";
 
 /// Streams until the viewer or the hub is gone (only the head for HEAD).
 pub fn stream(stream: &TcpStream, hub: &Hub, limits: &Limits, head_only: bool) {
     let mut out = Timed::new(stream, limits.write_timeout);
-    if out.write_all(HEAD.as_bytes()).is_err() || head_only {
+    if out.write_all(HEAD.as_bytes()).is_err()
+        || head_only
+        || out.write_all(RETRY.as_bytes()).is_err()
+    {
         return;
     }
     let mut last = 0;
