@@ -13,12 +13,13 @@ use std::sync::{mpsc, Arc};
 use std::time::Duration;
 use testkit::{send_request, stalled_client, until, HANG_GUARD};
 
-/// A server on 127.0.0.1 (any free port) serving `hub`, and its address.
-fn serve(hub: &Arc<Hub>, limits: Limits) -> (server::Server, String) {
+/// A server on 127.0.0.1 (any free port) within `limits`: its hub, the server, its address.
+fn serve(limits: Limits) -> (Arc<Hub>, server::Server, String) {
+    let hub = Arc::new(Hub::default());
     let listener = server::bind("127.0.0.1:0".parse().unwrap(), false).unwrap();
     let server = server::spawn(listener, hub.clone(), limits).unwrap();
     let addr = server.addr().to_string();
-    (server, addr)
+    (hub, server, addr)
 }
 
 /// One `GET path` (`Connection: close`): status and body.
@@ -40,9 +41,8 @@ fn get(addr: &str, path: &str) -> (u16, Vec<u8>) {
 
 #[test]
 fn a_viewer_that_never_reads_blocks_neither_another_viewer_nor_the_stop() {
-    let hub = Arc::new(Hub::default());
+    let (hub, server, addr) = serve(Limits::default());
     hub.publish("{\"frames\":1}".into(), None);
-    let (server, addr) = serve(&hub, Limits::default());
     let stalled = stalled_client(&addr, "/app.js", 600);
 
     let (status, page) = get(&addr, "/");
@@ -66,8 +66,7 @@ fn a_viewer_that_never_reads_blocks_neither_another_viewer_nor_the_stop() {
 #[test]
 fn a_huge_request_head_is_refused_without_being_read() {
     const HUGE_BYTES: usize = 64 << 20;
-    let hub = Arc::new(Hub::default());
-    let (_server, addr) = serve(&hub, Limits::default());
+    let (_hub, _server, addr) = serve(Limits::default());
     let mut stream = TcpStream::connect(&addr).unwrap();
     stream.set_write_timeout(Some(HANG_GUARD)).unwrap();
     stream.set_read_timeout(Some(HANG_GUARD)).unwrap();
@@ -106,12 +105,10 @@ fn a_huge_request_head_is_refused_without_being_read() {
 
 #[test]
 fn a_head_not_finished_before_the_deadline_is_answered_408() {
-    let hub = Arc::new(Hub::default());
-    let limits = Limits {
+    let (_hub, _server, addr) = serve(Limits {
         head_timeout: Duration::from_millis(300),
         ..Limits::default()
-    };
-    let (_server, addr) = serve(&hub, limits);
+    });
     let mut stream = send_request(&addr, "GET / HTTP/1.1\r\nHo");
     let mut answer = Vec::new();
     stream.read_to_end(&mut answer).unwrap();
@@ -122,12 +119,10 @@ fn a_head_not_finished_before_the_deadline_is_answered_408() {
 
 #[test]
 fn a_stalled_event_viewer_is_dropped_while_another_keeps_receiving() {
-    let hub = Arc::new(Hub::default());
-    let limits = Limits {
+    let (hub, server, addr) = serve(Limits {
         write_timeout: Duration::from_millis(500),
         ..Limits::default()
-    };
-    let (server, addr) = serve(&hub, limits);
+    });
     // Both viewers in before any snapshot: none can be dropped yet.
     let stalled = stalled_client(&addr, "/events", 1);
     until("the stalled viewer counted in", || {
