@@ -14,9 +14,9 @@
 mod common;
 mod dashboard_support;
 
-use common::Run;
+use common::{dashboard_address, Run};
 use dashboard_support::webdriver::Browser;
-use dashboard_support::{dashboard_address, get_json, http, Events};
+use dashboard_support::{get_json, http, Events};
 use serde_json::Value;
 use std::path::PathBuf;
 use testkit::until;

@@ -1,7 +1,8 @@
 //! Fault injection on `dicstream run`, with real processes and a short campaign: kill -9 of
 //! each child at three moments and of two children in a row, SIGSTOP/SIGCONT of each child
 //! (short, and past the stale time) and of `run`, SIGINT at 1 ms, 100 ms and mid-run, SIGHUP,
-//! a second `run` on the same instance, a full disk. Each ends either "completed" with exit 0
+//! SIGINT with a dashboard viewer that never reads, a second `run` on the same instance, a
+//! full disk. Each ends either "completed" with exit 0
 //! and consistent results, or with a non-zero exit whose `summary.json` names what failed
 //! (with results still consistent), and leaves nothing of its instance in `/dev/shm` or
 //! iceoryx2's folder. Every case prints a row of the fault table (`--nocapture` shows them).
@@ -13,7 +14,7 @@ use common::bench_run::{
     check_consistency, child_pid, config, signal, start_run, stray_file, summary, wait_child,
     wait_rows, whole_rows, SHORT_CAMPAIGN,
 };
-use common::Run;
+use common::{dashboard_address, Run};
 use std::os::unix::process::ExitStatusExt;
 use std::path::Path;
 use std::process::ExitStatus;
@@ -364,6 +365,32 @@ fn sigint_mid_run() {
 #[test]
 fn sighup_mid_run() {
     terminate(libc::SIGHUP, Duration::ZERO, 30);
+}
+
+/// A viewer of the run's dashboard that pipelines requests and never reads (issue 29: a laptop
+/// asleep behind `ssh -L`): SIGINT still ends the run, with its results, while it is connected.
+#[test]
+fn sigint_with_a_stalled_dashboard_viewer() {
+    let mut run = Run::new("stalled_viewer");
+    let config = bench(&run);
+    let out = run.dir.join("out");
+    let dashboard = ["--quiet", "--dashboard", "127.0.0.1:0"];
+    let parent = start_run(&mut run, "run", &config, &out, &dashboard);
+    let line = run
+        .child("run")
+        .wait_for_stderr("dashboard URL", |l| l.contains("http://"));
+    let stalled = testkit::stalled_client(&dashboard_address(&line), "/app.js", 600);
+    wait_rows(&out.join("frames.csv"), 0, 30);
+    signal(parent, libc::SIGINT);
+    let o = finish(
+        &mut run,
+        "run",
+        "SIGINT with a stalled dashboard viewer",
+        &out,
+    );
+    assert_eq!(o.exit, Some(130), "{}", o.failure);
+    assert_eq!(o.ending, "interrupted");
+    drop(stalled);
 }
 
 #[test]

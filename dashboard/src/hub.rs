@@ -2,8 +2,9 @@
 //! a condition variable the viewers' threads sleep on, and the count of connected viewers.
 //! Snapshots are shared (`Arc<str>`), never copied per viewer.
 
+use crate::slots::{Slot, Slots};
 use serde_json::Value;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::Duration;
 
@@ -19,17 +20,8 @@ struct Published {
 pub struct Hub {
     published: Mutex<Published>,
     changed: Condvar,
-    viewers: AtomicUsize,
+    viewers: Arc<Slots>,
     stop: AtomicBool,
-}
-
-/// One connected viewer (an event stream); the count drops when it is dropped.
-pub struct Viewer(Arc<Hub>);
-
-impl Drop for Viewer {
-    fn drop(&mut self) {
-        self.0.viewers.fetch_sub(1, Ordering::SeqCst);
-    }
 }
 
 impl Hub {
@@ -83,19 +75,14 @@ impl Hub {
         self.lock().processes.clone()
     }
 
-    /// Counts a viewer in, if fewer than `max` are connected.
-    pub fn join(self: &Arc<Self>, max: usize) -> Option<Viewer> {
-        let joined = self
-            .viewers
-            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
-                (n < max).then_some(n + 1)
-            })
-            .is_ok();
-        joined.then(|| Viewer(self.clone()))
+    /// Counts a viewer (an event stream) in, if fewer than `max` are connected; counted out
+    /// when the slot is dropped.
+    pub fn join(&self, max: usize) -> Option<Slot> {
+        self.viewers.take(max)
     }
 
     pub fn viewers(&self) -> usize {
-        self.viewers.load(Ordering::SeqCst)
+        self.viewers.taken()
     }
 
     pub fn stop(&self) {

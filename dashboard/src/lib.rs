@@ -6,7 +6,8 @@
 //! - [`state`] (pure): what is kept of the four services and the snapshot sent to viewers;
 //!   [`image`] the capped thumbnail, [`series`] and [`latency`] the bounded histories;
 //! - [`hub`]: the latest snapshot and image, shared with the viewers' threads;
-//! - [`server`]: read-only HTTP (tiny_http) with server-sent events, assets compiled in;
+//! - [`server`]: read-only HTTP on std with server-sent events, assets compiled in, a
+//!   deadline on every read and write so no viewer holds another or the stop;
 //! - [`feed`]: the IPC shell, a node of its own subscribing to the four services.
 
 #![forbid(unsafe_code)]
@@ -19,6 +20,7 @@ pub mod image;
 pub mod latency;
 pub mod series;
 pub mod server;
+mod slots;
 pub mod state;
 
 pub use error::DashboardError;
@@ -33,7 +35,7 @@ use std::thread::JoinHandle;
 pub struct Dashboard {
     hub: Arc<Hub>,
     addr: SocketAddr,
-    server: Option<JoinHandle<()>>,
+    server: Option<server::Server>,
     feeder: Option<JoinHandle<Result<(), DashboardError>>>,
 }
 
@@ -46,9 +48,10 @@ impl Dashboard {
         addr: SocketAddr,
         fallback: bool,
     ) -> Result<Dashboard, DashboardError> {
-        let server = server::bind(addr, fallback)?;
-        let addr = server.server_addr().to_ip().ok_or_else(|| {
-            DashboardError::Thread("the server's address is not an IP address".into())
+        let listener = server::bind(addr, fallback)?;
+        let addr = listener.local_addr().map_err(|e| DashboardError::Listen {
+            addr,
+            reason: e.to_string(),
         })?;
         let hub = Arc::new(Hub::default());
         let (ready_tx, ready_rx) = std::sync::mpsc::channel();
@@ -82,8 +85,9 @@ impl Dashboard {
             server: None,
             feeder: Some(feeder),
         };
-        dashboard.server =
-            Some(server::spawn(server, hub).map_err(|e| DashboardError::Thread(e.to_string()))?);
+        let server = server::spawn(listener, hub, server::Limits::default())
+            .map_err(|e| DashboardError::Thread(e.to_string()))?;
+        dashboard.server = Some(server);
         Ok(dashboard)
     }
 
@@ -119,8 +123,7 @@ impl Drop for Dashboard {
         if let Some(f) = self.feeder.take() {
             let _ = f.join();
         }
-        if let Some(s) = self.server.take() {
-            let _ = s.join();
-        }
+        // Waits for the accept thread only, never for a viewer.
+        drop(self.server.take());
     }
 }

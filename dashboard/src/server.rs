@@ -1,27 +1,34 @@
-//! The read-only HTTP server (tiny_http, one thread, plus one thread per event stream): the
-//! page and its script and style (compiled into the binary), the latest image, the latest
-//! snapshot, and `/events`, a server-sent-event stream of snapshots. Only GET and HEAD are
-//! served; nothing a viewer sends reaches the instance.
+//! The read-only HTTP server, on std: one thread accepts; each connection has a thread of its
+//! own (at most `max_connections`), reads request heads of bounded size before a deadline and
+//! writes each answer or event before another (`Limits`). A viewer beyond a limit is answered
+//! (408, 431, 503) or dropped, so no viewer holds another, the run's end or a signal.
+//! Stopping wakes the accept thread and waits for it only: connection threads end by their
+//! own deadlines. Only GET and HEAD are served; nothing a viewer sends reaches the instance.
+
+mod connection;
+mod events;
+mod head;
+mod limits;
+mod reply;
+mod route;
+mod timed;
+
+pub use limits::{Limits, MAX_VIEWERS};
 
 use crate::hub::Hub;
-use std::io::Write as _;
-use std::net::SocketAddr;
+use crate::slots::Slots;
+use std::net::{Ipv4Addr, Ipv6Addr, SocketAddr, TcpListener, TcpStream};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
-use tiny_http::{Header, Method, Request, Response, Server};
 
-/// Event streams served at once; a viewer beyond is answered 503.
-pub const MAX_VIEWERS: usize = 16;
-/// A comment line is sent when no snapshot came for this long (detects gone viewers).
-const KEEPALIVE: Duration = Duration::from_secs(5);
-
-const INDEX_HTML: &str = include_str!("assets/index.html");
-const APP_JS: &str = include_str!("assets/app.js");
-const STYLE_CSS: &str = include_str!("assets/style.css");
+/// How long stopping tries to connect to the server to wake its accept thread.
+const WAKE_TIMEOUT: Duration = Duration::from_secs(1);
+/// After a failed accept (no file descriptor left): the pause before the next.
+const ACCEPT_RETRY: Duration = Duration::from_millis(100);
 
 /// Binds `addr`; with `fallback`, a taken port is followed by the next ones, then any port.
-pub fn bind(addr: SocketAddr, fallback: bool) -> Result<Server, crate::DashboardError> {
+pub fn bind(addr: SocketAddr, fallback: bool) -> Result<TcpListener, crate::DashboardError> {
     let mut candidates = vec![addr];
     if fallback && addr.port() != 0 {
         let next = (1..=crate::address::DEFAULT_PORT_TRIES)
@@ -32,8 +39,8 @@ pub fn bind(addr: SocketAddr, fallback: bool) -> Result<Server, crate::Dashboard
     }
     let mut last_error = String::new();
     for candidate in candidates {
-        match Server::http(candidate) {
-            Ok(server) => return Ok(server),
+        match TcpListener::bind(candidate) {
+            Ok(listener) => return Ok(listener),
             Err(e) => last_error = e.to_string(),
         }
     }
@@ -43,102 +50,80 @@ pub fn bind(addr: SocketAddr, fallback: bool) -> Result<Server, crate::Dashboard
     })
 }
 
-/// Serves until the hub is stopped.
-pub fn spawn(server: Server, hub: Arc<Hub>) -> std::io::Result<JoinHandle<()>> {
-    std::thread::Builder::new()
-        .name("dashboard-http".into())
-        .spawn(move || {
-            while !hub.stopped() {
-                match server.recv_timeout(Duration::from_millis(250)) {
-                    Ok(Some(request)) => handle(request, &hub),
-                    Ok(None) => {}
-                    Err(_) => break,
-                }
-            }
-        })
+/// A running server; dropping it stops the hub and the server.
+pub struct Server {
+    hub: Arc<Hub>,
+    addr: SocketAddr,
+    accept: Option<JoinHandle<()>>,
 }
 
-fn header(name: &str, value: &str) -> Header {
-    Header::from_bytes(name.as_bytes(), value.as_bytes()).expect("valid header")
+/// Serves `listener` until the returned server is dropped.
+pub fn spawn(listener: TcpListener, hub: Arc<Hub>, limits: Limits) -> std::io::Result<Server> {
+    let addr = listener.local_addr()?;
+    let accept = {
+        let hub = hub.clone();
+        std::thread::Builder::new()
+            .name("dashboard-accept".into())
+            .spawn(move || accept(listener, &hub, Arc::new(limits)))?
+    };
+    Ok(Server {
+        hub,
+        addr,
+        accept: Some(accept),
+    })
 }
 
-fn respond(request: Request, status: u16, content_type: &str, body: impl Into<Vec<u8>>) {
-    let response = Response::from_data(body.into())
-        .with_status_code(status)
-        .with_header(header("Content-Type", content_type))
-        .with_header(header("Cache-Control", "no-store"))
-        .with_header(header("X-Content-Type-Options", "nosniff"));
-    // A viewer gone before the answer is not an error of the server.
-    let _ = request.respond(response);
-}
-
-fn handle(request: Request, hub: &Arc<Hub>) {
-    if !matches!(request.method(), Method::Get | Method::Head) {
-        return respond(request, 405, "text/plain", "read-only: GET only\n");
-    }
-    let path = request.url().split('?').next().unwrap_or("/").to_string();
-    match path.as_str() {
-        "/" | "/index.html" => respond(request, 200, "text/html; charset=utf-8", INDEX_HTML),
-        "/app.js" => respond(request, 200, "text/javascript; charset=utf-8", APP_JS),
-        "/style.css" => respond(request, 200, "text/css; charset=utf-8", STYLE_CSS),
-        "/image.png" => match hub.png() {
-            Some(png) => respond(request, 200, "image/png", png.to_vec()),
-            None => respond(request, 404, "text/plain", "no image yet\n"),
-        },
-        "/snapshot.json" => match hub.latest() {
-            Some(s) => respond(request, 200, "application/json", s.as_bytes()),
-            None => respond(request, 503, "text/plain", "no snapshot yet\n"),
-        },
-        "/events" => match hub.join(MAX_VIEWERS) {
-            Some(viewer) => {
-                let hub = hub.clone();
-                let writer = request.into_writer();
-                let spawned = std::thread::Builder::new()
-                    .name("dashboard-viewer".into())
-                    .spawn(move || {
-                        let _viewer = viewer;
-                        stream_events(writer, &hub)
-                    });
-                if let Err(e) = spawned {
-                    eprintln!("dashboard: cannot serve a viewer: {e}");
-                }
-            }
-            None => respond(
-                request,
-                503,
-                "text/plain",
-                format!("{MAX_VIEWERS} viewers already connected\n"),
-            ),
-        },
-        _ => respond(request, 404, "text/plain", "not found\n"),
+impl Server {
+    pub fn addr(&self) -> SocketAddr {
+        self.addr
     }
 }
 
-/// Writes snapshots as server-sent events until the viewer goes or the hub stops.
-fn stream_events(mut writer: Box<dyn std::io::Write + Send>, hub: &Hub) {
-    let head = "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n\
-                Connection: close\r\nX-Accel-Buffering: no\r\n\r\nretry: 1000\n\n";
-    if writer
-        .write_all(head.as_bytes())
-        .and_then(|_| writer.flush())
-        .is_err()
-    {
-        return;
+impl Drop for Server {
+    fn drop(&mut self) {
+        self.hub.stop();
+        // A connection of its own wakes the accept thread, which then sees the stop; if none
+        // can be made, the thread is left to end with the process rather than waited for.
+        let woken = TcpStream::connect_timeout(&wake_address(self.addr), WAKE_TIMEOUT).is_ok();
+        if let (true, Some(accept)) = (woken, self.accept.take()) {
+            let _ = accept.join();
+        }
     }
-    let mut last = 0;
-    while !hub.stopped() {
-        let sent = match hub.wait_newer(last, KEEPALIVE) {
-            Some((version, snapshot)) => {
-                last = version;
-                writer
-                    .write_all(b"event: snapshot\ndata: ")
-                    .and_then(|_| writer.write_all(snapshot.as_bytes()))
-                    .and_then(|_| writer.write_all(b"\n\n"))
-            }
-            None => writer.write_all(b": keepalive\n\n"),
-        };
-        if sent.and_then(|_| writer.flush()).is_err() {
+}
+
+/// Where the server can be reached from this machine (loopback for an unspecified address).
+fn wake_address(addr: SocketAddr) -> SocketAddr {
+    match addr.ip() {
+        ip if !ip.is_unspecified() => addr,
+        std::net::IpAddr::V4(_) => SocketAddr::new(Ipv4Addr::LOCALHOST.into(), addr.port()),
+        std::net::IpAddr::V6(_) => SocketAddr::new(Ipv6Addr::LOCALHOST.into(), addr.port()),
+    }
+}
+
+fn accept(listener: TcpListener, hub: &Arc<Hub>, limits: Arc<Limits>) {
+    let connections = Arc::new(Slots::default());
+    for stream in listener.incoming() {
+        if hub.stopped() {
             return;
+        }
+        let Ok(stream) = stream else {
+            // Out of file descriptors, say: a pause lets connections end.
+            std::thread::sleep(ACCEPT_RETRY);
+            continue;
+        };
+        let Some(slot) = connections.take(limits.max_connections) else {
+            connection::refuse_busy(stream, &limits);
+            continue;
+        };
+        let (hub, limits) = (hub.clone(), limits.clone());
+        let spawned = std::thread::Builder::new()
+            .name("dashboard-conn".into())
+            .spawn(move || {
+                let _slot = slot;
+                connection::serve(stream, &hub, &limits)
+            });
+        if let Err(e) = spawned {
+            eprintln!("dashboard: cannot serve a viewer: {e}");
         }
     }
 }

@@ -3,18 +3,21 @@
 //! exit), one hang guard ([`HANG_GUARD`]), a test's own instance whose shared-memory files are
 //! removed even when the test fails ([`TestInstance`]), a test's instance, children and scratch
 //! folder together ([`Run`]), unique instance names, polling for a condition no line announces
-//! ([`until`]), and the path to the reference data `testdata/` ([`shared_data`]: skipped with a message, or a
-//! failure under `DICSTREAM_REQUIRE_SHARED=1`).
+//! ([`until`]), HTTP clients ([`send_request`], and [`stalled_client`] that stops reading),
+//! and the path to the reference data `testdata/` ([`shared_data`]: skipped with a message, or
+//! a failure under `DICSTREAM_REQUIRE_SHARED=1`).
 //!
 //! Timeouts here only guard against a hang (a test that would otherwise never end); no test
 //! asserts a wall-clock time.
 
+mod http;
 mod instance;
 mod proc;
 mod run;
 mod shared;
 mod until;
 
+pub use http::{send_request, stalled_client};
 pub use instance::{unique_instance, TestInstance};
 pub use proc::{signal, Proc};
 pub use run::Run;

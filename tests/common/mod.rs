@@ -2,7 +2,9 @@
 //! (`testkit`: child processes, readiness, signals, the hang guard, test instances): [`Run`]
 //! is a `testkit::Run` whose children run the binary under test; `bench_run` drives
 //! `dicstream run`; `camera` makes the test itself the camera and the field reader of a live
-//! correlator; `namespace` runs a script in a mount namespace (a small tmpfs); `notified` waits on a subscriber's notifications under the hang guard.
+//! correlator; `namespace` runs a script in a mount namespace (a small tmpfs); `notified` waits
+//! on a subscriber's notifications under the hang guard; [`dashboard_address`] reads a
+//! dashboard's address from its stderr line.
 
 #![allow(dead_code)]
 
@@ -40,4 +42,16 @@ impl std::ops::DerefMut for Run {
 pub fn tap_json(stdout: &str) -> serde_json::Value {
     serde_json::from_str(stdout.trim())
         .unwrap_or_else(|e| panic!("tap --json printed no JSON object ({e}):\n{stdout}"))
+}
+
+/// The address a dashboard's stderr `line` gives (`... at http://ADDR:PORT/ ...`), as
+/// `ADDR:PORT`; panics unless it is a loopback one.
+pub fn dashboard_address(line: &str) -> String {
+    let url = line
+        .split("http://")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no URL in {line:?}"));
+    let addr = url.split('/').next().unwrap().to_string();
+    assert!(addr.starts_with("127.0.0.1:"), "{line}");
+    addr
 }

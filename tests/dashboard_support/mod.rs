@@ -1,43 +1,29 @@
 //! What only `tests/dashboard.rs` needs, beside the test kit (`testkit`: child processes,
-//! instances, [`until`](testkit::until), the hang guard): the dashboard's address from its
-//! stderr line, a plain HTTP/1.1 client and a server-sent-event reader over `TcpStream`, and a
-//! WebDriver client of Debian's chromium (`webdriver.rs`).
+//! instances, [`until`](testkit::until), the hang guard) and `common` (the dashboard's address
+//! from its stderr line): a plain HTTP/1.1 client and a server-sent-event reader over
+//! `TcpStream`, and a WebDriver client of Debian's chromium (`webdriver.rs`).
 //!
-//! Every wait is bounded by [`HANG_GUARD`], a guard against a hang only: no test asserts a
-//! wall-clock time.
+//! Every wait is bounded by [`HANG_GUARD`](testkit::HANG_GUARD), a guard against a hang only:
+//! no test asserts a wall-clock time.
 
 #![allow(dead_code)]
 
 pub mod webdriver;
 
 use serde_json::Value;
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufRead, BufReader, Read};
 use std::net::TcpStream;
-use testkit::HANG_GUARD;
-
-/// The address a dashboard's stderr `line` gives (`... at http://ADDR:PORT/ ...`), as
-/// `ADDR:PORT`; panics unless it is a loopback one.
-pub fn dashboard_address(line: &str) -> String {
-    let url = line
-        .split("http://")
-        .nth(1)
-        .unwrap_or_else(|| panic!("no URL in {line:?}"));
-    let addr = url.split('/').next().unwrap().to_string();
-    assert!(addr.starts_with("127.0.0.1:"), "{line}");
-    addr
-}
+use testkit::send_request;
 
 /// One HTTP/1.1 request (`Connection: close`): status and body.
 pub fn http(addr: &str, method: &str, path: &str, body: Option<&Value>) -> (u16, Vec<u8>) {
-    let mut stream = TcpStream::connect(addr).unwrap_or_else(|e| panic!("connect {addr}: {e}"));
-    stream.set_read_timeout(Some(HANG_GUARD)).unwrap();
     let body = body.map(|b| b.to_string()).unwrap_or_default();
     let request = format!(
         "{method} {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\
          Content-Type: application/json\r\nContent-Length: {}\r\n\r\n{body}",
         body.len()
     );
-    stream.write_all(request.as_bytes()).unwrap();
+    let mut stream = send_request(addr, &request);
     // The body ends at its Content-Length, at the last chunk, or when the server closes (a
     // keep-alive server, as chromedriver is, may not close).
     let mut raw = Vec::new();
@@ -120,14 +106,9 @@ pub struct Events {
 
 impl Events {
     pub fn connect(addr: &str) -> Events {
-        let mut stream = TcpStream::connect(addr).unwrap();
-        stream.set_read_timeout(Some(HANG_GUARD)).unwrap();
-        write!(
-            stream,
-            "GET /events HTTP/1.1\r\nHost: {addr}\r\nAccept: text/event-stream\r\n\r\n"
-        )
-        .unwrap();
-        let mut reader = BufReader::new(stream);
+        let request =
+            format!("GET /events HTTP/1.1\r\nHost: {addr}\r\nAccept: text/event-stream\r\n\r\n");
+        let mut reader = BufReader::new(send_request(addr, &request));
         let mut status = String::new();
         reader.read_line(&mut status).unwrap();
         assert!(status.starts_with("HTTP/1.1 200"), "{status}");
