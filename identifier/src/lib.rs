@@ -12,6 +12,7 @@
 //! - [`field_stress`]: a measured node's stress from its in-plane F and a law (section 4.c).
 //! - [`section_cut`]: the force through a band across an arm, the paper's section cut as a
 //!   virtual field.
+//! - [`vfm`]: the virtual fields method over the cuts of all frames of a test.
 //! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
 //! - [`plot`]: PNG plots of the data, fits, f(I1) and g(I2) (plotters, bitmap backend).
 //! - [`online`]: pairing strains with rig forces, accumulating the load path, refitting (no IPC).
@@ -41,3 +42,4 @@ pub mod route;
 pub mod section_cut;
 pub mod stability;
 pub mod subsample;
+pub mod vfm;
