@@ -3,8 +3,10 @@
 //! appends rows to a machine's CSV. Real processes on a unique instance; a writer thread
 //! appends rows at 100 Hz, each written in two pieces (a partial last line), plus one
 //! malformed line, while this test, subscribed to `rig/state` before the follower starts,
-//! receives every sample. Timeouts only guard against a hang; no assertion on a wall-clock
-//! time. Also: a GenICam camera the binary cannot open fails the run at start, said.
+//! receives every sample. A log as Excel writes it in a decimal-comma locale (BOM, quoted
+//! cells) with an extra cell: read as written, the bad line counted. Timeouts only guard
+//! against a hang; no assertion on a wall-clock time. Also: a GenICam camera the binary cannot
+//! open fails the run at start, said.
 
 mod common;
 
@@ -25,6 +27,20 @@ fn append(path: &Path, text: &str) {
         .unwrap();
     file.write_all(text.as_bytes()).unwrap();
     file.flush().unwrap();
+}
+
+/// `dicstream rig` following `csv` on instance `name`: its `Time` column and `force` as the X
+/// force, then `more`.
+fn follow_args(name: &str, csv: &Path, force: &str, more: &[&str]) -> Vec<String> {
+    let mut args = vec!["rig".to_string(), "--instance".into(), name.into()];
+    args.extend(["--follow-csv".into(), csv.display().to_string()]);
+    args.extend(["--time-column", "Time", "--force-x-column", force].map(String::from));
+    args.extend(more.iter().map(|a| a.to_string()));
+    args
+}
+
+fn strs(args: &[String]) -> Vec<&str> {
+    args.iter().map(String::as_str).collect()
 }
 
 /// Row k of the machine's log: time ms, Fx kN, Fy N, Dx mm.
@@ -48,21 +64,12 @@ fn rows_appended_at_100_hz_are_published_once_in_order_converted_and_shifted() {
     let (node, _) = instance.create_node("test").unwrap();
     let subscriber: ValueSubscriber<RigState> =
         ValueSubscriber::create(&node, &services::RIG_STATE).unwrap();
-    let name = run.name().to_string();
-    let csv_arg = csv.display().to_string();
     // The file does not exist yet: the follower waits for it.
-    run.spawn(
-        "rig",
+    let args = follow_args(
+        run.name(),
+        &csv,
+        "Fx",
         &[
-            "rig",
-            "--instance",
-            &name,
-            "--follow-csv",
-            &csv_arg,
-            "--time-column",
-            "Time",
-            "--force-x-column",
-            "Fx",
             "--force-y-column",
             "Fy",
             "--displacement-x-column",
@@ -72,8 +79,8 @@ fn rows_appended_at_100_hz_are_published_once_in_order_converted_and_shifted() {
             "--idle-timeout-s",
             "1.5",
         ],
-    )
-    .wait_line("rig: ready");
+    );
+    run.spawn("rig", &strs(&args)).wait_line("rig: ready");
     let writer_csv = csv.clone();
     let writer = std::thread::spawn(move || {
         append(&writer_csv, "Time (ms),Fx (kN),Fy (N),Dx (mm)\r\n");
@@ -138,26 +145,57 @@ fn rows_appended_at_100_hz_are_published_once_in_order_converted_and_shifted() {
 }
 
 #[test]
+fn a_log_with_a_bom_quoted_decimal_commas_and_an_extra_cell_is_read_as_written() {
+    let mut run = Run::new("csv_follow_quoted");
+    let csv = run.dir.join("machine.csv");
+    // Excel's "CSV UTF-8" in a decimal-comma locale: a BOM, quoted cells; one row with an
+    // extra cell, which must not be read as a force.
+    std::fs::write(
+        &csv,
+        "\u{feff}Time (s),Force (N)\r\n\"4,5\",\"450,5\"\r\n5,1,510\r\n\"5,5\",\"550,5\"\r\n",
+    )
+    .unwrap();
+    let instance = Instance::new(run.name()).unwrap();
+    let (node, _) = instance.create_node("test").unwrap();
+    let subscriber: ValueSubscriber<RigState> =
+        ValueSubscriber::create(&node, &services::RIG_STATE).unwrap();
+    let args = follow_args(run.name(), &csv, "Force", &[]);
+    run.spawn("rig", &strs(&args));
+    // Received while the follower lives (its samples go with it).
+    let mut published = Vec::new();
+    common::notified::wait_notified(subscriber.listener(), || {
+        subscriber.clear_events();
+        while let Some(state) = subscriber.receive().unwrap() {
+            let a = &state.actuators;
+            published.push((state.t_sim_s, 500.0 * (a[0].force_kn + a[1].force_kn)));
+        }
+        (published.len() < 2).then(|| format!("{published:?}"))
+    });
+    run.child("rig").signal(libc::SIGTERM);
+    let (status, _, stderr) = run.child("rig").wait();
+    assert!(status.success(), "{stderr}");
+    assert_eq!(published.len(), 2, "{published:?}\n{stderr}");
+    for ((t_s, f_n), (t_want, f_want)) in published.iter().zip([(4.5, 450.5), (5.5, 550.5)]) {
+        assert!(
+            (t_s - t_want).abs() < 1e-9 && (f_n - f_want).abs() < 1e-9,
+            "{published:?}"
+        );
+    }
+    assert!(
+        stderr.contains("line 3 skipped: 3 cells where the header has 2: \"5,1,510\"")
+            && stderr.contains("2 rows published, 1 malformed lines skipped")
+            && stderr.contains("stopped by signal"),
+        "{stderr}"
+    );
+}
+
+#[test]
 fn a_log_without_the_configured_column_is_refused_with_the_column_named() {
     let mut run = Run::new("csv_follow_missing");
     let csv = run.dir.join("machine.csv");
     std::fs::write(&csv, "Time (s),Force (kN)\n0,1\n").unwrap();
-    let name = run.name().to_string();
-    let csv_arg = csv.display().to_string();
-    let (status, _, stderr) = run.run_to_end(
-        "rig",
-        &[
-            "rig",
-            "--instance",
-            &name,
-            "--follow-csv",
-            &csv_arg,
-            "--time-column",
-            "Time",
-            "--force-x-column",
-            "Fx",
-        ],
-    );
+    let args = follow_args(run.name(), &csv, "Fx", &[]);
+    let (status, _, stderr) = run.run_to_end("rig", &strs(&args));
     assert_eq!(status.code(), Some(78), "{stderr}");
     assert!(
         stderr.contains("\"Fx\"") && stderr.contains("Force (kN)"),

@@ -41,7 +41,8 @@ pub struct FollowCsvArgs {
     /// Unit of the displacement columns: mm, um or m [default: as their headers say]
     #[arg(long, requires = "follow_csv")]
     pub displacement_unit: Option<LengthUnit>,
-    /// Cell delimiter: ",", ";" or "tab" (with ";" and tab a decimal comma is read too)
+    /// Cell delimiter: ",", ";" or "tab" (cells may be quoted, "4,5"; a comma inside a cell is
+    /// a decimal comma)
     #[arg(long, default_value_t = Delimiter::Comma, requires = "follow_csv")]
     pub delimiter: Delimiter,
     /// Seconds added to the machine's time to put it on the camera's (camera − machine)
@@ -138,9 +139,9 @@ pub fn run(args: FollowCsvArgs, instance: String) -> anyhow::Result<()> {
         "rig: followed {}: {} rows published, {} malformed lines skipped, {} truncation(s) or \
          rotation(s){}",
         path.display(),
-        summary.rows_published,
-        summary.malformed,
-        summary.restarts,
+        summary.counters.rows,
+        summary.counters.malformed_lines,
+        summary.counters.restarts,
         if summary.stopped_by_signal {
             "; stopped by signal"
         } else {

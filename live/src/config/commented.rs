@@ -69,7 +69,7 @@ const COMMENTS: &[(&str, &str)] = &[
     ("rig.csv.time_unit", "Units: s/ms/min, N/kN, mm/um/m; \"\" = as the header says (`Fx (kN)`)."),
     ("rig.csv.force_unit", ""),
     ("rig.csv.displacement_unit", ""),
-    ("rig.csv.delimiter", "\",\", \";\" or \"tab\" (with \";\" and tab a decimal comma is read too)."),
+    ("rig.csv.delimiter", "\",\", \";\" or \"tab\"; cells may be quoted, a comma in a cell is a decimal comma."),
     ("rig.csv.offset_s", "Seconds added to the machine's time to put it on the camera's."),
     ("rig.csv.section_x_mm2", "Initial specimen sections normal to X and Y, mm² (stress = force / section)."),
     ("rig.csv.section_y_mm2", ""),

@@ -2,6 +2,8 @@
 //! header names them (`Time (s)`, `Fx [kN]` or plain `Time`), the configuration may state
 //! the units; every value is converted to s, N and mm.
 
+use super::malformed::{excerpt, RowError};
+
 /// Why a follow cannot start (or go on).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum CsvError {
@@ -31,6 +33,9 @@ pub enum CsvError {
         header_unit: String,
         config_unit: String,
     },
+    /// The first line cannot be split into cells (the header is an excerpt).
+    #[error("the header {header:?} cannot be read: {why}")]
+    BadHeader { header: String, why: RowError },
     #[error("{0}")]
     Spec(String),
 }
@@ -133,7 +138,8 @@ pub struct CsvColumns {
     pub time_unit: Option<TimeUnit>,
     pub force_unit: Option<ForceUnit>,
     pub displacement_unit: Option<LengthUnit>,
-    /// `,`, `;` or a tab. With `;` or a tab a decimal comma is read too.
+    /// `,`, `;` or a tab. A comma inside a cell is a decimal comma (with `,` the cell is
+    /// quoted, `"4,5"`).
     pub delimiter: char,
 }
 
@@ -168,7 +174,8 @@ pub struct Row {
 /// Where each configured column is, and its factor to s, N or mm.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Layout {
-    delimiter: char,
+    /// Cells of the header: every row has as many.
+    cells: usize,
     time: (usize, f64),
     force: [Option<(usize, f64)>; 3],
     displacement: [Option<(usize, f64)>; 3],
@@ -176,9 +183,10 @@ pub struct Layout {
     names: Vec<(usize, String)>,
 }
 
-/// A header cell as (name, unit): `Fx (kN)`, `Fx [kN]` or `Fx`; quotes removed.
+/// A header cell as (name, unit): `Fx (kN)`, `Fx [kN]` or `Fx` (quotes are the record
+/// reader's).
 fn split_unit(cell: &str) -> (String, Option<String>) {
-    let cell = cell.trim().trim_matches('"').trim();
+    let cell = cell.trim();
     for (open, close) in [('(', ')'), ('[', ']')] {
         if let Some(stripped) = cell.strip_suffix(close) {
             if let Some(at) = stripped.rfind(open) {
@@ -234,10 +242,15 @@ fn factor<U: Copy + PartialEq>(
 }
 
 impl Layout {
-    /// Finds the configured columns in the header line.
-    pub fn from_header(line: &str, spec: &CsvColumns) -> Result<Layout, CsvError> {
+    /// Finds the configured columns in the header's cells (`line`: the header as written,
+    /// for the errors).
+    pub fn from_header<C: AsRef<str>>(
+        header: &[C],
+        line: &str,
+        spec: &CsvColumns,
+    ) -> Result<Layout, CsvError> {
         let cells: Vec<(String, Option<String>)> =
-            line.split(spec.delimiter).map(split_unit).collect();
+            header.iter().map(|c| split_unit(c.as_ref())).collect();
         let find = |c: &ColumnSpec| -> Result<(usize, Option<&str>), CsvError> {
             let at: Vec<usize> = (0..cells.len())
                 .filter(|&i| cells[i].0 == c.name.trim())
@@ -302,7 +315,7 @@ impl Layout {
             }
         }
         Ok(Layout {
-            delimiter: spec.delimiter,
+            cells: cells.len(),
             time,
             force,
             displacement,
@@ -310,28 +323,23 @@ impl Layout {
         })
     }
 
-    /// Parses one data line (no newline); the error says which cell and why.
-    pub fn parse_row(&self, line: &str) -> Result<Row, String> {
-        let cells: Vec<&str> = line.split(self.delimiter).collect();
-        let decimal_comma = self.delimiter != ',';
-        let value = |(at, f): (usize, f64)| -> Result<f64, String> {
-            let cell = cells.get(at).ok_or_else(|| {
-                format!(
-                    "{} cells, column {} is cell {}",
-                    cells.len(),
-                    self.name_of(at),
-                    at + 1
-                )
-            })?;
-            let text = cell.trim().trim_matches('"').trim();
-            let text = if decimal_comma {
-                text.replace(',', ".")
-            } else {
-                text.to_string()
-            };
-            match text.parse::<f64>() {
+    /// Reads one row's cells; the error says which cell and why. A comma inside a cell is a
+    /// decimal comma (with `,` as the delimiter, such a cell is quoted: `"4,5"`).
+    pub fn parse_row<C: AsRef<str>>(&self, cells: &[C]) -> Result<Row, RowError> {
+        if cells.len() != self.cells {
+            return Err(RowError::CellCount {
+                found: cells.len(),
+                expected: self.cells,
+            });
+        }
+        let value = |(at, f): (usize, f64)| -> Result<f64, RowError> {
+            let cell = cells[at].as_ref();
+            match cell.trim().replace(',', ".").parse::<f64>() {
                 Ok(v) if v.is_finite() => Ok(v * f),
-                _ => Err(format!("{} = {cell:?} is not a number", self.name_of(at))),
+                _ => Err(RowError::NotANumber {
+                    column: self.name_of(at).to_string(),
+                    cell: excerpt(cell.as_bytes()),
+                }),
             }
         };
         let mut row = Row {
@@ -370,37 +378,77 @@ impl Layout {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::csv_follow::record::RecordReader;
+
+    /// Time `t` in s and force `F` (in `force_unit` if given).
+    fn t_and_f(delimiter: char, force_unit: Option<ForceUnit>) -> CsvColumns {
+        CsvColumns {
+            time: ColumnSpec::new("t", None),
+            force: [Some(ColumnSpec::new("F", None)), None, None],
+            displacement: [None, None, None],
+            time_unit: Some(TimeUnit::S),
+            force_unit,
+            displacement_unit: None,
+            delimiter,
+        }
+    }
+
+    fn layout(header: &str, spec: &CsvColumns) -> Result<Layout, CsvError> {
+        let mut reader = RecordReader::new(spec.delimiter);
+        Layout::from_header(&reader.split(header.as_bytes()).unwrap(), header, spec)
+    }
 
     #[test]
     fn header_cells_give_name_and_unit() {
         assert_eq!(split_unit(" Fx (kN) "), ("Fx".into(), Some("kN".into())));
-        assert_eq!(
-            split_unit("\"Time [s]\""),
-            ("Time".into(), Some("s".into()))
-        );
+        assert_eq!(split_unit("Time [s]"), ("Time".into(), Some("s".into())));
         assert_eq!(split_unit("Fx"), ("Fx".into(), None));
     }
 
     #[test]
     fn a_unit_stated_nowhere_or_twice_differently_is_an_error() {
-        let spec = CsvColumns {
-            time: ColumnSpec::new("t", None),
-            force: [Some(ColumnSpec::new("F", None)), None, None],
-            displacement: [None, None, None],
-            time_unit: Some(TimeUnit::S),
-            force_unit: None,
-            displacement_unit: None,
-            delimiter: ';',
-        };
-        let e = Layout::from_header("t;F", &spec).unwrap_err();
+        let spec = t_and_f(';', None);
+        let e = layout("t;F", &spec).unwrap_err();
         assert!(matches!(e, CsvError::NoUnit { .. }), "{e}");
-        let e = Layout::from_header("t (ms);F (N)", &spec).unwrap_err();
+        let e = layout("t (ms);F (N)", &spec).unwrap_err();
         assert!(matches!(e, CsvError::UnitDisagrees { .. }), "{e}");
-        let e = Layout::from_header("t;F (lbf)", &spec).unwrap_err();
+        let e = layout("t;F (lbf)", &spec).unwrap_err();
         assert!(e.to_string().contains("lbf"), "{e}");
-        let layout = Layout::from_header("t;F (N)", &spec).unwrap();
-        // Semicolons and decimal commas.
-        let row = layout.parse_row("1,5;2,25").unwrap();
+        let found = layout("t;F (N)", &spec).unwrap();
+        // Decimal commas.
+        let row = found.parse_row(&["1,5", " 2,25"]).unwrap();
         assert_eq!((row.t_s, row.force_n[0]), (1.5, Some(2.25)));
+    }
+
+    #[test]
+    fn a_row_of_another_width_or_with_a_cell_not_a_number_is_refused_naming_it() {
+        let spec = t_and_f(',', Some(ForceUnit::Newton));
+        let found = layout("t,F,note", &spec).unwrap();
+        assert_eq!(
+            found.parse_row(&["5", "1", "x", "510"]).unwrap_err(),
+            RowError::CellCount {
+                found: 4,
+                expected: 3
+            }
+        );
+        assert_eq!(
+            found.parse_row(&["5", "1"]).unwrap_err(),
+            RowError::CellCount {
+                found: 2,
+                expected: 3
+            }
+        );
+        let long = "x".repeat(10_000);
+        let e = found.parse_row(&["5", long.as_str(), ""]).unwrap_err();
+        assert!(
+            matches!(&e, RowError::NotANumber { column, cell } if column == "F" && cell.len() < 300),
+            "{e}"
+        );
+        // Both separators in one cell is no number.
+        let e = found.parse_row(&["1,234.5", "1", ""]).unwrap_err();
+        assert!(
+            matches!(&e, RowError::NotANumber { column, .. } if column == "t"),
+            "{e}"
+        );
     }
 }

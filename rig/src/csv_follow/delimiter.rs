@@ -1,13 +1,12 @@
 //! The cell delimiter of a machine's CSV log, as a user names it (`,`, `;` or `tab`).
 
-/// What separates the cells of a row.
+/// What separates the cells of a row. With any of them a comma inside a cell is a decimal
+/// comma (`4,5` = 4.5; with a comma as delimiter such a cell is quoted, `"4,5"`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Delimiter {
     #[default]
     Comma,
-    /// With a semicolon, a decimal comma is read too (`4,5` = 4.5).
     Semicolon,
-    /// With a tab, a decimal comma is read too.
     Tab,
 }
 

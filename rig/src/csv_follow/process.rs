@@ -1,16 +1,14 @@
 //! The process shell of the CSV follower (`dicstream rig --follow-csv FILE`): polls the file,
 //! publishes one `rig/state` sample per row on the rig's service, in the simulated rig's
-//! layout ([`super::clock::rig_state`]), and reports on stderr the waits, malformed lines,
-//! truncations and rotations. The only IPC of the follower.
+//! layout ([`super::clock::rig_state`]), reports on stderr the waits, malformed lines
+//! ([`super::report`]), truncations and rotations. The only IPC of the follower.
 
 use super::clock::{rig_state, MachineClock};
-use super::{CsvColumns, CsvError, FileTail, Follower, LineEvent, TailRead};
+use super::report::MalformedReport;
+use super::{CsvColumns, CsvError, FileTail, FollowCounters, Follower, LineEvent, TailRead};
 use crate::process::StatePort;
 use std::path::PathBuf;
 use std::time::{Duration, Instant, SystemTime};
-
-/// Malformed lines reported one by one; later ones are counted only.
-const MALFORMED_REPORTED: u64 = 20;
 
 #[derive(Clone, Debug)]
 pub struct FollowOptions {
@@ -66,9 +64,8 @@ impl FollowError {
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FollowSummary {
-    pub rows_published: u64,
-    pub malformed: u64,
-    pub restarts: u64,
+    /// Rows published, malformed lines, restarts.
+    pub counters: FollowCounters,
     pub stopped_by_signal: bool,
 }
 
@@ -86,6 +83,8 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
     } = StatePort::open(&options.instance)?;
     let mut clock = MachineClock::new(options.offset_s);
     let mut summary = FollowSummary::default();
+    let mut report = MalformedReport::new(path.display().to_string());
+    let mut rows_published = 0;
     let mut waiting_reported = false;
     let mut last_row_at = Instant::now();
     let mut ready = false;
@@ -106,12 +105,10 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
             TailRead::StartedOver { why } => {
                 eprintln!(
                     "rig: {} was {why}: reading it again from its header (rows published so \
-                     far: {})",
+                     far: {rows_published})",
                     path.display(),
-                    summary.rows_published
                 );
                 follower.start_over();
-                summary.restarts = follower.counters.restarts;
             }
             TailRead::Appended { bytes, modified: m } => {
                 modified = Some(m);
@@ -127,22 +124,18 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
                         ),
                         LineEvent::Row(row) => batch.push(row),
                         LineEvent::Malformed { line_no, text, why } => {
-                            summary.malformed = follower.counters.malformed;
-                            if summary.malformed <= MALFORMED_REPORTED {
-                                eprintln!(
-                                    "rig: {} line {line_no} skipped: {why}: {text:?}{}",
-                                    path.display(),
-                                    if summary.malformed == MALFORMED_REPORTED {
-                                        " (further malformed lines are counted only)"
-                                    } else {
-                                        ""
-                                    }
-                                );
+                            if let Some(line) =
+                                report.malformed(line_no, &text, &why, Instant::now())
+                            {
+                                eprintln!("{line}");
                             }
                         }
                     }
                 }
             }
+        }
+        if let Some(line) = report.tick(Instant::now()) {
+            eprintln!("{line}");
         }
         if !ready {
             // Ready once the header, if the file has one already, has been checked.
@@ -159,12 +152,12 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
             let host_ns = clock.host_ns(row.t_s).expect("anchored above");
             publisher.publish(rig_state(
                 row,
-                summary.rows_published,
+                rows_published,
                 host_ns,
                 options.offset_s,
                 options.sections_mm2,
             ))?;
-            summary.rows_published += 1;
+            rows_published += 1;
         }
         if !batch.is_empty() {
             last_row_at = Instant::now();
@@ -175,12 +168,22 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
         }
         if options
             .idle_timeout
-            .is_some_and(|t| summary.rows_published > 0 && last_row_at.elapsed() > t)
+            .is_some_and(|t| rows_published > 0 && last_row_at.elapsed() > t)
         {
             break;
         }
         std::thread::sleep(options.poll);
     }
-    summary.malformed = follower.counters.malformed;
+    if let Some(line) = report.finish() {
+        eprintln!("{line}");
+    }
+    let unfinished = follower.unfinished_line_bytes();
+    if unfinished > 0 {
+        eprintln!(
+            "rig: {}: a last line of {unfinished} bytes without its newline was not read",
+            path.display()
+        );
+    }
+    summary.counters = follower.counters;
     Ok(summary)
 }
