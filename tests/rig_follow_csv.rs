@@ -5,8 +5,9 @@
 //! malformed line, while this test, subscribed to `rig/state` before the follower starts,
 //! receives every sample. A log as Excel writes it in a decimal-comma locale (BOM, quoted
 //! cells) with an extra cell: read as written, the bad line counted. Timeouts only guard
-//! against a hang; no assertion on a wall-clock time. Also: a GenICam camera the binary cannot
-//! open fails the run at start, said.
+//! against a hang; no assertion on a wall-clock time. The run's `summary.json` counts the
+//! machine log's malformed line. Also: a GenICam camera the binary cannot open fails the run at
+//! start, said.
 
 mod common;
 
@@ -148,6 +149,7 @@ fn rows_appended_at_100_hz_are_published_once_in_order_converted_and_shifted() {
 fn a_log_with_a_bom_quoted_decimal_commas_and_an_extra_cell_is_read_as_written() {
     let mut run = Run::new("csv_follow_quoted");
     let csv = run.dir.join("machine.csv");
+    let counts = run.dir.join("counts.json");
     // Excel's "CSV UTF-8" in a decimal-comma locale: a BOM, quoted cells; one row with an
     // extra cell, which must not be read as a force.
     std::fs::write(
@@ -159,7 +161,8 @@ fn a_log_with_a_bom_quoted_decimal_commas_and_an_extra_cell_is_read_as_written()
     let (node, _) = instance.create_node("test").unwrap();
     let subscriber: ValueSubscriber<RigState> =
         ValueSubscriber::create(&node, &services::RIG_STATE).unwrap();
-    let args = follow_args(run.name(), &csv, "Force", &[]);
+    let counts_arg = counts.display().to_string();
+    let args = follow_args(run.name(), &csv, "Force", &["--counts-json", &counts_arg]);
     run.spawn("rig", &strs(&args));
     // Received while the follower lives (its samples go with it).
     let mut published = Vec::new();
@@ -187,6 +190,10 @@ fn a_log_with_a_bom_quoted_decimal_commas_and_an_extra_cell_is_read_as_written()
             && stderr.contains("stopped by signal"),
         "{stderr}"
     );
+    let counts: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&counts).unwrap()).unwrap();
+    assert_eq!(counts["malformed_lines"], 1, "{counts}");
+    assert_eq!(counts["rows"], 2, "{counts}");
 }
 
 #[test]
@@ -257,6 +264,10 @@ fn a_run_on_a_watched_folder_and_a_machine_log_ends_with_results_without_truth()
     append(&csv, "t,F\n");
     let mut t = 0.0;
     for (k, file) in files.iter().enumerate() {
+        if k == 3 {
+            // One line the machine's software garbled: skipped, and counted in the summary.
+            append(&csv, &format!("{t:.2},\"2,5\",x\n"));
+        }
         // Rows at 100 Hz over a second, then the image of that moment, by rename.
         for _ in 0..100 {
             t += 0.01;
@@ -283,6 +294,12 @@ fn a_run_on_a_watched_folder_and_a_machine_log_ends_with_results_without_truth()
     );
     assert_eq!(s["faults"].as_array().map(Vec::len), Some(0), "{s}");
     assert_eq!(s["camera_source"], "watch");
+    assert_eq!(s["machine_csv"]["malformed_lines"], 1, "{s}");
+    assert_eq!(s["machine_csv"]["rows"], 700, "{s}");
+    assert!(
+        stderr.contains("run: 1 malformed line(s) of the machine's CSV skipped"),
+        "{stderr}"
+    );
     assert_eq!(s["frames_captured"], 6, "{s}");
     assert!(s["acceptance"].is_null(), "{s}");
     assert!(s["displacement_error_mean_px"].is_null(), "{s}");

@@ -75,6 +75,10 @@ impl ResultsDir {
     pub fn frames_csv(&self) -> PathBuf {
         self.path("frames.csv")
     }
+    /// A followed machine CSV's counts (rows, malformed lines, restarts), kept by the rig.
+    pub fn machine_csv_json(&self) -> PathBuf {
+        self.path("machine_csv.json")
+    }
     pub fn identification_json(&self) -> PathBuf {
         self.path("identification.json")
     }

@@ -102,6 +102,10 @@ pub struct RunReport {
     /// Where frames and rig samples came from ([camera] source, [rig] source).
     pub camera_source: CameraSource,
     pub rig_source: RigSource,
+    /// With `[rig] source = "csv-follow"`: the machine CSV's rows read, malformed lines
+    /// skipped and restarts (truncations, rotations), as the follower kept them in
+    /// `machine_csv.json`.
+    pub machine_csv: Option<rig::csv_follow::FollowCounters>,
     /// What `strain_map.png` shows.
     pub strain_map: Option<StrainMapInfo>,
     /// Files of the instance left once every process had stopped (named, then removed).
@@ -776,6 +780,7 @@ fn finish(
         )
     });
     let displacement_error_mean_px = mean_displacement_error(&results.frames_csv());
+    let machine_csv = machine_csv_counts(config, results);
     let wall_s = started.elapsed().as_secs_f64();
     let frames_captured = recorder.last_frame_id.map_or(0, |id| id + 1);
     let frames_not_correlated = frames_captured.saturating_sub(recorder.fields_seen);
@@ -832,6 +837,7 @@ fn finish(
         acceptance_skipped,
         camera_source: config.camera.source,
         rig_source: config.rig.source,
+        machine_csv,
         strain_map,
         leftover_shm_files,
         exit_code,
@@ -863,6 +869,39 @@ fn write_histograms(
         &results.path("latency_identification.hgrm"),
         recorder.latency_identification.hgrm().as_bytes(),
     )
+}
+
+/// A followed machine CSV's counts, from the follower's `machine_csv.json` (none when the
+/// follower never started following); skipped lines are said on stderr.
+fn machine_csv_counts(
+    config: &RunConfig,
+    results: &ResultsDir,
+) -> Option<rig::csv_follow::FollowCounters> {
+    use rig::csv_follow::counts_file::{read, CountsReadError};
+    if config.rig.source != RigSource::CsvFollow {
+        return None;
+    }
+    match read(&results.machine_csv_json()) {
+        Ok(counts) => {
+            if counts.malformed_lines > 0 {
+                eprintln!(
+                    "run: {} malformed line(s) of the machine's CSV skipped (logs/rig.log names \
+                     them)",
+                    counts.malformed_lines
+                );
+            }
+            Some(counts)
+        }
+        Err(CountsReadError::Read { reason, .. })
+            if reason.kind() == std::io::ErrorKind::NotFound =>
+        {
+            None
+        }
+        Err(e) => {
+            eprintln!("run: {e}");
+            None
+        }
+    }
 }
 
 /// Mean of the `disp_error_mean_px` column of `frames.csv`, if any frame has it.

@@ -65,6 +65,10 @@ pub struct FollowCsvArgs {
     /// End (exit 0) after this many seconds without a new row, once rows have come
     #[arg(long, value_name = "S", requires = "follow_csv")]
     pub idle_timeout_s: Option<f64>,
+    /// Keep the follow's counts (rows, malformed_lines, restarts) in this JSON file, replaced
+    /// as they change
+    #[arg(long, value_name = "FILE", requires = "follow_csv")]
+    pub counts_json: Option<PathBuf>,
 }
 
 /// The columns to follow, checked (names, units, delimiter) before anything starts.
@@ -133,6 +137,7 @@ pub fn run(args: FollowCsvArgs, instance: String) -> anyhow::Result<()> {
         sections_mm2: [args.section_x_mm2, args.section_y_mm2],
         poll: Duration::from_millis(args.poll_ms),
         idle_timeout,
+        counts_json: args.counts_json.clone(),
     };
     let summary = follow(options).map_err(|e| wire::exit::in_context("rig", &e))?;
     eprintln!(

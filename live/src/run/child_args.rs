@@ -62,7 +62,7 @@ pub fn child_args(
     let k = &config.correlator;
     let g = &config.rig;
     let extra: Vec<String> = match role {
-        Role::Rig if config.rig.source == RigSource::CsvFollow => csv_follow_args(config),
+        Role::Rig if config.rig.source == RigSource::CsvFollow => csv_follow_args(config, results),
         Role::Producer if config.camera.source != CameraSource::Simulated => {
             real_camera_args(config, results, first_frame_id)
         }
@@ -149,8 +149,9 @@ pub fn child_args(
     args
 }
 
-/// `rig --follow-csv FILE ...`: the machine's log of `[rig.csv]`.
-fn csv_follow_args(config: &RunConfig) -> Vec<String> {
+/// `rig --follow-csv FILE ...`: the machine's log of `[rig.csv]`, its counts kept beside the
+/// results.
+fn csv_follow_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
     let v = &config.rig.csv;
     let path = |p: &PathBuf| p.to_string_lossy().into_owned();
     let mut args = vec!["--follow-csv".to_string(), path(&v.file)];
@@ -183,6 +184,8 @@ fn csv_follow_args(config: &RunConfig) -> Vec<String> {
         v.section_y_mm2.to_string(),
         "--idle-timeout-s".into(),
         v.idle_timeout_s.to_string(),
+        "--counts-json".into(),
+        path(&results.machine_csv_json()),
     ]);
     args
 }
@@ -405,6 +408,10 @@ mod tests {
         assert!(!args.contains(&"--force-y-column".to_string()), "{args:?}");
         assert!(args.contains(&"--offset-s=-0.5".to_string()), "{args:?}");
         assert_eq!(value(&args, "--section-x-mm2"), "40");
+        assert_eq!(
+            value(&args, "--counts-json"),
+            "/results/run/machine_csv.json"
+        );
         assert!(!args.contains(&"--campaign".to_string()));
     }
 

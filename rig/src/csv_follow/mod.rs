@@ -5,11 +5,13 @@
 //! columns in the header and converts their units, [`tail`] reads what was appended to the
 //! file since the last poll (waiting for a file that does not exist yet, noticing truncation
 //! and rotation), and [`Follower`] ties them: bytes in, rows or malformed lines out;
-//! [`report`] says the malformed lines on stderr, rate-limited but never silent. The process
+//! [`report`] says the malformed lines on stderr, rate-limited but never silent, and
+//! [`counts_file`] keeps the counters in a JSON file for `dicstream run`. The process
 //! shell that publishes the rows on `rig/state` is [`process`] (feature `process`).
 
 pub mod clock;
 pub mod columns;
+pub mod counts_file;
 pub mod delimiter;
 pub mod lines;
 pub mod malformed;
@@ -40,8 +42,8 @@ pub enum LineEvent {
     },
 }
 
-/// Counters of a follow.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// Counters of a follow (also the run's `machine_csv.json` and `summary.json`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct FollowCounters {
     /// Rows read (each published).
     pub rows: u64,

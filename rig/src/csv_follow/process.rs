@@ -1,9 +1,11 @@
 //! The process shell of the CSV follower (`dicstream rig --follow-csv FILE`): polls the file,
 //! publishes one `rig/state` sample per row on the rig's service, in the simulated rig's
 //! layout ([`super::clock::rig_state`]), reports on stderr the waits, malformed lines
-//! ([`super::report`]), truncations and rotations. The only IPC of the follower.
+//! ([`super::report`]), truncations and rotations, and keeps its counters in the
+//! `--counts-json` file ([`super::counts_file`]). The only IPC of the follower.
 
 use super::clock::{rig_state, MachineClock};
+use super::counts_file::CountsFile;
 use super::report::MalformedReport;
 use super::{CsvColumns, CsvError, FileTail, FollowCounters, Follower, LineEvent, TailRead};
 use crate::process::StatePort;
@@ -23,6 +25,8 @@ pub struct FollowOptions {
     pub poll: Duration,
     /// End (successfully) after this long without a new row, once rows have come.
     pub idle_timeout: Option<Duration>,
+    /// Where the counters are kept as JSON while the follow goes on.
+    pub counts_json: Option<PathBuf>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -42,6 +46,9 @@ pub enum FollowError {
     },
     #[error(transparent)]
     Instance(#[from] wire::InstanceError),
+    /// The counts file could not be written (exit code 74, from its source).
+    #[error("{0}")]
+    File(#[from] wire::files::FileError),
 }
 
 /// The columns error, carrying the exit code a run must not restart on.
@@ -84,6 +91,7 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
     let mut clock = MachineClock::new(options.offset_s);
     let mut summary = FollowSummary::default();
     let mut report = MalformedReport::new(path.display().to_string());
+    let mut counts = options.counts_json.as_deref().map(CountsFile::new);
     let mut rows_published = 0;
     let mut waiting_reported = false;
     let mut last_row_at = Instant::now();
@@ -138,7 +146,11 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
             eprintln!("{line}");
         }
         if !ready {
-            // Ready once the header, if the file has one already, has been checked.
+            // Ready once the header, if the file has one already, has been checked, and the
+            // counts file is there.
+            if let Some(counts) = &mut counts {
+                counts.update(follower.counters, Instant::now(), false)?;
+            }
             eprintln!("rig: ready (instance {})", instance.name());
             ready = true;
         }
@@ -162,6 +174,9 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
         if !batch.is_empty() {
             last_row_at = Instant::now();
         }
+        if let Some(counts) = &mut counts {
+            counts.update(follower.counters, Instant::now(), false)?;
+        }
         if wire::signals::requested().is_some() {
             summary.stopped_by_signal = true;
             break;
@@ -183,6 +198,9 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
             "rig: {}: a last line of {unfinished} bytes without its newline was not read",
             path.display()
         );
+    }
+    if let Some(counts) = &mut counts {
+        counts.update(follower.counters, Instant::now(), true)?;
     }
     summary.counters = follower.counters;
     Ok(summary)
