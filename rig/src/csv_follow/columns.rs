@@ -4,6 +4,8 @@
 
 use super::malformed::{excerpt, RowError};
 
+use wire::names::Named;
+
 /// Why a follow cannot start (or go on).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum CsvError {
@@ -19,13 +21,13 @@ pub enum CsvError {
     NoUnit {
         what: &'static str,
         name: String,
-        expected: &'static str,
+        expected: String,
     },
     #[error("unknown unit {unit:?} for {what}: expected {expected}")]
     UnknownUnit {
         what: &'static str,
         unit: String,
-        expected: &'static str,
+        expected: String,
     },
     #[error("{what}: the header says {header_unit:?}, the configuration {config_unit:?}")]
     UnitDisagrees {
@@ -63,16 +65,9 @@ pub enum LengthUnit {
     M,
 }
 
-pub const TIME_UNITS: &str = "s, ms or min";
-pub const FORCE_UNITS: &str = "N or kN";
-pub const LENGTH_UNITS: &str = "mm, um or m";
-
 wire::named!(TimeUnit, "time unit", { S => "s" | "sec", Ms => "ms", Min => "min" });
 
 impl TimeUnit {
-    pub fn parse(text: &str) -> Option<TimeUnit> {
-        text.parse().ok()
-    }
     pub fn to_s(self) -> f64 {
         match self {
             TimeUnit::S => 1.0,
@@ -85,9 +80,6 @@ impl TimeUnit {
 wire::named!(ForceUnit, "force unit", { Newton => "N", KiloNewton => "kN" | "KN" });
 
 impl ForceUnit {
-    pub fn parse(text: &str) -> Option<ForceUnit> {
-        text.parse().ok()
-    }
     pub fn to_n(self) -> f64 {
         match self {
             ForceUnit::Newton => 1.0,
@@ -99,9 +91,6 @@ impl ForceUnit {
 wire::named!(LengthUnit, "displacement unit", { Mm => "mm", Um => "um" | "µm", M => "m" });
 
 impl LengthUnit {
-    pub fn parse(text: &str) -> Option<LengthUnit> {
-        text.parse().ok()
-    }
     pub fn to_mm(self) -> f64 {
         match self {
             LengthUnit::Mm => 1.0,
@@ -201,20 +190,20 @@ fn split_unit(cell: &str) -> (String, Option<String>) {
 }
 
 /// The unit factor of a column: from the header, the configuration, both (must agree).
-fn factor<U: Copy + PartialEq>(
+fn factor<U: Named + PartialEq>(
     what: &'static str,
     spec: &ColumnSpec,
     header_unit: Option<&str>,
     config_unit: Option<U>,
-    parse: fn(&str) -> Option<U>,
-    expected: &'static str,
     to_base: fn(U) -> f64,
 ) -> Result<f64, CsvError> {
+    let parse = |u: &str| U::parse_name(u).ok();
+    let expected = U::expected();
     let spec_unit = match &spec.unit {
         Some(u) => Some(parse(u).ok_or_else(|| CsvError::UnknownUnit {
             what,
             unit: u.clone(),
-            expected,
+            expected: expected.clone(),
         })?),
         None => config_unit,
     };
@@ -222,7 +211,7 @@ fn factor<U: Copy + PartialEq>(
         Some(u) => Some(parse(u).ok_or_else(|| CsvError::UnknownUnit {
             what,
             unit: u.to_string(),
-            expected,
+            expected: expected.clone(),
         })?),
         None => None,
     };
@@ -271,15 +260,7 @@ impl Layout {
         let (t_at, t_unit) = find(&spec.time)?;
         let time = (
             t_at,
-            factor(
-                "time",
-                &spec.time,
-                t_unit,
-                spec.time_unit,
-                TimeUnit::parse,
-                TIME_UNITS,
-                TimeUnit::to_s,
-            )?,
+            factor("time", &spec.time, t_unit, spec.time_unit, TimeUnit::to_s)?,
         );
         let mut force = [None; 3];
         let mut displacement = [None; 3];
@@ -287,15 +268,7 @@ impl Layout {
         for axis in 0..3 {
             if let Some(c) = &spec.force[axis] {
                 let (at, unit) = find(c)?;
-                let f = factor(
-                    "force",
-                    c,
-                    unit,
-                    spec.force_unit,
-                    ForceUnit::parse,
-                    FORCE_UNITS,
-                    ForceUnit::to_n,
-                )?;
+                let f = factor("force", c, unit, spec.force_unit, ForceUnit::to_n)?;
                 force[axis] = Some((at, f));
                 names.push((at, c.name.clone()));
             }
@@ -306,8 +279,6 @@ impl Layout {
                     c,
                     unit,
                     spec.displacement_unit,
-                    LengthUnit::parse,
-                    LENGTH_UNITS,
                     LengthUnit::to_mm,
                 )?;
                 displacement[axis] = Some((at, f));
