@@ -1,11 +1,12 @@
 //! Fault injection on `dicstream run`, with real processes and a short campaign: kill -9 of
 //! each child at three moments and of two children in a row, SIGSTOP/SIGCONT of each child
 //! (short, and past the stale time) and of `run`, SIGINT at 1 ms, 100 ms and mid-run, SIGHUP,
-//! a second `run` on the same instance, a full disk. Each ends either "completed" with exit 0
-//! and consistent results, or with a non-zero exit whose `summary.json` names what failed
-//! (with results still consistent), and leaves nothing of its instance in `/dev/shm` or
-//! iceoryx2's folder. Every case prints a row of the fault table (`--nocapture` shows them).
-//! No wall-clock assertion: waits are on result files, bounded by the hang guard.
+//! a second `run` on the same instance, kill -9 of a run over an earlier run's folder, a full
+//! disk. Each ends either "completed" with exit 0 and consistent results, or with a non-zero
+//! exit whose `summary.json` names what failed (with results still consistent), and leaves
+//! nothing of its instance in `/dev/shm` or iceoryx2's folder. Every case prints a row of the
+//! fault table (`--nocapture` shows them). No wall-clock assertion: waits are on result
+//! files, bounded by the hang guard.
 
 mod common;
 
@@ -15,7 +16,7 @@ use common::bench_run::{
 };
 use common::Run;
 use std::os::unix::process::ExitStatusExt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitStatus;
 use std::time::Duration;
 
@@ -364,6 +365,45 @@ fn sigint_mid_run() {
 #[test]
 fn sighup_mid_run() {
     terminate(libc::SIGHUP, Duration::ZERO, 30);
+}
+
+/// `--out` on a folder holding an earlier completed run, then kill -9 of the new run: the
+/// earlier run was moved aside whole, and the folder's `summary.json` says the new run is
+/// `running` (its pid), never the earlier verdict beside the new data.
+#[test]
+fn a_run_over_an_earlier_one_moves_it_aside_and_says_running_when_killed() {
+    let mut run = Run::new("out_reused");
+    let config = bench(&run);
+    let out = run.dir.join("out");
+    std::fs::create_dir_all(out.join("fields")).unwrap();
+    let earlier = r#"{"ending": "completed", "exit_code": 0, "fields": 285}"#;
+    std::fs::write(out.join("summary.json"), earlier).unwrap();
+    std::fs::write(out.join("config.toml"), "# the earlier run\n").unwrap();
+    std::fs::write(out.join("fields/field_999990.csv"), "x\n").unwrap();
+    let pid = start_run(&mut run, "run", &config, &out, &["--quiet"]);
+    wait_rows(&out.join("frames.csv"), 0, 10);
+    signal(pid, libc::SIGKILL);
+    let (status, _, stderr) = run.child("run").wait();
+    assert_eq!(status.signal(), Some(libc::SIGKILL), "{stderr}");
+    let s = summary(&out);
+    assert_eq!(s["ending"], "running", "{s}");
+    assert_eq!(s["pid"], pid, "{s}");
+    let aside = PathBuf::from(s["previous_run_moved_to"].as_str().expect("moved aside"));
+    assert!(
+        stderr.contains(&format!("its files were moved into {}", aside.display())),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(aside.join("summary.json")).unwrap(),
+        earlier
+    );
+    assert!(aside.join("fields/field_999990.csv").exists());
+    assert!(!out.join("fields/field_999990.csv").exists());
+    eprintln!(
+        "| kill -9 of a run over an earlier one | running (pid {pid}) | killed by signal 9 | \
+         earlier run in {} |",
+        aside.display()
+    );
 }
 
 #[test]

@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 mod child_args;
+pub mod start;
 mod verdict;
 
 /// What to run.
@@ -72,6 +73,10 @@ pub struct RunReport {
     pub results: PathBuf,
     pub instance: String,
     pub ending: Ending,
+    /// Start time, pid, configuration, the earlier run set aside (also in the summary written
+    /// at the start, `ending` = `running`).
+    #[serde(flatten)]
+    pub start: start::RunStart,
     pub failure: Option<String>,
     pub wall_s: f64,
     pub frames_captured: u64,
@@ -210,10 +215,23 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
     // Before anything is written or started: a second run on this instance is refused.
     let _owner = instance.claim("run")?;
     wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes(config)?)?;
+    // A folder given again: the earlier run's files are moved aside, never mixed with these.
+    let mut previous_run_moved_to = None;
     let results = match &options.results {
-        Some(root) => ResultsDir::at(root)?,
+        Some(root) => {
+            previous_run_moved_to = crate::results::previous::set_aside(root)?;
+            if let Some(aside) = &previous_run_moved_to {
+                eprintln!(
+                    "run: {} held an earlier run: its files were moved into {}",
+                    root.display(),
+                    aside.display()
+                );
+            }
+            ResultsDir::at(root)?
+        }
         None => ResultsDir::create_dated(Path::new(&config.run.results_dir))?,
     };
+    let run_start = start::RunStart::now(&results, previous_run_moved_to);
     wire::files::write_atomic(
         &results.config(),
         format!(
@@ -261,6 +279,14 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
             verbose: options.verbose,
             ..LoopState::default()
         };
+        // From here on the run ends through `finish`, which replaces it.
+        start::write_running(
+            &results,
+            &instance_name,
+            &run_start,
+            &config.camera.source,
+            &config.rig.source,
+        )?;
         let result = start_children(&mut supervisor, config, &instance_name, &results).and_then(
             |all_ready| match all_ready {
                 false => Ok(Ending::Interrupted),
@@ -309,6 +335,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
         config,
         &results,
         &instance_name,
+        run_start,
         recorder,
         state,
         ending,
@@ -657,6 +684,7 @@ fn finish(
     config: &RunConfig,
     results: &ResultsDir,
     instance: &str,
+    start: start::RunStart,
     recorder: Recorder,
     state: LoopState,
     ending: Ending,
@@ -815,6 +843,7 @@ fn finish(
         results: results.root.clone(),
         instance: instance.to_string(),
         ending,
+        start,
         failure,
         wall_s,
         frames_captured,
