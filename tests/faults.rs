@@ -1,8 +1,8 @@
 //! Fault injection on `dicstream run`, with real processes and a short campaign: kill -9 of
 //! each child at three moments and of two children in a row, SIGSTOP/SIGCONT of each child
 //! (short, and past the stale time) and of `run`, SIGINT at 1 ms, 100 ms and mid-run, SIGHUP,
-//! a second `run` on the same instance, kill -9 of a run over an earlier run's folder, a full
-//! disk. Each ends either "completed" with exit 0 and consistent results, or with a non-zero
+//! a second `run` on the same instance, kill -9 of a run over an earlier run's folder, too few
+//! file descriptors, a full disk. Each ends either "completed" with exit 0 and consistent results, or with a non-zero
 //! exit whose `summary.json` names what failed (with results still consistent), and leaves
 //! nothing of its instance in `/dev/shm` or iceoryx2's folder. Every case prints a row of the
 //! fault table (`--nocapture` shows them). No wall-clock assertion: waits are on result
@@ -404,6 +404,90 @@ fn a_run_over_an_earlier_one_moves_it_aside_and_says_running_when_killed() {
          earlier run in {} |",
         aside.display()
     );
+}
+
+/// File descriptors each process of these runs may open (`ulimit -n`): too few for the
+/// identifier's connection to the correlator's fields (issue 29: the run then ended "nothing
+/// was identified" with `faults: []`, the error only in the identifier's log).
+const FEW_DESCRIPTORS: u32 = 64;
+
+/// `dicstream run` under `ulimit -n 64`: a process whose subscriber cannot connect stops with
+/// exit code 71 naming the descriptors and their limit, and the run fails naming it in
+/// `faults`, not restarted.
+#[test]
+fn too_few_file_descriptors_are_a_fault_naming_the_process_and_the_limit() {
+    let run = Run::new("few_descriptors");
+    let config = bench(&run);
+    let out = run.dir.join("out");
+    let (status, stdout, stderr) = run_with_descriptors(&run, &config, &out, FEW_DESCRIPTORS);
+    assert_eq!(status.code(), Some(1), "{stdout}\n{stderr}");
+    let s = summary(&out);
+    assert_eq!(s["ending"], "failed", "{s}");
+    let faults: Vec<&str> = s["faults"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    let fault = faults
+        .iter()
+        .find(|f| f.ends_with("exit status 71"))
+        .unwrap_or_else(|| panic!("no process ended for its descriptors: {s}"));
+    let failure = s["failure"].as_str().unwrap();
+    for part in [
+        "cannot connect to a publisher of",
+        "file descriptors exhausted",
+        &format!("of the limit {FEW_DESCRIPTORS} (RLIMIT_NOFILE"),
+        "not restarted",
+    ] {
+        assert!(failure.contains(part), "{part:?} not in {failure}");
+    }
+    assert!(
+        run.instance.leftover_files().is_empty(),
+        "{:?}",
+        run.instance.leftover_files()
+    );
+    eprintln!("| ulimit -n {FEW_DESCRIPTORS} | failed: {fault} | 1 | named in faults |");
+    // Fewer still: the run's own monitor cannot open a service, and says why at start.
+    let out = run.dir.join("out_24");
+    let (status, stdout, stderr) = run_with_descriptors(&run, &config, &out, 24);
+    assert_eq!(status.code(), Some(1), "{stdout}\n{stderr}");
+    assert!(
+        stderr.contains("file descriptors exhausted")
+            && stderr.contains("of the limit 24 (RLIMIT_NOFILE"),
+        "{stderr}"
+    );
+    assert!(
+        !out.join("summary.json").exists(),
+        "a run that never started"
+    );
+    eprintln!("| ulimit -n 24 | refused at start, naming the descriptors | 1 | nothing written |");
+}
+
+/// `dicstream run` on `config` with at most `descriptors` open file descriptors per process.
+fn run_with_descriptors(
+    run: &Run,
+    config: &Path,
+    out: &Path,
+    descriptors: u32,
+) -> (ExitStatus, String, String) {
+    let mut command = std::process::Command::new("sh");
+    command.args([
+        "-c",
+        &format!("ulimit -n {descriptors} && exec \"$0\" \"$@\""),
+        env!("CARGO_BIN_EXE_dicstream"),
+        "run",
+        "--config",
+        &config.display().to_string(),
+        "--instance",
+        run.name(),
+        "--out",
+        &out.display().to_string(),
+        "--quiet",
+        // The run's own dashboard would need descriptors of the run's process too.
+        "--no-dashboard",
+    ]);
+    common::Proc::spawn("run", command).wait()
 }
 
 #[test]

@@ -433,11 +433,12 @@ fn interrupted(signal: i32) -> Ending {
 }
 
 /// The samples seen so far per service, for the liveness watch.
-fn counts(recorder: &Recorder) -> Counts {
+fn counts(recorder: &Recorder, supervisor: &mut Supervisor) -> Counts {
     Counts {
         rig_states: recorder.rig_samples_seen,
         frames: recorder.frames_seen,
         fields: recorder.fields_seen,
+        identifier_heard_fields: supervisor.heard_input(Role::Identifier),
     }
 }
 
@@ -477,7 +478,7 @@ fn event_loop(
         liveness.ignore_silence(Role::Rig);
     }
     for role in Role::ALL {
-        liveness.reset(role, &counts(recorder), Instant::now());
+        liveness.reset(role, &counts(recorder, supervisor), Instant::now());
     }
     loop {
         // Woken by a sample, a signal, or SIGCONT after this monitor was stopped (Ctrl-Z, fg):
@@ -494,12 +495,13 @@ fn event_loop(
         }
 
         if matches!(phase, Phase::Running) {
+            let now_counts = counts(recorder, supervisor);
             let stopped = |role| {
                 supervisor
                     .pid(role)
                     .is_some_and(crate::children::process_stopped)
             };
-            for (role, why) in liveness.check(&counts(recorder), stopped, Instant::now()) {
+            for (role, why) in liveness.check(&now_counts, stopped, Instant::now()) {
                 // Handled below like a death (reported, restarted if configured).
                 supervisor.kill(role, &format!("stale: {why}"));
             }
@@ -556,7 +558,7 @@ fn event_loop(
             }
             // The restarted child is watched afresh (the others too: the restart paused them).
             for role in Role::ALL {
-                liveness.reset(role, &counts(recorder), Instant::now());
+                liveness.reset(role, &counts(recorder, supervisor), Instant::now());
             }
         }
 
@@ -646,6 +648,9 @@ fn handle_death(
         }
         Some(code) if code == i32::from(wire::exit::CANNOT_RESUME) => {
             bail!("{report}\n(it could not resume its test safely)");
+        }
+        Some(code) if code == i32::from(wire::exit::RESOURCES) => {
+            bail!("{report}\n(it could not get a system resource it needs: not restarted)");
         }
         Some(code) if code == i32::from(wire::exit::CONFIG) => {
             bail!("{report}\n(its configuration does not fit its input: not restarted)");

@@ -41,6 +41,10 @@ pub enum InstanceError {
     },
     #[error("{0}")]
     Io(String),
+    /// A subscriber that could not connect to a publisher (exit code
+    /// [`crate::exit::RESOURCES`]).
+    #[error(transparent)]
+    Connection(#[from] crate::resources::ConnectionError),
 }
 
 /// One run's name and the iceoryx2 configuration that isolates it. Dropped after the nodes it

@@ -24,6 +24,8 @@ mod layout_check;
 pub mod owner;
 #[cfg(feature = "ipc")]
 pub mod pubsub;
+#[cfg(feature = "ipc")]
+pub mod resources;
 pub mod rig;
 pub mod services;
 #[cfg(feature = "ipc")]
