@@ -448,20 +448,26 @@ fn too_few_file_descriptors_are_a_fault_naming_the_process_and_the_limit() {
         run.instance.leftover_files()
     );
     eprintln!("| ulimit -n {FEW_DESCRIPTORS} | failed: {fault} | 1 | named in faults |");
-    // Fewer still: the run's own monitor cannot open a service, and says why at start.
-    let out = run.dir.join("out_24");
-    let (status, stdout, stderr) = run_with_descriptors(&run, &config, &out, 24);
-    assert_eq!(status.code(), Some(1), "{stdout}\n{stderr}");
-    assert!(
-        stderr.contains("file descriptors exhausted")
-            && stderr.contains("of the limit 24 (RLIMIT_NOFILE"),
-        "{stderr}"
-    );
-    assert!(
-        !out.join("summary.json").exists(),
-        "a run that never started"
-    );
-    eprintln!("| ulimit -n 24 | refused at start, naming the descriptors | 1 | nothing written |");
+    // Fewer still: the run's own monitor cannot open a service (24) or create its node (6),
+    // and says why at start.
+    for descriptors in [24, 6] {
+        let out = run.dir.join(format!("out_{descriptors}"));
+        let (status, stdout, stderr) = run_with_descriptors(&run, &config, &out, descriptors);
+        assert_eq!(status.code(), Some(1), "{stdout}\n{stderr}");
+        assert!(
+            stderr.contains("file descriptors exhausted")
+                && stderr.contains(&format!("of the limit {descriptors} (RLIMIT_NOFILE")),
+            "{stderr}"
+        );
+        assert!(
+            !out.join("summary.json").exists(),
+            "a run that never started"
+        );
+        eprintln!(
+            "| ulimit -n {descriptors} | refused at start, naming the descriptors | 1 | nothing \
+             written |"
+        );
+    }
 }
 
 /// `dicstream run` on `config` with at most `descriptors` open file descriptors per process.

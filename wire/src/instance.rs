@@ -136,7 +136,7 @@ impl Instance {
             // Signals are handled by `crate::signals` (installed first thing in `main`).
             .signal_handling_mode(SignalHandlingMode::Disabled)
             .create::<ipc::Service>()
-            .map_err(|e| node_error(format!("{e:?}")))?;
+            .map_err(|e| node_error(format!("{e:?}; {}", crate::resources::Resources::now())))?;
         Ok((node, removed))
     }
 
