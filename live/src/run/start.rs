@@ -39,26 +39,26 @@ impl RunStart {
     }
 }
 
-/// `summary.json` while the run goes on.
+/// `summary.json` while the run goes on (the sources as the final summary writes them).
 #[derive(Serialize)]
-struct Running<'a> {
+struct Running<'a, C: Serialize + ?Sized, R: Serialize + ?Sized> {
     results: &'a std::path::Path,
     instance: &'a str,
     /// Always `running`: the final summary replaces this one.
     ending: &'static str,
     #[serde(flatten)]
     start: &'a RunStart,
-    camera_source: &'a str,
-    rig_source: &'a str,
+    camera_source: &'a C,
+    rig_source: &'a R,
 }
 
 /// Writes `summary.json` saying the run is going on (atomically, like the final one).
-pub fn write_running(
+pub fn write_running<C: Serialize + ?Sized, R: Serialize + ?Sized>(
     results: &ResultsDir,
     instance: &str,
     start: &RunStart,
-    camera_source: &str,
-    rig_source: &str,
+    camera_source: &C,
+    rig_source: &R,
 ) -> anyhow::Result<()> {
     let running = Running {
         results: &results.root,
