@@ -1,12 +1,13 @@
 //! Fault injection on `dicstream run`, with real processes and a short campaign: kill -9 of
 //! each child at three moments and of two children in a row, SIGSTOP/SIGCONT of each child
 //! (short, and past the stale time) and of `run`, SIGINT at 1 ms, 100 ms and mid-run, SIGHUP,
-//! SIGINT with a dashboard viewer that never reads, a second `run` on the same instance, a
-//! full disk. Each ends either "completed" with exit 0
-//! and consistent results, or with a non-zero exit whose `summary.json` names what failed
-//! (with results still consistent), and leaves nothing of its instance in `/dev/shm` or
-//! iceoryx2's folder. Every case prints a row of the fault table (`--nocapture` shows them).
-//! No wall-clock assertion: waits are on result files, bounded by the hang guard.
+//! SIGINT with a dashboard viewer that never reads, a second `run` on the same instance,
+//! kill -9 of a run over an earlier run's folder, too few file descriptors, a full disk. Each
+//! ends either "completed" with exit 0 and consistent results, or with a non-zero exit whose
+//! `summary.json` names what failed (with results still consistent), and leaves nothing of its
+//! instance in `/dev/shm` or iceoryx2's folder. Every case prints a row of the fault table
+//! (`--nocapture` shows them). No wall-clock assertion: waits are on result files, bounded by
+//! the hang guard.
 
 mod common;
 
@@ -16,7 +17,7 @@ use common::bench_run::{
 };
 use common::{dashboard_address, Run};
 use std::os::unix::process::ExitStatusExt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitStatus;
 use std::time::Duration;
 
@@ -391,6 +392,135 @@ fn sigint_with_a_stalled_dashboard_viewer() {
     assert_eq!(o.exit, Some(130), "{}", o.failure);
     assert_eq!(o.ending, "interrupted");
     drop(stalled);
+}
+
+/// `--out` on a folder holding an earlier completed run, then kill -9 of the new run: the
+/// earlier run was moved aside whole, and the folder's `summary.json` says the new run is
+/// `running` (its pid), never the earlier verdict beside the new data.
+#[test]
+fn a_run_over_an_earlier_one_moves_it_aside_and_says_running_when_killed() {
+    let mut run = Run::new("out_reused");
+    let config = bench(&run);
+    let out = run.dir.join("out");
+    std::fs::create_dir_all(out.join("fields")).unwrap();
+    let earlier = r#"{"ending": "completed", "exit_code": 0, "fields": 285}"#;
+    std::fs::write(out.join("summary.json"), earlier).unwrap();
+    std::fs::write(out.join("config.toml"), "# the earlier run\n").unwrap();
+    std::fs::write(out.join("fields/field_999990.csv"), "x\n").unwrap();
+    let pid = start_run(&mut run, "run", &config, &out, &["--quiet"]);
+    wait_rows(&out.join("frames.csv"), 0, 10);
+    signal(pid, libc::SIGKILL);
+    let (status, _, stderr) = run.child("run").wait();
+    assert_eq!(status.signal(), Some(libc::SIGKILL), "{stderr}");
+    let s = summary(&out);
+    assert_eq!(s["ending"], "running", "{s}");
+    assert_eq!(s["pid"], pid, "{s}");
+    let aside = PathBuf::from(s["previous_run_moved_to"].as_str().expect("moved aside"));
+    assert!(
+        stderr.contains(&format!("its files were moved into {}", aside.display())),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(aside.join("summary.json")).unwrap(),
+        earlier
+    );
+    assert!(aside.join("fields/field_999990.csv").exists());
+    assert!(!out.join("fields/field_999990.csv").exists());
+    eprintln!(
+        "| kill -9 of a run over an earlier one | running (pid {pid}) | killed by signal 9 | \
+         earlier run in {} |",
+        aside.display()
+    );
+}
+
+/// File descriptors each process of these runs may open (`ulimit -n`): too few for the
+/// identifier's connection to the correlator's fields (issue 29: the run then ended "nothing
+/// was identified" with `faults: []`, the error only in the identifier's log).
+const FEW_DESCRIPTORS: u32 = 64;
+
+/// `dicstream run` under `ulimit -n 64`: a process whose subscriber cannot connect stops with
+/// exit code 71 naming the descriptors and their limit, and the run fails naming it in
+/// `faults`, not restarted.
+#[test]
+fn too_few_file_descriptors_are_a_fault_naming_the_process_and_the_limit() {
+    let run = Run::new("few_descriptors");
+    let config = bench(&run);
+    let out = run.dir.join("out");
+    let (status, stdout, stderr) = run_with_descriptors(&run, &config, &out, FEW_DESCRIPTORS);
+    assert_eq!(status.code(), Some(1), "{stdout}\n{stderr}");
+    let s = summary(&out);
+    assert_eq!(s["ending"], "failed", "{s}");
+    let faults: Vec<&str> = s["faults"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    let fault = faults
+        .iter()
+        .find(|f| f.ends_with("exit status 71"))
+        .unwrap_or_else(|| panic!("no process ended for its descriptors: {s}"));
+    let failure = s["failure"].as_str().unwrap();
+    for part in [
+        "cannot connect to a publisher of",
+        "file descriptors exhausted",
+        &format!("of the limit {FEW_DESCRIPTORS} (RLIMIT_NOFILE"),
+        "not restarted",
+    ] {
+        assert!(failure.contains(part), "{part:?} not in {failure}");
+    }
+    assert!(
+        run.instance.leftover_files().is_empty(),
+        "{:?}",
+        run.instance.leftover_files()
+    );
+    eprintln!("| ulimit -n {FEW_DESCRIPTORS} | failed: {fault} | 1 | named in faults |");
+    // Fewer still: the run's own monitor cannot open a service (24) or create its node (6),
+    // and says why at start.
+    for descriptors in [24, 6] {
+        let out = run.dir.join(format!("out_{descriptors}"));
+        let (status, stdout, stderr) = run_with_descriptors(&run, &config, &out, descriptors);
+        assert_eq!(status.code(), Some(1), "{stdout}\n{stderr}");
+        assert!(
+            stderr.contains("file descriptors exhausted")
+                && stderr.contains(&format!("of the limit {descriptors} (RLIMIT_NOFILE")),
+            "{stderr}"
+        );
+        assert!(
+            !out.join("summary.json").exists(),
+            "a run that never started"
+        );
+        eprintln!(
+            "| ulimit -n {descriptors} | refused at start, naming the descriptors | 1 | nothing \
+             written |"
+        );
+    }
+}
+
+/// `dicstream run` on `config` with at most `descriptors` open file descriptors per process.
+fn run_with_descriptors(
+    run: &Run,
+    config: &Path,
+    out: &Path,
+    descriptors: u32,
+) -> (ExitStatus, String, String) {
+    let mut command = std::process::Command::new("sh");
+    command.args([
+        "-c",
+        &format!("ulimit -n {descriptors} && exec \"$0\" \"$@\""),
+        env!("CARGO_BIN_EXE_dicstream"),
+        "run",
+        "--config",
+        &config.display().to_string(),
+        "--instance",
+        run.name(),
+        "--out",
+        &out.display().to_string(),
+        "--quiet",
+        // The run's own dashboard would need descriptors of the run's process too.
+        "--no-dashboard",
+    ]);
+    common::Proc::spawn("run", command).wait()
 }
 
 #[test]

@@ -34,7 +34,8 @@ use wire::{services, FieldHeader, FieldNode, FrameHeader, GaugeStrain, Instance}
 pub enum ProcessError {
     #[error(transparent)]
     Settings(#[from] crate::settings::SettingsError),
-    #[error(transparent)]
+    /// Also the `source()`: a subscriber that cannot connect keeps its exit code.
+    #[error("{0}")]
     Instance(#[from] wire::InstanceError),
     #[error(transparent)]
     State(#[from] crate::state::StateError),

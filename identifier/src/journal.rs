@@ -8,7 +8,6 @@
 //! where a state has two) is refused with a message saying so, never misread.
 
 use crate::data::BiaxialState;
-use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
 pub const HEADER: &str = "lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa,frame_id";
@@ -28,7 +27,7 @@ pub enum JournalError {
     Header { path: PathBuf, header: String },
     #[error("journal {}: written by an earlier version (header {PER_CASE_HEADER:?}: one stress a point, where a biaxial state has two); move it aside to start a new path", .path.display())]
     PerCase { path: PathBuf },
-    #[error("journal {} line {line}: {row:?} is not {HEADER}", .path.display())]
+    #[error("journal {} line {line}: {row:?} is not {HEADER} (a complete row, not a torn write: the journal is corrupt; move it aside to start a new path)", .path.display())]
     Row {
         path: PathBuf,
         line: usize,
@@ -43,23 +42,25 @@ pub struct JournalPoint {
     pub frame_id: u64,
 }
 
-/// Reads a journal. A missing file is an empty journal; a torn last line (the process was
-/// killed while writing it) is ignored; any other malformed line is an error naming it.
+/// Reads a journal. A missing file is an empty journal. A torn last row (bytes after the
+/// last newline: the process was killed while writing it) is ignored, whatever it holds, as
+/// [`JournalWriter::open`] cuts it off; every complete row must be a state, or the journal is
+/// refused naming the line (a corrupt row is never dropped silently).
 pub fn read(path: &Path) -> Result<Vec<JournalPoint>, JournalError> {
-    let unreadable = |reason| JournalError::Read {
-        path: path.to_path_buf(),
-        reason,
-    };
-    let file = match std::fs::File::open(path) {
-        Ok(f) => f,
+    let bytes = match std::fs::read(path) {
+        Ok(bytes) => bytes,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(unreadable(e)),
+        Err(reason) => {
+            return Err(JournalError::Read {
+                path: path.to_path_buf(),
+                reason,
+            })
+        }
     };
-    let lines: Vec<String> = std::io::BufReader::new(file)
-        .lines()
-        .collect::<Result<_, _>>()
-        .map_err(unreadable)?;
-    let Some((header, rows)) = lines.split_first() else {
+    let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let text = String::from_utf8_lossy(&bytes[..whole]);
+    let mut lines = text.lines();
+    let Some(header) = lines.next() else {
         return Ok(Vec::new());
     };
     if header.trim() == PER_CASE_HEADER {
@@ -70,25 +71,19 @@ pub fn read(path: &Path) -> Result<Vec<JournalPoint>, JournalError> {
     if header.trim() != HEADER {
         return Err(JournalError::Header {
             path: path.to_path_buf(),
-            header: header.clone(),
+            header: header.to_owned(),
         });
     }
-    let mut points = Vec::with_capacity(rows.len());
-    for (k, row) in rows.iter().enumerate() {
-        let last = k + 1 == rows.len();
-        match parse_row(row) {
-            Some(p) => points.push(p),
-            None if last => break,
-            None => {
-                return Err(JournalError::Row {
-                    path: path.to_path_buf(),
-                    line: k + 2,
-                    row: row.clone(),
-                })
-            }
-        }
-    }
-    Ok(points)
+    lines
+        .enumerate()
+        .map(|(k, row)| {
+            parse_row(row).ok_or_else(|| JournalError::Row {
+                path: path.to_path_buf(),
+                line: k + 2,
+                row: row.to_owned(),
+            })
+        })
+        .collect()
 }
 
 fn parse_row(row: &str) -> Option<JournalPoint> {
@@ -169,9 +164,28 @@ mod tests {
         let mut w = JournalWriter::open(&path).unwrap();
         w.append(&points[1]).unwrap();
         assert_eq!(read(&path).unwrap(), points.to_vec());
-        // A kill mid-write leaves a torn last line: ignored.
-        std::fs::write(&path, format!("{}\n1.25,0.9,0.31,0,7\n1.5,1.2,0.", HEADER)).unwrap();
-        assert_eq!(read(&path).unwrap(), points[..1].to_vec());
+        // A kill mid-write leaves a torn last line: ignored, also when what was written of it
+        // happens to parse (frame 9 of 90), as the writer cuts it off.
+        for torn in ["1.5,1.2,0.", "1.5,1.2,0.9,0.6,9"] {
+            std::fs::write(&path, format!("{HEADER}\n1.25,0.9,0.31,0,7\n{torn}")).unwrap();
+            assert_eq!(read(&path).unwrap(), points[..1].to_vec(), "{torn}");
+        }
+        // A complete last row that is corrupt is refused naming the file and the line.
+        std::fs::write(
+            &path,
+            format!("{HEADER}\n1.25,0.9,0.31,0,7\n1.5,#,0.9,0.6,90\n"),
+        )
+        .unwrap();
+        let error = read(&path).unwrap_err();
+        assert!(
+            matches!(error, JournalError::Row { line: 3, .. }),
+            "{error}"
+        );
+        let message = error.to_string();
+        assert!(
+            message.contains(&path.display().to_string()) && message.contains("line 3"),
+            "{message}"
+        );
         // A bad line in the middle is an error naming the line.
         std::fs::write(
             &path,

@@ -45,7 +45,8 @@ pub struct ProcessSummary {
 /// also the error's `source()`, so that `wire::exit::code_of` finds its exit code.
 #[derive(Debug, thiserror::Error)]
 pub enum ProcessError {
-    #[error(transparent)]
+    /// Also the `source()`: a subscriber that cannot connect keeps its exit code.
+    #[error("{0}")]
     Instance(#[from] wire::InstanceError),
     #[error(transparent)]
     Journal(#[from] crate::journal::JournalError),
@@ -60,6 +61,10 @@ pub enum ProcessError {
     #[error(transparent)]
     Json(#[from] serde_json::Error),
 }
+
+/// The line printed when the first field comes (`identifier: first field received (frame N)`):
+/// `dicstream run` reads it to tell an identifier that hears its input from one that does not.
+pub const FIRST_FIELD_LINE: &str = "identifier: first field received";
 
 /// How long one WaitSet wait lasts before the idle clock is checked.
 const WAIT_SLICE: Duration = Duration::from_millis(200);
@@ -218,6 +223,12 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
                     }
                     while let Some(sample) = fields.receive()? {
                         summary.fields_received += 1;
+                        if summary.fields_received == 1 {
+                            eprintln!(
+                                "{FIRST_FIELD_LINE} (frame {})",
+                                sample.user_header().frame_id
+                            );
+                        }
                         if let Some(field) = field_sample(sample.user_header()) {
                             let outcome = online.push_field(field);
                             record(&field, outcome)?;

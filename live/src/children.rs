@@ -61,6 +61,8 @@ struct Managed {
     /// Starts so far; lines of older generations are stale.
     generation: u32,
     ready: bool,
+    /// The process said its input reached it (the identifier's first field).
+    heard_input: bool,
     last_lines: VecDeque<String>,
     /// CPU time (s) of earlier generations, and the last sample of the current one.
     cpu_s_ended: f64,
@@ -151,6 +153,7 @@ impl Supervisor {
                 child: None,
                 generation: 0,
                 ready: false,
+                heard_input: false,
                 last_lines: VecDeque::new(),
                 cpu_s_ended: 0.0,
                 cpu_s_current: 0.0,
@@ -168,6 +171,7 @@ impl Supervisor {
         managed.args = args;
         managed.generation += 1;
         managed.ready = false;
+        managed.heard_input = false;
         managed.last_lines.clear();
         managed.cpu_s_ended += std::mem::take(&mut managed.cpu_s_current);
         let generation = managed.generation;
@@ -239,6 +243,9 @@ impl Supervisor {
         if line.starts_with(&format!("{}: ready", role.name())) {
             managed.ready = true;
         }
+        if role == Role::Identifier && line.starts_with(identifier::process::FIRST_FIELD_LINE) {
+            managed.heard_input = true;
+        }
         if role == Role::Producer {
             if let Some(event) = camera_event(&line) {
                 self.camera_events.push((event, line.clone()));
@@ -261,6 +268,12 @@ impl Supervisor {
     pub fn is_ready(&mut self, role: Role) -> bool {
         self.drain_lines();
         self.managed(role).ready
+    }
+
+    /// Whether the running `role` said its input reached it (only the identifier says so).
+    pub fn heard_input(&mut self, role: Role) -> bool {
+        self.drain_lines();
+        self.managed(role).heard_input
     }
 
     pub fn pid(&self, role: Role) -> Option<u32> {

@@ -2,8 +2,11 @@
 //! state `T`: SIGSTOP, a debugger) for the stale time, or when it has published nothing for
 //! that long while its input kept coming (the rig always publishes; the camera publishes when
 //! rig states come; the correlator when frames come). The identifier publishes only when a
-//! new point is accepted, so only its stopped state is watched. Pure: the run feeds it the
-//! counts of samples seen per service and the children's stopped states.
+//! new point is accepted, so what is watched is that it hears its input: it says so at its
+//! first field, and fields published for the stale time without that line mean a subscriber
+//! that never connected (it would end the run with nothing identified and no fault). Pure:
+//! the run feeds it the counts of samples seen per service, whether the identifier heard a
+//! field, and the children's stopped states.
 
 use crate::children::Role;
 use std::time::{Duration, Instant};
@@ -14,6 +17,8 @@ pub struct Counts {
     pub rig_states: u64,
     pub frames: u64,
     pub fields: u64,
+    /// The running identifier said its first field reached it.
+    pub identifier_heard_fields: bool,
 }
 
 impl Counts {
@@ -37,6 +42,9 @@ struct Watch {
     /// The input count when the output last changed.
     input_then: Option<u64>,
     stopped_since: Option<Instant>,
+    /// The identifier: fields it was to hear published since (its first after the start).
+    fields_since: Option<Instant>,
+    fields_then: u64,
 }
 
 pub struct Liveness {
@@ -69,6 +77,8 @@ impl Liveness {
             output_since: now,
             input_then: input,
             stopped_since: None,
+            fields_since: None,
+            fields_then: counts.fields,
         });
     }
 
@@ -101,12 +111,18 @@ impl Liveness {
                     continue;
                 }
             }
-            let Some((output, input)) = counts.of(role) else {
-                continue;
-            };
             if self.silence_ignored[role as usize] {
                 continue;
             }
+            if role == Role::Identifier {
+                if let Some(why) = deaf(watch, counts, now, self.stale_after) {
+                    stale.push((role, why));
+                }
+                continue;
+            }
+            let Some((output, input)) = counts.of(role) else {
+                continue;
+            };
             if output != watch.output {
                 watch.output = output;
                 watch.output_since = now;
@@ -135,6 +151,27 @@ impl Liveness {
         }
         stale
     }
+}
+
+/// Why the identifier is deaf: fields published for `stale_after` since it started and
+/// none heard. None while it heard one, or nothing was published.
+fn deaf(watch: &mut Watch, counts: &Counts, now: Instant, stale_after: Duration) -> Option<String> {
+    if counts.identifier_heard_fields {
+        return None;
+    }
+    if watch.fields_since.is_none() && counts.fields > watch.fields_then {
+        watch.fields_since = Some(now);
+    }
+    let since = watch.fields_since?;
+    let deaf_for = now.duration_since(since);
+    (deaf_for >= stale_after).then(|| {
+        format!(
+            "received no field for {:.1} s while {} were published (its subscriber never \
+             connected: see its log)",
+            deaf_for.as_secs_f64(),
+            counts.fields - watch.fields_then
+        )
+    })
 }
 
 #[cfg(test)]
@@ -210,6 +247,38 @@ mod tests {
         counts.rig_states += 100;
         let stale = quiet.check(&counts, |_| false, t + Duration::from_secs(10));
         assert!(!stale.iter().any(|s| s.0 == Role::Correlator), "{stale:?}");
+    }
+
+    #[test]
+    fn an_identifier_that_hears_no_field_while_fields_are_published_is_stale() {
+        let t0 = Instant::now();
+        let mut counts = Counts::default();
+        let mut liveness = watching_all(&counts, t0);
+        // Long before the first field: not deaf.
+        let t1 = t0 + Duration::from_secs(30);
+        let stale = liveness.check(&counts, |_| false, t1);
+        assert!(!stale.iter().any(|s| s.0 == Role::Identifier), "{stale:?}");
+        // Fields come from t1 on, the identifier says nothing: stale after the stale time.
+        let mut stale = Vec::new();
+        for step in 1..=6u64 {
+            counts.rig_states += 100;
+            counts.frames += 10;
+            counts.fields += 10;
+            stale = liveness.check(&counts, |_| false, t1 + Duration::from_secs(step));
+            let identifier = stale.iter().find(|s| s.0 == Role::Identifier);
+            assert_eq!(identifier.is_some(), step > 5, "step {step}: {stale:?}");
+        }
+        let why = &stale.iter().find(|s| s.0 == Role::Identifier).unwrap().1;
+        assert!(
+            why.starts_with("received no field for 5.0 s while 60 were"),
+            "{why}"
+        );
+        // One that said it heard a field is not.
+        let mut heard = watching_all(&counts, t1);
+        counts.identifier_heard_fields = true;
+        counts.fields += 100;
+        let stale = heard.check(&counts, |_| false, t1 + Duration::from_secs(60));
+        assert!(!stale.iter().any(|s| s.0 == Role::Identifier), "{stale:?}");
     }
 
     #[test]

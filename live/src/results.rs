@@ -5,6 +5,8 @@
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 
+pub mod previous;
+
 /// Paths of one run's results.
 #[derive(Clone, Debug)]
 pub struct ResultsDir {
@@ -99,6 +101,19 @@ impl ResultsDir {
     }
     pub fn summary_json(&self) -> PathBuf {
         self.path("summary.json")
+    }
+
+    /// The files a run writes at the top of its folder (`config.toml` first of all): any of
+    /// them present means the folder holds a run ([`previous::set_aside`]).
+    pub fn run_files(&self) -> [PathBuf; 6] {
+        [
+            self.config(),
+            self.summary_json(),
+            self.frames_csv(),
+            self.rig_csv(),
+            self.identification_json(),
+            self.journal(),
+        ]
     }
 }
 

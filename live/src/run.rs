@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 mod child_args;
+pub mod start;
 mod verdict;
 
 /// What to run.
@@ -72,6 +73,10 @@ pub struct RunReport {
     pub results: PathBuf,
     pub instance: String,
     pub ending: Ending,
+    /// Start time, pid, configuration, the earlier run set aside (also in the summary written
+    /// at the start, `ending` = `running`).
+    #[serde(flatten)]
+    pub start: start::RunStart,
     pub failure: Option<String>,
     pub wall_s: f64,
     pub frames_captured: u64,
@@ -214,10 +219,23 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
     // Before anything is written or started: a second run on this instance is refused.
     let _owner = instance.claim("run")?;
     wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes(config)?)?;
+    // A folder given again: the earlier run's files are moved aside, never mixed with these.
+    let mut previous_run_moved_to = None;
     let results = match &options.results {
-        Some(root) => ResultsDir::at(root)?,
+        Some(root) => {
+            previous_run_moved_to = crate::results::previous::set_aside(root)?;
+            if let Some(aside) = &previous_run_moved_to {
+                eprintln!(
+                    "run: {} held an earlier run: its files were moved into {}",
+                    root.display(),
+                    aside.display()
+                );
+            }
+            ResultsDir::at(root)?
+        }
         None => ResultsDir::create_dated(Path::new(&config.run.results_dir))?,
     };
+    let run_start = start::RunStart::now(&results, previous_run_moved_to);
     wire::files::write_atomic(
         &results.config(),
         format!(
@@ -265,6 +283,14 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
             verbose: options.verbose,
             ..LoopState::default()
         };
+        // From here on the run ends through `finish`, which replaces it.
+        start::write_running(
+            &results,
+            &instance_name,
+            &run_start,
+            &config.camera.source,
+            &config.rig.source,
+        )?;
         let result = start_children(&mut supervisor, config, &instance_name, &results).and_then(
             |all_ready| match all_ready {
                 false => Ok(Ending::Interrupted),
@@ -313,6 +339,7 @@ pub fn run(options: RunOptions) -> anyhow::Result<RunReport> {
         config,
         &results,
         &instance_name,
+        run_start,
         recorder,
         state,
         ending,
@@ -410,11 +437,12 @@ fn interrupted(signal: i32) -> Ending {
 }
 
 /// The samples seen so far per service, for the liveness watch.
-fn counts(recorder: &Recorder) -> Counts {
+fn counts(recorder: &Recorder, supervisor: &mut Supervisor) -> Counts {
     Counts {
         rig_states: recorder.rig_samples_seen,
         frames: recorder.frames_seen,
         fields: recorder.fields_seen,
+        identifier_heard_fields: supervisor.heard_input(Role::Identifier),
     }
 }
 
@@ -454,7 +482,7 @@ fn event_loop(
         liveness.ignore_silence(Role::Rig);
     }
     for role in Role::ALL {
-        liveness.reset(role, &counts(recorder), Instant::now());
+        liveness.reset(role, &counts(recorder, supervisor), Instant::now());
     }
     loop {
         // Woken by a sample, a signal, or SIGCONT after this monitor was stopped (Ctrl-Z, fg):
@@ -471,12 +499,13 @@ fn event_loop(
         }
 
         if matches!(phase, Phase::Running) {
+            let now_counts = counts(recorder, supervisor);
             let stopped = |role| {
                 supervisor
                     .pid(role)
                     .is_some_and(crate::children::process_stopped)
             };
-            for (role, why) in liveness.check(&counts(recorder), stopped, Instant::now()) {
+            for (role, why) in liveness.check(&now_counts, stopped, Instant::now()) {
                 // Handled below like a death (reported, restarted if configured).
                 supervisor.kill(role, &format!("stale: {why}"));
             }
@@ -533,7 +562,7 @@ fn event_loop(
             }
             // The restarted child is watched afresh (the others too: the restart paused them).
             for role in Role::ALL {
-                liveness.reset(role, &counts(recorder), Instant::now());
+                liveness.reset(role, &counts(recorder, supervisor), Instant::now());
             }
         }
 
@@ -624,6 +653,9 @@ fn handle_death(
         Some(code) if code == i32::from(wire::exit::CANNOT_RESUME) => {
             bail!("{report}\n(it could not resume its test safely)");
         }
+        Some(code) if code == i32::from(wire::exit::RESOURCES) => {
+            bail!("{report}\n(it could not get a system resource it needs: not restarted)");
+        }
         Some(code) if code == i32::from(wire::exit::CONFIG) => {
             bail!("{report}\n(its configuration does not fit its input: not restarted)");
         }
@@ -661,6 +693,7 @@ fn finish(
     config: &RunConfig,
     results: &ResultsDir,
     instance: &str,
+    start: start::RunStart,
     recorder: Recorder,
     state: LoopState,
     ending: Ending,
@@ -819,6 +852,7 @@ fn finish(
         results: results.root.clone(),
         instance: instance.to_string(),
         ending,
+        start,
         failure,
         wall_s,
         frames_captured,

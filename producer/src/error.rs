@@ -35,6 +35,22 @@ pub enum ProducerError {
         /// The largest frame side, px.
         max_side_px: u32,
     },
+    /// An image file's header declares more pixel bytes than the file can hold, even at the
+    /// best compression of its format (refused before any pixel is decoded or allocated).
+    #[error("image {path} declares {width}x{height} px ({pixel_bytes} bytes of pixels) in a file of {file_bytes} bytes, more than {max_expansion} times its size, which no format read here compresses to: a truncated or corrupt header; refused before decoding")]
+    ImageBeyondFile {
+        /// The file.
+        path: PathBuf,
+        /// Declared size, px.
+        width: u32,
+        height: u32,
+        /// Bytes the declared pixels take decoded.
+        pixel_bytes: u64,
+        /// Size of the file.
+        file_bytes: u64,
+        /// The largest expansion of any format read ([`crate::image_io::MAX_EXPANSION`]).
+        max_expansion: u64,
+    },
     /// An image has a pixel type replay does not support.
     #[error("unsupported pixel type in {path}: {found}; expected 8- or 16-bit grayscale (or colour, converted to luma)")]
     PixelType {

@@ -69,15 +69,25 @@ fn decode_error(path: &Path, error: impl std::fmt::Display) -> ProducerError {
     }
 }
 
-/// Opens the decoder and reads the header; refuses a declared size beyond
-/// [`MAX_SIDE_PX`] at once (a kilobyte file may declare gigapixels).
+/// The most a file read here can expand into pixels: deflate (PNG, TIFF) reaches at most
+/// 1032:1 and TIFF's LZW about 1300:1 (12-bit codes for runs of up to 4096 bytes), so an
+/// image file declaring more pixel bytes than this many times its own size cannot hold them
+/// (a truncated or corrupt header, or an image with nothing to correlate).
+pub const MAX_EXPANSION: u64 = 4096;
+
+/// Opens the decoder and reads the header; refuses, before any pixel is decoded or allocated,
+/// a declared side beyond [`MAX_SIDE_PX`] (a kilobyte file may declare gigapixels) and a
+/// declared size the file cannot hold ([`MAX_EXPANSION`]).
 fn open_decoder(path: &Path) -> Result<impl ImageDecoder, ProducerError> {
     let io_error = |reason| ProducerError::Io {
         path: path.to_path_buf(),
         reason,
     };
-    let reader = ImageReader::open(path).map_err(io_error)?;
-    let reader = reader.with_guessed_format().map_err(io_error)?;
+    let file = std::fs::File::open(path).map_err(io_error)?;
+    let file_bytes = file.metadata().map_err(io_error)?.len();
+    let reader = ImageReader::new(std::io::BufReader::new(file))
+        .with_guessed_format()
+        .map_err(io_error)?;
     let decoder = reader.into_decoder().map_err(|e| decode_error(path, e))?;
     let (width, height) = decoder.dimensions();
     if width > MAX_SIDE_PX || height > MAX_SIDE_PX {
@@ -86,6 +96,17 @@ fn open_decoder(path: &Path) -> Result<impl ImageDecoder, ProducerError> {
             width,
             height,
             max_side_px: MAX_SIDE_PX,
+        });
+    }
+    let pixel_bytes = decoder.total_bytes();
+    if pixel_bytes > file_bytes.saturating_mul(MAX_EXPANSION) {
+        return Err(ProducerError::ImageBeyondFile {
+            path: path.to_path_buf(),
+            width,
+            height,
+            pixel_bytes,
+            file_bytes,
+            max_expansion: MAX_EXPANSION,
         });
     }
     Ok(decoder)
@@ -170,4 +191,57 @@ pub fn decode_into(
         }
     }
     Ok(shape)
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A little-endian TIFF of `len_bytes` bytes whose header declares `side` x `side` px at
+    /// 16 bit, uncompressed, in one strip (which the file does not hold).
+    pub(crate) fn tiff_declaring(side: u32, len_bytes: usize) -> Vec<u8> {
+        let entries: [(u16, u16, u32); 9] = [
+            (256, 4, side),            // ImageWidth, LONG
+            (257, 4, side),            // ImageLength
+            (258, 3, 16),              // BitsPerSample, SHORT
+            (259, 3, 1),               // Compression: none
+            (262, 3, 1),               // PhotometricInterpretation: BlackIsZero
+            (273, 4, 150),             // StripOffsets
+            (277, 3, 1),               // SamplesPerPixel
+            (278, 4, side),            // RowsPerStrip
+            (279, 4, side * side * 2), // StripByteCounts
+        ];
+        let mut bytes = b"II*\0".to_vec();
+        bytes.extend(8u32.to_le_bytes());
+        bytes.extend((entries.len() as u16).to_le_bytes());
+        for (tag, kind, value) in entries {
+            bytes.extend(tag.to_le_bytes());
+            bytes.extend(kind.to_le_bytes());
+            bytes.extend(1u32.to_le_bytes());
+            bytes.extend(value.to_le_bytes());
+        }
+        bytes.extend(0u32.to_le_bytes());
+        bytes.resize(len_bytes, 0);
+        bytes
+    }
+
+    #[test]
+    fn a_header_declaring_more_pixels_than_the_file_can_hold_is_refused_from_the_header() {
+        let dir = std::env::temp_dir().join(format!("image_io_test_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("huge.tif");
+        // 16384² px at 16 bit is 512 MiB of pixels in a 200-byte file.
+        std::fs::write(&path, tiff_declaring(16_384, 200)).unwrap();
+        for result in [read_shape(&path).map(|_| ()), read_image(&path).map(|_| ())] {
+            let message = result.expect_err("refused").to_string();
+            for part in [
+                path.display().to_string().as_str(),
+                "16384x16384 px (536870912 bytes of pixels)",
+                "file of 200 bytes",
+            ] {
+                assert!(message.contains(part), "{part:?} not in {message}");
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

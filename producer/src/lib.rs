@@ -52,5 +52,5 @@ pub use source::{FrameDims, FrameInfo, FrameSource, Truth};
 pub use speckle::{Speckle, SpeckleParams};
 pub use watch::{
     is_temporary_name, WatchCounts, WatchEnd, WatchNote, WatchSettings, WatchedFile, Watcher,
-    DEFAULT_MAX_DECODE_ATTEMPTS, DEFAULT_POLL_MS, DEFAULT_SETTLE_MS, TEMPORARY_SUFFIXES,
+    DEFAULT_FAILURE_WAIT_SETTLES, DEFAULT_POLL_MS, DEFAULT_SETTLE_MS, TEMPORARY_SUFFIXES,
 };

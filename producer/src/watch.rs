@@ -8,9 +8,11 @@
 //! in the previous poll (same device and inode). Temporary names (dot-files, `.tmp`, `.part`,
 //! `.partial`, `.crdownload`, `~`) and files without an image extension are never read.
 //! Complete is not trusted blindly: the file is decoded in full, and checked unchanged (size,
-//! modification time) after the decode; a file that fails to decode is retried every
-//! `settle` (the count starts again if it changes), and after `max_decode_attempts` failures
-//! it is reported and skipped. So a frame is never published from a half-written file.
+//! modification time) after the decode. A file that fails to decode is reported once and
+//! decoded again only if it changes (a writer that paused longer than the settle time goes
+//! on): decoding the same bytes again would fail the same way. Unchanged for
+//! `failure_wait_settles` settle times after the failure, it is skipped. So a frame is never
+//! published from a half-written file, and a hopeless file costs one decode.
 //!
 //! The folder is polled (every `poll_interval`, sleeping in between): portable, no
 //! dependency, and it also sees files written over a network share (NFS, SMB), which inotify
@@ -31,8 +33,9 @@ use crate::source::{check_buffer, FrameInfo};
 pub const DEFAULT_SETTLE_MS: u64 = 250;
 /// Default interval between two looks at the folder, ms.
 pub const DEFAULT_POLL_MS: u64 = 50;
-/// Default decode attempts of a complete-looking file before it is skipped.
-pub const DEFAULT_MAX_DECODE_ATTEMPTS: u32 = 5;
+/// Default wait for a change of a file that failed to decode before it is skipped, in settle
+/// times.
+pub const DEFAULT_FAILURE_WAIT_SETTLES: u32 = 4;
 /// Name endings of files being written under a temporary name (compared case-insensitively);
 /// dot-files are temporary too.
 pub const TEMPORARY_SUFFIXES: [&str; 5] = [".tmp", ".part", ".partial", ".crdownload", "~"];
@@ -50,13 +53,14 @@ pub struct WatchSettings {
     pub poll_interval: Duration,
     /// End after this long without a new image (`None`: watch until stopped).
     pub idle_timeout: Option<Duration>,
-    /// Decode failures of one unchanged file before it is reported and skipped.
-    pub max_decode_attempts: u32,
+    /// A file that failed to decode is skipped when it stays unchanged this many settle times
+    /// after the failure (it is decoded again only if it changes).
+    pub failure_wait_settles: u32,
 }
 
 impl WatchSettings {
     /// The defaults for `dir`: new files only, 250 ms settle time, 50 ms polling, no idle
-    /// timeout, 5 decode attempts.
+    /// timeout, a failed file skipped after 4 settle times unchanged.
     pub fn new(dir: impl Into<PathBuf>) -> Self {
         WatchSettings {
             dir: dir.into(),
@@ -64,7 +68,7 @@ impl WatchSettings {
             settle: Duration::from_millis(DEFAULT_SETTLE_MS),
             poll_interval: Duration::from_millis(DEFAULT_POLL_MS),
             idle_timeout: None,
-            max_decode_attempts: DEFAULT_MAX_DECODE_ATTEMPTS,
+            failure_wait_settles: DEFAULT_FAILURE_WAIT_SETTLES,
         }
     }
 }
@@ -95,15 +99,15 @@ impl WatchedFile {
 /// What the watcher has to say, for the command's messages.
 #[derive(Clone, Debug, PartialEq)]
 pub enum WatchNote {
-    /// A complete-looking file could not be decoded; it is tried again after the settle time.
-    Retrying {
+    /// A complete-looking file could not be decoded: it is decoded again if it changes within
+    /// `wait`, else skipped.
+    Unreadable {
         path: PathBuf,
-        attempt: u32,
-        max_attempts: u32,
         reason: String,
+        wait: Duration,
     },
-    /// A file is not published, ever (undecodable after every attempt, another size or depth
-    /// than the first frame, out of natural order).
+    /// A file is not published, ever (undecodable and unchanged after the failure, another
+    /// size or depth than the first frame, out of natural order).
     Skipped { path: PathBuf, reason: String },
     /// A file was published as frame `frame_id` (noted by the shell, which stamps the id).
     Published { frame_id: u64, file: WatchedFile },
@@ -123,6 +127,7 @@ pub enum WatchEnd {
 pub struct WatchCounts {
     pub published: u64,
     pub skipped: u64,
+    /// Decodes of a file that had failed to decode and changed since.
     pub retries: u64,
     /// True when the watch ended for the idle timeout.
     pub ended_idle: bool,
@@ -138,10 +143,31 @@ struct Pending {
     /// When size, modification time or identity last changed (or the file appeared).
     changed_at: Instant,
     renamed: bool,
-    /// Decode failures since the last change.
-    attempts: u32,
-    /// Not before this instant (after a failed decode).
-    retry_at: Option<Instant>,
+    /// The decode failure of the file as it is now (cleared when it changes).
+    failure: Option<Failure>,
+    /// It failed to decode at least once (a later decode is a retry).
+    failed_before: bool,
+}
+
+impl Pending {
+    /// Takes in a change of size, modification time or identity, seen at `now`: the file
+    /// settles again and its failure, if any, is forgotten.
+    fn changed(&mut self, meta: &std::fs::Metadata, now: Instant) {
+        self.size_bytes = meta.len();
+        self.modified = meta.modified().unwrap_or(SystemTime::UNIX_EPOCH);
+        self.file_id = file_id(meta);
+        self.changed_at = now;
+        self.renamed = false;
+        self.failure = None;
+    }
+}
+
+/// A decode failure of a file that has not changed since.
+#[derive(Clone, Debug)]
+struct Failure {
+    reason: String,
+    /// Skipped if still unchanged then.
+    skip_at: Instant,
 }
 
 /// Whether one decode gave a frame.
@@ -281,9 +307,22 @@ impl Watcher {
                     }
                 }
                 let p = &self.pending[&name];
-                let due = p.retry_at.is_none_or(|at| now >= at)
-                    && ((p.renamed && p.attempts == 0)
-                        || now.duration_since(p.changed_at) >= self.settings.settle);
+                if let Some(failure) = &p.failure {
+                    if now < failure.skip_at {
+                        // Waiting for a change; later files wait, so the order holds.
+                        break;
+                    }
+                    let wait = self.settings.settle * self.settings.failure_wait_settles;
+                    let reason = format!(
+                        "{} (unchanged for {} ms after the failure)",
+                        failure.reason,
+                        wait.as_millis()
+                    );
+                    let path = p.path.clone();
+                    self.skip(&name, path, reason);
+                    continue;
+                }
+                let due = p.renamed || now.duration_since(p.changed_at) >= self.settings.settle;
                 if !due {
                     // Head of the line: later files wait, so the order holds.
                     break;
@@ -355,6 +394,13 @@ impl Watcher {
         out: &mut [u16],
         expected: Option<ImageShape>,
     ) -> Attempt {
+        if self
+            .pending
+            .get(&file.name)
+            .is_some_and(|p| p.failed_before)
+        {
+            self.counts.retries += 1;
+        }
         let found = match decode_into(&file.path, &mut self.scratch, out) {
             Ok(shape) => shape,
             // Another pixel count than the frame's: a shape mismatch (checked below).
@@ -420,41 +466,31 @@ impl Watcher {
             return false;
         }
         if let Some(p) = self.pending.get_mut(&file.name) {
-            p.size_bytes = meta.len();
-            p.modified = modified;
-            p.file_id = file_id(&meta);
-            p.changed_at = Instant::now();
-            p.renamed = false;
-            p.attempts = 0;
-            p.retry_at = None;
+            p.changed(&meta, Instant::now());
         }
         self.last_activity = Instant::now();
         true
     }
 
-    /// A decode failure of an unchanged file: retried after the settle time, skipped after
-    /// the last attempt.
+    /// A decode failure of a settled file: reported once; the file waits for a change (then
+    /// it settles and is decoded again) and is skipped if none comes in time. The same bytes
+    /// are never decoded twice.
     fn failed(&mut self, file: &WatchedFile, error: &ProducerError) {
-        let max_attempts = self.settings.max_decode_attempts.max(1);
-        let settle = self.settings.settle;
+        let wait = self.settings.settle * self.settings.failure_wait_settles;
         let Some(p) = self.pending.get_mut(&file.name) else {
             return;
         };
-        p.attempts += 1;
-        let attempt = p.attempts;
-        if attempt >= max_attempts {
-            let reason = format!("{error} (tried {attempt} times, unchanged in between)");
-            self.skip(&file.name, file.path.clone(), reason);
-        } else {
-            p.retry_at = Some(Instant::now() + settle);
-            self.counts.retries += 1;
-            self.notes.push(WatchNote::Retrying {
-                path: file.path.clone(),
-                attempt,
-                max_attempts,
-                reason: error.to_string(),
-            });
-        }
+        let reason = error.to_string();
+        p.failure = Some(Failure {
+            reason: reason.clone(),
+            skip_at: Instant::now() + wait,
+        });
+        p.failed_before = true;
+        self.notes.push(WatchNote::Unreadable {
+            path: file.path.clone(),
+            reason,
+            wait,
+        });
     }
 
     fn skip(&mut self, name: &str, path: PathBuf, reason: String) {
@@ -515,21 +551,15 @@ impl Watcher {
                             file_id: id,
                             changed_at: now,
                             renamed,
-                            attempts: 0,
-                            retry_at: None,
+                            failure: None,
+                            failed_before: false,
                         },
                     );
                     self.last_activity = now;
                 }
                 Some(p) => {
                     if p.size_bytes != meta.len() || p.modified != modified || p.file_id != id {
-                        p.size_bytes = meta.len();
-                        p.modified = modified;
-                        p.file_id = id;
-                        p.changed_at = now;
-                        p.renamed = false;
-                        p.attempts = 0;
-                        p.retry_at = None;
+                        p.changed(&meta, now);
                         self.last_activity = now;
                     }
                 }
@@ -584,6 +614,67 @@ mod tests {
         for name in ["img_1.tif", "img.png", "part.bmp"] {
             assert!(!is_temporary_name(name), "{name}");
         }
+    }
+
+    #[test]
+    fn a_file_that_fails_to_decode_is_reported_once_and_skipped_unchanged_without_a_retry() {
+        let dir = std::env::temp_dir().join(format!("watch_test_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // Before a good image: garbage, and a 200-byte TIFF declaring 16384² px at 16 bit.
+        std::fs::write(dir.join("img_1.tif"), b"not an image at all".repeat(10)).unwrap();
+        let huge = crate::image_io::tests::tiff_declaring(16_384, 200);
+        std::fs::write(dir.join("img_2.tif"), huge).unwrap();
+        image::save_buffer(
+            dir.join("img_3.png"),
+            &[7u8; 16 * 12],
+            16,
+            12,
+            image::ExtendedColorType::L8,
+        )
+        .unwrap();
+        let mut watcher = Watcher::open(WatchSettings {
+            from_start: true,
+            settle: Duration::from_millis(20),
+            poll_interval: Duration::from_millis(5),
+            ..WatchSettings::new(&dir)
+        })
+        .unwrap();
+        let mut sleep = |pause| {
+            std::thread::sleep(pause);
+            true
+        };
+        let shape = watcher.first_shape(&mut sleep).unwrap().unwrap();
+        assert_eq!((shape.width, shape.height), (16, 12));
+        assert_eq!(watcher.first(), Some(dir.join("img_3.png").as_path()));
+        let notes = watcher.take_notes();
+        for name in ["img_1.tif", "img_2.tif"] {
+            let path = dir.join(name);
+            let unreadable = notes
+                .iter()
+                .filter(|n| matches!(n, WatchNote::Unreadable { path: p, .. } if *p == path))
+                .count();
+            assert_eq!(
+                unreadable, 1,
+                "{name} reported once, decoded once\n{notes:?}"
+            );
+            assert!(
+                notes.iter().any(|n| matches!(
+                    n,
+                    WatchNote::Skipped { path: p, reason } if *p == path
+                        && reason.contains("unchanged for 80 ms after the failure")
+                )),
+                "{name} skipped\n{notes:?}"
+            );
+        }
+        assert!(
+            notes.iter().any(|n| matches!(
+                n,
+                WatchNote::Unreadable { reason, .. } if reason.contains("200 bytes")
+            )),
+            "the TIFF refused from its header\n{notes:?}"
+        );
+        assert_eq!(watcher.counts().retries, 0);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -73,15 +73,11 @@ pub fn run(
         settings,
         on_event,
         |note| match note {
-            WatchNote::Retrying {
-                path,
-                attempt,
-                max_attempts,
-                reason,
-            } => eprintln!(
-                "producer: {} not readable yet (attempt {attempt} of {max_attempts}, tried again \
-                 after the settle time): {reason}",
-                path.display()
+            WatchNote::Unreadable { path, reason, wait } => eprintln!(
+                "producer: {} not readable: {reason}; decoded again if it changes within {} ms, \
+                 else skipped",
+                path.display(),
+                wait.as_millis()
             ),
             WatchNote::Skipped { path, reason } => {
                 eprintln!(

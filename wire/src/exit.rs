@@ -6,6 +6,9 @@
 pub const OUTPUT_FAILED: u8 = 74;
 /// The rig could not resume its test safely from its journal: it unloaded and stopped.
 pub const CANNOT_RESUME: u8 = 75;
+/// The process could not get a system resource it needs (a subscriber that cannot connect to
+/// a publisher: no file descriptor left, `/dev/shm` full): a restart would fail the same way.
+pub const RESOURCES: u8 = 71;
 /// The process's configuration does not fit its input (a followed CSV without the configured
 /// columns): a restart would fail the same way.
 pub const CONFIG: u8 = 78;
@@ -30,6 +33,17 @@ pub fn code_of(error: &(dyn std::error::Error + 'static)) -> Option<u8> {
         }
         if error.downcast_ref::<crate::files::FileError>().is_some() {
             return Some(OUTPUT_FAILED);
+        }
+        #[cfg(feature = "ipc")]
+        if error
+            .downcast_ref::<crate::resources::ConnectionError>()
+            .is_some()
+            || matches!(
+                error.downcast_ref::<crate::instance::InstanceError>(),
+                Some(crate::instance::InstanceError::Connection(_))
+            )
+        {
+            return Some(RESOURCES);
         }
         next = error.source();
     }
@@ -63,5 +77,37 @@ mod tests {
             .starts_with("rig process: cannot write rig.csv"));
         let other: Box<dyn std::error::Error + Send + Sync> = "no".into();
         assert_eq!(in_context("rig", &*other).code, 1);
+    }
+
+    #[cfg(feature = "ipc")]
+    #[test]
+    fn a_subscriber_that_cannot_connect_asks_for_resources_and_names_them() {
+        /// A process error carrying the instance's error as its source, as the identifier's.
+        #[derive(Debug, thiserror::Error)]
+        #[error("{0}")]
+        struct Wrapper(#[from] crate::instance::InstanceError);
+        let error = Wrapper::from(crate::instance::InstanceError::from(
+            crate::resources::ConnectionError {
+                service: "fields".into(),
+                detail: "UnableToMapSendersDataSegment(InternalError)".into(),
+                resources: crate::resources::Resources {
+                    open_descriptors: Some(64),
+                    descriptor_limit: Some(64),
+                    shm_free_bytes: Some(1 << 30),
+                },
+            },
+        ));
+        let exit = in_context("identifier process", &error);
+        assert_eq!(exit.code, RESOURCES);
+        assert!(
+            exit.message.starts_with(
+                "identifier process: cannot connect to a publisher of fields \
+                 (UnableToMapSendersDataSegment(InternalError))"
+            ) && exit
+                .message
+                .contains("file descriptors exhausted: 64 open of the limit 64"),
+            "{}",
+            exit.message
+        );
     }
 }

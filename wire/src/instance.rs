@@ -41,6 +41,10 @@ pub enum InstanceError {
     },
     #[error("{0}")]
     Io(String),
+    /// A subscriber that could not connect to a publisher (exit code
+    /// [`crate::exit::RESOURCES`]).
+    #[error(transparent)]
+    Connection(#[from] crate::resources::ConnectionError),
 }
 
 /// One run's name and the iceoryx2 configuration that isolates it. Dropped after the nodes it
@@ -132,7 +136,7 @@ impl Instance {
             // Signals are handled by `crate::signals` (installed first thing in `main`).
             .signal_handling_mode(SignalHandlingMode::Disabled)
             .create::<ipc::Service>()
-            .map_err(|e| node_error(format!("{e:?}")))?;
+            .map_err(|e| node_error(format!("{e:?}; {}", crate::resources::Resources::now())))?;
         Ok((node, removed))
     }
 

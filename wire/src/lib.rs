@@ -25,6 +25,8 @@ pub mod names;
 pub mod owner;
 #[cfg(feature = "ipc")]
 pub mod pubsub;
+#[cfg(feature = "ipc")]
+pub mod resources;
 pub mod rig;
 pub mod services;
 #[cfg(feature = "ipc")]

@@ -12,13 +12,17 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use iceoryx2::sample::Sample;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+mod connect;
 
 type Ipc = ipc::Service;
 
 fn service_error(spec: &ServiceSpec, detail: impl Debug) -> InstanceError {
     InstanceError::Service {
         service: spec.name.to_string(),
-        detail: format!("{detail:?}"),
+        detail: format!("{detail:?}; {}", crate::resources::Resources::now()),
     }
 }
 
@@ -148,10 +152,12 @@ where
     }
 }
 
-/// Receives `[T]` slices behind a header `H`.
+/// Receives `[T]` slices behind a header `H`. A publisher it cannot connect to is an error
+/// (`connect.rs`).
 pub struct SliceSubscriber<T: Debug + ZeroCopySend + 'static, H: Debug + ZeroCopySend + 'static> {
     subscriber: Subscriber<Ipc, [T], H>,
     listener: Listener<Ipc>,
+    service: &'static str,
 }
 
 impl<T, H> SliceSubscriber<T, H>
@@ -168,14 +174,18 @@ where
         )
         .open_or_create()
         .map_err(|e| service_error(spec, e))?;
+        let failed = Arc::new(AtomicBool::new(false));
         let subscriber = service
             .subscriber_builder()
             .buffer_size(spec.subscriber_buffer)
+            .set_degradation_handler(connect::handler(failed.clone()))
             .create()
             .map_err(|e| service_error(spec, e))?;
+        connect::after_creation(spec.name, &failed)?;
         Ok(SliceSubscriber {
             subscriber,
             listener: open_listener(node, spec)?,
+            service: spec.name,
         })
     }
 
@@ -191,12 +201,7 @@ where
 
     /// The next queued sample, if any. Drain until `None` after each wake-up.
     pub fn receive(&self) -> Result<Option<Sample<Ipc, [T], H>>, InstanceError> {
-        self.subscriber
-            .receive()
-            .map_err(|e| InstanceError::Service {
-                service: "receive".into(),
-                detail: format!("{e:?}"),
-            })
+        connect::checked(self.service, || self.subscriber.receive())
     }
 }
 
@@ -238,10 +243,12 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> ValuePublisher<T> {
     }
 }
 
-/// Receives single values of `T`.
+/// Receives single values of `T`. A publisher it cannot connect to is an error
+/// (`connect.rs`).
 pub struct ValueSubscriber<T: Debug + ZeroCopySend + 'static> {
     subscriber: Subscriber<Ipc, T, ()>,
     listener: Listener<Ipc>,
+    service: &'static str,
 }
 
 impl<T: Debug + ZeroCopySend + Copy + 'static> ValueSubscriber<T> {
@@ -253,14 +260,18 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> ValueSubscriber<T> {
         )
         .open_or_create()
         .map_err(|e| service_error(spec, e))?;
+        let failed = Arc::new(AtomicBool::new(false));
         let subscriber = service
             .subscriber_builder()
             .buffer_size(spec.subscriber_buffer)
+            .set_degradation_handler(connect::handler(failed.clone()))
             .create()
             .map_err(|e| service_error(spec, e))?;
+        connect::after_creation(spec.name, &failed)?;
         Ok(ValueSubscriber {
             subscriber,
             listener: open_listener(node, spec)?,
+            service: spec.name,
         })
     }
 
@@ -274,13 +285,7 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> ValueSubscriber<T> {
 
     /// The next queued value, if any.
     pub fn receive(&self) -> Result<Option<T>, InstanceError> {
-        let sample = self
-            .subscriber
-            .receive()
-            .map_err(|e| InstanceError::Service {
-                service: "receive".into(),
-                detail: format!("{e:?}"),
-            })?;
+        let sample = connect::checked(self.service, || self.subscriber.receive())?;
         Ok(sample.map(|s| *s))
     }
 }

@@ -1,0 +1,134 @@
+//! The system resources iceoryx2 needs, so that an error from it names them: file descriptors
+//! (every shared-memory segment, connection and event a process opens holds one; the limit is
+//! `RLIMIT_NOFILE`, `ulimit -n`) and the free space of `/dev/shm`.
+
+use std::fmt;
+
+/// Descriptors this close to the limit count as exhausted: a failed connection gives back
+/// the few it had opened before the one that failed.
+pub const DESCRIPTOR_MARGIN: u64 = 8;
+
+/// What the process has, read when an error needs it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Resources {
+    /// File descriptors open (None: unknown).
+    pub open_descriptors: Option<u64>,
+    /// The soft limit of `RLIMIT_NOFILE` (None: unlimited or unknown).
+    pub descriptor_limit: Option<u64>,
+    /// Free bytes of `/dev/shm` (None: unknown).
+    pub shm_free_bytes: Option<u64>,
+}
+
+impl Resources {
+    /// Reads them now.
+    pub fn now() -> Resources {
+        let descriptor_limit = descriptor_limit();
+        let open_descriptors = match std::fs::read_dir("/proc/self/fd") {
+            // Less the listing's own descriptor.
+            Ok(entries) => Some((entries.count() as u64).saturating_sub(1)),
+            // Not even one left to list them.
+            Err(e) if e.raw_os_error() == Some(libc::EMFILE) => descriptor_limit,
+            Err(_) => None,
+        };
+        Resources {
+            open_descriptors,
+            descriptor_limit,
+            shm_free_bytes: crate::shm::free_bytes(crate::shm::SHM_PATH).ok(),
+        }
+    }
+
+    /// Open descriptors within [`DESCRIPTOR_MARGIN`] of the limit.
+    pub fn descriptors_exhausted(&self) -> bool {
+        matches!(
+            (self.open_descriptors, self.descriptor_limit),
+            (Some(open), Some(limit)) if open + DESCRIPTOR_MARGIN >= limit
+        )
+    }
+}
+
+/// The soft limit of open file descriptors, None when unlimited.
+fn descriptor_limit() -> Option<u64> {
+    let mut limit = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: getrlimit writes into the struct we own.
+    let rc = unsafe { libc::getrlimit(libc::RLIMIT_NOFILE, &mut limit) };
+    (rc == 0 && limit.rlim_cur != libc::RLIM_INFINITY).then_some(limit.rlim_cur)
+}
+
+impl fmt::Display for Resources {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let known = |n: Option<u64>| n.map_or("?".to_string(), |n| n.to_string());
+        if self.descriptors_exhausted() {
+            write!(
+                f,
+                "file descriptors exhausted: {} open of the limit {} (RLIMIT_NOFILE; raise it \
+                 with `ulimit -n`)",
+                known(self.open_descriptors),
+                known(self.descriptor_limit)
+            )?;
+        } else {
+            write!(
+                f,
+                "file descriptors: {} open of the limit {} (RLIMIT_NOFILE)",
+                known(self.open_descriptors),
+                self.descriptor_limit
+                    .map_or("unlimited".to_string(), |n| n.to_string())
+            )?;
+        }
+        match self.shm_free_bytes {
+            Some(free) => write!(
+                f,
+                "; {}: {:.1} MiB free",
+                crate::shm::SHM_PATH,
+                free as f64 / 1048576.0
+            ),
+            None => write!(f, "; {}: free space unknown", crate::shm::SHM_PATH),
+        }
+    }
+}
+
+/// A subscriber that could not connect to a publisher: it would never receive its samples.
+/// The process stops with [`crate::exit::RESOURCES`], naming the resources it had.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot connect to a publisher of {service} ({detail}): the process would never receive its samples; {resources}")]
+pub struct ConnectionError {
+    /// The service.
+    pub service: String,
+    /// iceoryx2's error.
+    pub detail: String,
+    pub resources: Resources,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn descriptors_near_the_limit_are_named_as_exhausted_with_the_limit() {
+        let full = Resources {
+            open_descriptors: Some(60),
+            descriptor_limit: Some(64),
+            shm_free_bytes: Some(512 << 20),
+        };
+        assert!(full.descriptors_exhausted());
+        let text = full.to_string();
+        assert!(
+            text.contains("file descriptors exhausted: 60 open of the limit 64")
+                && text.contains("ulimit -n")
+                && text.contains("/dev/shm: 512.0 MiB free"),
+            "{text}"
+        );
+        let plenty = Resources {
+            open_descriptors: Some(20),
+            ..full
+        };
+        assert!(!plenty.descriptors_exhausted());
+        assert!(plenty
+            .to_string()
+            .starts_with("file descriptors: 20 open of the limit 64"));
+        let now = Resources::now();
+        assert!(now.open_descriptors.is_some_and(|n| n >= 3), "{now:?}");
+    }
+}
