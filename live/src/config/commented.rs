@@ -112,7 +112,11 @@ impl RunConfig {
         let mut out = String::from(PREAMBLE);
         let mut table = String::new();
         let mut said: Vec<String> = Vec::new();
+        // The TOML's own blank lines are left out: one blank line goes before each table.
         for line in RunConfig::default().to_toml().lines() {
+            if line.trim().is_empty() {
+                continue;
+            }
             if let Some(entry) = entry_of(line, &table) {
                 if line.trim_start().starts_with('[') {
                     table = table_of(line);
