@@ -1,0 +1,172 @@
+//! The cruciform: its mesh (area, grips, slits, refusals) and the mesh convergence of the arm
+//! force at a grip stretch of 2.
+
+mod common;
+
+use common::Solved;
+use membrane::specimens::cruciform::CruciformGeometry;
+use membrane::{GeometryError, NewtonSettings};
+use std::time::Instant;
+
+#[test]
+fn cruciform_mesh_has_the_area_of_the_drawing_and_four_grips() {
+    for geometry in [
+        CruciformGeometry::default(),
+        CruciformGeometry {
+            fillet_radius_mm: 0.0,
+            ..CruciformGeometry::default()
+        },
+        CruciformGeometry {
+            slits_per_arm: 3,
+            slit_length_mm: 40.0,
+            ..CruciformGeometry::default()
+        },
+    ] {
+        let specimen = geometry.mesh().unwrap();
+        let area = specimen.mesh.area_mm2().unwrap();
+        let exact = geometry.area_mm2();
+        assert!((area - exact).abs() < 1e-4 * exact, "{area} vs {exact} mm²");
+        assert_eq!(specimen.grips.len(), 4);
+        let across = specimen.grip("x+").unwrap().nodes.len();
+        for grip in &specimen.grips {
+            assert_eq!(grip.nodes.len(), across, "{}", grip.name);
+            for &n in &grip.nodes {
+                let p = specimen.mesh.nodes_mm[n];
+                let along = p[0] * grip.axis[0] + p[1] * grip.axis[1];
+                assert!((along - 130.0).abs() < 1e-9);
+            }
+        }
+    }
+}
+
+#[test]
+fn slits_cut_the_arms_into_fingers() {
+    let plain = CruciformGeometry::default().mesh().unwrap();
+    let geometry = CruciformGeometry {
+        slits_per_arm: 1,
+        slit_length_mm: 40.0,
+        ..CruciformGeometry::default()
+    };
+    let slit = geometry.mesh().unwrap();
+    assert_eq!(slit.mesh.elements.len(), plain.mesh.elements.len());
+    // Each arm's slit doubles its nodes from the grip to (not including) the slit's tip:
+    // 40 mm of 10 mm elements, 8 half-cells, 4 slits.
+    assert_eq!(slit.mesh.nodes_mm.len(), plain.mesh.nodes_mm.len() + 4 * 8);
+    assert_eq!(
+        slit.grip("x+").unwrap().nodes.len(),
+        plain.grip("x+").unwrap().nodes.len() + 1
+    );
+}
+
+#[test]
+fn geometries_that_cannot_be_meshed_are_refused_with_the_value() {
+    let base = CruciformGeometry::default();
+    let cases = [
+        (
+            CruciformGeometry {
+                fillet_radius_mm: 120.0,
+                ..base
+            },
+            GeometryError::FilletTooLarge {
+                radius_mm: 120.0,
+                limit_name: "arm width",
+                limit_mm: 100.0,
+            },
+        ),
+        (
+            CruciformGeometry {
+                arm_length_mm: 15.0,
+                ..base
+            },
+            GeometryError::FilletTooLarge {
+                radius_mm: 20.0,
+                limit_name: "arm length",
+                limit_mm: 15.0,
+            },
+        ),
+        (
+            CruciformGeometry {
+                arm_width_mm: -3.0,
+                ..base
+            },
+            GeometryError::NotPositive {
+                name: "arm width",
+                value_mm: -3.0,
+            },
+        ),
+        (
+            CruciformGeometry {
+                element_size_mm: 0.0,
+                ..base
+            },
+            GeometryError::NotPositive {
+                name: "element size",
+                value_mm: 0.0,
+            },
+        ),
+    ];
+    for (geometry, expected) in cases {
+        assert_eq!(geometry.mesh().unwrap_err(), expected);
+    }
+    let too_long = CruciformGeometry {
+        slits_per_arm: 2,
+        slit_length_mm: 70.0,
+        ..base
+    };
+    assert!(matches!(
+        too_long.mesh(),
+        Err(GeometryError::Slit { count: 2, .. })
+    ));
+    let too_fine = CruciformGeometry {
+        element_size_mm: 1e-3,
+        ..base
+    };
+    assert!(matches!(
+        too_fine.mesh(),
+        Err(GeometryError::TooManyElements { .. })
+    ));
+}
+
+/// Arm force (N) at a grip stretch of 2 (each grip pulled by half the grip-to-grip distance),
+/// with the free DOFs and the time to mesh, solve and evaluate the fields (ms).
+fn arm_force_at_grip_stretch_2(element_size_mm: f64) -> (f64, usize, f64) {
+    let geometry = CruciformGeometry {
+        element_size_mm,
+        ..CruciformGeometry::default()
+    };
+    let pull_mm = 0.5 * geometry.arm_width_mm + geometry.arm_length_mm;
+    let started = Instant::now();
+    let solved = Solved::new(
+        geometry.mesh().unwrap(),
+        |s| s.pull_all(pull_mm),
+        NewtonSettings::default(),
+    );
+    let ms = started.elapsed().as_secs_f64() * 1e3;
+    let equilibrium = &solved.equilibrium;
+    let last = equilibrium.steps.last().unwrap();
+    println!(
+        "h = {element_size_mm} mm: {} steps, last residuals {:?}, states {:?}",
+        equilibrium.steps.len(),
+        last.residuals_n,
+        last.states
+    );
+    (solved.grip_force_n("x+")[0], equilibrium.free_dofs, ms)
+}
+
+#[test]
+fn arm_force_converges_with_the_mesh() {
+    println!("| element mm | free DOFs | arm force N | change | solve ms |");
+    let mut previous: Option<f64> = None;
+    let mut changes = Vec::new();
+    for size in [10.0, 5.0] {
+        let (force, dofs, ms) = arm_force_at_grip_stretch_2(size);
+        let change = previous.map(|p| (force - p) / p);
+        println!(
+            "| {size} | {dofs} | {force:.4} | {} | {ms:.0} |",
+            change.map_or("".into(), |c| format!("{:+.3} %", 100.0 * c))
+        );
+        changes.extend(change);
+        previous = Some(force);
+    }
+    assert!(changes[0].abs() < 5e-3, "{changes:?}");
+}
