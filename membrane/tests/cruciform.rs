@@ -158,7 +158,7 @@ fn arm_force_converges_with_the_mesh() {
     println!("| element mm | free DOFs | arm force N | change | solve ms |");
     let mut previous: Option<f64> = None;
     let mut changes = Vec::new();
-    for size in [10.0, 5.0] {
+    for size in [20.0, 10.0, 5.0] {
         let (force, dofs, ms) = arm_force_at_grip_stretch_2(size);
         let change = previous.map(|p| (force - p) / p);
         println!(
@@ -168,5 +168,52 @@ fn arm_force_converges_with_the_mesh() {
         changes.extend(change);
         previous = Some(force);
     }
-    assert!(changes[0].abs() < 5e-3, "{changes:?}");
+    // Default mesh (10 mm) to twice finer.
+    assert!(changes[1].abs() < 5e-3, "{changes:?}");
+}
+
+#[test]
+fn misalignment_is_a_boundary_condition() {
+    let geometry = CruciformGeometry {
+        element_size_mm: 20.0,
+        ..CruciformGeometry::default()
+    };
+    let pull_mm = 0.25 * (0.5 * geometry.arm_width_mm + geometry.arm_length_mm);
+    let aligned = Solved::new(
+        geometry.mesh().unwrap(),
+        |s| s.pull_all(pull_mm),
+        NewtonSettings::default(),
+    );
+    // The sheet turned by 3° in the x+ grip, and clamped off-centre along x: x- pulls 1.5 times
+    // what x+ pulls.
+    let misaligned = Solved::new(
+        geometry.mesh().unwrap(),
+        |s| {
+            s.grips
+                .iter()
+                .map(|g| match g.name {
+                    "x+" => g.clamp(pull_mm, 3f64.to_radians()),
+                    "x-" => g.clamp(1.5 * pull_mm, 0.0),
+                    _ => g.clamp(pull_mm, 0.0),
+                })
+                .collect()
+        },
+        NewtonSettings::default(),
+    );
+    for solved in [&aligned, &misaligned] {
+        let total = ["x+", "y+", "x-", "y-"]
+            .map(|g| solved.grip_force_n(g))
+            .iter()
+            .fold([0.0; 2], |acc, f| [acc[0] + f[0], acc[1] + f[1]]);
+        let scale = solved.grip_force_n("x+")[0];
+        assert!(
+            total[0].abs() < 1e-8 * scale && total[1].abs() < 1e-8 * scale,
+            "{total:?}"
+        );
+    }
+    let (straight, turned) = (aligned.grip_force_n("x+"), misaligned.grip_force_n("x+"));
+    println!("x+ grip force aligned {straight:?} N, misaligned {turned:?} N");
+    // Aligned, only the mesh's own asymmetry (alternating diagonals) pulls sideways.
+    assert!(straight[1].abs() < 2e-4 * straight[0], "{straight:?}");
+    assert!(turned[1].abs() > 20.0 * straight[1].abs(), "{turned:?}");
 }
