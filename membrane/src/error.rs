@@ -62,8 +62,8 @@ pub enum SolveError {
     UnknownNode { node: usize, nodes: usize },
     #[error("nothing is clamped: the sheet is free to move as a rigid body")]
     NoClamp,
-    #[error("the sparse factorisation failed: {reason}")]
-    Factorisation { reason: String },
+    #[error("the sparse factorisation could not be made: {cause}")]
+    Factorisation { cause: faer::sparse::CreationError },
 }
 
 impl SolveError {

@@ -13,7 +13,7 @@ use crate::error::SolveError;
 use crate::law::MembraneLaw;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{CreationError, SparseColMat, Triplet};
 use faer::{Mat, Side};
 
 /// Newton and load stepping settings.
@@ -92,7 +92,7 @@ enum Failure {
     Unstable {
         pivot: usize,
     },
-    Factorisation(String),
+    Factorisation(CreationError),
 }
 
 struct Solver<'m, 'a, L: MembraneLaw + ?Sized> {
@@ -223,7 +223,7 @@ impl<L: MembraneLaw + ?Sized> Solver<'_, '_, L> {
                 load_factor,
                 converged_load_factor,
             },
-            Failure::Factorisation(reason) => SolveError::Factorisation { reason },
+            Failure::Factorisation(cause) => SolveError::Factorisation { cause },
         }
     }
 
@@ -382,12 +382,12 @@ impl<L: MembraneLaw + ?Sized> Solver<'_, '_, L> {
         }
         let n = self.free_count;
         let matrix = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets)
-            .map_err(|e| Failure::Factorisation(format!("{e:?}")))?;
+            .map_err(Failure::Factorisation)?;
         let symbolic = match &self.symbolic {
             Some(s) => s.clone(),
             None => {
                 let s = SymbolicLlt::try_new(matrix.symbolic(), Side::Lower)
-                    .map_err(|e| Failure::Factorisation(format!("{e:?}")))?;
+                    .map_err(|e| Failure::Factorisation(e.into()))?;
                 self.symbolic = Some(s.clone());
                 s
             }
@@ -397,7 +397,7 @@ impl<L: MembraneLaw + ?Sized> Solver<'_, '_, L> {
                 faer::sparse::linalg::LltError::Numeric(
                     faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index },
                 ) => Failure::Unstable { pivot: index },
-                other => Failure::Factorisation(format!("{other:?}")),
+                faer::sparse::linalg::LltError::Generic(e) => Failure::Factorisation(e.into()),
             },
         )?;
         let mut x = Mat::from_fn(n, 1, |i, _| rhs[i]);
