@@ -217,3 +217,35 @@ fn misalignment_is_a_boundary_condition() {
     assert!(straight[1].abs() < 2e-4 * straight[0], "{straight:?}");
     assert!(turned[1].abs() > 20.0 * straight[1].abs(), "{turned:?}");
 }
+
+#[test]
+fn a_slit_cruciform_is_solved_with_its_fingers_free() {
+    let geometry = CruciformGeometry {
+        element_size_mm: 10.0,
+        slits_per_arm: 3,
+        slit_length_mm: 40.0,
+        ..CruciformGeometry::default()
+    };
+    let plain = CruciformGeometry {
+        slits_per_arm: 0,
+        ..geometry
+    };
+    let pull_mm = 0.5 * (0.5 * geometry.arm_width_mm + geometry.arm_length_mm);
+    let force = |g: CruciformGeometry| {
+        let solved = Solved::new(
+            g.mesh().unwrap(),
+            |s| s.pull_all(pull_mm),
+            NewtonSettings::default(),
+        );
+        let last = solved.equilibrium.steps.last().unwrap();
+        println!(
+            "{} slits: residuals {:?}, states {:?}",
+            g.slits_per_arm, last.residuals_n, last.states
+        );
+        solved.grip_force_n("x+")[0]
+    };
+    let (slit, whole) = (force(geometry), force(plain));
+    println!("arm force at grip stretch 1.5: slit {slit:.3} N, whole {whole:.3} N");
+    // The fingers do not pull each other sideways: the slit arm is softer.
+    assert!(slit < whole && slit > 0.5 * whole, "{slit} vs {whole}");
+}
