@@ -1,6 +1,6 @@
 //! Why a specimen cannot be meshed or a load cannot be solved: each error holds the offending
-//! value and, for a solve, the load factor reached (the last converged state stays with the
-//! solver; no force is ever read from an unconverged iterate).
+//! value and, for a solve, the load factor reached (`solve_until_stopped` also gives the last
+//! converged equilibrium; no force is ever read from an unconverged iterate).
 
 /// A geometry that cannot be meshed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

@@ -29,5 +29,5 @@ pub use constitutive::{MembraneState, Wrinkling};
 pub use error::{GeometryError, SolveError};
 pub use law::{InvariantDerivatives, MembraneLaw};
 pub use mesh::Mesh;
-pub use solver::{solve, Equilibrium, NewtonSettings, StepRecord};
+pub use solver::{solve, solve_until_stopped, Equilibrium, NewtonSettings, Outcome, StepRecord};
 pub use specimens::Specimen;

@@ -105,12 +105,34 @@ struct Solver<'m, 'a, L: MembraneLaw + ?Sized> {
     symbolic: Option<SymbolicLlt<usize>>,
 }
 
-/// Solves the clamped sheet up to load factor 1.
+/// Solves the clamped sheet up to load factor 1: its equilibrium there, or why it stopped.
 pub fn solve<L: MembraneLaw + ?Sized>(
     membrane: &Membrane<'_, L>,
     clamps: &[Clamp],
     settings: NewtonSettings,
 ) -> Result<Equilibrium, SolveError> {
+    let outcome = solve_until_stopped(membrane, clamps, settings)?;
+    match outcome.stopped {
+        Some(error) => Err(error),
+        None => Ok(outcome.reached),
+    }
+}
+
+/// How far a load went: the last converged equilibrium (at load factor 1 if it went through,
+/// else where it stopped, with its forces) and, if it stopped, why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outcome {
+    pub reached: Equilibrium,
+    pub stopped: Option<SolveError>,
+}
+
+/// [`solve`], keeping the last converged equilibrium when the load stops on the way; an error
+/// only for clamps that cannot be applied.
+pub fn solve_until_stopped<L: MembraneLaw + ?Sized>(
+    membrane: &Membrane<'_, L>,
+    clamps: &[Clamp],
+    settings: NewtonSettings,
+) -> Result<Outcome, SolveError> {
     let nodes = membrane.mesh.nodes_mm.len();
     if clamps.iter().all(|c| c.nodes.is_empty()) {
         return Err(SolveError::NoClamp);
@@ -137,7 +159,7 @@ pub fn solve<L: MembraneLaw + ?Sized>(
         free_count,
         symbolic: None,
     };
-    solver.run()
+    Ok(solver.run())
 }
 
 fn norm(v: impl Iterator<Item = f64>) -> f64 {
@@ -145,13 +167,14 @@ fn norm(v: impl Iterator<Item = f64>) -> f64 {
 }
 
 impl<L: MembraneLaw + ?Sized> Solver<'_, '_, L> {
-    fn run(&mut self) -> Result<Equilibrium, SolveError> {
+    fn run(&mut self) -> Outcome {
         let mut u = vec![0.0; self.free.len()];
         let mut converged = 0.0;
         let mut increment = 1.0 / self.settings.load_steps.max(1) as f64;
         let mut cuts = 0;
         let mut steps = Vec::new();
         let mut forces = vec![0.0; self.free.len()];
+        let mut stopped = None;
         while converged < 1.0 {
             let target = if converged + increment > 1.0 - 1e-12 {
                 1.0
@@ -166,7 +189,8 @@ impl<L: MembraneLaw + ?Sized> Solver<'_, '_, L> {
                     steps.push(record);
                 }
                 Err(failure) if cuts >= self.settings.max_step_cuts => {
-                    return Err(self.error(failure, target, converged))
+                    stopped = Some(self.error(failure, target, converged));
+                    break;
                 }
                 Err(_) => {
                     increment *= 0.5;
@@ -174,13 +198,16 @@ impl<L: MembraneLaw + ?Sized> Solver<'_, '_, L> {
                 }
             }
         }
-        Ok(Equilibrium {
-            load_factor: converged,
-            displacement_mm: u,
-            nodal_forces_n: forces,
-            steps,
-            free_dofs: self.free_count,
-        })
+        Outcome {
+            reached: Equilibrium {
+                load_factor: converged,
+                displacement_mm: u,
+                nodal_forces_n: forces,
+                steps,
+                free_dofs: self.free_count,
+            },
+            stopped,
+        }
     }
 
     fn error(&self, failure: Failure, load_factor: f64, converged_load_factor: f64) -> SolveError {

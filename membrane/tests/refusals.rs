@@ -6,8 +6,8 @@ mod common;
 use common::square;
 use material::InvariantLaw;
 use membrane::{
-    solve, Clamp, Held, InvariantDerivatives, Membrane, MembraneLaw, NewtonSettings, RigidMotion,
-    SolveError, Wrinkling,
+    solve, solve_until_stopped, Clamp, Held, InvariantDerivatives, Membrane, MembraneLaw,
+    NewtonSettings, RigidMotion, SolveError, Wrinkling,
 };
 
 #[test]
@@ -85,11 +85,26 @@ fn stopped(law: &dyn MembraneLaw) -> SolveError {
 #[test]
 fn a_law_unstable_along_the_path_stops_the_solve() {
     // W1 = 0.5 − 0.2 (I1 − 3): stiff at first, softening until the sheet is unstable.
-    let error = stopped(&InvariantDerivatives(|i1: f64, _i2: f64| {
-        Some((0.5 - 0.2 * (i1 - 3.0), 0.0))
-    }));
+    let law = InvariantDerivatives(|i1: f64, _i2: f64| Some((0.5 - 0.2 * (i1 - 3.0), 0.0)));
+    let error = stopped(&law);
     assert!(matches!(error, SolveError::Unstable { .. }), "{error:?}");
     assert!(error.converged_load_factor().unwrap() > 0.0);
+    // The equilibrium reached before it stopped, with its forces, is kept.
+    let specimen = square(10.0, 4);
+    let membrane = Membrane::new(&specimen.mesh, 2.0, &law, Wrinkling::off()).unwrap();
+    let outcome = solve_until_stopped(
+        &membrane,
+        &specimen.pull_all(10.0),
+        NewtonSettings::default(),
+    )
+    .unwrap();
+    assert_eq!(outcome.stopped, Some(error.clone()));
+    assert_eq!(
+        Some(outcome.reached.load_factor),
+        error.converged_load_factor()
+    );
+    let grip = &specimen.grip("x+").unwrap().nodes;
+    assert!(outcome.reached.grip_force_n(grip)[0] > 0.0);
 }
 
 #[test]
