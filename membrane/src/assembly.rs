@@ -7,7 +7,7 @@
 
 use crate::constitutive::{self, MembraneState, PointFailure, StateCount, Voigt, Wrinkling};
 use crate::error::GeometryError;
-use crate::law::MembraneLaw;
+use crate::law::SheetLaw;
 use crate::mesh::Mesh;
 use crate::t6::{GaussPoint, NODES};
 
@@ -17,7 +17,7 @@ pub const ELEMENT_DOFS: usize = 2 * NODES;
 pub type ElementMatrix = [[f64; ELEMENT_DOFS]; ELEMENT_DOFS];
 
 /// The discretised sheet: mesh, reference thickness, law and its Gauss points.
-pub struct Membrane<'a, L: MembraneLaw + ?Sized> {
+pub struct Membrane<'a, L: SheetLaw + ?Sized> {
     pub mesh: &'a Mesh,
     pub thickness_mm: f64,
     pub law: &'a L,
@@ -53,7 +53,7 @@ pub struct PointField {
     pub state: MembraneState,
 }
 
-impl<'a, L: MembraneLaw + ?Sized> Membrane<'a, L> {
+impl<'a, L: SheetLaw + ?Sized> Membrane<'a, L> {
     pub fn new(
         mesh: &'a Mesh,
         thickness_mm: f64,

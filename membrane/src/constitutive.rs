@@ -9,7 +9,7 @@
 //! from W1, W2 and W11, W12, W22 (the chain rule below), checked against finite differences in
 //! the tests.
 
-use crate::law::MembraneLaw;
+use crate::law::{MembraneLaw, SheetLaw};
 use crate::wrinkling;
 
 /// A symmetric 2×2 tensor in Voigt order [11, 22, 12].
@@ -131,8 +131,11 @@ pub(crate) fn invariant_jets(c: &Voigt) -> Option<(Jet, Jet)> {
     Some((i1, i2))
 }
 
-/// w(c) = W(I1, I2) to second order: gradient and Hessian in c.
-fn taut_energy_jet<L: MembraneLaw + ?Sized>(law: &L, c: &Voigt) -> Result<Jet, PointFailure> {
+/// w(c) = W(I1, I2) of an invariant law to second order: gradient and Hessian in c.
+pub(crate) fn invariant_energy_jet<L: MembraneLaw + ?Sized>(
+    law: &L,
+    c: &Voigt,
+) -> Result<Jet, PointFailure> {
     let (i1, i2) = invariant_jets(c).ok_or(PointFailure::Inverted {
         det_c: c[0] * c[1] - c[2] * c[2],
     })?;
@@ -170,11 +173,16 @@ fn stress_and_tangent(jet: &Jet) -> (Voigt, Matrix3) {
 }
 
 /// The full (taut) law at c, without tension-field relaxation.
-pub fn taut_response<L: MembraneLaw + ?Sized>(
+pub fn taut_response<L: SheetLaw + ?Sized>(
     law: &L,
     c: &Voigt,
 ) -> Result<PointResponse, PointFailure> {
-    let jet = taut_energy_jet(law, c)?;
+    let (gradient, hessian) = law.energy_derivatives(c)?;
+    let jet = Jet {
+        value: f64::NAN,
+        gradient,
+        hessian,
+    };
     let (stress_pk2_mpa, tangent_mpa) = stress_and_tangent(&jet);
     let (i1, i2) = invariant_jets(c)
         .map(|(a, b)| (a.value, b.value))
@@ -232,7 +240,7 @@ pub fn principal_values(t: &Voigt) -> (f64, f64) {
 }
 
 /// The membrane law at c with tension-field relaxation: taut, wrinkled or slack.
-pub fn response<L: MembraneLaw + ?Sized>(
+pub fn response<L: SheetLaw + ?Sized>(
     law: &L,
     c: &Voigt,
     wrinkling: &Wrinkling,

@@ -8,6 +8,7 @@
 //! tangent is then exact to ~1e-10 relative, enough for Newton's quadratic convergence down to
 //! the tolerance).
 
+use crate::constitutive::{Matrix3, PointFailure, Voigt};
 use material::InvariantLaw;
 
 /// Second derivatives of W, MPa: [W11, W12, W22].
@@ -32,6 +33,28 @@ pub trait MembraneLaw {
         let w12 = 0.5 * ((b1p - b1m) / (2.0 * h2) + (a2p - a2m) / (2.0 * h1));
         let out = [w11, w12, w22];
         out.iter().all(|v| v.is_finite()).then_some(out)
+    }
+}
+
+/// The sheet's law at a point, as the element needs it: the reduced energy w(c) of the
+/// plane-stress incompressible state, c = [C11, C22, C12], to second order, and the
+/// uniaxial energy φ(μ) = W_UT(√μ) that wrinkling relaxes to. Every [`MembraneLaw`] is one
+/// (analytic in W1, W2, W11, W12, W22); so is a law given by its principal stresses
+/// ([`crate::principal::PrincipalStresses`], e.g. Ogden).
+pub trait SheetLaw {
+    /// (∂w/∂c, ∂²w/∂c²), MPa.
+    fn energy_derivatives(&self, c: &Voigt) -> Result<(Voigt, Matrix3), PointFailure>;
+    /// (φ'(μ), φ''(μ)), MPa, μ = λ² of uniaxial tension.
+    fn uniaxial_energy_derivatives_mpa(&self, mu: f64) -> Option<(f64, f64)>;
+}
+
+impl<T: MembraneLaw + ?Sized> SheetLaw for T {
+    fn energy_derivatives(&self, c: &Voigt) -> Result<(Voigt, Matrix3), PointFailure> {
+        crate::constitutive::invariant_energy_jet(self, c).map(|jet| (jet.gradient, jet.hessian))
+    }
+
+    fn uniaxial_energy_derivatives_mpa(&self, mu: f64) -> Option<(f64, f64)> {
+        crate::wrinkling::invariant_uniaxial_derivatives(self, mu)
     }
 }
 

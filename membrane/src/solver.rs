@@ -10,7 +10,7 @@ use crate::assembly::{Evaluation, FailureAt, Membrane};
 use crate::boundary::Clamp;
 use crate::constitutive::{PointFailure, StateCount};
 use crate::error::SolveError;
-use crate::law::MembraneLaw;
+use crate::law::SheetLaw;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{CreationError, SparseColMat, Triplet};
@@ -95,7 +95,7 @@ enum Failure {
     Factorisation(CreationError),
 }
 
-struct Solver<'m, 'a, L: MembraneLaw + ?Sized> {
+struct Solver<'m, 'a, L: SheetLaw + ?Sized> {
     membrane: &'m Membrane<'a, L>,
     clamps: &'m [Clamp],
     settings: NewtonSettings,
@@ -106,7 +106,7 @@ struct Solver<'m, 'a, L: MembraneLaw + ?Sized> {
 }
 
 /// Solves the clamped sheet up to load factor 1: its equilibrium there, or why it stopped.
-pub fn solve<L: MembraneLaw + ?Sized>(
+pub fn solve<L: SheetLaw + ?Sized>(
     membrane: &Membrane<'_, L>,
     clamps: &[Clamp],
     settings: NewtonSettings,
@@ -128,7 +128,7 @@ pub struct Outcome {
 
 /// [`solve`], keeping the last converged equilibrium when the load stops on the way; an error
 /// only for clamps that cannot be applied.
-pub fn solve_until_stopped<L: MembraneLaw + ?Sized>(
+pub fn solve_until_stopped<L: SheetLaw + ?Sized>(
     membrane: &Membrane<'_, L>,
     clamps: &[Clamp],
     settings: NewtonSettings,
@@ -166,7 +166,7 @@ fn norm(v: impl Iterator<Item = f64>) -> f64 {
     v.map(|x| x * x).sum::<f64>().sqrt()
 }
 
-impl<L: MembraneLaw + ?Sized> Solver<'_, '_, L> {
+impl<L: SheetLaw + ?Sized> Solver<'_, '_, L> {
     fn run(&mut self) -> Outcome {
         let mut u = vec![0.0; self.free.len()];
         let mut converged = 0.0;

@@ -10,10 +10,10 @@
 //! I2 = 1/μ + 2 μ^(1/2).
 
 use crate::constitutive::{combine, outer, Jet, Voigt};
-use crate::law::MembraneLaw;
+use crate::law::{MembraneLaw, SheetLaw};
 
 /// Major eigenvalue μ1 of C as a jet in c = [C11, C22, C12]; `None` at equal eigenvalues.
-fn major_eigenvalue_jet(c: &Voigt) -> Option<Jet> {
+pub(crate) fn major_eigenvalue_jet(c: &Voigt) -> Option<Jet> {
     let d = 0.5 * (c[0] - c[1]);
     let r = (d * d + c[2] * c[2]).sqrt();
     if r.is_nan() || r <= 0.0 {
@@ -34,8 +34,11 @@ fn major_eigenvalue_jet(c: &Voigt) -> Option<Jet> {
     })
 }
 
-/// φ'(μ) and φ''(μ), MPa.
-fn uniaxial_derivatives<L: MembraneLaw + ?Sized>(law: &L, mu: f64) -> Option<(f64, f64)> {
+/// φ'(μ) and φ''(μ) of an invariant law, MPa.
+pub(crate) fn invariant_uniaxial_derivatives<L: MembraneLaw + ?Sized>(
+    law: &L,
+    mu: f64,
+) -> Option<(f64, f64)> {
     let root = mu.sqrt();
     let (i1, i2) = (mu + 2.0 / root, 1.0 / mu + 2.0 * root);
     let (w1, w2) = law.first_derivatives_mpa(i1, i2)?;
@@ -52,9 +55,9 @@ fn uniaxial_derivatives<L: MembraneLaw + ?Sized>(law: &L, mu: f64) -> Option<(f6
 }
 
 /// The relaxed energy's jet in c (gradient and Hessian; the value is not needed).
-pub(crate) fn relaxed_energy_jet<L: MembraneLaw + ?Sized>(law: &L, c: &Voigt) -> Option<Jet> {
+pub(crate) fn relaxed_energy_jet<L: SheetLaw + ?Sized>(law: &L, c: &Voigt) -> Option<Jet> {
     let mu = major_eigenvalue_jet(c)?;
-    let (d1, d2) = uniaxial_derivatives(law, mu.value)?;
+    let (d1, d2) = law.uniaxial_energy_derivatives_mpa(mu.value)?;
     let g = mu.gradient;
     Some(Jet {
         value: f64::NAN,

@@ -6,16 +6,18 @@ mod common;
 use common::{noise, square};
 use material::InvariantLaw;
 use membrane::constitutive::{response, PointResponse};
-use membrane::{InvariantDerivatives, Membrane, MembraneLaw, MembraneState, Wrinkling};
+use membrane::{
+    InvariantDerivatives, Membrane, MembraneState, PrincipalStresses, SheetLaw, Wrinkling,
+};
 
 /// S at Green-Lagrange e = [E11, E22, 2E12].
-fn at_strain(law: &dyn MembraneLaw, e: [f64; 3], wrinkling: &Wrinkling) -> PointResponse {
+fn at_strain(law: &dyn SheetLaw, e: [f64; 3], wrinkling: &Wrinkling) -> PointResponse {
     let c = [1.0 + 2.0 * e[0], 1.0 + 2.0 * e[1], e[2]];
     response(law, &c, wrinkling).unwrap()
 }
 
 fn check_point(
-    law: &dyn MembraneLaw,
+    law: &dyn SheetLaw,
     e: [f64; 3],
     wrinkling: &Wrinkling,
     state: MembraneState,
@@ -59,15 +61,21 @@ fn point_tangent_matches_finite_differences() {
             0.05 + 0.01 * (i1 - 3.0) * (i1 - 3.0),
         ))
     });
-    let laws: [&dyn MembraneLaw; 2] = [&smactane, &coupled];
+    // Ogden (2 terms) through its principal stresses.
+    let ogden = PrincipalStresses(|l1: f64, l2: f64| {
+        let l3 = 1.0 / (l1 * l2);
+        let s = |l: f64| 0.6 * (l.powf(1.3) - l3.powf(1.3)) + 0.01 * (l.powf(5.0) - l3.powf(5.0));
+        Some([s(l1), s(l2)])
+    });
+    let laws: [&dyn SheetLaw; 3] = [&smactane, &coupled, &ogden];
     let on = Wrinkling::default();
     for law in laws {
         for e in [[0.3, 0.1, 0.2], [1.5, 0.4, -0.3], [0.05, 0.02, 0.01]] {
-            check_point(law, e, &on, MembraneState::Taut, 1e-7);
+            check_point(law, e, &on, MembraneState::Taut, 1e-6);
         }
         // Stretched along x, not enough lateral contraction allowed: wrinkled.
         for e in [[0.6, -0.3, 0.1], [2.0, -0.35, 0.2]] {
-            check_point(law, e, &on, MembraneState::Wrinkled, 1e-7);
+            check_point(law, e, &on, MembraneState::Wrinkled, 1e-6);
         }
     }
 }
@@ -149,5 +157,42 @@ fn assembled_tangent_matches_finite_differences_of_the_forces() {
             "dof {i}: K v = {} vs {fd}",
             k_v[i]
         );
+    }
+}
+
+#[test]
+fn principal_stresses_give_the_invariant_law_back() {
+    let law = InvariantLaw::smactane();
+    let by_stresses =
+        PrincipalStresses(|l1: f64, l2: f64| Some(law.in_plane_stress(l1, l2).cauchy_stress_mpa));
+    let on = Wrinkling::default();
+    // Generic, equal-stretch (the limit) and wrinkled states.
+    for e in [
+        [0.3, 0.1, 0.2],
+        [0.0, 0.0, 0.0],
+        [0.4, 0.4, 0.0],
+        [0.6, -0.3, 0.1],
+    ] {
+        let (a, b) = (at_strain(&law, e, &on), at_strain(&by_stresses, e, &on));
+        assert_eq!(a.state, b.state);
+        let scale = a
+            .tangent_mpa
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        for i in 0..3 {
+            assert!(
+                (a.stress_pk2_mpa[i] - b.stress_pk2_mpa[i]).abs() < 1e-12 * scale,
+                "{e:?}"
+            );
+            for j in 0..3 {
+                assert!(
+                    (a.tangent_mpa[i][j] - b.tangent_mpa[i][j]).abs() < 1e-6 * scale,
+                    "{e:?} D[{i}][{j}]: {} vs {}",
+                    a.tangent_mpa[i][j],
+                    b.tangent_mpa[i][j]
+                );
+            }
+        }
     }
 }
