@@ -1,6 +1,6 @@
 //! Static equilibrium of the clamped sheet: load stepping (clamp motions ramped), Newton with
 //! the consistent tangent and a backtracking line search, the load step halved when an
-//! increment fails. The stiffness of a stable hyperelastic membrane with clamps is symmetric
+//! increment fails and doubled back after two that converge. The stiffness of a stable hyperelastic membrane with clamps is symmetric
 //! positive definite, so it is factorised by `faer`'s sparse Cholesky (supernodal, fill-reducing
 //! ordering, the symbolic analysis done once per solve): a failed factorisation is the
 //! structure or the law losing stability, reported as such instead of stepping on with an
@@ -26,7 +26,8 @@ pub struct NewtonSettings {
     pub absolute_tolerance_n: f64,
     /// Initial number of equal load steps.
     pub load_steps: usize,
-    /// Halvings of a failed load step before giving up.
+    /// Halvings of the initial load step allowed: a step that fails at 1/2^cuts of the initial
+    /// one stops the load (the step grows back by doubling after two converged steps).
     pub max_step_cuts: usize,
     /// Halvings of the Newton step in the line search.
     pub line_search_halvings: usize,
@@ -170,8 +171,11 @@ impl<L: SheetLaw + ?Sized> Solver<'_, '_, L> {
     fn run(&mut self) -> Outcome {
         let mut u = vec![0.0; self.free.len()];
         let mut converged = 0.0;
-        let mut increment = 1.0 / self.settings.load_steps.max(1) as f64;
-        let mut cuts = 0;
+        let initial = 1.0 / self.settings.load_steps.max(1) as f64;
+        // The smallest step: a failure there stops the load (no creeping towards a limit).
+        let smallest = initial / 2f64.powi(self.settings.max_step_cuts.min(60) as i32);
+        let mut increment = initial;
+        let mut successes = 0;
         let mut steps = Vec::new();
         let mut forces = vec![0.0; self.free.len()];
         let mut stopped = None;
@@ -187,14 +191,20 @@ impl<L: SheetLaw + ?Sized> Solver<'_, '_, L> {
                     forces = evaluation.forces_n;
                     converged = target;
                     steps.push(record);
+                    // Two good steps in a row after a cut: the step grows back.
+                    successes += 1;
+                    if successes >= 2 && increment < initial {
+                        increment = (2.0 * increment).min(initial);
+                        successes = 0;
+                    }
                 }
-                Err(failure) if cuts >= self.settings.max_step_cuts => {
+                Err(failure) if increment <= smallest * (1.0 + 1e-9) => {
                     stopped = Some(self.error(failure, target, converged));
                     break;
                 }
                 Err(_) => {
                     increment *= 0.5;
-                    cuts += 1;
+                    successes = 0;
                 }
             }
         }
