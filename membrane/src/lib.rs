@@ -1,0 +1,35 @@
+//! Finite-element model of a thin incompressible hyperelastic sheet: plane-stress membrane,
+//! total Lagrangian, large deformation, six-node triangles (T6).
+//!
+//! Incompressibility is built into plane stress (λ3² = 1 / det C of the in-plane C): no
+//! pressure field, no locking. The law is any [`SheetLaw`]: a [`MembraneLaw`] (W1, W2 of an
+//! invariant-based potential: `material::InvariantLaw`, or a catalogue model through
+//! [`InvariantDerivatives`]) or a law by its principal stresses ([`PrincipalStresses`]: Ogden). A sheet carries no compression: tension-field relaxation
+//! ([`Wrinkling`]). The specimens of the paper are meshed in code ([`specimens`]), clamped by
+//! grips moving as rigid bodies ([`Clamp`]), and solved by Newton with line search and load
+//! stepping ([`solve`]); a failure names its state and reason ([`SolveError`]).
+//! Units: mm, N, MPa.
+
+#![forbid(unsafe_code)]
+
+pub mod assembly;
+pub mod boundary;
+pub mod constitutive;
+pub mod error;
+pub mod law;
+pub mod mesh;
+pub mod principal;
+pub mod solver;
+pub mod specimens;
+pub mod t6;
+mod wrinkling;
+
+pub use assembly::{Membrane, PointField};
+pub use boundary::{Clamp, Held, RigidMotion};
+pub use constitutive::{MembraneState, Wrinkling};
+pub use error::{GeometryError, SolveError};
+pub use law::{InvariantDerivatives, MembraneLaw, SheetLaw};
+pub use mesh::Mesh;
+pub use principal::PrincipalStresses;
+pub use solver::{solve, solve_until_stopped, Equilibrium, NewtonSettings, Outcome, StepRecord};
+pub use specimens::Specimen;
