@@ -12,7 +12,7 @@ use crate::campaign::CampaignEvent;
 use crate::session::{PeriodEvent, Session};
 use crate::strain::FieldClock;
 use iceoryx2::prelude::*;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 use wire::files::RowFile;
 use wire::rig::{RigReply, RigState};
@@ -67,20 +67,8 @@ impl RigShell {
             log_every,
         )?;
         let journal_path = journal_path(&options)?;
-        // Resume where a journal says an earlier rig of these settings had got to (before
-        // anything is published: the replay takes a fraction of a second).
         let resumed = match &journal_path {
-            Some(path) if options.strain.is_some() => {
-                refuse_strain_resume(path)?;
-                None
-            }
-            Some(path) => resume::resume(
-                &mut session,
-                path,
-                settings,
-                options.log_path.as_deref(),
-                options.exit_when_done.then_some(options.program.is_some()),
-            )?,
+            Some(path) => resume_from(&options, &mut session, path, settings)?,
             None => None,
         };
         if let Some(strain) = &options.strain {
@@ -101,19 +89,9 @@ impl RigShell {
         };
         let field_clock = FieldClock::new((10.0 * options.publish_hz).ceil() as usize);
         let mut summary = ProcessSummary::default();
-        // The log grows by whole rows; a resumed rig goes on after the rows its journal
-        // names. Only now, the role claimed: a second rig refused at the claim has written
-        // nothing.
         let was_resumed = resumed.is_some();
-        let log_finding = resumed.and_then(|r| r.log.map(|finding| (finding, r.rows_logged)));
-        let log = match (&options.log_path, log_finding) {
-            (Some(path), Some((finding, rows_logged))) => {
-                summary.rows_logged = rows_logged;
-                Some(resume::reopen_log(path, finding)?)
-            }
-            (Some(path), None) => Some(RowFile::create(path, &crate::log::csv_header())?),
-            (None, _) => None,
-        };
+        // Only now, the role claimed: a second rig refused at the claim has written nothing.
+        let log = open_log(&options, resumed, &mut summary)?;
         say_ready(&port, &session, was_resumed);
         summary.samples_published = session.periods;
         let started = Instant::now();
@@ -372,6 +350,46 @@ fn journal_path(options: &ProcessOptions) -> Result<Option<PathBuf>, ProcessErro
         reason,
     })?;
     Ok(Some(dir.join(crate::journal::FILE_NAME)))
+}
+
+/// Resumes where a journal says an earlier rig of these settings had got to (before anything
+/// is published: the replay takes a fraction of a second); a strain-controlled rig refuses to.
+fn resume_from(
+    options: &ProcessOptions,
+    session: &mut Session,
+    journal: &Path,
+    settings: u64,
+) -> Result<Option<resume::Resumed>, ProcessError> {
+    if options.strain.is_some() {
+        refuse_strain_resume(journal)?;
+        return Ok(None);
+    }
+    resume::resume(
+        session,
+        journal,
+        settings,
+        options.log_path.as_deref(),
+        options.exit_when_done.then_some(options.program.is_some()),
+    )
+}
+
+/// The log, which grows by whole rows: a resumed rig's reopened after the rows its journal
+/// names (counted in `summary`), else a new one; None without a log path.
+fn open_log(
+    options: &ProcessOptions,
+    resumed: Option<resume::Resumed>,
+    summary: &mut ProcessSummary,
+) -> Result<Option<RowFile>, ProcessError> {
+    let Some(path) = &options.log_path else {
+        return Ok(None);
+    };
+    match resumed.and_then(|r| r.log.map(|finding| (finding, r.rows_logged))) {
+        Some((finding, rows_logged)) => {
+            summary.rows_logged = rows_logged;
+            Ok(Some(resume::reopen_log(path, finding)?))
+        }
+        None => Ok(Some(RowFile::create(path, &crate::log::csv_header())?)),
+    }
 }
 
 /// The `rig/command` server.
