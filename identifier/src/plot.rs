@@ -71,20 +71,9 @@ pub fn chart(
     series: &[Series],
 ) -> Result<(), PlotError> {
     let err = |e: &dyn std::fmt::Display| PlotError(format!("{}: {e}", path.display()));
-    let finite = series
-        .iter()
-        .flat_map(|s| s.points.iter())
-        .filter(|p| p.0.is_finite() && p.1.is_finite());
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y) in finite {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    if x0 >= x1 || y0 > y1 {
+    let Some((x0, x1, y0, y1)) = bounds(series) else {
         return Err(PlotError(format!("{}: nothing to plot", path.display())));
-    }
+    };
     let pad = 0.05 * (y1 - y0).max(1e-9);
     let text = text_available();
     // Drawn in memory, then encoded and written atomically: a full disk leaves no partial or
@@ -158,10 +147,31 @@ pub fn chart(
         }
         root.present().map_err(|e| err(&e))?;
     }
+    write_png(path, &rgb)
+}
+
+/// The finite points' (x0, x1, y0, y1); None when they span no x range.
+fn bounds(series: &[Series]) -> Option<(f64, f64, f64, f64)> {
+    let finite = series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| p.0.is_finite() && p.1.is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in finite {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    (x0 < x1 && y0 <= y1).then_some((x0, x1, y0, y1))
+}
+
+/// The RGB image encoded as a PNG and written atomically at `path`.
+fn write_png(path: &Path, rgb: &[u8]) -> Result<(), PlotError> {
     let mut png = Vec::new();
     image::ImageEncoder::write_image(
         image::codecs::png::PngEncoder::new(&mut png),
-        &rgb,
+        rgb,
         SIZE_PX.0,
         SIZE_PX.1,
         image::ExtendedColorType::Rgb8,
