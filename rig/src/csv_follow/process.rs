@@ -4,9 +4,9 @@
 //! truncations and rotations. The only IPC of the follower.
 
 use super::clock::{rig_state, MachineClock};
-use super::{CsvColumns, CsvError, FileTail, Follower, LineEvent, TailRead};
+use super::{CsvColumns, CsvError, FileTail, Follower, LineEvent, Row, TailRead};
 use crate::process::StatePort;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime};
 
 /// Malformed lines reported one by one; later ones are counted only.
@@ -115,33 +115,7 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
             }
             TailRead::Appended { bytes, modified: m } => {
                 modified = Some(m);
-                for event in follower
-                    .feed(&bytes)
-                    .map_err(|e| FollowError::columns(&path, e))?
-                {
-                    match event {
-                        LineEvent::Header => eprintln!(
-                            "rig: following {} (columns {})",
-                            path.display(),
-                            follower.layout().map_or(String::new(), |l| l.describe())
-                        ),
-                        LineEvent::Row(row) => batch.push(row),
-                        LineEvent::Malformed { line_no, text, why } => {
-                            summary.malformed = follower.counters.malformed;
-                            if summary.malformed <= MALFORMED_REPORTED {
-                                eprintln!(
-                                    "rig: {} line {line_no} skipped: {why}: {text:?}{}",
-                                    path.display(),
-                                    if summary.malformed == MALFORMED_REPORTED {
-                                        " (further malformed lines are counted only)"
-                                    } else {
-                                        ""
-                                    }
-                                );
-                            }
-                        }
-                    }
-                }
+                feed(&mut follower, &bytes, &path, &mut summary, &mut batch)?;
             }
         }
         if !ready {
@@ -155,17 +129,7 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
                 .map_or(0, |d| d.as_nanos() as u64);
             clock.anchor(last.t_s, wire::monotonic_ns(), age_ns);
         }
-        for row in &batch {
-            let host_ns = clock.host_ns(row.t_s).expect("anchored above");
-            publisher.publish(rig_state(
-                row,
-                summary.rows_published,
-                host_ns,
-                options.offset_s,
-                options.sections_mm2,
-            ))?;
-            summary.rows_published += 1;
-        }
+        publish(&publisher, &batch, &clock, &options, &mut summary)?;
         if !batch.is_empty() {
             last_row_at = Instant::now();
         }
@@ -183,4 +147,65 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
     }
     summary.malformed = follower.counters.malformed;
     Ok(summary)
+}
+
+/// The events of newly appended bytes: rows into `batch`, the header and the malformed lines
+/// reported (the first [`MALFORMED_REPORTED`], then counted only).
+fn feed(
+    follower: &mut Follower,
+    bytes: &[u8],
+    path: &Path,
+    summary: &mut FollowSummary,
+    batch: &mut Vec<Row>,
+) -> Result<(), FollowError> {
+    for event in follower
+        .feed(bytes)
+        .map_err(|e| FollowError::columns(path, e))?
+    {
+        match event {
+            LineEvent::Header => eprintln!(
+                "rig: following {} (columns {})",
+                path.display(),
+                follower.layout().map_or(String::new(), |l| l.describe())
+            ),
+            LineEvent::Row(row) => batch.push(row),
+            LineEvent::Malformed { line_no, text, why } => {
+                summary.malformed = follower.counters.malformed;
+                if summary.malformed <= MALFORMED_REPORTED {
+                    eprintln!(
+                        "rig: {} line {line_no} skipped: {why}: {text:?}{}",
+                        path.display(),
+                        if summary.malformed == MALFORMED_REPORTED {
+                            " (further malformed lines are counted only)"
+                        } else {
+                            ""
+                        }
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One `rig/state` sample per row, on the host clock.
+fn publish(
+    publisher: &wire::pubsub::ValuePublisher<wire::rig::RigState>,
+    batch: &[Row],
+    clock: &MachineClock,
+    options: &FollowOptions,
+    summary: &mut FollowSummary,
+) -> Result<(), FollowError> {
+    for row in batch {
+        let host_ns = clock.host_ns(row.t_s).expect("anchored above");
+        publisher.publish(rig_state(
+            row,
+            summary.rows_published,
+            host_ns,
+            options.offset_s,
+            options.sections_mm2,
+        ))?;
+        summary.rows_published += 1;
+    }
+    Ok(())
 }
