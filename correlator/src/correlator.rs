@@ -3,10 +3,12 @@
 //! of failed nodes in `growth.rs`, IC-GN in `icgn_stage.rs`, the followed mesh at a reference
 //! update in `followed.rs`, measurements against the origin in `reanchor.rs`.
 
+mod assemble;
 mod followed;
 mod growth;
 mod guess;
 mod icgn_stage;
+mod parts;
 mod reanchor;
 
 use crate::field::{Field, Node, NodeStatus};
@@ -14,14 +16,15 @@ use crate::global::GlobalCorrelator;
 use crate::icgn::bspline::Coefficients;
 use crate::icgn::subset::SubsetStats;
 use crate::interpolate::{identity_plus, Mat2};
-use crate::keypoints::{KeypointMatcher, KeypointSet};
+use crate::keypoints::KeypointMatcher;
 use crate::mesh::Mesh;
 use crate::pool::{Pool, SharedSlice};
 use crate::settings::{CorrelatorSettings, GuessMode, Roi, SettingsError};
-use crate::strain::{gauge, node_strains_and_gradients, strains_from_gradients, AffineSums};
+use crate::strain::AffineSums;
 use crate::zoi::{
     spectrum_len, GradientSensitivity, Image, SubpixelIterations, TimeSplit, ZoiResult,
 };
+use parts::{FrameResults, History, Origin, Reference, Scratch};
 use rustfft::num_complex::Complex32;
 
 /// Per-node state of the current reference image.
@@ -169,77 +172,31 @@ pub struct Correlator {
     /// IC-GN: the B-spline coefficients of the image being correlated (the reference's while
     /// a reference is prepared), made in `new`.
     coefficients: Option<Coefficients>,
-    /// IC-GN: the B-spline coefficients of the origin (the frame the mesh was defined in),
-    /// while it is known, for the measurements against it (`reanchor`).
-    origin_coefficients: Option<Coefficients>,
-    /// IC-GN: per node, the reference subset's f̂, ∂f̂/∂x, ∂f̂/∂y (3 n² values) and constants.
-    subset_planes: Vec<f32>,
-    subset_stats: Vec<SubsetStats>,
-    /// IC-GN: each node's gradient against the current reference in the last frame (the next
-    /// frame's guess), None when unknown.
-    previous_gradient: Vec<Option<Mat2>>,
     /// The prefilter's time, for the time split (profiling only).
     profiling: bool,
     coefficients_ns: u64,
     mesh: Mesh,
     pool: Pool,
     global: GlobalCorrelator,
-    /// The global correlator's reference is older than `reference_pixels` (it is renewed
-    /// only when a frame needs the global displacement).
-    global_reference_stale: bool,
-    reference_pixels: Vec<u16>,
-    has_reference: bool,
-    ref_nodes: Vec<RefNode>,
-    plain_spectra: Vec<Complex32>,
-    /// Windowed, normalised reference ZOIs (n² per node, spatial).
-    windowed_references: Vec<f32>,
-    /// Per node, how its rigid estimate shifts under a displacement gradient.
-    sensitivities: Vec<GradientSensitivity>,
-    /// Initial guess per node against the current reference (px).
-    guesses: Vec<(f64, f64)>,
-    results: Vec<ZoiResult>,
-    /// Total displacement of the previous frame, for the predictor (None = no usable value).
-    previous: Vec<Option<(f64, f64)>>,
-    /// The same one frame earlier: with `previous`, the node's velocity per frame.
-    previous2: Vec<Option<(f64, f64)>>,
-    has_previous: bool,
-    /// Nodes found inconsistent with their neighbours in this frame (scratch).
-    outliers: Vec<bool>,
-    /// Each node's distance to the affine fit of its neighbours (scratch, NaN: no fit).
-    residuals: Vec<f64>,
-    /// Nodes valid in every frame since the reference sequence began: they measure their own
-    /// material. A node that failed once was carried by an extrapolation since, and may be
-    /// off by that extrapolation's error (it follows whatever material it came back on).
-    never_lost: Vec<bool>,
-    /// Nodes correlated a second time in this frame (scratch, capacity: every node).
-    retry: Vec<usize>,
-    /// Scores of the valid nodes (scratch for their median, capacity: every node).
-    scores: Vec<f64>,
-    field: Field,
-    scratch_pairs: Vec<(f64, f64)>,
-    frames_since_reference: u64,
-    /// The final check of each node's result (ZNCC, see `verify`), 0 when unchecked.
-    zncc: Vec<f64>,
-    /// Nodes to correlate again (growth, keypoints, refinement; capacity: every node).
-    entries: Vec<Entry>,
-    /// Verified neighbours a node had when growth last tried it (it is tried again only
-    /// when it has more).
-    grown_from: Vec<u8>,
     /// Made on first need (a reference whose cheaper guesses did not verify).
     keypoint_matcher: Option<KeypointMatcher>,
-    /// The current reference's keypoints, detected on first need.
-    reference_keypoints: Option<KeypointSet>,
-    /// The image the mesh was defined in (given to `set_reference`), while known, and whether
-    /// the current reference is still that image (see `reanchor`).
-    origin_pixels: Vec<u16>,
-    origin_known: bool,
-    reference_is_origin: bool,
+    reference: Reference,
+    /// The frame the mesh was defined in, while this correlator knows it.
+    origin: Option<Origin>,
     /// Counts the origins this correlator has had (the state folder rewrites its copy when it
     /// changes).
     origin_generation: u64,
-    /// Results of the returned nodes measured against the origin (scratch, capacity: every
-    /// node).
-    reanchored: Vec<(ZoiResult, f64)>,
+    history: History,
+    frame: FrameResults,
+    scratch: Scratch,
+    field: Field,
+}
+
+/// The reference image, which every correlation after the first `set_reference` has.
+fn reference_pixels(pixels: &Option<Vec<u16>>) -> &[u16] {
+    pixels
+        .as_deref()
+        .expect("a reference is set before correlating")
 }
 
 impl Correlator {
@@ -285,43 +242,29 @@ impl Correlator {
             fft_px,
             fft_pad_px: (settings.zoi_px - fft_px) / 2,
             coefficients: icgn.then(|| Coefficients::new(width_px, height_px)),
-            origin_coefficients: icgn.then(|| Coefficients::new(width_px, height_px)),
-            subset_planes: vec![0.0; nodes * subset_values],
-            subset_stats: vec![SubsetStats::default(); if icgn { nodes } else { 0 }],
-            previous_gradient: vec![None; nodes],
             profiling: false,
             coefficients_ns: 0,
             global: GlobalCorrelator::new(roi),
-            global_reference_stale: true,
-            reference_pixels: vec![0; width_px * height_px],
-            has_reference: false,
-            ref_nodes,
-            plain_spectra: vec![zero; nodes * n2],
-            windowed_references: vec![0.0; nodes * fft_px * fft_px],
-            sensitivities: vec![GradientSensitivity::default(); nodes],
-            guesses: vec![(0.0, 0.0); nodes],
-            results: vec![ZoiResult::default(); nodes],
-            previous: vec![None; nodes],
-            previous2: vec![None; nodes],
-            has_previous: false,
-            outliers: vec![false; nodes],
-            residuals: vec![0.0; nodes],
-            never_lost: vec![true; nodes],
-            retry: Vec::with_capacity(nodes),
-            scores: Vec::with_capacity(nodes),
-            field,
-            scratch_pairs: vec![(0.0, 0.0); nodes],
-            frames_since_reference: 0,
-            zncc: vec![0.0; nodes],
-            entries: Vec::with_capacity(nodes),
-            grown_from: vec![0; nodes],
             keypoint_matcher: None,
-            reference_keypoints: None,
-            origin_pixels: vec![0; width_px * height_px],
-            origin_known: false,
-            reference_is_origin: true,
+            reference: Reference {
+                pixels: None,
+                nodes: ref_nodes,
+                plain_spectra: vec![zero; nodes * n2],
+                windowed: vec![0.0; nodes * fft_px * fft_px],
+                sensitivities: vec![GradientSensitivity::default(); nodes],
+                subset_planes: vec![0.0; nodes * subset_values],
+                subset_stats: vec![SubsetStats::default(); if icgn { nodes } else { 0 }],
+                keypoints: None,
+                global_stale: true,
+                frames_since: 0,
+                is_origin: true,
+            },
+            origin: None,
             origin_generation: 0,
-            reanchored: Vec::with_capacity(nodes),
+            history: History::new(nodes),
+            frame: FrameResults::new(nodes),
+            scratch: Scratch::new(nodes),
+            field,
             settings,
             width_px,
             height_px,
@@ -366,20 +309,15 @@ impl Correlator {
     /// the nodes' initial positions and previous fields are forgotten.
     pub fn set_reference(&mut self, pixels: &[u16]) -> Result<(), SettingsError> {
         self.check_size("reference", pixels)?;
-        for (k, r) in self.ref_nodes.iter_mut().enumerate() {
+        for (k, r) in self.reference.nodes.iter_mut().enumerate() {
             *r = RefNode {
                 top_left: self.mesh.top_left[k],
                 ..RefNode::default()
             };
         }
-        self.previous.fill(None);
-        self.previous2.fill(None);
-        self.has_previous = false;
-        self.never_lost.fill(true);
-        self.origin_pixels.copy_from_slice(pixels);
-        self.origin_known = true;
-        self.reference_is_origin = true;
-        self.origin_generation += 1;
+        self.history.restart();
+        self.set_origin_pixels(pixels);
+        self.reference.is_origin = true;
         self.take_reference(pixels, false);
         self.origin_coefficients_from_reference();
         Ok(())
@@ -392,17 +330,17 @@ impl Correlator {
 
     /// The current reference image (row-major), or None before the first reference.
     pub fn reference_pixels(&self) -> Option<&[u16]> {
-        self.has_reference
-            .then_some(self.reference_pixels.as_slice())
+        self.reference.pixels.as_deref()
     }
 
     /// Nodes of the current reference that have enough texture to be correlated (0 for a flat
     /// image, or before the first reference).
     pub fn reference_textured_nodes(&self) -> usize {
-        if !self.has_reference {
+        if self.reference.pixels.is_none() {
             return 0;
         }
-        self.ref_nodes
+        self.reference
+            .nodes
             .iter()
             .filter(|r| r.status == NodeStatus::Ok)
             .count()
@@ -414,7 +352,7 @@ impl Correlator {
     /// everything [`Correlator::restore_reference`] needs to resume measuring the same total
     /// displacement in another process.
     pub fn reference_base_px(&self) -> impl ExactSizeIterator<Item = (f64, f64)> + '_ {
-        self.ref_nodes.iter().map(|r| r.base_px)
+        self.reference.nodes.iter().map(|r| r.base_px)
     }
 
     /// Resumes against a saved reference: its pixels and the per-node base displacements read
@@ -428,10 +366,10 @@ impl Correlator {
         base_px: &[(f64, f64)],
     ) -> Result<(), SettingsError> {
         self.check_size("reference", pixels)?;
-        if base_px.len() != self.ref_nodes.len() {
+        if base_px.len() != self.reference.nodes.len() {
             return Err(SettingsError::BaseLength {
                 got: base_px.len(),
-                expected: self.ref_nodes.len(),
+                expected: self.reference.nodes.len(),
             });
         }
         if let Some(k) = base_px
@@ -440,31 +378,28 @@ impl Correlator {
         {
             return Err(SettingsError::BaseNotFinite { node: k });
         }
-        for ((k, r), &base) in self.ref_nodes.iter_mut().enumerate().zip(base_px) {
+        for ((k, r), &base) in self.reference.nodes.iter_mut().enumerate().zip(base_px) {
             *r = RefNode {
                 top_left: self.mesh.top_left[k],
                 base_px: base,
                 ..RefNode::default()
             };
         }
-        self.previous.fill(None);
-        self.previous2.fill(None);
-        self.has_previous = false;
-        self.never_lost.fill(true);
+        self.history.restart();
         // The saved state holds the current reference, not the frame the mesh was defined in
         // (unless they are the same: every base is zero).
-        self.reference_is_origin = base_px.iter().all(|&b| b == (0.0, 0.0));
-        self.origin_known = self.reference_is_origin;
-        if self.origin_known {
-            self.origin_pixels.copy_from_slice(pixels);
-            self.origin_generation += 1;
+        self.reference.is_origin = base_px.iter().all(|&b| b == (0.0, 0.0));
+        if self.reference.is_origin {
+            self.set_origin_pixels(pixels);
+        } else {
+            self.origin = None;
         }
         // The gradient at each base: the least-squares fit of the saved bases around it.
-        for k in 0..self.ref_nodes.len() {
-            self.ref_nodes[k].base_gradient = self.base_fit_gradient(k);
+        for k in 0..self.reference.nodes.len() {
+            self.reference.nodes[k].base_gradient = self.base_fit_gradient(k);
         }
         self.take_reference(pixels, false);
-        if self.reference_is_origin {
+        if self.reference.is_origin {
             self.origin_coefficients_from_reference();
         }
         Ok(())
@@ -474,7 +409,7 @@ impl Correlator {
     /// correlator knows it: a correlator restored from a saved reference knows it only when
     /// that reference is the origin or [`Correlator::restore_origin`] gave it back.
     pub fn origin_pixels(&self) -> Option<&[u16]> {
-        self.origin_known.then_some(self.origin_pixels.as_slice())
+        self.origin.as_ref().map(|origin| origin.pixels.as_slice())
     }
 
     /// Changes whenever the origin changes (a new `set_reference`).
@@ -486,14 +421,31 @@ impl Correlator {
     /// reference), so that its bases are measured against it again at reference updates.
     pub fn restore_origin(&mut self, pixels: &[u16]) -> Result<(), SettingsError> {
         self.check_size("origin", pixels)?;
-        self.origin_pixels.copy_from_slice(pixels);
-        self.origin_known = true;
-        self.origin_generation += 1;
-        if let Some(mut origin) = self.origin_coefficients.take() {
-            self.prefilter_into(&mut origin, pixels);
-            self.origin_coefficients = Some(origin);
+        self.set_origin_pixels(pixels);
+        let origin = self.origin.as_mut().and_then(|o| o.coefficients.take());
+        if let Some(mut coefficients) = origin {
+            self.prefilter_into(&mut coefficients, pixels);
+            if let Some(origin) = &mut self.origin {
+                origin.coefficients = Some(coefficients);
+            }
         }
         Ok(())
+    }
+
+    /// A new origin: its pixels (into the buffers of the last one when there was one), its
+    /// B-spline coefficients still to be computed by the caller.
+    fn set_origin_pixels(&mut self, pixels: &[u16]) {
+        match &mut self.origin {
+            Some(origin) => origin.pixels.copy_from_slice(pixels),
+            None => {
+                let icgn = self.settings.method.is_icgn();
+                self.origin = Some(Origin {
+                    pixels: pixels.to_vec(),
+                    coefficients: icgn.then(|| Coefficients::new(self.width_px, self.height_px)),
+                });
+            }
+        }
+        self.origin_generation += 1;
     }
 
     /// Copies the pixels as the current reference and prepares the spectra (and IC-GN subsets)
@@ -501,17 +453,20 @@ impl Correlator {
     /// `coefficients_hold_pixels`: the B-spline coefficients are already those of `pixels`
     /// (the frame just correlated becomes the reference).
     fn take_reference(&mut self, pixels: &[u16], coefficients_hold_pixels: bool) {
-        self.reference_pixels.copy_from_slice(pixels);
-        self.previous_gradient.fill(None);
+        match &mut self.reference.pixels {
+            Some(reference) => reference.copy_from_slice(pixels),
+            None => self.reference.pixels = Some(pixels.to_vec()),
+        }
+        self.history.gradients.fill(None);
         let n = self.settings.zoi_px;
         let (fft, pad) = (self.fft_px, self.fft_pad_px);
         let half = (n as f64 - 1.0) / 2.0;
         let image = Image {
-            pixels: &self.reference_pixels,
+            pixels: reference_pixels(&self.reference.pixels),
             width_px: self.width_px,
             height_px: self.height_px,
         };
-        for (k, r) in self.ref_nodes.iter_mut().enumerate() {
+        for (k, r) in self.reference.nodes.iter_mut().enumerate() {
             let (x, y) = (
                 self.field.nodes[k].x_px + r.base_px.0,
                 self.field.nodes[k].y_px + r.base_px.1,
@@ -525,13 +480,13 @@ impl Correlator {
                 r.status = NodeStatus::OutsideImage;
             }
         }
-        self.global_reference_stale = true;
-        self.reference_keypoints = None;
+        self.reference.global_stale = true;
+        self.reference.keypoints = None;
         let n2 = spectrum_len(fft);
-        let plain = SharedSlice::new(&mut self.plain_spectra);
-        let windowed = SharedSlice::new(&mut self.windowed_references);
-        let sensitivities = SharedSlice::new(&mut self.sensitivities);
-        let ref_nodes = SharedSlice::new(&mut self.ref_nodes);
+        let plain = SharedSlice::new(&mut self.reference.plain_spectra);
+        let windowed = SharedSlice::new(&mut self.reference.windowed);
+        let sensitivities = SharedSlice::new(&mut self.reference.sensitivities);
+        let ref_nodes = SharedSlice::new(&mut self.reference.nodes);
         self.pool.run(self.mesh.len(), &|engine, k| {
             // SAFETY: item k touches only node k's slots.
             let mut r = unsafe { ref_nodes.read(k) };
@@ -555,14 +510,13 @@ impl Correlator {
             }
             self.prepare_subsets();
         }
-        self.has_reference = true;
-        self.frames_since_reference = 0;
+        self.reference.frames_since = 0;
     }
 
     /// Correlates one deformed image against the current reference and returns the field.
     pub fn correlate(&mut self, pixels: &[u16]) -> Result<&Field, SettingsError> {
         self.check_size("deformed", pixels)?;
-        if !self.has_reference {
+        if self.reference.pixels.is_none() {
             return Err(SettingsError::NoReference);
         }
         let image = Image {
@@ -588,169 +542,11 @@ impl Correlator {
         Ok(&self.field)
     }
 
-    /// Results (against the current reference, at the ZOI centres) to total displacements at
-    /// the followed nodes, then strains and gauge.
-    fn assemble(&mut self, image: Image) {
-        let (nx, ny) = (self.mesh.nx, self.mesh.ny);
-        // First-order corrections with the local gradient ∇u of the results: the rigid ZOI's
-        // estimate is u(centre) + K vec(∇u) (see `GradientSensitivity`), and the followed
-        // point is off the ZOI centre by r: u(x + r) ≈ u(x) + ∇u r.
-        // IC-GN measures the subset centre through its own gradient: no rigid-ZOI bias, and
-        // its own gradient carries the followed point.
-        let icgn = self.settings.method.is_icgn();
-        let correct_gradient = self.settings.gradient_correction && !icgn;
-        for k in 0..nx * ny {
-            let r = self.ref_nodes[k];
-            let result = self.results[k];
-            let mut u = (result.u_px, result.v_px);
-            if result.status == NodeStatus::Ok {
-                let gradient = if icgn {
-                    let g = result.warp_gradient;
-                    Some(nalgebra::Matrix2::new(g[0][0], g[0][1], g[1][0], g[1][1]))
-                } else {
-                    self.result_gradient(k)
-                };
-                if let Some(g) = gradient {
-                    if correct_gradient {
-                        // A warped ZOI is biased only by the gradient beyond its warp.
-                        let bias = self.sensitivities[k]
-                            .bias_px(difference(to_mat2(g), result.warp_gradient));
-                        u.0 -= bias.0;
-                        u.1 -= bias.1;
-                    }
-                    u.0 += g[(0, 0)] * r.offset_px.0 + g[(0, 1)] * r.offset_px.1;
-                    u.1 += g[(1, 0)] * r.offset_px.0 + g[(1, 1)] * r.offset_px.1;
-                }
-            }
-            self.scratch_pairs[k] = u;
-        }
-        for k in 0..nx * ny {
-            let r = self.ref_nodes[k];
-            let result = self.results[k];
-            let node = &mut self.field.nodes[k];
-            let ok = result.status == NodeStatus::Ok;
-            node.u_px = if ok {
-                r.base_px.0 + self.scratch_pairs[k].0
-            } else {
-                0.0
-            };
-            node.v_px = if ok {
-                r.base_px.1 + self.scratch_pairs[k].1
-            } else {
-                0.0
-            };
-            node.score = self.zncc[k];
-            node.iterations = result.iterations;
-            node.status = result.status;
-        }
-        let min_score = self.settings.min_relative_score
-            * median_ok_score(self.results.iter().copied(), &mut self.scores);
-        for (node, result) in self.field.nodes.iter_mut().zip(&self.results) {
-            if node.status == NodeStatus::Ok && result.score < min_score {
-                node.status = NodeStatus::NotConverged;
-                node.u_px = 0.0;
-                node.v_px = 0.0;
-            }
-        }
-        // A node far from what its neighbours say (a false match on other material, or a
-        // noise-driven one) is not trusted: it is marked inconsistent, so that it neither biases
-        // the strains nor moves the followed mesh onto the wrong material.
-        for k in 0..nx * ny {
-            self.residuals[k] = if self.field.nodes[k].status == NodeStatus::Ok {
-                self.affine_fit(Some(k), EXTRAPOLATION_RINGS, Some(k), Support::Valid)
-                    .map_or(f64::NAN, |fit| {
-                        let (u, v) = self.extrapolate(k, fit);
-                        let node = &self.field.nodes[k];
-                        (node.u_px - u).hypot(node.v_px - v)
-                    })
-            } else {
-                f64::NAN
-            };
-        }
-        let limit_px = median(self.residuals.iter().copied(), &mut self.scores)
-            .map_or(OUTLIER_MAX_PX, |m| {
-                (OUTLIER_SCATTER * m).clamp(OUTLIER_MIN_PX, OUTLIER_MAX_PX)
-            });
-        for (outlier, &residual) in self.outliers.iter_mut().zip(&self.residuals) {
-            *outlier = residual > limit_px;
-        }
-        for (node, _) in self
-            .field
-            .nodes
-            .iter_mut()
-            .zip(&self.outliers)
-            .filter(|(_, &outlier)| outlier)
-        {
-            node.status = NodeStatus::Inconsistent;
-            node.u_px = 0.0;
-            node.v_px = 0.0;
-        }
-        self.reanchor_returned(image);
-        let (mut valid, mut su, mut sv) = (0usize, 0.0, 0.0);
-        for node in self
-            .field
-            .nodes
-            .iter()
-            .filter(|n| n.status == NodeStatus::Ok)
-        {
-            valid += 1;
-            su += node.u_px;
-            sv += node.v_px;
-        }
-        self.field.valid = valid;
-        self.field.u_mean_px = if valid > 0 { su / valid as f64 } else { 0.0 };
-        self.field.v_mean_px = if valid > 0 { sv / valid as f64 } else { 0.0 };
-        if icgn {
-            for k in 0..nx * ny {
-                self.field.gradients[k] = if self.field.nodes[k].status == NodeStatus::Ok {
-                    compose_gradients(
-                        self.results[k].warp_gradient,
-                        self.ref_nodes[k].base_gradient,
-                    )
-                } else {
-                    [[0.0; 2]; 2]
-                };
-            }
-            strains_from_gradients(
-                &mut self.field.nodes,
-                &self.field.gradients,
-                self.settings.strain,
-            );
-        } else {
-            node_strains_and_gradients(
-                &mut self.field.nodes,
-                (nx, ny),
-                self.settings.strain_window_nodes,
-                self.settings.strain,
-                &mut self.field.gradients,
-            );
-        }
-        self.field.gauge = gauge(&self.field.nodes);
-        for (never_lost, node) in self.never_lost.iter_mut().zip(&self.field.nodes) {
-            *never_lost &= node.status == NodeStatus::Ok;
-        }
-        std::mem::swap(&mut self.previous, &mut self.previous2);
-        for (p, node) in self.previous.iter_mut().zip(&self.field.nodes) {
-            *p = (node.status == NodeStatus::Ok).then_some((node.u_px, node.v_px));
-        }
-        if icgn {
-            for ((g, node), result) in self
-                .previous_gradient
-                .iter_mut()
-                .zip(&self.field.nodes)
-                .zip(&self.results)
-            {
-                *g = (node.status == NodeStatus::Ok).then_some(result.warp_gradient);
-            }
-        }
-        self.has_previous = true;
-    }
-
     /// Least-squares gradient of the current results over the 3x3 nodes around k (ZOI centres).
     fn result_gradient(&self, k: usize) -> Option<nalgebra::Matrix2<f64>> {
         result_gradient(
-            &self.results,
-            &self.ref_nodes,
+            &self.frame.results,
+            &self.reference.nodes,
             (self.mesh.nx, self.mesh.ny),
             k,
         )

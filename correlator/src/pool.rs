@@ -4,6 +4,7 @@
 //! nothing is allocated per job or per item.
 
 use crate::zoi::ZoiEngine;
+use std::marker::PhantomData;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
@@ -187,22 +188,26 @@ impl Drop for Pool {
     }
 }
 
-/// A raw pointer that lets pool items write disjoint elements of one slice.
+/// A slice that pool items write in disjoint parts: made from a `&'a mut [T]`, which it keeps
+/// borrowed for `'a`, so the slice can be neither used nor freed while items write through it;
+/// the slices it hands out live no longer than the borrow of the `SharedSlice` they come from.
 #[derive(Clone, Copy)]
-pub struct SharedSlice<T> {
+pub struct SharedSlice<'a, T> {
     ptr: *mut T,
     len: usize,
+    borrow: PhantomData<&'a mut [T]>,
 }
 // SAFETY: users write each index from at most one item, and read only indices no item of the
-// current job writes.
-unsafe impl<T: Send> Send for SharedSlice<T> {}
-unsafe impl<T: Send> Sync for SharedSlice<T> {}
+// current job writes; the pointee is exclusively borrowed for 'a, so nothing else touches it.
+unsafe impl<T: Send> Send for SharedSlice<'_, T> {}
+unsafe impl<T: Send> Sync for SharedSlice<'_, T> {}
 
-impl<T: Copy> SharedSlice<T> {
-    pub fn new(slice: &mut [T]) -> Self {
+impl<'a, T: Copy> SharedSlice<'a, T> {
+    pub fn new(slice: &'a mut [T]) -> Self {
         Self {
             ptr: slice.as_mut_ptr(),
             len: slice.len(),
+            borrow: PhantomData,
         }
     }
     /// # Safety
@@ -210,6 +215,7 @@ impl<T: Copy> SharedSlice<T> {
     #[inline]
     pub unsafe fn write(&self, i: usize, value: T) {
         assert!(i < self.len);
+        // SAFETY: in bounds (asserted) of a slice borrowed for 'a; exclusive per the contract.
         unsafe { self.ptr.add(i).write(value) }
     }
     /// # Safety
@@ -217,23 +223,33 @@ impl<T: Copy> SharedSlice<T> {
     #[inline]
     pub unsafe fn read(&self, i: usize) -> T {
         assert!(i < self.len);
+        // SAFETY: in bounds (asserted); no concurrent write per the contract.
         unsafe { self.ptr.add(i).read() }
     }
 }
 
-impl<T> SharedSlice<T> {
+impl<'a, T> SharedSlice<'a, T> {
     /// The first element, for items that split the slice in ways `slice_mut` cannot say
-    /// (strided columns).
+    /// (strided columns). Valid while this `SharedSlice` is borrowed.
     #[inline]
     pub fn as_mut_ptr(&self) -> *mut T {
         self.ptr
     }
 
+    /// `start..start + len` of the slice, for as long as this `SharedSlice` is borrowed (never
+    /// longer than the `'a` borrow of the slice it was made from).
+    ///
     /// # Safety
     /// No other item of the running job may access `start..start + len`.
+    // Several items hold disjoint parts at once through one shared `SharedSlice`: the
+    // exclusivity `&mut` promises is the caller's contract below, as with `UnsafeCell`.
+    #[allow(clippy::mut_from_ref)]
     #[inline]
-    pub unsafe fn slice_mut<'a>(&self, start: usize, len: usize) -> &'a mut [T] {
+    pub unsafe fn slice_mut(&self, start: usize, len: usize) -> &mut [T] {
         assert!(start + len <= self.len);
+        // SAFETY: in bounds (asserted) of a slice exclusively borrowed for 'a, which outlives
+        // the borrow of `self` the result is tied to; disjoint from every other item's part
+        // per the contract.
         unsafe { std::slice::from_raw_parts_mut(self.ptr.add(start), len) }
     }
 }

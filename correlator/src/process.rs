@@ -205,53 +205,8 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
     let frames_guard = waitset.attach_notification(frames.listener())?;
 
     let mut live = Live::new(&config);
-    let starting_reference = match (saved, &config.reference) {
-        (Some(saved), reference) => {
-            let path = state.as_ref().expect("saved implies a state dir").path();
-            if let Some(image) = reference {
-                eprintln!(
-                    "correlator: resuming from {}; --reference {} ignored",
-                    path.display(),
-                    image.label
-                );
-            }
-            live.resume(&node, &saved, path)?;
-            format!(
-                "resumed {} from {}",
-                ReferenceId(Some(saved.reference_frame_id)),
-                path.display()
-            )
-        }
-        (None, Some(image)) => {
-            live.start_from_image(&node, image)?;
-            if let (Some(state), Some(correlator)) = (state.as_mut(), live.correlator.as_ref()) {
-                state.save(correlator, ReferenceIds::FROM_FILE)?;
-                live.summary.state_saves += 1;
-            }
-            format!(
-                "reference image {} ({}x{} px)",
-                image.label, image.width_px, image.height_px
-            )
-        }
-        (None, None) => "reference: the first frame".to_string(),
-    };
-    let s = &config.settings;
-    eprintln!(
-        "correlator: ready: instance {}, subscribed to '{}', publishing '{}'; ZOI {} px, step {} px, {:?} reference, {:?} guess, {} strain, {} thread(s); {starting_reference}{}",
-        instance.name(),
-        services::FRAMES.name,
-        services::FIELDS.name,
-        s.zoi_px,
-        s.step_px,
-        s.reference,
-        s.guess,
-        s.strain.name(),
-        s.threads,
-        match &config.state_dir {
-            Some(dir) => format!("; state in {}", dir.display()),
-            None => String::new(),
-        }
-    );
+    let starting_reference = start(&mut live, &node, saved, state.as_mut(), &config)?;
+    print_ready(&config, &instance, &starting_reference);
 
     let started = Instant::now();
     let mut last_activity = started;
@@ -312,6 +267,68 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
     summary.correlate_p99_ms = live.run_hist.quantile_ms(0.99);
     summary.state_saves = state.as_ref().map_or(0, |s| s.saves);
     Ok(summary)
+}
+
+/// The reference the process starts from: the state folder's (resumed), a reference image
+/// (saved to the state folder), or the first frame; said in the ready line.
+fn start(
+    live: &mut Live,
+    node: &Node<ipc::Service>,
+    saved: Option<SavedReference>,
+    mut state: Option<&mut StateDir>,
+    config: &ProcessConfig,
+) -> Result<String, ProcessError> {
+    Ok(match (saved, &config.reference) {
+        (Some(saved), reference) => {
+            let path = state.as_ref().expect("saved implies a state dir").path();
+            if let Some(image) = reference {
+                eprintln!(
+                    "correlator: resuming from {}; --reference {} ignored",
+                    path.display(),
+                    image.label
+                );
+            }
+            live.resume(node, &saved, path)?;
+            format!(
+                "resumed {} from {}",
+                ReferenceId(Some(saved.reference_frame_id)),
+                path.display()
+            )
+        }
+        (None, Some(image)) => {
+            live.start_from_image(node, image)?;
+            if let (Some(state), Some(correlator)) = (state.as_mut(), live.correlator.as_ref()) {
+                state.save(correlator, ReferenceIds::FROM_FILE)?;
+                live.summary.state_saves += 1;
+            }
+            format!(
+                "reference image {} ({}x{} px)",
+                image.label, image.width_px, image.height_px
+            )
+        }
+        (None, None) => "reference: the first frame".to_string(),
+    })
+}
+
+/// The ready line: the services, the settings, where the reference comes from.
+fn print_ready(config: &ProcessConfig, instance: &Instance, starting_reference: &str) {
+    let s = &config.settings;
+    eprintln!(
+        "correlator: ready: instance {}, subscribed to '{}', publishing '{}'; ZOI {} px, step {} px, {:?} reference, {:?} guess, {} strain, {} thread(s); {starting_reference}{}",
+        instance.name(),
+        services::FRAMES.name,
+        services::FIELDS.name,
+        s.zoi_px,
+        s.step_px,
+        s.reference,
+        s.guess,
+        s.strain.name(),
+        s.threads,
+        match &config.state_dir {
+            Some(dir) => format!("; state in {}", dir.display()),
+            None => String::new(),
+        }
+    );
 }
 
 type FieldPublisher = SlicePublisher<FieldNode, FieldHeader>;
@@ -454,9 +471,48 @@ impl Live {
             self.reject(header.frame_id, &reason);
             return Ok(());
         }
-        let (w, h) = (header.width_px as usize, header.height_px as usize);
-        let mut new_reference = false;
-        // A new frame sequence (the next test, a new specimen) starts from a new reference.
+        self.check_sequence(&header);
+        let Some(mut new_reference) = self.ready_reference(node, &header, pixels)? else {
+            return Ok(());
+        };
+        let correlator = self.correlator.as_mut().expect("made above");
+        let reference_frame_id = self.reference_frame_id.expect("set with the correlator");
+        let t = Instant::now();
+        correlator.correlate(pixels)?;
+        let correlate_ns = t.elapsed().as_nanos() as u64;
+        self.warn_few_valid(header.frame_id);
+        // The frame is no longer needed: the correlator copied it if it became the reference.
+        drop(sample);
+        self.run_hist.record_ns(correlate_ns);
+        self.window_hist.record_ns(correlate_ns);
+        self.summary.frames_correlated += 1;
+        if self.field().reference_updated {
+            self.reference_frame_id = Some(header.frame_id);
+            new_reference = true;
+        }
+        self.summary.reference_frame_id = self.reference_frame_id;
+        // Saved before the field goes out: whoever sees field k may rely on the state folder
+        // holding the reference that field k left behind.
+        if let (true, Some(state)) = (new_reference, state) {
+            self.save_reference(state)?;
+        }
+        let times = FieldTimes {
+            reference_frame_id,
+            origin_frame_id: self.origin_frame_id,
+            t_received_ns,
+            correlate_ns,
+            frames_dropped: self.summary.frames_dropped(),
+        };
+        self.publish_field(&header, times)
+    }
+
+    /// The last field (a correlator exists once a frame was handled).
+    fn field(&self) -> &Field {
+        self.correlator.as_ref().expect("made above").field()
+    }
+
+    /// A new frame sequence (the next test, a new specimen) starts from a new reference.
+    fn check_sequence(&mut self, header: &FrameHeader) {
         if self.reference_frame_id.is_some()
             && self.sequence_id.is_some_and(|s| s != header.sequence_id)
         {
@@ -468,20 +524,19 @@ impl Live {
             );
             self.reference_frame_id = None;
         }
-        // No correlator yet, or one made for a flat first frame of another size.
-        let fits = |c: &Correlator| c.image_size() == (w, h);
-        if self.reference_frame_id.is_none() && !self.correlator.as_ref().is_some_and(fits) {
-            self.correlator = None;
-            match Correlator::new(self.settings.clone(), w, h) {
-                Ok(correlator) => self.correlator = Some(correlator),
-                Err(e) => {
-                    self.reject(
-                        header.frame_id,
-                        &format_args!("cannot be a reference with these settings: {e}"),
-                    );
-                    return Ok(());
-                }
-            }
+    }
+
+    /// A correlator with a reference for this frame: whether the frame just became the
+    /// reference, or None when the frame is refused (logged).
+    fn ready_reference(
+        &mut self,
+        node: &Node<ipc::Service>,
+        header: &FrameHeader,
+        pixels: &[u16],
+    ) -> Result<Option<bool>, ProcessError> {
+        let (w, h) = (header.width_px as usize, header.height_px as usize);
+        if !self.make_correlator(header.frame_id, (w, h)) {
+            return Ok(None);
         }
         match &mut self.correlator {
             // The first frame of the right size becomes the reference, unless it is flat
@@ -495,7 +550,7 @@ impl Live {
                         header.frame_id,
                         &"it is flat (no ZOI has texture): not taken as the reference; waiting for a textured frame",
                     );
-                    return Ok(());
+                    return Ok(None);
                 }
                 let (nx, ny) = correlator.mesh_size();
                 if self.publisher.is_none() {
@@ -504,11 +559,11 @@ impl Live {
                 self.reference_frame_id = Some(header.frame_id);
                 self.origin_frame_id = header.frame_id;
                 self.sequence_id = Some(header.sequence_id);
-                new_reference = true;
                 eprintln!(
                     "correlator: frame {} ({w}x{h} px, {} bit) is the reference; mesh {nx}x{ny} nodes",
                     header.frame_id, header.bit_depth
                 );
+                Ok(Some(true))
             }
             Some(correlator) if correlator.image_size() != (w, h) => {
                 let (rw, rh) = correlator.image_size();
@@ -518,68 +573,67 @@ impl Live {
                         "it is {w}x{h} px but the reference is {rw}x{rh} px: every frame must have the reference's size"
                     ),
                 );
-                return Ok(());
+                Ok(None)
             }
-            _ => {}
+            _ => Ok(Some(false)),
         }
-        let correlator = self.correlator.as_mut().expect("made above");
-        let reference_frame_id = self.reference_frame_id.expect("set with the correlator");
-        let origin_frame_id = self.origin_frame_id;
-        let t = Instant::now();
-        correlator.correlate(pixels)?;
-        let correlate_ns = t.elapsed().as_nanos() as u64;
-        let correlator = &*correlator;
-        let field = correlator.field();
+    }
+
+    /// No correlator yet, or one made for a flat first frame of another size: a new one for
+    /// images of `size`; false when the settings refuse it (the frame is refused, logged).
+    fn make_correlator(&mut self, frame_id: u64, (w, h): (usize, usize)) -> bool {
+        let fits = |c: &Correlator| c.image_size() == (w, h);
+        if self.reference_frame_id.is_some() || self.correlator.as_ref().is_some_and(fits) {
+            return true;
+        }
+        self.correlator = None;
+        match Correlator::new(self.settings.clone(), w, h) {
+            Ok(correlator) => {
+                self.correlator = Some(correlator);
+                true
+            }
+            Err(e) => {
+                self.reject(
+                    frame_id,
+                    &format_args!("cannot be a reference with these settings: {e}"),
+                );
+                false
+            }
+        }
+    }
+
+    /// A rate-limited warning when fewer than half the nodes are valid.
+    fn warn_few_valid(&mut self, frame_id: u64) {
+        let field = self.correlator.as_ref().expect("made above").field();
         if 2 * field.valid < field.nodes.len() && self.few_valid.allow() {
             eprintln!(
-                "correlator: warning: frame {}: only {} of {} nodes valid ({})",
-                header.frame_id,
+                "correlator: warning: frame {frame_id}: only {} of {} nodes valid ({})",
                 field.valid,
                 field.nodes.len(),
                 field.refusals()
             );
         }
-        // The frame is no longer needed: the correlator copied it if it became the reference.
-        drop(sample);
-        self.run_hist.record_ns(correlate_ns);
-        self.window_hist.record_ns(correlate_ns);
-        self.summary.frames_correlated += 1;
-        let frames_dropped = self.summary.frames_dropped();
-        if field.reference_updated {
-            self.reference_frame_id = Some(header.frame_id);
-            new_reference = true;
-        }
-        self.summary.reference_frame_id = self.reference_frame_id;
-        // Saved before the field goes out: whoever sees field k may rely on the state folder
-        // holding the reference that field k left behind.
-        if new_reference {
-            if let Some(state) = state {
-                let ids = ReferenceIds {
-                    reference_frame_id: self.reference_frame_id.expect("set"),
-                    origin_frame_id: self.origin_frame_id,
-                    sequence_id: self.sequence_id.unwrap_or(0),
-                };
-                state.save(correlator, ids)?;
-            }
-        }
+    }
+
+    /// The reference the last field left behind, into the state folder.
+    fn save_reference(&self, state: &mut StateDir) -> Result<(), ProcessError> {
+        let ids = ReferenceIds {
+            reference_frame_id: self.reference_frame_id.expect("set"),
+            origin_frame_id: self.origin_frame_id,
+            sequence_id: self.sequence_id.unwrap_or(0),
+        };
+        state.save(self.correlator.as_ref().expect("made above"), ids)?;
+        Ok(())
+    }
+
+    /// The last field, written in place into a loaned `[FieldNode]` slice.
+    fn publish_field(&self, header: &FrameHeader, times: FieldTimes) -> Result<(), ProcessError> {
+        let field = self.field();
         let publisher = self.publisher.as_ref().expect("opened with the correlator");
         let settings = &self.settings;
         publisher
             .publish(field.nodes.len(), |out, nodes| {
-                fill_field(
-                    out,
-                    nodes,
-                    field,
-                    &header,
-                    FieldTimes {
-                        reference_frame_id,
-                        origin_frame_id,
-                        t_received_ns,
-                        correlate_ns,
-                        frames_dropped,
-                    },
-                    settings,
-                );
+                fill_field(out, nodes, field, header, times, settings);
                 Ok::<bool, std::convert::Infallible>(true)
             })?
             .unwrap_or_else(|never| match never {});

@@ -304,10 +304,34 @@ pub fn fit_data(
     options: &FitOptions,
     progress: &mut dyn FnMut(FitStage),
 ) -> Result<Fit, FitError> {
-    let name = model.name();
     if data.is_empty() {
         return Err(FitError::NoData);
     }
+    let points = weighted_points(&data, options)?;
+    let (m, n) = (points.len(), model.param_names().len());
+    if m < n + 1 {
+        return Err(FitError::Lsq {
+            model: model.name(),
+            error: LsqError::TooFewPoints {
+                points: m,
+                params: n,
+            },
+        });
+    }
+    let mut problem = Problem {
+        set: PointSet::new(model, &points, options.threads),
+        path: options.jacobian,
+    };
+    let (params, converged) = solve(&mut problem, model, &data, options, progress)?;
+    fit_at(&problem, model, &data, params, converged, m)
+}
+
+/// Each point's kinematics, stress and residual factor (√weight / scale); a bad weight or a
+/// zero stress under relative residuals refused.
+fn weighted_points(
+    data: &FitData,
+    options: &FitOptions,
+) -> Result<Vec<(Kinematics, f64, f64)>, FitError> {
     let all = data.points();
     let mut points = Vec::with_capacity(all.len());
     for &(group, kinematics, stretch, stress) in &all {
@@ -335,110 +359,140 @@ pub fn fit_data(
         };
         points.push((kinematics, stress, weight.sqrt() / scale));
     }
-    let m = points.len();
+    Ok(points)
+}
+
+/// The fitted parameters and whether the search converged: linear least squares for an
+/// all-linear model, else from the warm start when it succeeds, else from the best starts.
+fn solve(
+    problem: &mut Problem,
+    model: &Model,
+    data: &FitData,
+    options: &FitOptions,
+    progress: &mut dyn FnMut(FitStage),
+) -> Result<(Vec<f64>, bool), FitError> {
     let n = model.param_names().len();
-    if m < n + 1 {
-        return Err(FitError::Lsq {
-            model: name,
-            error: LsqError::TooFewPoints {
-                points: m,
-                params: n,
+    let linear = model.linear_params();
+    if linear.iter().all(|&l| l) {
+        let params = problem
+            .solve_linear(&vec![0.0; n], &linear)
+            .map_err(|error| FitError::Lsq {
+                model: model.name(),
+                error,
+            })?;
+        return Ok((params, true));
+    }
+    let warm = options.warm_start.as_ref().filter(|w| w.len() == n);
+    if let Some(warm) = warm.and_then(|w| warm_start(problem, w, &linear)) {
+        return Ok((warm.params, warm.converged));
+    }
+    let starts: Vec<Vec<f64>> = nonlinear_starts(model, data)
+        .into_iter()
+        .chain(options.extra_starts.iter().cloned())
+        .collect();
+    let candidates = screen_starts(problem, model, starts, &linear, progress)?;
+    let best = refine_best(problem, &candidates, progress).ok_or(FitError::NoValidStart {
+        model: model.name(),
+    })?;
+    Ok((best.params, best.converged))
+}
+
+/// Levenberg-Marquardt from a warm start (its linear parameters solved first).
+fn warm_start(problem: &mut Problem, start: &[f64], linear: &[bool]) -> Option<lsq::LmResult> {
+    let start = if linear.iter().any(|&l| l) {
+        problem.solve_linear(start, linear).ok()?
+    } else {
+        start.to_vec()
+    };
+    problem.levenberg_marquardt(&start).ok()
+}
+
+/// Every start with its linear parameters solved, and its cost, best first; refused when
+/// none has a cost.
+fn screen_starts(
+    problem: &mut Problem,
+    model: &Model,
+    starts: Vec<Vec<f64>>,
+    linear: &[bool],
+    progress: &mut dyn FnMut(FitStage),
+) -> Result<Vec<(f64, Vec<f64>)>, FitError> {
+    let n = linear.len();
+    let mut candidates: Vec<(f64, Vec<f64>)> = Vec::new();
+    let mut last_error = None;
+    let start_count = starts.len();
+    for (k, start) in starts.into_iter().enumerate() {
+        progress(FitStage::Screening {
+            start: k + 1,
+            starts: start_count,
+        });
+        assert_eq!(
+            start.len(),
+            n,
+            "start length must match the parameter count"
+        );
+        let full = if linear.iter().any(|&l| l) {
+            problem.solve_linear_with_cost(&start, linear)
+        } else {
+            let cost = problem.cost(&start);
+            Ok((start, cost))
+        };
+        match full {
+            Ok((p, Some(cost))) => candidates.push((cost, p)),
+            Ok((_, None)) => {}
+            Err(e) => last_error = Some(e),
+        }
+    }
+    if candidates.is_empty() {
+        return Err(match last_error {
+            Some(error @ (LsqError::TooFewPoints { .. } | LsqError::RankDeficient { .. })) => {
+                FitError::Lsq {
+                    model: model.name(),
+                    error,
+                }
+            }
+            _ => FitError::NoValidStart {
+                model: model.name(),
             },
         });
     }
-    let mut problem = Problem {
-        set: PointSet::new(model, &points, options.threads),
-        path: options.jacobian,
-    };
-    let linear = model.linear_params();
-    let lsq_err = |error| FitError::Lsq {
-        model: name.clone(),
-        error,
-    };
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(candidates)
+}
 
-    let (params, converged) = if linear.iter().all(|&l| l) {
-        (
-            problem
-                .solve_linear(&vec![0.0; n], &linear)
-                .map_err(lsq_err)?,
-            true,
-        )
-    } else if let Some(warm) = options
-        .warm_start
-        .as_ref()
-        .filter(|w| w.len() == n)
-        .and_then(|w| {
-            let start = if linear.iter().any(|&l| l) {
-                problem.solve_linear(w, &linear).ok()?
-            } else {
-                w.clone()
-            };
-            problem.levenberg_marquardt(&start).ok()
-        })
-    {
-        (warm.params, warm.converged)
-    } else {
-        let mut candidates: Vec<(f64, Vec<f64>)> = Vec::new();
-        let mut last_error = None;
-        let starts: Vec<Vec<f64>> = nonlinear_starts(model, &data)
-            .into_iter()
-            .chain(options.extra_starts.iter().cloned())
-            .collect();
-        let start_count = starts.len();
-        for (k, start) in starts.into_iter().enumerate() {
-            progress(FitStage::Screening {
-                start: k + 1,
-                starts: start_count,
-            });
-            assert_eq!(
-                start.len(),
-                n,
-                "start length must match the parameter count"
-            );
-            let has_linear = linear.iter().any(|&l| l);
-            let full = if has_linear {
-                problem.solve_linear_with_cost(&start, &linear)
-            } else {
-                let cost = problem.cost(&start);
-                Ok((start, cost))
-            };
-            match full {
-                Ok((p, Some(cost))) => candidates.push((cost, p)),
-                Ok((_, None)) => {}
-                Err(e) => last_error = Some(e),
+/// Levenberg-Marquardt from the [`LM_STARTS_REFINED`] best candidates: the lowest cost.
+fn refine_best(
+    problem: &mut Problem,
+    candidates: &[(f64, Vec<f64>)],
+    progress: &mut dyn FnMut(FitStage),
+) -> Option<lsq::LmResult> {
+    let mut best: Option<lsq::LmResult> = None;
+    let refined = candidates.len().min(LM_STARTS_REFINED);
+    for (k, (_, start)) in candidates.iter().take(refined).enumerate() {
+        progress(FitStage::Refining {
+            start: k + 1,
+            starts: refined,
+        });
+        if let Ok(res) = problem.levenberg_marquardt(start) {
+            if best.as_ref().is_none_or(|b| res.cost < b.cost) {
+                best = Some(res);
             }
         }
-        if candidates.is_empty() {
-            return Err(match last_error {
-                Some(LsqError::TooFewPoints { .. }) | Some(LsqError::RankDeficient { .. }) => {
-                    lsq_err(last_error.unwrap())
-                }
-                _ => FitError::NoValidStart { model: name },
-            });
-        }
-        candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut best: Option<lsq::LmResult> = None;
-        let refined = candidates.len().min(LM_STARTS_REFINED);
-        for (k, (_, start)) in candidates.iter().take(refined).enumerate() {
-            progress(FitStage::Refining {
-                start: k + 1,
-                starts: refined,
-            });
-            let res = problem.levenberg_marquardt(start);
-            if let Ok(res) = res {
-                if best.as_ref().is_none_or(|b| res.cost < b.cost) {
-                    best = Some(res);
-                }
-            }
-        }
-        let best = best.ok_or(FitError::NoValidStart {
-            model: name.clone(),
-        })?;
-        (best.params, best.converged)
-    };
+    }
+    best
+}
 
+/// The fit at `params`: standard deviations, per-group statistics, AIC, stability.
+fn fit_at(
+    problem: &Problem,
+    model: &Model,
+    data: &FitData,
+    params: Vec<f64>,
+    converged: bool,
+    m: usize,
+) -> Result<Fit, FitError> {
+    let n = params.len();
     let r = problem.residuals(&params).ok_or(FitError::NoValidStart {
-        model: name.clone(),
+        model: model.name(),
     })?;
     let objective = r.norm_squared();
     let jac = problem.jacobian(&params);
@@ -449,7 +503,7 @@ pub fn fit_data(
             .collect(),
         None => vec![None; n],
     };
-    let (rms_mpa, cases) = group_stats(model, &params, &data);
+    let (rms_mpa, cases) = group_stats(model, &params, data);
     let max_stretch = data.max_stretch();
     let stability = LoadCase::ALL
         .iter()

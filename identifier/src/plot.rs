@@ -71,20 +71,9 @@ pub fn chart(
     series: &[Series],
 ) -> Result<(), PlotError> {
     let err = |e: &dyn std::fmt::Display| PlotError(format!("{}: {e}", path.display()));
-    let finite = series
-        .iter()
-        .flat_map(|s| s.points.iter())
-        .filter(|p| p.0.is_finite() && p.1.is_finite());
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y) in finite {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    if x0 >= x1 || y0 > y1 {
+    let Some((x0, x1, y0, y1)) = bounds(series) else {
         return Err(PlotError(format!("{}: nothing to plot", path.display())));
-    }
+    };
     let pad = 0.05 * (y1 - y0).max(1e-9);
     let text = text_available();
     // Drawn in memory, then encoded and written atomically: a full disk leaves no partial or
@@ -158,10 +147,31 @@ pub fn chart(
         }
         root.present().map_err(|e| err(&e))?;
     }
+    write_png(path, &rgb)
+}
+
+/// The finite points' (x0, x1, y0, y1); None when they span no x range.
+fn bounds(series: &[Series]) -> Option<(f64, f64, f64, f64)> {
+    let finite = series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| p.0.is_finite() && p.1.is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in finite {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    (x0 < x1 && y0 <= y1).then_some((x0, x1, y0, y1))
+}
+
+/// The RGB image encoded as a PNG and written atomically at `path`.
+fn write_png(path: &Path, rgb: &[u8]) -> Result<(), PlotError> {
     let mut png = Vec::new();
     image::ImageEncoder::write_image(
         image::codecs::png::PngEncoder::new(&mut png),
-        &rgb,
+        rgb,
         SIZE_PX.0,
         SIZE_PX.1,
         image::ExtendedColorType::Rgb8,
@@ -186,38 +196,13 @@ pub fn write_plots(
     let mut written = Vec::new();
     let shown = &fits[..fits.len().min(MAX_FITS_PLOTTED)];
     for curve in curves {
-        let max_stretch = curve.stretch.last().copied().unwrap_or(1.0);
-        let mut series = vec![Series {
-            label: format!("{} data", curve.case),
-            points: curve
-                .stretch
-                .iter()
-                .copied()
-                .zip(curve.nominal_stress_mpa.iter().copied())
-                .collect(),
-            markers: true,
-        }];
-        for fit in shown {
-            let points = sample(1.0, max_stretch)
-                .filter_map(|l| {
-                    fit.model
-                        .nominal_stress_mpa(&fit.params, curve.case, l)
-                        .map(|p| (l, p))
-                })
-                .collect();
-            series.push(Series {
-                label: fit.model.name(),
-                points,
-                markers: false,
-            });
-        }
         let path = dir.join(format!("stress_{}.png", curve.case));
         chart(
             &path,
             &format!("{} tension", curve.case),
             "stretch",
             "nominal stress (MPa)",
-            &series,
+            &stress_series(curve, shown),
         )?;
         written.push(path);
     }
@@ -238,74 +223,11 @@ pub fn write_plots(
             continue;
         };
         let max_stretch = curve.stretch.last().copied().unwrap_or(1.0);
-        let mut series = Vec::new();
-        if let Some(r) = route {
-            let (points, label, fitted): (&Vec<(f64, f64)>, &str, Vec<LabelledFn>) = if which == 0 {
-                (
-                    &r.f_points,
-                    "f from eq. 19 (g-corrected)",
-                    vec![(
-                        "ln f = Σ a_i (I1-3)^i".into(),
-                        InvariantFn::ExpPoly(r.a.clone()),
-                    )],
-                )
-            } else {
-                (
-                    &r.g_points,
-                    "g from eq. 23",
-                    vec![
-                        (
-                            "g = exp Σ b_i (I2-3)^i".into(),
-                            InvariantFn::ExpPoly(r.b.clone()),
-                        ),
-                        (
-                            "g = Σ c_i / I2^i".into(),
-                            InvariantFn::InversePower(r.c.clone()),
-                        ),
-                    ],
-                )
-            };
-            series.push(Series {
-                label: label.into(),
-                points: points.clone(),
-                markers: true,
-            });
-            if which == 0 {
-                series.push(Series {
-                    label: "f from eq. 20 (no g)".into(),
-                    points: r.f_points_uncorrected.clone(),
-                    markers: true,
-                });
-            }
-            for (label, func) in fitted {
-                let points = sample(1.0 + 1e-3, max_stretch)
-                    .map(|l| {
-                        let (i1, i2) = case.invariants(l);
-                        let inv = if which == 0 { i1 } else { i2 };
-                        (inv, func.value_mpa(inv))
-                    })
-                    .collect();
-                series.push(Series {
-                    label,
-                    points,
-                    markers: false,
-                });
-            }
-        }
-        for fit in &invariant_fits {
-            let points = sample(1.0 + 1e-3, max_stretch)
-                .filter_map(|l| {
-                    let (i1, i2) = case.invariants(l);
-                    let (w1, w2) = fit.model.invariant_derivatives_mpa(&fit.params, i1, i2)?;
-                    Some(if which == 0 { (i1, w1) } else { (i2, w2) })
-                })
-                .collect();
-            series.push(Series {
-                label: fit.model.name(),
-                points,
-                markers: false,
-            });
-        }
+        let mut series = match route {
+            Some(r) => route_series(r, case, which, max_stretch),
+            None => Vec::new(),
+        };
+        series.extend(invariant_series(&invariant_fits, case, which, max_stretch));
         if series.is_empty() {
             continue;
         }
@@ -319,4 +241,109 @@ pub fn write_plots(
         written.push(path);
     }
     Ok(written)
+}
+
+/// A curve's data and each shown fit's nominal stress along it.
+fn stress_series(curve: &Curve, shown: &[Fit]) -> Vec<Series> {
+    let max_stretch = curve.stretch.last().copied().unwrap_or(1.0);
+    let mut series = vec![Series {
+        label: format!("{} data", curve.case),
+        points: curve
+            .stretch
+            .iter()
+            .copied()
+            .zip(curve.nominal_stress_mpa.iter().copied())
+            .collect(),
+        markers: true,
+    }];
+    for fit in shown {
+        let points = sample(1.0, max_stretch)
+            .filter_map(|l| {
+                fit.model
+                    .nominal_stress_mpa(&fit.params, curve.case, l)
+                    .map(|p| (l, p))
+            })
+            .collect();
+        series.push(Series {
+            label: fit.model.name(),
+            points,
+            markers: false,
+        });
+    }
+    series
+}
+
+/// The paper's route along `case`'s path: f (`which` 0: eq. 19 and 20, and its fit) or g (1:
+/// eq. 23, and its two fits).
+fn route_series(r: &RouteResult, case: LoadCase, which: usize, max_stretch: f64) -> Vec<Series> {
+    let mut series = Vec::new();
+    let (points, label, fitted): (&Vec<(f64, f64)>, &str, Vec<LabelledFn>) = if which == 0 {
+        (
+            &r.f_points,
+            "f from eq. 19 (g-corrected)",
+            vec![(
+                "ln f = Σ a_i (I1-3)^i".into(),
+                InvariantFn::ExpPoly(r.a.clone()),
+            )],
+        )
+    } else {
+        (
+            &r.g_points,
+            "g from eq. 23",
+            vec![
+                (
+                    "g = exp Σ b_i (I2-3)^i".into(),
+                    InvariantFn::ExpPoly(r.b.clone()),
+                ),
+                (
+                    "g = Σ c_i / I2^i".into(),
+                    InvariantFn::InversePower(r.c.clone()),
+                ),
+            ],
+        )
+    };
+    series.push(Series {
+        label: label.into(),
+        points: points.clone(),
+        markers: true,
+    });
+    if which == 0 {
+        series.push(Series {
+            label: "f from eq. 20 (no g)".into(),
+            points: r.f_points_uncorrected.clone(),
+            markers: true,
+        });
+    }
+    for (label, func) in fitted {
+        let points = sample(1.0 + 1e-3, max_stretch)
+            .map(|l| {
+                let (i1, i2) = case.invariants(l);
+                let inv = if which == 0 { i1 } else { i2 };
+                (inv, func.value_mpa(inv))
+            })
+            .collect();
+        series.push(Series {
+            label,
+            points,
+            markers: false,
+        });
+    }
+    series
+}
+
+/// Each fit's f (`which` 0) or g (1) along `case`'s path.
+fn invariant_series(fits: &[&Fit], case: LoadCase, which: usize, max_stretch: f64) -> Vec<Series> {
+    fits.iter()
+        .map(|fit| Series {
+            label: fit.model.name(),
+            points: sample(1.0 + 1e-3, max_stretch)
+                .filter_map(|l| {
+                    let (i1, i2) = case.invariants(l);
+                    let (w1, w2) = fit.model.invariant_derivatives_mpa(&fit.params, i1, i2)?;
+                    Some(if which == 0 { (i1, w1) } else { (i2, w2) })
+                })
+                .collect(),
+            markers: false,
+        })
+        .collect()
 }

@@ -3,16 +3,18 @@
 //! the final fits as JSON (atomically) when it stops. Sleeps in a WaitSet: no polling.
 
 use crate::models::Model;
-use crate::online::{FieldOutcome, FieldSample, OnlineConfig, OnlineIdentifier, RigSample};
+use crate::online::{FieldSample, OnlineConfig, OnlineIdentifier, RigSample};
 use crate::report::fit_json;
 use iceoryx2::prelude::*;
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use wire::identification::{RankedModel, MAX_COEFFICIENTS, MAX_RANKED};
 use wire::pubsub::{SliceSubscriber, ValuePublisher, ValueSubscriber};
 use wire::{
     services, FieldHeader, FieldNode, IdentificationReport, Instance, RigState, StrainMeasure,
 };
+
+mod shell;
 
 /// Settings of the process.
 #[derive(Clone, Debug)]
@@ -168,133 +170,44 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
     eprintln!("identifier: ready (instance {})", instance.name());
     let fields_guard = waitset.attach_notification(fields.listener())?;
     let rig_guard = waitset.attach_notification(rig.listener())?;
-
-    let mut online = OnlineIdentifier::new(config.online.clone());
-    let mut journal = match &config.journal {
-        Some(path) => {
-            let restored = crate::journal::read(path)?;
-            let kept = restored.iter().filter(|p| online.restore(p.state)).count();
-            if !restored.is_empty() {
-                eprintln!(
-                    "identifier: rebuilt the load path from {}: {kept} of {} points",
-                    path.display(),
-                    restored.len()
-                );
-            }
-            Some(crate::journal::JournalWriter::open(path)?)
-        }
-        None => None,
-    };
-    let mut summary = ProcessSummary::default();
-    let mut last_fits = Vec::new();
-    let mut last_json_write: Option<Instant> = None;
-    let mut last_activity = Instant::now();
-    let mut failure: Option<ProcessError> = None;
+    let mut identifier = shell::Identifier::open(&config)?;
     loop {
-        let mut stop = false;
         let mut accepted_any = false;
+        let mut failure: Option<ProcessError> = None;
         waitset.wait_and_process_once_with_timeout(
             |id| {
-                let mut step = || -> Result<(), ProcessError> {
-                    if id.has_event_from(&rig_guard) {
-                        rig.clear_events();
-                    }
-                    if id.has_event_from(&fields_guard) {
-                        fields.clear_events();
-                    }
-                    // Rig first: fields name rig samples.
-                    let mut record = |field: &FieldSample, outcome: FieldOutcome| {
-                        if let FieldOutcome::Accepted { state, .. } = outcome {
-                            accepted_any = true;
-                            if let Some(journal) = journal.as_mut() {
-                                journal.append(&crate::journal::JournalPoint {
-                                    state,
-                                    frame_id: field.frame_id,
-                                })?;
-                            }
-                        }
-                        Ok::<(), wire::files::FileError>(())
-                    };
-                    while let Some(state) = rig.receive()? {
-                        summary.rig_samples_received += 1;
-                        for (field, outcome) in online.push_rig(rig_sample(&state)) {
-                            record(&field, outcome)?;
-                        }
-                    }
-                    while let Some(sample) = fields.receive()? {
-                        summary.fields_received += 1;
-                        if summary.fields_received == 1 {
-                            eprintln!(
-                                "{FIRST_FIELD_LINE} (frame {})",
-                                sample.user_header().frame_id
-                            );
-                        }
-                        if let Some(field) = field_sample(sample.user_header()) {
-                            let outcome = online.push_field(field);
-                            record(&field, outcome)?;
-                        }
-                    }
-                    Ok(())
-                };
-                if let Err(e) = step() {
-                    failure = Some(e);
-                    return CallbackProgression::Stop;
+                if id.has_event_from(&rig_guard) {
+                    rig.clear_events();
                 }
-                CallbackProgression::Continue
+                if id.has_event_from(&fields_guard) {
+                    fields.clear_events();
+                }
+                match identifier.take_samples(&rig, &fields) {
+                    Ok(accepted) => {
+                        accepted_any |= accepted;
+                        CallbackProgression::Continue
+                    }
+                    Err(e) => {
+                        failure = Some(e);
+                        CallbackProgression::Stop
+                    }
+                }
             },
             WAIT_SLICE,
         )?;
-        if let Some(e) = failure.take() {
+        if let Some(e) = failure {
             return Err(e);
         }
         // An early wake-up (a signal, SIGCONT after SIGSTOP) is not a request to stop.
-        if wire::signals::requested().is_some() {
-            stop = true;
-        }
+        let signalled = wire::signals::requested().is_some();
         if accepted_any {
-            last_activity = Instant::now();
-            if let Some(fits) = online.refit() {
-                let mut report = build_report(&fits, online.point_counts(), online.last_accepted);
-                report.t_published_ns = wire::monotonic_ns();
-                publisher.publish(report)?;
-                summary.reports_published += 1;
-                last_fits = fits;
-                if last_json_write.is_none_or(|t| t.elapsed() >= Duration::from_secs(1)) {
-                    wire::files::write_atomic(
-                        &config.output_json,
-                        final_json(&summary, &online, &last_fits)?.as_bytes(),
-                    )?;
-                    last_json_write = Some(Instant::now());
-                }
-            }
+            identifier.refit(&publisher)?;
         }
-        if config
-            .max_fields
-            .is_some_and(|m| summary.fields_received >= m)
-        {
-            stop = true;
-        }
-        if config
-            .idle_timeout
-            .is_some_and(|t| last_activity.elapsed() > t)
-        {
-            stop = true;
-        }
-        if stop {
+        if signalled || identifier.limit_reached() {
             break;
         }
     }
-    if last_fits.is_empty() {
-        // Restored points and nothing new: still report the fits of the path.
-        last_fits = online.refit().unwrap_or_default();
-    }
-    summary.best_model = last_fits.first().map(|f| f.model.name());
-    wire::files::write_atomic(
-        &config.output_json,
-        final_json(&summary, &online, &last_fits)?.as_bytes(),
-    )?;
-    summary.points = online.point_counts();
-    Ok(summary)
+    identifier.finish()
 }
 
 /// The JSON of `identification.json`: points per case, pairing counters, ranked fits.

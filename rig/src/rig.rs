@@ -200,16 +200,7 @@ impl Rig {
 
     fn apply(&mut self, command: RigCommand) -> Result<(), Refusal> {
         match command {
-            RigCommand::SetSetpoint { channel, value } => {
-                if !value.is_finite() {
-                    return Err(Refusal::NotFinite { what: "set-point" });
-                }
-                self.refuse_if_program_active()?;
-                let mode = self.check_active(channel)?;
-                self.check_level(channel, mode, value)?;
-                self.controller.set_setpoint(channel, value);
-                Ok(())
-            }
+            RigCommand::SetSetpoint { channel, value } => self.set_setpoint(channel, value),
             RigCommand::SetActuatorMode { actuator, mode } => {
                 self.refuse_if_program_active()?;
                 self.check_active(Channel::Actuator(actuator))?;
@@ -224,36 +215,9 @@ impl Rig {
                 Ok(())
             }
             RigCommand::StartProgram(program) => self.start_program(&program),
-            RigCommand::HoldProgram => {
-                if self.program != ProgramStatus::Running {
-                    return Err(Refusal::NoProgram {
-                        expected: "running",
-                    });
-                }
-                self.program = ProgramStatus::Held;
-                Ok(())
-            }
-            RigCommand::ResumeProgram => {
-                if self.program != ProgramStatus::Held {
-                    return Err(Refusal::NoProgram { expected: "held" });
-                }
-                self.refuse_if_unsafe()?;
-                self.program = ProgramStatus::Running;
-                Ok(())
-            }
-            RigCommand::StopProgram { transition } => {
-                if !matches!(self.program, ProgramStatus::Running | ProgramStatus::Held) {
-                    return Err(Refusal::NoProgram {
-                        expected: "running or held",
-                    });
-                }
-                let run = self.run.as_mut().expect("a running program has a run");
-                let transition = transition.unwrap_or(run.stop);
-                let rate = run.stop_rate_per_s;
-                run.stop(transition, rate);
-                self.program = ProgramStatus::Stopped;
-                Ok(())
-            }
+            RigCommand::HoldProgram => self.hold_program(),
+            RigCommand::ResumeProgram => self.resume_program(),
+            RigCommand::StopProgram { transition } => self.stop_program(transition),
             RigCommand::SetLimits { actuator, limits } => {
                 limits.validate().map_err(Refusal::invalid)?;
                 self.config.limits.channels[actuator.index()] = limits;
@@ -264,28 +228,10 @@ impl Rig {
                 Ok(())
             }
             RigCommand::ResetLimits => {
-                // Only trips whose condition has cleared are reset.
-                let mut still = 0;
-                for id in ActuatorId::ALL {
-                    still |= violations(
-                        &self.config.limits.channels[id.index()],
-                        &self.signals(id),
-                        id.index(),
-                    );
-                }
-                self.tripped &= still | EMERGENCY_STOP_BIT;
+                self.reset_limits();
                 Ok(())
             }
-            RigCommand::HydraulicsOn => {
-                if self.emergency_stop {
-                    return Err(Refusal::EmergencyStopLatched);
-                }
-                if !self.hydraulics_on {
-                    self.controller.track(&self.feedback);
-                    self.hydraulics_on = true;
-                }
-                Ok(())
-            }
+            RigCommand::HydraulicsOn => self.switch_hydraulics_on(),
             RigCommand::HydraulicsOff => {
                 self.hydraulics_off();
                 Ok(())
@@ -301,30 +247,7 @@ impl Rig {
                 self.tripped &= !EMERGENCY_STOP_BIT;
                 Ok(())
             }
-            RigCommand::MountSpecimen(config) => {
-                self.refuse_if_program_active()?;
-                for axis in Axis::ALL {
-                    let elongation_mm = self.snapshot.axes[axis.index()].elongation_mm;
-                    if elongation_mm.abs() > MOUNT_TOLERANCE_MM {
-                        return Err(Refusal::Invalid {
-                            reason: format!(
-                                "{axis:?} elongation is {elongation_mm:.2} mm: unload to within \
-                                 {MOUNT_TOLERANCE_MM} mm of the mounting position before changing \
-                                 the specimen"
-                            ),
-                        });
-                    }
-                }
-                let specimen = match &config {
-                    Some(c) => Some(Specimen::new((**c).clone()).map_err(Refusal::invalid)?),
-                    None => None,
-                };
-                self.specimen = specimen;
-                self.config.specimen = config.map(|c| *c);
-                self.load_specimen();
-                self.read_sensors();
-                Ok(())
-            }
+            RigCommand::MountSpecimen(config) => self.mount_specimen(config),
             RigCommand::BreakSpecimen => match self.specimen.as_mut() {
                 Some(specimen) => {
                     specimen.break_now();
@@ -335,6 +258,103 @@ impl Rig {
                 }),
             },
         }
+    }
+
+    fn set_setpoint(&mut self, channel: Channel, value: f64) -> Result<(), Refusal> {
+        if !value.is_finite() {
+            return Err(Refusal::NotFinite { what: "set-point" });
+        }
+        self.refuse_if_program_active()?;
+        let mode = self.check_active(channel)?;
+        self.check_level(channel, mode, value)?;
+        self.controller.set_setpoint(channel, value);
+        Ok(())
+    }
+
+    fn hold_program(&mut self) -> Result<(), Refusal> {
+        if self.program != ProgramStatus::Running {
+            return Err(Refusal::NoProgram {
+                expected: "running",
+            });
+        }
+        self.program = ProgramStatus::Held;
+        Ok(())
+    }
+
+    fn resume_program(&mut self) -> Result<(), Refusal> {
+        if self.program != ProgramStatus::Held {
+            return Err(Refusal::NoProgram { expected: "held" });
+        }
+        self.refuse_if_unsafe()?;
+        self.program = ProgramStatus::Running;
+        Ok(())
+    }
+
+    fn stop_program(&mut self, transition: Option<StopTransition>) -> Result<(), Refusal> {
+        if !matches!(self.program, ProgramStatus::Running | ProgramStatus::Held) {
+            return Err(Refusal::NoProgram {
+                expected: "running or held",
+            });
+        }
+        let run = self.run.as_mut().expect("a running program has a run");
+        let transition = transition.unwrap_or(run.stop);
+        let rate = run.stop_rate_per_s;
+        run.stop(transition, rate);
+        self.program = ProgramStatus::Stopped;
+        Ok(())
+    }
+
+    /// Only trips whose condition has cleared are reset.
+    fn reset_limits(&mut self) {
+        self.tripped &= self.violations_now() | EMERGENCY_STOP_BIT;
+    }
+
+    /// The limit bits every actuator violates now.
+    fn violations_now(&self) -> u32 {
+        ActuatorId::ALL.into_iter().fold(0, |bits, id| {
+            bits | violations(
+                &self.config.limits.channels[id.index()],
+                &self.signals(id),
+                id.index(),
+            )
+        })
+    }
+
+    fn switch_hydraulics_on(&mut self) -> Result<(), Refusal> {
+        if self.emergency_stop {
+            return Err(Refusal::EmergencyStopLatched);
+        }
+        if !self.hydraulics_on {
+            self.controller.track(&self.feedback);
+            self.hydraulics_on = true;
+        }
+        Ok(())
+    }
+
+    /// A new specimen (or none), only with both axes back at the mounting position.
+    fn mount_specimen(&mut self, config: Option<Box<SpecimenConfig>>) -> Result<(), Refusal> {
+        self.refuse_if_program_active()?;
+        for axis in Axis::ALL {
+            let elongation_mm = self.snapshot.axes[axis.index()].elongation_mm;
+            if elongation_mm.abs() > MOUNT_TOLERANCE_MM {
+                return Err(Refusal::Invalid {
+                    reason: format!(
+                        "{axis:?} elongation is {elongation_mm:.2} mm: unload to within \
+                         {MOUNT_TOLERANCE_MM} mm of the mounting position before changing \
+                         the specimen"
+                    ),
+                });
+            }
+        }
+        let specimen = match &config {
+            Some(c) => Some(Specimen::new((**c).clone()).map_err(Refusal::invalid)?),
+            None => None,
+        };
+        self.specimen = specimen;
+        self.config.specimen = config.map(|c| *c);
+        self.load_specimen();
+        self.read_sensors();
+        Ok(())
     }
 
     fn refuse_if_program_active(&self) -> Result<(), Refusal> {
@@ -567,14 +587,7 @@ impl Rig {
 
     /// Limit detectors and the break detector, then their actions (rising edges only).
     fn detect(&mut self) {
-        let mut now = 0;
-        for id in ActuatorId::ALL {
-            now |= violations(
-                &self.config.limits.channels[id.index()],
-                &self.signals(id),
-                id.index(),
-            );
-        }
+        let now = self.violations_now();
         let mut rising = now & !self.tripped;
         // Break detector on the X and Y pairs.
         let alpha = self.dt_s / 0.020;

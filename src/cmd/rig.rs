@@ -99,59 +99,8 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
     let speed = Speed::parse(&args.speed)?;
     let mut config = RigConfig::default();
     let strain = strain_test(&args)?;
-    let campaign = match (&args.campaign, args.test.as_deref()) {
-        (Some(spec), _) => Some(Campaign::parse(spec)?),
-        (None, Some("campaign")) => Some(Campaign::paper()),
-        _ => None,
-    };
-    let campaign = match (campaign, &args.law_f, &args.law_g) {
-        (Some(c), f, g) if f.is_some() || g.is_some() => {
-            let smactane = identifier::law::InvariantLaw::smactane();
-            let a = f
-                .clone()
-                .unwrap_or_else(|| smactane.f.coefficients().to_vec());
-            let b = g
-                .clone()
-                .unwrap_or_else(|| smactane.g.coefficients().to_vec());
-            // The same refusals as a run's [specimen].
-            let law = identifier::law::InvariantLaw::exp_poly(&a, &b).map_err(|e| match e {
-                identifier::law::LawError::Coefficients {
-                    which,
-                    coefficients,
-                } => anyhow::anyhow!(
-                    "--law-{which} {coefficients:?}: expected one or more finite numbers"
-                ),
-                identifier::law::LawError::Stiffness { .. } => {
-                    anyhow::anyhow!("--law-f/--law-g: {e}")
-                }
-            })?;
-            Some(c.with_law(law))
-        }
-        (None, Some(_), _) | (None, _, Some(_)) if strain.is_none() => {
-            anyhow::bail!(
-                "--law-f / --law-g apply to a campaign (--campaign or --test campaign) or a \
-                 strain-controlled test (--control strain)"
-            )
-        }
-        (c, _, _) => c,
-    };
-    let test = args.test.as_deref().filter(|t| *t != "campaign");
-    let program = match (&args.program, test) {
-        (Some(path), _) => {
-            let program = || format!("program {}", path.display());
-            let text = std::fs::read_to_string(path).with_context(program)?;
-            let base = path.parent().map(PathBuf::from).unwrap_or_default();
-            Some(Program::from_toml(&text, &base).with_context(program)?)
-        }
-        (None, Some(name)) => {
-            let test = BuiltinTest::parse(name).ok_or_else(|| {
-                anyhow::anyhow!("--test {name:?}: expected uniaxial, equibiaxial or campaign")
-            })?;
-            config.specimen = Some(test.specimen());
-            Some(test.program(args.rate, args.stretch)?)
-        }
-        (None, None) => None,
-    };
+    let campaign = campaign_of(&args, strain.is_some())?;
+    let program = program_of(&args, &mut config)?;
     // The cruciform a strain-controlled test mounts, of --law-f / --law-g if given.
     let mut strain_specimen = BuiltinTest::Equibiaxial.specimen();
     if let Some(law) = law_of(&args)? {
@@ -180,6 +129,68 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
     // The process's messages name their causes; `in_context` keeps the exit code its error
     // asks for (a results file, a journal it cannot follow).
     let summary = run_process(options).map_err(|e| wire::exit::in_context("rig process", &e))?;
+    print_summary(&summary);
+    Ok(())
+}
+
+/// The campaign of `--campaign` or `--test campaign`, with the law of `--law-f` / `--law-g`
+/// when given (which only a campaign or, with `strain`, a strain-controlled test takes).
+fn campaign_of(args: &RigArgs, strain: bool) -> anyhow::Result<Option<Campaign>> {
+    let campaign = match (&args.campaign, args.test.as_deref()) {
+        (Some(spec), _) => Some(Campaign::parse(spec)?),
+        (None, Some("campaign")) => Some(Campaign::paper()),
+        _ => None,
+    };
+    Ok(match (campaign, &args.law_f, &args.law_g) {
+        (Some(c), f, g) if f.is_some() || g.is_some() => {
+            let (a, b) = law_coefficients(args);
+            // The same refusals as a run's [specimen].
+            let law = identifier::law::InvariantLaw::exp_poly(&a, &b).map_err(|e| match e {
+                identifier::law::LawError::Coefficients {
+                    which,
+                    coefficients,
+                } => anyhow::anyhow!(
+                    "--law-{which} {coefficients:?}: expected one or more finite numbers"
+                ),
+                identifier::law::LawError::Stiffness { .. } => {
+                    anyhow::anyhow!("--law-f/--law-g: {e}")
+                }
+            })?;
+            Some(c.with_law(law))
+        }
+        (None, Some(_), _) | (None, _, Some(_)) if !strain => {
+            anyhow::bail!(
+                "--law-f / --law-g apply to a campaign (--campaign or --test campaign) or a \
+                 strain-controlled test (--control strain)"
+            )
+        }
+        (c, _, _) => c,
+    })
+}
+
+/// The program of `--program FILE` or of a built-in `--test` (which mounts its specimen in
+/// `config`).
+fn program_of(args: &RigArgs, config: &mut RigConfig) -> anyhow::Result<Option<Program>> {
+    let test = args.test.as_deref().filter(|t| *t != "campaign");
+    Ok(match (&args.program, test) {
+        (Some(path), _) => {
+            let program = || format!("program {}", path.display());
+            let text = std::fs::read_to_string(path).with_context(program)?;
+            let base = path.parent().map(PathBuf::from).unwrap_or_default();
+            Some(Program::from_toml(&text, &base).with_context(program)?)
+        }
+        (None, Some(name)) => {
+            let test = BuiltinTest::parse(name).ok_or_else(|| {
+                anyhow::anyhow!("--test {name:?}: expected uniaxial, equibiaxial or campaign")
+            })?;
+            config.specimen = Some(test.specimen());
+            Some(test.program(args.rate, args.stretch)?)
+        }
+        (None, None) => None,
+    })
+}
+
+fn print_summary(summary: &rig::process::ProcessSummary) {
     eprintln!(
         "rig: {:.1} s simulated in {:.1} s wall ({:.0}x), {} samples published, {} log rows, \
          commands {} accepted / {} refused, limits tripped {:#x}",
@@ -192,7 +203,6 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         summary.commands_refused,
         summary.limits_tripped
     );
-    Ok(())
 }
 
 /// The strain-controlled test of `--control strain`, refused with the flag named.
@@ -227,11 +237,8 @@ fn strain_test(args: &RigArgs) -> anyhow::Result<Option<rig::strain::StrainTest>
     }
 }
 
-/// The law of --law-f / --law-g (None: the specimen's own).
-fn law_of(args: &RigArgs) -> anyhow::Result<Option<identifier::law::InvariantLaw>> {
-    if args.law_f.is_none() && args.law_g.is_none() {
-        return Ok(None);
-    }
+/// The coefficients of `--law-f` and `--law-g`, each SMACTANE's when not given.
+fn law_coefficients(args: &RigArgs) -> (Vec<f64>, Vec<f64>) {
     let smactane = identifier::law::InvariantLaw::smactane();
     let a = args
         .law_f
@@ -241,6 +248,15 @@ fn law_of(args: &RigArgs) -> anyhow::Result<Option<identifier::law::InvariantLaw
         .law_g
         .clone()
         .unwrap_or_else(|| smactane.g.coefficients().to_vec());
+    (a, b)
+}
+
+/// The law of --law-f / --law-g (None: the specimen's own).
+fn law_of(args: &RigArgs) -> anyhow::Result<Option<identifier::law::InvariantLaw>> {
+    if args.law_f.is_none() && args.law_g.is_none() {
+        return Ok(None);
+    }
+    let (a, b) = law_coefficients(args);
     identifier::law::InvariantLaw::exp_poly(&a, &b)
         .map(Some)
         .map_err(|e| anyhow::anyhow!("--law-f/--law-g: {e}"))

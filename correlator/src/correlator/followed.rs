@@ -23,7 +23,7 @@ impl Correlator {
             for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
                 let m = jj * nx + ii;
                 let (a, b) = (&self.field.nodes[m], &self.field.nodes[k]);
-                let base = self.ref_nodes[m].base_px;
+                let base = self.reference.nodes[m].base_px;
                 sums.add(a.x_px - b.x_px, a.y_px - b.y_px, base.0, base.1);
             }
         }
@@ -31,7 +31,7 @@ impl Correlator {
     }
 
     pub(super) fn update_reference(&mut self, pixels: &[u16]) {
-        self.frames_since_reference += 1;
+        self.reference.frames_since += 1;
         self.field.reference_updated = false;
         let replace = match self.settings.reference {
             ReferenceMode::Fixed => false,
@@ -42,7 +42,7 @@ impl Correlator {
             } => {
                 let limit = max_displacement_zoi_fraction * self.settings.zoi_px as f64;
                 let (mut largest, mut score_sum, mut count) = (0.0f64, 0.0, 0.0);
-                for (k, result) in self.results.iter().enumerate() {
+                for (k, result) in self.frame.results.iter().enumerate() {
                     if result.status == NodeStatus::Ok {
                         let _ = k;
                         largest = largest.max(result.u_px.abs()).max(result.v_px.abs());
@@ -70,7 +70,7 @@ impl Correlator {
         let whole_mesh_valid = self.affine_fit_around(None, 0);
         for k in 0..nx * ny {
             let node = self.field.nodes[k];
-            self.scratch_pairs[k] = if node.status == NodeStatus::Ok {
+            self.scratch.pairs[k] = if node.status == NodeStatus::Ok {
                 (node.u_px, node.v_px)
             } else {
                 self.affine_fit(Some(k), CARRY_RINGS, None, Support::NeverLost)
@@ -87,18 +87,19 @@ impl Correlator {
             width_px: self.width_px,
             height_px: self.height_px,
         });
-        for (r, &base) in self.ref_nodes.iter_mut().zip(&self.scratch_pairs) {
+        for (r, &base) in self.reference.nodes.iter_mut().zip(&self.scratch.pairs) {
             r.base_px = base;
         }
         for k in 0..nx * ny {
-            self.ref_nodes[k].base_gradient = if self.field.nodes[k].status == NodeStatus::Ok {
+            self.reference.nodes[k].base_gradient = if self.field.nodes[k].status == NodeStatus::Ok
+            {
                 self.field.gradients[k]
             } else {
                 self.base_fit_gradient(k)
             };
         }
         self.take_reference(pixels, self.settings.method.is_icgn());
-        self.reference_is_origin = false;
+        self.reference.is_origin = false;
         self.field.reference_updated = true;
     }
 
@@ -149,7 +150,7 @@ impl Correlator {
                 let node = &self.field.nodes[m];
                 let supported = match support {
                     Support::Valid => true,
-                    Support::NeverLost => self.never_lost[m],
+                    Support::NeverLost => self.history.never_lost[m],
                 };
                 if node.status == NodeStatus::Ok && supported && exclude != Some(m) {
                     sums.add(

@@ -31,7 +31,7 @@ const KEYPOINTS_BELOW_FRACTION: f64 = 0.5;
 impl Correlator {
     fn reference_image(&self) -> Image<'_> {
         Image {
-            pixels: &self.reference_pixels,
+            pixels: super::reference_pixels(&self.reference.pixels),
             width_px: self.width_px,
             height_px: self.height_px,
         }
@@ -41,7 +41,7 @@ impl Correlator {
     /// its ZOI was sampled through.
     pub(super) fn local_gradient(&self, k: usize) -> Mat2 {
         self.result_gradient(k)
-            .map_or(self.results[k].warp_gradient, to_mat2)
+            .map_or(self.frame.results[k].warp_gradient, to_mat2)
     }
 
     /// The final check of every `ok` result: the ZNCC through its displacement and its
@@ -51,13 +51,13 @@ impl Correlator {
         let n = self.settings.zoi_px;
         let min_zncc = self.settings.min_zncc;
         let reference = Image {
-            pixels: &self.reference_pixels,
+            pixels: super::reference_pixels(&self.reference.pixels),
             width_px: self.width_px,
             height_px: self.height_px,
         };
-        let (results, ref_nodes) = (&self.results, &self.ref_nodes);
+        let (results, ref_nodes) = (&self.frame.results, &self.reference.nodes);
         let mesh = (self.mesh.nx, self.mesh.ny);
-        let zncc = SharedSlice::new(&mut self.zncc);
+        let zncc = SharedSlice::new(&mut self.frame.zncc);
         // Results are only read here; the verdicts go to `zncc` and become statuses below.
         self.pool.run(results.len(), &|engine, k| {
             let mut timer = crate::zoi::Timer::start(engine.profile);
@@ -78,7 +78,7 @@ impl Correlator {
             // SAFETY: item k writes only node k's slot.
             unsafe { zncc.write(k, score) };
         });
-        for (result, &score) in self.results.iter_mut().zip(&self.zncc) {
+        for (result, &score) in self.frame.results.iter_mut().zip(&self.frame.zncc) {
             if result.status == NodeStatus::Ok && score < min_zncc {
                 result.status = NodeStatus::LowZncc;
             }
@@ -88,12 +88,12 @@ impl Correlator {
     /// Guess `auto` after the first pass: growth, keypoints when too few nodes verify, and
     /// the refinement of a fresh reference (see the module documentation).
     pub(super) fn improve(&mut self, image: Image) {
-        let fresh = !self.has_previous;
+        let fresh = self.history.previous.is_none();
         self.grow(image);
         // Nodes that could have verified: textured in the reference, and not sent out of the
         // image (material that left the field of view is no failure of the guess).
         let (mut candidates, mut verified) = (0usize, 0usize);
-        for (r, result) in self.ref_nodes.iter().zip(&self.results) {
+        for (r, result) in self.reference.nodes.iter().zip(&self.frame.results) {
             if r.status == NodeStatus::Ok && result.status != NodeStatus::OutsideImage {
                 candidates += 1;
                 verified += usize::from(result.status == NodeStatus::Ok);
@@ -113,12 +113,12 @@ impl Correlator {
     /// Reliability-guided growth from the verified nodes (module documentation, step 1).
     fn grow(&mut self, image: Image) {
         let (nx, ny) = (self.mesh.nx, self.mesh.ny);
-        self.grown_from.fill(0);
+        self.scratch.grown_from.fill(0);
         loop {
-            self.entries.clear();
+            self.scratch.entries.clear();
             for k in 0..nx * ny {
-                if self.ref_nodes[k].status != NodeStatus::Ok
-                    || self.results[k].status == NodeStatus::Ok
+                if self.reference.nodes[k].status != NodeStatus::Ok
+                    || self.frame.results[k].status == NodeStatus::Ok
                 {
                     continue;
                 }
@@ -127,24 +127,27 @@ impl Correlator {
                 for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
                     for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
                         let m = jj * nx + ii;
-                        if m != k && self.results[m].status == NodeStatus::Ok {
+                        if m != k && self.frame.results[m].status == NodeStatus::Ok {
                             count += 1;
-                            if best.is_none_or(|b| self.zncc[m] > self.zncc[b]) {
+                            if best.is_none_or(|b| self.frame.zncc[m] > self.frame.zncc[b]) {
                                 best = Some(m);
                             }
                         }
                     }
                 }
                 let Some(m) = best else { continue };
-                if count <= self.grown_from[k] {
+                if count <= self.scratch.grown_from[k] {
                     continue;
                 }
-                self.grown_from[k] = count;
+                self.scratch.grown_from[k] = count;
                 let g = self.local_gradient(m);
-                let (a, b) = (self.ref_nodes[k].top_left, self.ref_nodes[m].top_left);
+                let (a, b) = (
+                    self.reference.nodes[k].top_left,
+                    self.reference.nodes[m].top_left,
+                );
                 let (dx, dy) = (a.0 as f64 - b.0 as f64, a.1 as f64 - b.1 as f64);
-                let from = self.results[m];
-                self.entries.push(Entry {
+                let from = self.frame.results[m];
+                self.scratch.entries.push(Entry {
                     node: k,
                     guess_px: (
                         from.u_px + g[0][0] * dx + g[0][1] * dy,
@@ -153,7 +156,7 @@ impl Correlator {
                     gradient: g,
                 });
             }
-            if self.entries.is_empty() {
+            if self.scratch.entries.is_empty() {
                 return;
             }
             if self.correlate_entries(image, false) == 0 {
@@ -171,14 +174,15 @@ impl Correlator {
             .keypoint_matcher
             .take()
             .unwrap_or_else(|| KeypointMatcher::new(w, h, self.settings.threads));
-        if self.reference_keypoints.is_none() {
+        if self.reference.keypoints.is_none() {
             let roi = self.roi;
             let region = (roi.x_px, roi.y_px, roi.width_px, roi.height_px);
-            self.reference_keypoints = Some(matcher.detect(self.reference_image(), region));
+            self.reference.keypoints = Some(matcher.detect(self.reference_image(), region));
         }
         let deformed = matcher.detect(image, (0, 0, w, h));
         let guess = self
-            .reference_keypoints
+            .reference
+            .keypoints
             .as_ref()
             .and_then(|reference| matcher.estimate(reference, &deformed));
         self.keypoint_matcher = Some(matcher);
@@ -187,19 +191,19 @@ impl Correlator {
         };
         self.field.keypoints_used = true;
         let half = (self.settings.zoi_px as f64 - 1.0) / 2.0;
-        self.entries.clear();
-        for k in 0..self.results.len() {
-            if self.ref_nodes[k].status != NodeStatus::Ok
-                || self.results[k].status == NodeStatus::Ok
+        self.scratch.entries.clear();
+        for k in 0..self.frame.results.len() {
+            if self.reference.nodes[k].status != NodeStatus::Ok
+                || self.frame.results[k].status == NodeStatus::Ok
             {
                 continue;
             }
-            let (x0, y0) = self.ref_nodes[k].top_left;
+            let (x0, y0) = self.reference.nodes[k].top_left;
             let c = [x0 as f64 + half, y0 as f64 + half];
             let affine = guess.local_affine(c);
             let moved = affine.apply(c);
             let a = affine.a;
-            self.entries.push(Entry {
+            self.scratch.entries.push(Entry {
                 node: k,
                 guess_px: (moved[0] - c[0], moved[1] - c[1]),
                 gradient: [[a[0][0] - 1.0, a[0][1]], [a[1][0], a[1][1] - 1.0]],
@@ -213,9 +217,9 @@ impl Correlator {
     /// documentation, step 3).
     fn refine(&mut self, image: Image) {
         let n = self.settings.zoi_px;
-        self.entries.clear();
-        for k in 0..self.results.len() {
-            let result = self.results[k];
+        self.scratch.entries.clear();
+        for k in 0..self.frame.results.len() {
+            let result = self.frame.results[k];
             if result.status != NodeStatus::Ok {
                 continue;
             }
@@ -223,7 +227,7 @@ impl Correlator {
                 continue;
             };
             if warp_worth_it(difference(g, result.warp_gradient), n) {
-                self.entries.push(Entry {
+                self.scratch.entries.push(Entry {
                     node: k,
                     guess_px: (result.u_px, result.v_px),
                     gradient: g,
@@ -244,14 +248,14 @@ impl Correlator {
         let iterations = super::fft_iterations(&self.settings);
         let min_zncc = self.settings.min_zncc;
         let reference = Image {
-            pixels: &self.reference_pixels,
+            pixels: super::reference_pixels(&self.reference.pixels),
             width_px: self.width_px,
             height_px: self.height_px,
         };
-        let (entries, ref_nodes) = (&self.entries, &self.ref_nodes);
-        let (plain, windowed) = (&self.plain_spectra, &self.windowed_references);
-        let results = SharedSlice::new(&mut self.results);
-        let zncc = SharedSlice::new(&mut self.zncc);
+        let (entries, ref_nodes) = (&self.scratch.entries, &self.reference.nodes);
+        let (plain, windowed) = (&self.reference.plain_spectra, &self.reference.windowed);
+        let results = SharedSlice::new(&mut self.frame.results);
+        let zncc = SharedSlice::new(&mut self.frame.zncc);
         let verified = std::sync::atomic::AtomicUsize::new(0);
         self.pool.run(entries.len(), &|engine, i| {
             let entry = entries[i];

@@ -44,10 +44,8 @@ impl Correlator {
 
     /// The origin's coefficients are the reference's (right after `set_reference`).
     pub(super) fn origin_coefficients_from_reference(&mut self) {
-        if let (Some(origin), Some(reference)) = (
-            self.origin_coefficients.as_mut(),
-            self.coefficients.as_ref(),
-        ) {
+        let origin = self.origin.as_mut().and_then(|o| o.coefficients.as_mut());
+        if let (Some(origin), Some(reference)) = (origin, self.coefficients.as_ref()) {
             origin.data.copy_from_slice(&reference.data);
         }
     }
@@ -78,14 +76,14 @@ impl Correlator {
         let order = self.order();
         let values = PLANES * n * n;
         let reference = Image {
-            pixels: &self.reference_pixels,
+            pixels: super::reference_pixels(&self.reference.pixels),
             width_px: self.width_px,
             height_px: self.height_px,
         };
         let coefficients = self.coefficients.as_ref().expect("IC-GN coefficients");
-        let planes = SharedSlice::new(&mut self.subset_planes);
-        let stats = SharedSlice::new(&mut self.subset_stats);
-        let ref_nodes = SharedSlice::new(&mut self.ref_nodes);
+        let planes = SharedSlice::new(&mut self.reference.subset_planes);
+        let stats = SharedSlice::new(&mut self.reference.subset_stats);
+        let ref_nodes = SharedSlice::new(&mut self.reference.nodes);
         self.pool.run(self.mesh.len(), &|_, k| {
             // SAFETY: item k touches only node k's slots.
             let mut r = unsafe { ref_nodes.read(k) };
@@ -115,16 +113,17 @@ impl Correlator {
     /// correlator holds, from `guess_px` and `gradient` (`reanchor`): the subset is prepared in
     /// the engine's scratch. None without IC-GN or without the origin's coefficients.
     pub(super) fn origin_icgn(&self) -> Option<OriginIcgn<'_>> {
-        if !self.settings.method.is_icgn() || !self.origin_known {
+        if !self.settings.method.is_icgn() {
             return None;
         }
+        let origin = self.origin.as_ref()?;
         Some(OriginIcgn {
             origin: Image {
-                pixels: &self.origin_pixels,
+                pixels: &origin.pixels,
                 width_px: self.width_px,
                 height_px: self.height_px,
             },
-            origin_coefficients: self.origin_coefficients.as_ref()?,
+            origin_coefficients: origin.coefficients.as_ref()?,
             frame_coefficients: self.coefficients.as_ref()?,
             n: self.settings.zoi_px,
             order: self.order(),
@@ -135,16 +134,16 @@ impl Correlator {
     /// IC-GN for every node whose guess verified (see the module documentation).
     pub(super) fn refine_icgn(&mut self, image: Image) {
         let use_previous = self.settings.guess != GuessMode::Correli;
-        self.entries.clear();
-        for k in 0..self.results.len() {
-            let result = self.results[k];
+        self.scratch.entries.clear();
+        for k in 0..self.frame.results.len() {
+            let result = self.frame.results[k];
             if result.status != NodeStatus::Ok {
                 continue;
             }
             // The paper's guess ignores previous frames, and so does its gradient.
-            let previous = self.previous_gradient[k].filter(|_| use_previous);
+            let previous = self.history.gradients[k].filter(|_| use_previous);
             let gradient = previous.unwrap_or_else(|| self.local_gradient(k));
-            self.entries.push(Entry {
+            self.scratch.entries.push(Entry {
                 node: k,
                 guess_px: (result.u_px, result.v_px),
                 gradient,
@@ -159,15 +158,15 @@ impl Correlator {
             self.settings.min_zncc,
         );
         let reference = Image {
-            pixels: &self.reference_pixels,
+            pixels: super::reference_pixels(&self.reference.pixels),
             width_px: self.width_px,
             height_px: self.height_px,
         };
         let coefficients = self.coefficients.as_ref().expect("IC-GN coefficients");
-        let (entries, ref_nodes) = (&self.entries, &self.ref_nodes);
-        let (planes, stats) = (&self.subset_planes, &self.subset_stats);
-        let results = SharedSlice::new(&mut self.results);
-        let zncc = SharedSlice::new(&mut self.zncc);
+        let (entries, ref_nodes) = (&self.scratch.entries, &self.reference.nodes);
+        let (planes, stats) = (&self.reference.subset_planes, &self.reference.subset_stats);
+        let results = SharedSlice::new(&mut self.frame.results);
+        let zncc = SharedSlice::new(&mut self.frame.zncc);
         self.pool.run(entries.len(), &|engine, i| {
             let entry = entries[i];
             let k = entry.node;

@@ -22,28 +22,28 @@ use crate::zoi::{Image, ZoiResult};
 impl Correlator {
     /// Measures the returned nodes against the origin (see the module documentation).
     pub(super) fn reanchor_returned(&mut self, image: Image) {
-        if !self.origin_known || self.reference_is_origin {
+        if self.origin.is_none() || self.reference.is_origin {
             return;
         }
         let whole_mesh = self.affine_fit(None, 0, None, Support::NeverLost);
-        self.entries.clear();
+        self.scratch.entries.clear();
         for k in 0..self.field.nodes.len() {
             let node = self.field.nodes[k];
-            if node.status != NodeStatus::Ok || self.never_lost[k] {
+            if node.status != NodeStatus::Ok || self.history.never_lost[k] {
                 continue;
             }
             let gradient: Mat2 = self
                 .affine_fit(Some(k), CARRY_RINGS, Some(k), Support::NeverLost)
                 .or(whole_mesh)
                 .map_or([[0.0; 2]; 2], |fit| to_mat2(fit.gradient));
-            self.entries.push(Entry {
+            self.scratch.entries.push(Entry {
                 node: k,
                 guess_px: (node.u_px, node.v_px),
                 gradient,
             });
         }
         self.measure_against_origin(image);
-        for (entry, &(result, score)) in self.entries.iter().zip(&self.reanchored) {
+        for (entry, &(result, score)) in self.scratch.entries.iter().zip(&self.scratch.reanchored) {
             let k = entry.node;
             let node = &mut self.field.nodes[k];
             if result.status == NodeStatus::Ok && score >= self.settings.min_zncc {
@@ -51,10 +51,10 @@ impl Correlator {
                 node.u_px = result.u_px;
                 node.v_px = result.v_px;
                 node.score = score;
-                let base = &mut self.ref_nodes[k].base_px;
+                let base = &mut self.reference.nodes[k].base_px;
                 base.0 += correction.0;
                 base.1 += correction.1;
-                self.never_lost[k] = true;
+                self.history.never_lost[k] = true;
             } else {
                 node.status = NodeStatus::LowZncc;
                 node.score = score;
@@ -70,10 +70,10 @@ impl Correlator {
     /// reference to reference (a border node of an incremental reference drifted by 1.7 px
     /// over 70 updates without this).
     pub(super) fn bases_from_origin(&mut self, image: Image) {
-        if !self.origin_known || self.reference_is_origin {
+        if self.origin.is_none() || self.reference.is_origin {
             return;
         }
-        self.entries.clear();
+        self.scratch.entries.clear();
         for k in 0..self.field.nodes.len() {
             if self.field.nodes[k].status != NodeStatus::Ok {
                 continue;
@@ -81,16 +81,16 @@ impl Correlator {
             let gradient: Mat2 = self
                 .affine_fit(Some(k), EXTRAPOLATION_RINGS, None, Support::Valid)
                 .map_or([[0.0; 2]; 2], |fit| to_mat2(fit.gradient));
-            self.entries.push(Entry {
+            self.scratch.entries.push(Entry {
                 node: k,
-                guess_px: self.scratch_pairs[k],
+                guess_px: self.scratch.pairs[k],
                 gradient,
             });
         }
         self.measure_against_origin(image);
-        for (entry, &(result, score)) in self.entries.iter().zip(&self.reanchored) {
+        for (entry, &(result, score)) in self.scratch.entries.iter().zip(&self.scratch.reanchored) {
             if result.status == NodeStatus::Ok && score >= self.settings.min_zncc {
-                self.scratch_pairs[entry.node] = (result.u_px, result.v_px);
+                self.scratch.pairs[entry.node] = (result.u_px, result.v_px);
             }
         }
     }
@@ -103,16 +103,20 @@ impl Correlator {
         let offset = (n - self.fft_px) as f64 / 2.0 - pad as f64;
         // A measurement, not a guess, when IC-GN has no origin coefficients: the paper's iterations.
         let iterations = crate::zoi::SubpixelIterations::paper(self.settings.max_iterations);
+        let Some(origin) = &self.origin else {
+            return;
+        };
         let origin = Image {
-            pixels: &self.origin_pixels,
+            pixels: &origin.pixels,
             width_px: self.width_px,
             height_px: self.height_px,
         };
-        self.reanchored.clear();
-        self.reanchored
-            .resize(self.entries.len(), (ZoiResult::default(), 0.0));
-        let (entries, top_left) = (&self.entries, &self.mesh.top_left);
-        let out = SharedSlice::new(&mut self.reanchored);
+        // Out of `self` while the items write it (no allocation: the buffer moves back).
+        let mut reanchored = std::mem::take(&mut self.scratch.reanchored);
+        reanchored.clear();
+        reanchored.resize(self.scratch.entries.len(), (ZoiResult::default(), 0.0));
+        let (entries, top_left) = (&self.scratch.entries, &self.mesh.top_left);
+        let out = SharedSlice::new(&mut reanchored);
         // IC-GN methods measure with IC-GN: the origin's subset prepared on the fly.
         let icgn = self.origin_icgn();
         let min_zncc = self.settings.min_zncc;
@@ -170,5 +174,6 @@ impl Correlator {
             // SAFETY: item i writes only slot i.
             unsafe { out.write(i, (result, score)) };
         });
+        self.scratch.reanchored = reanchored;
     }
 }

@@ -14,7 +14,6 @@ use wire::files::RowFile;
 
 /// Where the replay brought the rig, and what its log needs.
 pub(super) struct Resumed {
-    pub journal: Journal,
     /// The log against the replay (None: the rig logs nothing).
     pub log: Option<LogFinding>,
     /// Rows the log holds once reopened (under its header).
@@ -106,7 +105,6 @@ pub(super) fn resume(
         })?;
     let (Some(check), Some(log)) = (check, log_path) else {
         return Ok(Some(Resumed {
-            journal,
             log: None,
             rows_logged: 0,
         }));
@@ -125,7 +123,6 @@ pub(super) fn resume(
     }
     let finding = check.finish().map_err(|e| log_refused(log, e))?;
     Ok(Some(Resumed {
-        journal,
         log: Some(finding),
         rows_logged: rows,
     }))
