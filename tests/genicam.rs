@@ -359,7 +359,7 @@ fn an_unsupported_pixel_format_is_a_clear_error() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(
-        stderr.contains("unknown pixel format \"RGB8\"") && stderr.contains("Mono12"),
+        stderr.contains("pixel format \"RGB8\": expected") && stderr.contains("Mono12"),
         "{stderr}"
     );
 
