@@ -26,11 +26,13 @@ mod shell;
 /// The rig's place on an instance, one for the simulated rig and the CSV follower: the claim
 /// of the `rig` role (a second rig is refused), its node (dead nodes of the instance cleaned,
 /// and said) and the `rig/state` publisher.
+/// Fields drop in declaration order: the publisher, then the node, then the owner claim, and
+/// the instance last, which removes iceoryx2's node counter once no node of it is left.
 pub(crate) struct StatePort {
-    pub instance: wire::Instance,
-    pub _owner: wire::owner::Owner,
-    pub node: Node<ipc::Service>,
     pub publisher: wire::pubsub::ValuePublisher<RigState>,
+    pub node: Node<ipc::Service>,
+    pub _owner: wire::owner::Owner,
+    pub instance: wire::Instance,
 }
 
 impl StatePort {

@@ -39,9 +39,10 @@ pub(super) struct RigShell {
     settings: u64,
     session: Session,
     journal_path: Option<PathBuf>,
-    port: StatePort,
+    // Ports on the node drop before it (fields drop in declaration order): `port` last.
     server: CommandServer,
     fields: Option<FieldSubscriber>,
+    port: StatePort,
     field_clock: FieldClock,
     log: Option<RowFile>,
     /// Log rows not yet appended.
