@@ -35,7 +35,7 @@ pub trait Named: Copy + Sized + 'static {
             .ok_or_else(|| UnknownName {
                 what: Self::WHAT,
                 given: text.to_string(),
-                expected: expected_list(Self::ALL.iter().map(|v| v.name())),
+                expected: Self::expected(),
             })
     }
 

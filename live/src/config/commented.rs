@@ -105,21 +105,31 @@ fn comment(entry: &str) -> Option<&'static str> {
     COMMENTS.iter().find(|(e, _)| *e == entry).map(|(_, c)| *c)
 }
 
+/// The non-blank lines of a written configuration, each with what it opens (`entry_of`),
+/// following the tables.
+fn entries(toml: &str) -> Vec<(&str, Option<String>)> {
+    let mut table = String::new();
+    let mut out = Vec::new();
+    for line in toml.lines().filter(|l| !l.trim().is_empty()) {
+        let entry = entry_of(line, &table);
+        if line.trim_start().starts_with('[') {
+            table = table_of(line);
+        }
+        out.push((line, entry));
+    }
+    out
+}
+
 impl RunConfig {
     /// The defaults as a commented TOML file to start from. Each comment is written once, above
-    /// the first occurrence of its key or table.
+    /// the first occurrence of its key or table; the TOML's own blank lines are left out and
+    /// one blank line goes before each table.
     pub fn commented_defaults() -> String {
         let mut out = String::from(PREAMBLE);
-        let mut table = String::new();
         let mut said: Vec<String> = Vec::new();
-        // The TOML's own blank lines are left out: one blank line goes before each table.
-        for line in RunConfig::default().to_toml().lines() {
-            if line.trim().is_empty() {
-                continue;
-            }
-            if let Some(entry) = entry_of(line, &table) {
+        for (line, entry) in entries(&RunConfig::default().to_toml()) {
+            if let Some(entry) = entry {
                 if line.trim_start().starts_with('[') {
-                    table = table_of(line);
                     let _ = writeln!(out);
                 }
                 if !said.contains(&entry) {
@@ -139,21 +149,16 @@ impl RunConfig {
 mod tests {
     use super::*;
 
-    /// Every entry the types write (with every optional key given, so none is skipped).
+    /// Every entry the defaults write (optional keys that are absent by default are not
+    /// written: their comment is their neighbour's).
     fn written_entries() -> Vec<String> {
-        let mut table = String::new();
-        let mut entries = Vec::new();
-        for line in RunConfig::default().to_toml().lines() {
-            if let Some(entry) = entry_of(line, &table) {
-                if line.trim_start().starts_with('[') {
-                    table = table_of(line);
-                }
-                if !entries.contains(&entry) {
-                    entries.push(entry);
-                }
+        let mut written: Vec<String> = Vec::new();
+        for (_, entry) in entries(&RunConfig::default().to_toml()) {
+            if let Some(entry) = entry.filter(|e| !written.contains(e)) {
+                written.push(entry);
             }
         }
-        entries
+        written
     }
 
     #[test]
