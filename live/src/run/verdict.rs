@@ -1,56 +1,100 @@
-//! Pure: how a run ended becomes its `failure` text and the exit code of `dicstream run`
-//! (see [`super::exit_code`]). The one place that decides them.
+//! Pure: how a run ended becomes its ending, its `failure` text and the exit code of
+//! `dicstream run` (see [`super::exit_code`]). The one place that decides them.
 
 use super::{exit_code, Ending};
 use crate::acceptance::Acceptance;
 
-/// What makes the results doubtful or the run failed, and the exit code. A completed run
-/// passes only if its acceptance (when there is a ground truth) compared something and
-/// passed, and no frame was lost to a fault; `signal` is the one that interrupted it.
-pub(super) fn verdict(
-    ending: Ending,
-    failure: Option<String>,
-    acceptance: Option<&Acceptance>,
-    acceptance_skipped: bool,
-    frames_lost_to_faults: u64,
-    signal: Option<i32>,
-    faults: &[String],
-) -> (Option<String>, u8) {
-    match ending {
-        Ending::Failed => (failure, exit_code::FAILED),
+/// What the end of a run knows that decides its verdict.
+pub(super) struct Facts<'a> {
+    /// How the loop ended (Failed with the error's chain in `failure`).
+    pub(super) ending: Ending,
+    pub(super) failure: Option<String>,
+    pub(super) acceptance: Option<&'a Acceptance>,
+    /// The acceptance was skipped (no ground truth): its absence is no doubt.
+    pub(super) acceptance_skipped: bool,
+    pub(super) frames_lost_to_faults: u64,
+    /// The termination signal that interrupted the run.
+    pub(super) signal: Option<i32>,
+    pub(super) faults: &'a [String],
+    /// Results files that could not be written, each with why.
+    pub(super) unwritten: &'a [String],
+}
+
+/// The ending, what makes the results doubtful or the run failed, and the exit code.
+#[derive(Debug, PartialEq, Eq)]
+pub(super) struct Verdict {
+    pub(super) ending: Ending,
+    pub(super) failure: Option<String>,
+    pub(super) exit_code: u8,
+}
+
+/// The verdict of a run. A completed run passes only if its acceptance (when there is a
+/// ground truth) compared something and passed, and no frame was lost to a fault; results
+/// that could not be written fail a run that was not interrupted (it did not deliver them).
+pub(super) fn verdict(facts: Facts) -> Verdict {
+    let (failure, exit_code) = match facts.ending {
+        Ending::Failed => (facts.failure, exit_code::FAILED),
         Ending::Interrupted => {
-            let signal = signal.unwrap_or(libc::SIGINT);
+            let signal = facts.signal.unwrap_or(libc::SIGINT);
             (
                 Some(format!("interrupted by {}", wire::signals::name(signal))),
                 exit_code::SIGNAL_BASE.saturating_add(signal as u8),
             )
         }
-        Ending::Completed => {
-            let mut doubts = Vec::new();
-            match acceptance {
-                None if acceptance_skipped => {}
-                None => doubts.push("nothing was identified".to_string()),
-                Some(a) if a.tested_nothing() => doubts.push(format!(
-                    "the acceptance tested nothing ({})",
-                    a.why_nothing_tested()
-                )),
-                Some(a) if !a.passed => doubts.push(format!(
-                    "the identified law did not pass the acceptance (tolerance {:.0} %)",
-                    100.0 * a.tolerance
-                )),
-                Some(_) => {}
-            }
-            if frames_lost_to_faults > 0 {
-                doubts.push(format!(
-                    "{frames_lost_to_faults} frame(s) were lost to faults ({})",
-                    faults.join("; ")
-                ));
-            }
-            match doubts.is_empty() {
-                true => (None, exit_code::PASSED),
-                false => (Some(doubts.join("; ")), exit_code::DOUBTFUL),
-            }
-        }
+        Ending::Completed => match doubts(&facts) {
+            None => (None, exit_code::PASSED),
+            Some(doubts) => (Some(doubts), exit_code::DOUBTFUL),
+        },
+    };
+    let verdict = Verdict {
+        ending: facts.ending,
+        failure,
+        exit_code,
+    };
+    match facts.unwritten.is_empty() || facts.ending == Ending::Interrupted {
+        true => verdict,
+        false => unwritten(verdict, facts.unwritten),
+    }
+}
+
+/// What makes a completed run's results doubtful, if anything.
+fn doubts(facts: &Facts) -> Option<String> {
+    let mut doubts = Vec::new();
+    match facts.acceptance {
+        None if facts.acceptance_skipped => {}
+        None => doubts.push("nothing was identified".to_string()),
+        Some(a) if a.tested_nothing() => doubts.push(format!(
+            "the acceptance tested nothing ({})",
+            a.why_nothing_tested()
+        )),
+        Some(a) if !a.passed => doubts.push(format!(
+            "the identified law did not pass the acceptance (tolerance {:.0} %)",
+            100.0 * a.tolerance
+        )),
+        Some(_) => {}
+    }
+    if facts.frames_lost_to_faults > 0 {
+        doubts.push(format!(
+            "{} frame(s) were lost to faults ({})",
+            facts.frames_lost_to_faults,
+            facts.faults.join("; ")
+        ));
+    }
+    (!doubts.is_empty()).then(|| doubts.join("; "))
+}
+
+/// A run whose results could not all be written (a full disk) failed: the files are named
+/// after the failure it already had, or in place of its doubts.
+fn unwritten(verdict: Verdict, notes: &[String]) -> Verdict {
+    let missing = format!("results not written: {}", notes.join("; "));
+    let failure = match verdict.failure {
+        Some(f) if verdict.ending == Ending::Failed => format!("{f}; {missing}"),
+        _ => missing,
+    };
+    Verdict {
+        ending: Ending::Failed,
+        failure: Some(failure),
+        exit_code: exit_code::FAILED,
     }
 }
 
@@ -59,8 +103,27 @@ mod tests {
     use super::*;
     use crate::acceptance::{accept, accept_path, true_law};
 
+    /// A run that ended as `ending`, with nothing else known.
+    fn facts(ending: Ending) -> Facts<'static> {
+        Facts {
+            ending,
+            failure: None,
+            acceptance: None,
+            acceptance_skipped: false,
+            frames_lost_to_faults: 0,
+            signal: None,
+            faults: &[],
+            unwritten: &[],
+        }
+    }
+
     fn completed(acceptance: Option<&Acceptance>, skipped: bool) -> (Option<String>, u8) {
-        verdict(Ending::Completed, None, acceptance, skipped, 0, None, &[])
+        let v = verdict(Facts {
+            acceptance,
+            acceptance_skipped: skipped,
+            ..facts(Ending::Completed)
+        });
+        (v.failure, v.exit_code)
     }
 
     #[test]
@@ -104,30 +167,61 @@ mod tests {
     #[test]
     fn faults_failures_and_signals_keep_their_codes() {
         let faults = ["correlator killed by signal 9".to_string()];
-        let (failure, code) = verdict(Ending::Completed, None, None, true, 3, None, &faults);
-        assert_eq!(code, exit_code::DOUBTFUL);
-        assert!(failure
+        let lost = verdict(Facts {
+            acceptance_skipped: true,
+            frames_lost_to_faults: 3,
+            faults: &faults,
+            ..facts(Ending::Completed)
+        });
+        assert_eq!(lost.exit_code, exit_code::DOUBTFUL);
+        assert!(lost
+            .failure
             .unwrap()
             .contains("3 frame(s) were lost to faults (correlator killed"));
-        let failed = verdict(
-            Ending::Failed,
-            Some("rig exited 75".into()),
-            None,
-            false,
-            0,
-            None,
-            &[],
+        let failed = verdict(Facts {
+            failure: Some("rig exited 75".into()),
+            ..facts(Ending::Failed)
+        });
+        let expected = Verdict {
+            ending: Ending::Failed,
+            failure: Some("rig exited 75".into()),
+            exit_code: exit_code::FAILED,
+        };
+        assert_eq!(failed, expected);
+        let interrupted = verdict(Facts {
+            signal: Some(libc::SIGTERM),
+            ..facts(Ending::Interrupted)
+        });
+        assert_eq!(interrupted.exit_code, 143);
+    }
+
+    #[test]
+    fn results_not_written_fail_a_run_unless_it_was_interrupted() {
+        let unwritten = ["latency.png: disk full".to_string()];
+        let doubtful = verdict(Facts {
+            unwritten: &unwritten,
+            ..facts(Ending::Completed)
+        });
+        let expected = Verdict {
+            ending: Ending::Failed,
+            failure: Some("results not written: latency.png: disk full".into()),
+            exit_code: exit_code::FAILED,
+        };
+        assert_eq!(doubtful, expected);
+        let failed = verdict(Facts {
+            failure: Some("rig exited 74".into()),
+            unwritten: &unwritten,
+            ..facts(Ending::Failed)
+        });
+        assert_eq!(
+            failed.failure.as_deref(),
+            Some("rig exited 74; results not written: latency.png: disk full")
         );
-        assert_eq!(failed, (Some("rig exited 75".into()), exit_code::FAILED));
-        let (_, code) = verdict(
-            Ending::Interrupted,
-            None,
-            None,
-            false,
-            0,
-            Some(libc::SIGTERM),
-            &[],
-        );
-        assert_eq!(code, 143);
+        let interrupted = verdict(Facts {
+            unwritten: &unwritten,
+            ..facts(Ending::Interrupted)
+        });
+        assert_eq!(interrupted.ending, Ending::Interrupted);
+        assert_eq!(interrupted.exit_code, 130);
     }
 }

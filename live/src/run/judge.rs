@@ -1,0 +1,63 @@
+//! The identified law against the specimen's true one ([`crate::acceptance`]), when the run
+//! has a ground truth: on the uniaxial and equibiaxial curves the tests reached, or along a
+//! strain-controlled path off them. Without a ground truth, why it was skipped.
+
+use crate::acceptance::{accept, accept_path, Acceptance};
+use crate::config::{RigSource, RunConfig};
+use crate::recorder::Recorder;
+use identifier::law::InvariantLaw;
+use wire::IdentificationReport;
+
+/// The acceptance of the run's last identification, and why there is none if it was skipped.
+pub(super) struct Judged {
+    pub(super) acceptance: Option<Acceptance>,
+    pub(super) skipped: Option<String>,
+}
+
+/// Judges the last identification the run recorded (said on stderr when skipped).
+pub(super) fn judge(config: &RunConfig, recorder: &Recorder) -> Judged {
+    let has_truth = config.camera.source.has_truth() && config.rig.source == RigSource::Simulated;
+    let skipped = (!has_truth && recorder.last_report.is_some()).then(|| {
+        format!(
+            "no ground truth with [camera] source = {:?} and [rig] source = {:?}: the \
+             identified law is not compared with [specimen]",
+            config.camera.source, config.rig.source
+        )
+    });
+    if let Some(why) = &skipped {
+        eprintln!("run: acceptance skipped: {why}");
+    }
+    let acceptance = recorder
+        .last_report
+        .filter(|_| has_truth)
+        .map(|report| accept_report(config, recorder, &report));
+    Judged {
+        acceptance,
+        skipped,
+    }
+}
+
+/// The acceptance of `report` against the configuration's law.
+fn accept_report(
+    config: &RunConfig,
+    recorder: &Recorder,
+    report: &IdentificationReport,
+) -> Acceptance {
+    let truth: InvariantLaw = config.law().expect("validated law");
+    let a = &report.a[..report.a_count as usize];
+    let b = &report.b[..report.b_count as usize];
+    // A strain-controlled path off the uniaxial and equibiaxial curves (pure shear, any ρ but
+    // 1) is compared along its own path, up to the larger stretch the gauge zone reached.
+    let off_path = config
+        .strain_test()
+        .ok()
+        .flatten()
+        .filter(|t| t.kind != rig::strain::StrainKind::Equibiaxial);
+    if let Some(test) = &off_path {
+        let reached = recorder.max_stretch[2];
+        return accept_path(&truth, a, b, test.kind.name(), test.ratio, reached);
+    }
+    let tested =
+        |case: usize| (recorder.max_stretch[case] > 1.01).then_some(recorder.max_stretch[case]);
+    accept(&truth, a, b, tested(1), tested(2))
+}

@@ -1,0 +1,64 @@
+//! The start of the children: consumers first, each waited for until it says it is ready.
+
+use super::open::Run;
+use super::READY_TIMEOUT;
+use crate::children::Role;
+use crate::config::{CameraSource, RunConfig};
+
+/// Consumers first, so that nothing the rig and the camera publish is missed.
+const START_ORDER: [Role; 4] = [
+    Role::Identifier,
+    Role::Correlator,
+    Role::Producer,
+    Role::Rig,
+];
+
+/// Whether the run waits for `role` to say it is ready before going on: a watched folder's
+/// camera is ready only at its first image (which sets the frame size), which may come long
+/// after the start; the run goes on at once and handles its exit like any other.
+pub(super) fn waits_for_ready(role: Role, config: &RunConfig) -> bool {
+    !(role == Role::Producer && config.camera.source == CameraSource::Watch)
+}
+
+impl Run<'_> {
+    /// Starts every child, each waited for until ready. False when a termination signal came
+    /// first (the children started so far are stopped by [`Run::stop`]).
+    pub(super) fn start_children(&mut self) -> anyhow::Result<bool> {
+        for role in START_ORDER {
+            if wire::signals::requested().is_some() {
+                return Ok(false);
+            }
+            self.supervisor.spawn(role, self.child_args(role, 0))?;
+            let waits = waits_for_ready(role, self.config());
+            if waits && !self.wait_ready_at_start(role)? {
+                return Ok(false);
+            }
+            let pid = self.supervisor.pid(role).unwrap_or(0);
+            match waits {
+                true => eprintln!("run: {} ready (pid {pid})", role.name()),
+                false => eprintln!(
+                    "run: {} started (pid {pid}); ready at its first image",
+                    role.name()
+                ),
+            }
+        }
+        // An exit while a later child was starting is kept by the supervisor: handled first
+        // thing by the event loop.
+        Ok(true)
+    }
+
+    /// Waits for `role` to be ready at the start of the run; a GenICam camera that cannot be
+    /// opened says what may be missing.
+    fn wait_ready_at_start(&mut self, role: Role) -> anyhow::Result<bool> {
+        let ready = self.supervisor.wait_ready(role, READY_TIMEOUT);
+        match (role, self.config().camera.source) {
+            (Role::Producer, CameraSource::Genicam) => ready.map_err(|e| {
+                e.context(
+                    "[camera] source = \"genicam\": the camera could not be opened (a \
+                     dicstream built without `--features genicam` says so above)",
+                )
+            }),
+            _ => ready,
+        }
+    }
+}

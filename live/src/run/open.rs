@@ -1,0 +1,118 @@
+//! The run while it goes on, [`Run`]: everything it holds, made once its instance is claimed
+//! and its results folder ready, before any child starts.
+
+use super::prepare::Prepared;
+use super::{start, RunOptions};
+use crate::children::{Role, Supervisor};
+use crate::config::RunConfig;
+use crate::liveness::Liveness;
+use crate::recorder::{Recorder, RecorderSettings};
+use crate::subscriptions::Subscriptions;
+use iceoryx2::prelude::*;
+use std::rc::Rc;
+use std::time::{Duration, Instant};
+
+/// Deaths, stale processes and restarts, as the run noticed them.
+#[derive(Default)]
+pub(super) struct Incidents {
+    pub(super) restarts: Vec<String>,
+    pub(super) restart_counts: [u32; 4],
+    /// Deaths and stale processes, as noticed (`<role> <how>`).
+    pub(super) faults: Vec<String>,
+}
+
+#[derive(Clone, Copy)]
+pub(super) enum Phase {
+    Running,
+    /// The campaign is over and the camera stopped: the correlator and the identifier finish.
+    Draining {
+        since: Instant,
+        last_frame: Option<u64>,
+    },
+}
+
+/// A run from the start of its first child to the stop of its last. Fields drop in their
+/// order: the monitor's ports before its node (iceoryx2 counts the node's users), both before
+/// the instance.
+pub(super) struct Run<'a> {
+    pub(super) options: &'a RunOptions,
+    /// The monitor's ports, shared with the event loop's WaitSet while it waits on them.
+    pub(super) subscriptions: Rc<Subscriptions>,
+    pub(super) node: Node<ipc::Service>,
+    pub(super) supervisor: Supervisor,
+    pub(super) recorder: Recorder,
+    pub(super) dashboard: Option<dashboard::Dashboard>,
+    /// The instance (claimed), its name, the results folder and the start of the run.
+    pub(super) prepared: Prepared,
+    pub(super) incidents: Incidents,
+    pub(super) started: Instant,
+    pub(super) monitor_cpu_at_start_s: f64,
+    /// A real camera reported lost and not yet back (the status line says so).
+    pub(super) camera_away: bool,
+    pub(super) phase: Phase,
+    pub(super) liveness: Liveness,
+}
+
+impl<'a> Run<'a> {
+    /// Opens the run: the children's supervisor, the monitor's node and ports, the recorder
+    /// and the dashboard; `summary.json` says `running` from here on (`finish` replaces it).
+    pub(super) fn open(options: &'a RunOptions, prepared: Prepared) -> anyhow::Result<Run<'a>> {
+        let config = &options.config;
+        let started = Instant::now();
+        let monitor_cpu_at_start_s = crate::children::own_cpu_s();
+        let t0_ns = wire::monotonic_ns();
+        let supervisor = Supervisor::new(&options.exe, &prepared.results.logs())?;
+        let (node, _) = prepared.instance.create_node("monitor")?;
+        let subscriptions = Rc::new(Subscriptions::new(&node)?);
+        let settings = RecorderSettings {
+            fields_every: config.run.fields_every,
+            vtk: config.run.vtk,
+            truth: config.camera.source.has_truth(),
+        };
+        let recorder = Recorder::new(&prepared.results, settings, t0_ns)?;
+        let dashboard = crate::dashboard_view::start(config, &prepared.name)?;
+        start::write_running(
+            &prepared.results,
+            &prepared.name,
+            &prepared.start,
+            &config.camera.source,
+            &config.rig.source,
+        )?;
+        Ok(Run {
+            options,
+            subscriptions,
+            node,
+            supervisor,
+            recorder,
+            dashboard,
+            prepared,
+            incidents: Incidents::default(),
+            started,
+            monitor_cpu_at_start_s,
+            camera_away: false,
+            phase: Phase::Running,
+            liveness: super::stale::liveness(config),
+        })
+    }
+
+    pub(super) fn config(&self) -> &'a RunConfig {
+        &self.options.config
+    }
+
+    /// How long a stopped child gets between SIGTERM and SIGKILL.
+    pub(super) fn stop_timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.config().run.stop_timeout_s)
+    }
+
+    /// The command line of `role` in this run (see [`super::child_args`]).
+    pub(super) fn child_args(&self, role: Role, first_frame_id: u64) -> Vec<String> {
+        let prepared = &self.prepared;
+        super::child_args(
+            role,
+            self.config(),
+            &prepared.name,
+            &prepared.results,
+            first_frame_id,
+        )
+    }
+}

@@ -1,0 +1,97 @@
+//! The files a run writes at its end from what it recorded: the latency histograms (also
+//! rewritten during the run), `latency.png`, the identification figures and `strain_map.png`.
+//! A file that cannot be written is a note, never the end of the others.
+
+use super::StrainMapInfo;
+use crate::config::RunConfig;
+use crate::latency::Latency;
+use crate::recorder::Recorder;
+use crate::results::ResultsDir;
+use wire::files::FileError;
+
+/// What the end of the run wrote: what `strain_map.png` shows, and the files that could not
+/// be written, each with why.
+pub(super) struct Outputs {
+    pub(super) strain_map: Option<StrainMapInfo>,
+    pub(super) notes: Vec<String>,
+}
+
+/// The latency histograms' files and what each holds.
+fn histograms(recorder: &Recorder) -> [(&'static str, &Latency); 2] {
+    [
+        ("latency.hgrm", &recorder.latency_field),
+        (
+            "latency_identification.hgrm",
+            &recorder.latency_identification,
+        ),
+    ]
+}
+
+fn write_histogram(results: &ResultsDir, name: &str, latency: &Latency) -> Result<(), FileError> {
+    wire::files::write_atomic(&results.path(name), latency.hgrm().as_bytes())
+}
+
+/// `latency.hgrm` (capture to field) and `latency_identification.hgrm`.
+pub(super) fn write_histograms(results: &ResultsDir, recorder: &Recorder) -> Result<(), FileError> {
+    histograms(recorder)
+        .into_iter()
+        .try_for_each(|(name, latency)| write_histogram(results, name, latency))
+}
+
+/// Writes every file of the end of the run.
+pub(super) fn write(config: &RunConfig, results: &ResultsDir, recorder: &Recorder) -> Outputs {
+    let mut notes = Vec::new();
+    let mut keep = |what: &str, result: anyhow::Result<()>| {
+        if let Err(e) = result {
+            notes.push(format!("{what}: {e:#}"));
+        }
+    };
+    for (name, latency) in histograms(recorder) {
+        keep(
+            name,
+            write_histogram(results, name, latency).map_err(Into::into),
+        );
+    }
+    let curves = [
+        ("capture to field", &recorder.latency_field),
+        (
+            "capture to identification",
+            &recorder.latency_identification,
+        ),
+    ];
+    keep(
+        "latency.png",
+        crate::figures::latency_png(&results.path("latency.png"), &curves),
+    );
+    let models = &config.identifier.models.0;
+    let figures = crate::figures::identification_figures(&results.root, &results.journal(), models);
+    keep("identification figures", figures.map(|_| ()));
+    let strain_map = strain_map(results, recorder);
+    let strain_map = strain_map.unwrap_or_else(|e| {
+        keep("strain_map.png", Err(e));
+        None
+    });
+    Outputs { strain_map, notes }
+}
+
+/// The most strained field of the last test over the image its mesh is defined in, as
+/// `strain_map.png` (none without both, or when the field is of another sequence).
+fn strain_map(results: &ResultsDir, recorder: &Recorder) -> anyhow::Result<Option<StrainMapInfo>> {
+    let (Some((frame, pixels)), Some((header, nodes))) =
+        (&recorder.sequence_first_frame, &recorder.peak_field)
+    else {
+        return Ok(None);
+    };
+    if header.origin_frame_id != frame.frame_id {
+        return Ok(None);
+    }
+    let field = crate::recorder::to_correlator_field(header, nodes);
+    let path = results.path("strain_map.png");
+    let range = crate::figures::strain_map(&path, pixels, frame.width_px as usize, &field)?;
+    Ok(Some(StrainMapInfo {
+        frame_id: header.frame_id,
+        origin_frame_id: header.origin_frame_id,
+        measure: wire::StrainMeasure::from_code(header.strain_measure).map_or("?", |m| m.name()),
+        exx_blue_to_red: range,
+    }))
+}

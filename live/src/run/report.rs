@@ -1,0 +1,71 @@
+//! What a run reports at its end: the final `summary.json` (the figures `dicstream run` prints
+//! come from it too).
+
+use super::{start::RunStart, Ending};
+use crate::acceptance::Acceptance;
+use crate::config::{CameraSource, RigSource};
+use crate::latency::Percentiles;
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// What the run did, also written as `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunReport {
+    pub results: PathBuf,
+    pub instance: String,
+    pub ending: Ending,
+    /// Start time, pid, configuration, the earlier run set aside (also in the summary written
+    /// at the start, `ending` = `running`).
+    #[serde(flatten)]
+    pub start: RunStart,
+    pub failure: Option<String>,
+    pub wall_s: f64,
+    pub frames_captured: u64,
+    pub fields: u64,
+    /// Frames captured that have no field: skipped by a correlator that fell behind, lost while
+    /// it was dead or stopped, or still on their way when the run stopped.
+    pub frames_not_correlated: u64,
+    /// Of those, the frames lost while a process was dead or stale (not skipped by a running
+    /// correlator): a fault cost them.
+    pub frames_lost_to_faults: u64,
+    /// Every death and stale process of the run, as noticed.
+    pub faults: Vec<String>,
+    pub identification_reports: u64,
+    pub restarts: Vec<String>,
+    /// CPU seconds used per process (user + system, all threads), and as a share of one core
+    /// over the run's wall time (1.0 = one core busy all along).
+    pub cpu_s: std::collections::BTreeMap<String, f64>,
+    pub cpu_cores: std::collections::BTreeMap<String, f64>,
+    pub latency_field_ms: Percentiles,
+    pub latency_identification_ms: Percentiles,
+    /// Mean over frames of the mean node displacement error against the truth (px), and the
+    /// worst node error of the run.
+    pub displacement_error_mean_px: Option<f64>,
+    pub acceptance: Option<Acceptance>,
+    /// Why there is no acceptance although a law was identified: a real camera or machine
+    /// has no ground truth to compare with.
+    pub acceptance_skipped: Option<String>,
+    /// Where frames and rig samples came from ([camera] source, [rig] source).
+    pub camera_source: CameraSource,
+    pub rig_source: RigSource,
+    /// With `[rig] source = "csv-follow"`: the machine CSV's rows read, malformed lines
+    /// skipped and restarts (truncations, rotations), as the follower kept them in
+    /// `machine_csv.json`.
+    pub machine_csv: Option<rig::csv_follow::FollowCounters>,
+    /// What `strain_map.png` shows.
+    pub strain_map: Option<StrainMapInfo>,
+    /// Files of the instance left once every process had stopped (named, then removed).
+    pub leftover_shm_files: usize,
+    /// The exit code of `dicstream run` (see [`super::exit_code`]).
+    pub exit_code: u8,
+}
+
+/// The field drawn in `strain_map.png` (the most strained field of the last test) and the
+/// exx range of its colours.
+#[derive(Clone, Debug, Serialize)]
+pub struct StrainMapInfo {
+    pub frame_id: u64,
+    pub origin_frame_id: u64,
+    pub measure: &'static str,
+    pub exx_blue_to_red: [f64; 2],
+}
