@@ -3,9 +3,9 @@
 //! camera's frame ids start.
 
 use crate::children::Role;
-use crate::config::{CameraSource, RigSource, RunConfig};
+use crate::config::{CameraSection, CameraSource, RigSource, RunConfig};
 use crate::results::ResultsDir;
-use std::path::PathBuf;
+use std::path::Path;
 
 /// Relative margin of the camera's stretch envelope beyond the campaign's largest stretch.
 const STRETCH_MARGIN: f64 = 0.05;
@@ -56,105 +56,126 @@ pub fn child_args(
     results: &ResultsDir,
     first_frame_id: u64,
 ) -> Vec<String> {
-    let path = |p: PathBuf| p.to_string_lossy().into_owned();
     let mut args = vec!["--instance".to_string(), instance.to_string()];
-    let c = &config.camera;
-    let k = &config.correlator;
-    let g = &config.rig;
-    let extra: Vec<String> = match role {
+    args.extend(match role {
         Role::Rig if config.rig.source == RigSource::CsvFollow => csv_follow_args(config, results),
         Role::Producer if config.camera.source != CameraSource::Simulated => {
             real_camera_args(config, results, first_frame_id)
         }
-        Role::Rig => [
-            match config.strain_test() {
-                Ok(Some(test)) => strain_args(&test),
-                _ => vec!["--campaign".into(), config.campaign_spec()],
-            },
-            vec![
-                format!("--law-f={}", fmt_list(&config.specimen.law_f)),
-                format!("--law-g={}", fmt_list(&config.specimen.law_g)),
-                "--speed".into(),
-                g.speed.to_string(),
-                "--publish-hz".into(),
-                g.publish_hz.to_string(),
-                "--log".into(),
-                path(results.rig_csv()),
-                "--log-hz".into(),
-                g.log_hz.to_string(),
-                "--seed".into(),
-                g.seed.to_string(),
-                "--state-dir".into(),
-                path(results.rig_state()),
-                "--exit-when-done".into(),
-            ],
-        ]
-        .concat(),
-        Role::Producer => vec![
-            "--follow-rig".into(),
-            "--fps".into(),
-            c.fps.to_string(),
-            "--width".into(),
-            c.width_px.to_string(),
-            "--height".into(),
-            c.height_px.to_string(),
-            "--bit-depth".into(),
-            c.bit_depth.to_string(),
-            "--mm-per-px".into(),
-            c.mm_per_px.to_string(),
-            "--max-stretch".into(),
-            // The rig overshoots a level by a little: the camera covers a margin beyond it.
-            (config.max_stretch() * (1.0 + STRETCH_MARGIN)).to_string(),
-            "--speckle-size-px".into(),
-            c.speckle_size_px.to_string(),
-            "--seed".into(),
-            c.seed.to_string(),
-            "--threads".into(),
-            c.threads.to_string(),
-            "--first-frame-id".into(),
-            first_frame_id.to_string(),
-        ],
-        Role::Correlator => vec![
-            "--method".into(),
-            k.method.to_string(),
-            "--zoi".into(),
-            k.zoi_px.to_string(),
-            "--step".into(),
-            k.step_px.to_string(),
-            "--threads".into(),
-            k.threads.to_string(),
-            "--strain".into(),
-            k.strain.to_string(),
-            "--reference-mode".into(),
-            k.reference.to_string(),
-            "--guess".into(),
-            k.guess.to_string(),
-            "--min-zncc".into(),
-            k.min_zncc.to_string(),
-            "--gradient-correction".into(),
-            k.gradient_correction.to_string(),
-            "--state-dir".into(),
-            path(results.correlator_state()),
-        ],
-        Role::Identifier => vec![
-            "--output".into(),
-            path(results.identification_json()),
-            "--journal".into(),
-            path(results.journal()),
-            "--model".into(),
-            config.identifier.models.to_string(),
-        ],
-    };
-    args.extend(extra);
+        Role::Rig => rig_args(config, results),
+        Role::Producer => simulated_camera_args(config, first_frame_id),
+        Role::Correlator => correlator_args(config, results),
+        Role::Identifier => identifier_args(config, results),
+    });
     args
+}
+
+/// A path as an argument.
+fn text(path: &Path) -> String {
+    path.to_string_lossy().into_owned()
+}
+
+/// The simulated rig: the campaign (or a strain-controlled test) on the specimen's law, its
+/// log and journal in the results.
+fn rig_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
+    let g = &config.rig;
+    let mut args = match config.strain_test() {
+        Ok(Some(test)) => strain_args(&test),
+        _ => vec!["--campaign".into(), config.campaign_spec()],
+    };
+    args.extend([
+        format!("--law-f={}", fmt_list(&config.specimen.law_f)),
+        format!("--law-g={}", fmt_list(&config.specimen.law_g)),
+        "--speed".into(),
+        g.speed.to_string(),
+        "--publish-hz".into(),
+        g.publish_hz.to_string(),
+        "--log".into(),
+        text(&results.rig_csv()),
+        "--log-hz".into(),
+        g.log_hz.to_string(),
+        "--seed".into(),
+        g.seed.to_string(),
+        "--state-dir".into(),
+        text(&results.rig_state()),
+        "--exit-when-done".into(),
+    ]);
+    args
+}
+
+/// The simulated camera, following the rig.
+fn simulated_camera_args(config: &RunConfig, first_frame_id: u64) -> Vec<String> {
+    let c = &config.camera;
+    vec![
+        "--follow-rig".into(),
+        "--fps".into(),
+        c.fps.to_string(),
+        "--width".into(),
+        c.width_px.to_string(),
+        "--height".into(),
+        c.height_px.to_string(),
+        "--bit-depth".into(),
+        c.bit_depth.to_string(),
+        "--mm-per-px".into(),
+        c.mm_per_px.to_string(),
+        "--max-stretch".into(),
+        // The rig overshoots a level by a little: the camera covers a margin beyond it.
+        (config.max_stretch() * (1.0 + STRETCH_MARGIN)).to_string(),
+        "--speckle-size-px".into(),
+        c.speckle_size_px.to_string(),
+        "--seed".into(),
+        c.seed.to_string(),
+        "--threads".into(),
+        c.threads.to_string(),
+        "--first-frame-id".into(),
+        first_frame_id.to_string(),
+    ]
+}
+
+/// The correlator's settings, its state in the results.
+fn correlator_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
+    let k = &config.correlator;
+    vec![
+        "--method".into(),
+        k.method.to_string(),
+        "--zoi".into(),
+        k.zoi_px.to_string(),
+        "--step".into(),
+        k.step_px.to_string(),
+        "--threads".into(),
+        k.threads.to_string(),
+        "--strain".into(),
+        k.strain.to_string(),
+        "--reference-mode".into(),
+        k.reference.to_string(),
+        "--guess".into(),
+        k.guess.to_string(),
+        "--min-zncc".into(),
+        k.min_zncc.to_string(),
+        "--gradient-correction".into(),
+        k.gradient_correction.to_string(),
+        "--state-dir".into(),
+        text(&results.correlator_state()),
+    ]
+}
+
+/// The identifier's models, its output and journal in the results.
+fn identifier_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
+    vec![
+        "--output".into(),
+        text(&results.identification_json()),
+        "--journal".into(),
+        text(&results.journal()),
+        "--model".into(),
+        config.identifier.models.to_string(),
+    ]
 }
 
 /// `rig --follow-csv FILE ...`: the machine's log of `[rig.csv]`, its counts kept beside the
 /// results.
 fn csv_follow_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
     let v = &config.rig.csv;
-    let path = |p: &PathBuf| p.to_string_lossy().into_owned();
-    let mut args = vec!["--follow-csv".to_string(), path(&v.file)];
+    let mut args = vec!["--follow-csv".to_string(), text(&v.file)];
     let mut named = |flag: &str, value: &str| {
         if !value.trim().is_empty() {
             args.push(flag.to_string());
@@ -185,7 +206,7 @@ fn csv_follow_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
         "--idle-timeout-s".into(),
         v.idle_timeout_s.to_string(),
         "--counts-json".into(),
-        path(&results.machine_csv_json()),
+        text(&results.machine_csv_json()),
     ]);
     args
 }
@@ -193,75 +214,78 @@ fn csv_follow_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
 /// The producer's options for a watched folder, a replay or a GenICam camera.
 fn real_camera_args(config: &RunConfig, results: &ResultsDir, first_frame_id: u64) -> Vec<String> {
     let c = &config.camera;
-    let mut args: Vec<String> = match config.camera.source {
-        CameraSource::Watch => {
-            let mut a = vec![
-                "--watch".to_string(),
-                c.watch_dir.to_string_lossy().into_owned(),
-                "--settle-ms".into(),
-                c.watch_settle_ms.to_string(),
-                // Which file each frame is, beside the results.
-                "--log".into(),
-                results
-                    .path("watched_frames.csv")
-                    .to_string_lossy()
-                    .into_owned(),
-            ];
-            if c.watch_from_start {
-                a.push("--from-start".into());
-            }
-            if c.watch_idle_timeout_s > 0.0 {
-                a.extend([
-                    "--idle-timeout-s".into(),
-                    c.watch_idle_timeout_s.to_string(),
-                ]);
-            }
-            a
-        }
+    let mut args = match c.source {
+        CameraSource::Watch => watch_args(c, results),
         CameraSource::Replay => vec![
             "--replay".into(),
             c.replay_files.clone(),
             "--fps".into(),
             c.fps.to_string(),
         ],
-        CameraSource::Genicam | CameraSource::Simulated => {
-            let mut a = vec![
-                "--camera".to_string(),
-                match c.genicam_id.trim() {
-                    "" => "genicam".to_string(),
-                    id => format!("genicam:{id}"),
-                },
-                "--fps".into(),
-                c.fps.to_string(),
-            ];
-            if let Some(us) = c.genicam_exposure_us {
-                a.extend(["--exposure-us".into(), us.to_string()]);
-            }
-            if let Some(db) = c.genicam_gain_db {
-                a.push(format!("--gain-db={db}"));
-            }
-            for (flag, value) in [
-                (
-                    "--pixel-format",
-                    c.genicam_pixel_format.map(|f| f.to_string()),
-                ),
-                ("--roi", c.genicam_roi.map(|r| r.to_string())),
-                ("--trigger", c.genicam_trigger.map(|t| t.to_string())),
-            ] {
-                if let Some(value) = value {
-                    a.extend([flag.to_string(), value]);
-                }
-            }
-            a
-        }
+        CameraSource::Genicam | CameraSource::Simulated => genicam_args(c),
     };
     args.extend(["--first-frame-id".into(), first_frame_id.to_string()]);
+    args
+}
+
+/// A watched folder, which file each frame is written beside the results.
+fn watch_args(c: &CameraSection, results: &ResultsDir) -> Vec<String> {
+    let mut args = vec![
+        "--watch".to_string(),
+        text(&c.watch_dir),
+        "--settle-ms".into(),
+        c.watch_settle_ms.to_string(),
+        "--log".into(),
+        text(&results.path("watched_frames.csv")),
+    ];
+    if c.watch_from_start {
+        args.push("--from-start".into());
+    }
+    if c.watch_idle_timeout_s > 0.0 {
+        args.extend([
+            "--idle-timeout-s".into(),
+            c.watch_idle_timeout_s.to_string(),
+        ]);
+    }
+    args
+}
+
+/// A GenICam camera (the first one, or the one named) with the settings given.
+fn genicam_args(c: &CameraSection) -> Vec<String> {
+    let mut args = vec![
+        "--camera".to_string(),
+        match c.genicam_id.trim() {
+            "" => "genicam".to_string(),
+            id => format!("genicam:{id}"),
+        },
+        "--fps".into(),
+        c.fps.to_string(),
+    ];
+    if let Some(us) = c.genicam_exposure_us {
+        args.extend(["--exposure-us".into(), us.to_string()]);
+    }
+    if let Some(db) = c.genicam_gain_db {
+        args.push(format!("--gain-db={db}"));
+    }
+    for (flag, value) in [
+        (
+            "--pixel-format",
+            c.genicam_pixel_format.map(|f| f.to_string()),
+        ),
+        ("--roi", c.genicam_roi.map(|r| r.to_string())),
+        ("--trigger", c.genicam_trigger.map(|t| t.to_string())),
+    ] {
+        if let Some(value) = value {
+            args.extend([flag.to_string(), value]);
+        }
+    }
     args
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::PathBuf;
 
     /// The value after `flag` (exactly one occurrence).
     fn value<'a>(args: &'a [String], flag: &str) -> &'a str {
