@@ -146,6 +146,41 @@ impl Supervisor {
 
     /// Starts `dicstream <role> <args...>`.
     pub fn spawn(&mut self, role: Role, args: Vec<String>) -> anyhow::Result<u32> {
+        let generation = self.next_generation(role, args);
+        let pipe = || format!("{}: cannot make a pipe", role.name());
+        let (reader, writer) = std::io::pipe().with_context(pipe)?;
+        let writer_err = writer.try_clone().with_context(pipe)?;
+        let mut command = Command::new(&self.exe);
+        command
+            .arg(role.name())
+            .args(&self.managed(role).args)
+            .stdin(Stdio::null())
+            .stdout(writer)
+            .stderr(writer_err)
+            .process_group(0);
+        with_parent_death_signal(&mut command);
+        let child = command
+            .spawn()
+            .with_context(|| format!("cannot start {} {}", self.exe.display(), role.name()))?;
+        // The parent's copies of the pipe's writing ends: the log thread then sees the end of
+        // the output when the child exits.
+        drop(command);
+        let pid = child.id();
+        self.managed(role).child = Some(child);
+        let log_path = self.log_dir.join(format!("{}.log", role.name()));
+        let mut log = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&log_path)
+            .with_context(|| log_path.display().to_string())?;
+        let _ = writeln!(log, "--- start {generation} (pid {pid})");
+        forward_lines(role, generation, reader, log, self.tx.clone())?;
+        Ok(pid)
+    }
+
+    /// Makes `role` ready for a new start with `args` (its first, or a restart); returns the
+    /// start's generation.
+    fn next_generation(&mut self, role: Role, args: Vec<String>) -> u32 {
         if !self.children.iter().any(|m| m.role == role) {
             self.children.push(Managed {
                 role,
@@ -159,9 +194,6 @@ impl Supervisor {
                 cpu_s_current: 0.0,
             });
         }
-        let exe = self.exe.clone();
-        let log_path = self.log_dir.join(format!("{}.log", role.name()));
-        let tx = self.tx.clone();
         let managed = self.managed(role);
         assert!(
             managed.child.is_none(),
@@ -174,59 +206,7 @@ impl Supervisor {
         managed.heard_input = false;
         managed.last_lines.clear();
         managed.cpu_s_ended += std::mem::take(&mut managed.cpu_s_current);
-        let generation = managed.generation;
-        let pipe = || format!("{}: cannot make a pipe", role.name());
-        let (reader, writer) = std::io::pipe().with_context(pipe)?;
-        let writer_err = writer.try_clone().with_context(pipe)?;
-        let mut command = Command::new(&exe);
-        command
-            .arg(role.name())
-            .args(&managed.args)
-            .stdin(Stdio::null())
-            .stdout(writer)
-            .stderr(writer_err)
-            .process_group(0);
-        // SAFETY: prctl is async-signal-safe; it only sets this child's parent-death signal.
-        unsafe {
-            command.pre_exec(|| {
-                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM) != 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                Ok(())
-            });
-        }
-        let child = command
-            .spawn()
-            .with_context(|| format!("cannot start {} {}", exe.display(), role.name()))?;
-        drop(command);
-        let pid = child.id();
-        managed.child = Some(child);
-        let mut log = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(&log_path)
-            .with_context(|| log_path.display().to_string())?;
-        let _ = writeln!(log, "--- start {generation} (pid {pid})");
-        std::thread::Builder::new()
-            .name(format!("{}-log", role.name()))
-            .spawn(move || {
-                for line in std::io::BufReader::new(reader).lines() {
-                    let Ok(line) = line else { break };
-                    let _ = writeln!(log, "{line}");
-                    if tx
-                        .send(Event::Line {
-                            role,
-                            generation,
-                            line,
-                        })
-                        .is_err()
-                    {
-                        break;
-                    }
-                }
-            })
-            .context("cannot start a log thread")?;
-        Ok(pid)
+        managed.generation
     }
 
     /// Takes in one printed line: readiness, last lines.
@@ -462,6 +442,49 @@ impl Supervisor {
             .filter_map(|&role| self.stop(role, timeout).map(|how| (role, how)))
             .collect()
     }
+}
+
+/// The child gets SIGTERM when this process dies (a supervisor killed with SIGKILL takes its
+/// children along).
+fn with_parent_death_signal(command: &mut Command) {
+    // SAFETY: prctl is async-signal-safe; it only sets this child's parent-death signal.
+    unsafe {
+        command.pre_exec(|| {
+            if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+}
+
+/// A thread that copies each line the child prints into its log and hands it to the
+/// supervisor, until the child closes its output (or the supervisor is gone).
+fn forward_lines(
+    role: Role,
+    generation: u32,
+    reader: std::io::PipeReader,
+    mut log: std::fs::File,
+    tx: Sender<Event>,
+) -> anyhow::Result<()> {
+    std::thread::Builder::new()
+        .name(format!("{}-log", role.name()))
+        .spawn(move || {
+            for line in std::io::BufReader::new(reader).lines() {
+                let Ok(line) = line else { break };
+                let _ = writeln!(log, "{line}");
+                let event = Event::Line {
+                    role,
+                    generation,
+                    line,
+                };
+                if tx.send(event).is_err() {
+                    break;
+                }
+            }
+        })
+        .context("cannot start a log thread")?;
+    Ok(())
 }
 
 /// The fields of `/proc/<pid>/stat` from the third on (state, ppid, ...; stat(5)): those after
