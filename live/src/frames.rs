@@ -196,6 +196,44 @@ pub struct FrameRow {
     pub frames_dropped: u64,
 }
 
+/// The forces (N) along x and y: the mean of each axis's two actuator forces (kN).
+fn forces_n(rig: &RigState) -> [f64; 2] {
+    let a = &rig.actuators;
+    [
+        500.0 * (a[0].force_kn + a[1].force_kn),
+        500.0 * (a[2].force_kn + a[3].force_kn),
+    ]
+}
+
+/// The Cauchy stresses (MPa) of `force_n` on the specimen's current sections (0 without one).
+fn cauchy_mpa(rig: &RigState, force_n: [f64; 2]) -> [f64; 2] {
+    let stress = |force: f64, section_mm2: f64| match section_mm2 > 0.0 {
+        true => force / section_mm2,
+        false => 0.0,
+    };
+    [
+        stress(force_n[0], rig.specimen_section_x_mm2),
+        stress(force_n[1], rig.specimen_section_y_mm2),
+    ]
+}
+
+/// The field's errors against the ground truth, its origin frame's truth `origin`: the mean
+/// and max node displacement error (px), and the measured minus true gauge log strain.
+fn truth_errors(
+    header: &FieldHeader,
+    nodes: &[FieldNode],
+    origin: &GroundTruth,
+) -> (Option<[f64; 2]>, Option<[f64; 2]>) {
+    let current = &header.truth;
+    let displacement_error_px =
+        truth::displacement_error(nodes, current, origin).map(|(mean, max, _)| [mean, max]);
+    let log = header.gauge_of(StrainMeasure::Log);
+    let log_strain_error = truth::relative_gradient(current, origin)
+        .and_then(|f| truth::log_strain(&f))
+        .map(|t| [log.exx - t[0], log.eyy - t[1]]);
+    (displacement_error_px, log_strain_error)
+}
+
 impl FrameRow {
     /// Builds the row of one field. `rig` is the field's rig sample, `origin_truth` the truth
     /// of the frame its node positions are measured in (its origin frame), `t0_ns` the
@@ -219,37 +257,11 @@ impl FrameRow {
             stretch[0].powi(2) + stretch[1].powi(2) + l3.powi(2),
             stretch[0].powi(-2) + stretch[1].powi(-2) + l3.powi(-2),
         ];
-        let force_n = rig.map(|s| {
-            let a = &s.actuators;
-            [
-                500.0 * (a[0].force_kn + a[1].force_kn),
-                500.0 * (a[2].force_kn + a[3].force_kn),
-            ]
-        });
-        let cauchy_mpa = rig.zip(force_n).map(|(s, f)| {
-            let stress = |force: f64, section: f64| {
-                if section > 0.0 {
-                    force / section
-                } else {
-                    0.0
-                }
-            };
-            [
-                stress(f[0], s.specimen_section_x_mm2),
-                stress(f[1], s.specimen_section_y_mm2),
-            ]
-        });
-        let truth_pair = (header.has_truth == 1)
-            .then_some(origin_truth)
-            .flatten()
-            .map(|origin| (&header.truth, origin));
-        let displacement_error_px = truth_pair
-            .and_then(|(current, origin)| truth::displacement_error(nodes, current, origin))
-            .map(|(mean, max, _)| [mean, max]);
-        let log_strain_error = truth_pair
-            .and_then(|(current, origin)| truth::relative_gradient(current, origin))
-            .and_then(|f| truth::log_strain(&f))
-            .map(|t| [log.exx - t[0], log.eyy - t[1]]);
+        let force_n = rig.map(forces_n);
+        let cauchy_mpa = rig.zip(force_n).map(|(s, f)| cauchy_mpa(s, f));
+        let (displacement_error_px, log_strain_error) = origin_truth
+            .filter(|_| header.has_truth == 1)
+            .map_or((None, None), |origin| truth_errors(header, nodes, origin));
         let ms = |ns: u64| ns as f64 * 1e-6;
         FrameRow {
             frame_id: header.frame_id,
