@@ -117,6 +117,15 @@ mod tests {
         }
     }
 
+    /// The verdict of a failed run, for `failure`.
+    fn failed_with(failure: &str) -> Verdict {
+        Verdict {
+            ending: Ending::Failed,
+            failure: Some(failure.into()),
+            exit_code: exit_code::FAILED,
+        }
+    }
+
     fn completed(acceptance: Option<&Acceptance>, skipped: bool) -> (Option<String>, u8) {
         let v = verdict(Facts {
             acceptance,
@@ -182,12 +191,7 @@ mod tests {
             failure: Some("rig exited 75".into()),
             ..facts(Ending::Failed)
         });
-        let expected = Verdict {
-            ending: Ending::Failed,
-            failure: Some("rig exited 75".into()),
-            exit_code: exit_code::FAILED,
-        };
-        assert_eq!(failed, expected);
+        assert_eq!(failed, failed_with("rig exited 75"));
         let interrupted = verdict(Facts {
             signal: Some(libc::SIGTERM),
             ..facts(Ending::Interrupted)
@@ -202,20 +206,18 @@ mod tests {
             unwritten: &unwritten,
             ..facts(Ending::Completed)
         });
-        let expected = Verdict {
-            ending: Ending::Failed,
-            failure: Some("results not written: latency.png: disk full".into()),
-            exit_code: exit_code::FAILED,
-        };
-        assert_eq!(doubtful, expected);
+        assert_eq!(
+            doubtful,
+            failed_with("results not written: latency.png: disk full")
+        );
         let failed = verdict(Facts {
             failure: Some("rig exited 74".into()),
             unwritten: &unwritten,
             ..facts(Ending::Failed)
         });
         assert_eq!(
-            failed.failure.as_deref(),
-            Some("rig exited 74; results not written: latency.png: disk full")
+            failed,
+            failed_with("rig exited 74; results not written: latency.png: disk full")
         );
         let interrupted = verdict(Facts {
             unwritten: &unwritten,
