@@ -202,23 +202,22 @@ mod tests {
     #[test]
     fn results_not_written_fail_a_run_unless_it_was_interrupted() {
         let unwritten = ["latency.png: disk full".to_string()];
-        let doubtful = verdict(Facts {
-            unwritten: &unwritten,
-            ..facts(Ending::Completed)
-        });
-        assert_eq!(
-            doubtful,
-            failed_with("results not written: latency.png: disk full")
-        );
-        let failed = verdict(Facts {
-            failure: Some("rig exited 74".into()),
-            unwritten: &unwritten,
-            ..facts(Ending::Failed)
-        });
-        assert_eq!(
-            failed,
-            failed_with("rig exited 74; results not written: latency.png: disk full")
-        );
+        let missing = "results not written: latency.png: disk full";
+        for (ending, failure, expected) in [
+            (Ending::Completed, None, missing.to_string()),
+            (
+                Ending::Failed,
+                Some("rig exited 74"),
+                format!("rig exited 74; {missing}"),
+            ),
+        ] {
+            let judged = verdict(Facts {
+                failure: failure.map(Into::into),
+                unwritten: &unwritten,
+                ..facts(ending)
+            });
+            assert_eq!(judged, failed_with(&expected), "{ending:?}");
+        }
         let interrupted = verdict(Facts {
             unwritten: &unwritten,
             ..facts(Ending::Interrupted)
