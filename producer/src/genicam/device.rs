@@ -180,6 +180,13 @@ fn connect(spec: &CameraSpec) -> Result<(Camera, String), GenicamError> {
     Ok((camera, id))
 }
 
+/// A camera acquiring: its stream, the control-lost flag the driver raises, and its image size.
+struct Started {
+    stream: Stream,
+    control_lost: Arc<AtomicBool>,
+    size_px: (u32, u32),
+}
+
 /// An opened camera being set up; its errors name it by `id`.
 struct Setup<'a> {
     camera: &'a Camera,
@@ -284,9 +291,8 @@ impl Setup<'_> {
         }
     }
 
-    /// Queues the buffers and starts acquiring: the stream, the control-lost flag the driver
-    /// raises, and the image size (px).
-    fn start(&self) -> Result<(Stream, Arc<AtomicBool>, (u32, u32)), GenicamError> {
+    /// Queues the buffers and starts acquiring.
+    fn start(&self) -> Result<Started, GenicamError> {
         let camera = self.camera;
         let (_, _, width, height) = camera
             .region()
@@ -308,11 +314,11 @@ impl Setup<'_> {
         camera
             .start_acquisition()
             .map_err(|e| self.stream_error("starting the acquisition", e))?;
-        Ok((
+        Ok(Started {
             stream,
             control_lost,
-            (width.max(0) as u32, height.max(0) as u32),
-        ))
+            size_px: (width.max(0) as u32, height.max(0) as u32),
+        })
     }
 }
 
@@ -340,7 +346,11 @@ impl Acquisition {
         let _ = camera.stop_acquisition();
         let format = setup.pixel_format(settings.pixel_format)?;
         setup.apply(settings)?;
-        let (stream, control_lost, (width_px, height_px)) = setup.start()?;
+        let Started {
+            stream,
+            control_lost,
+            size_px: (width_px, height_px),
+        } = setup.start()?;
         Ok(Acquisition {
             id,
             camera,
