@@ -31,11 +31,14 @@ impl Drop for TempDir {
 }
 
 fn write_png(path: &Path, pixels: &[u16], width: usize, height: usize) {
+    let dims = producer::FrameDims {
+        width: width as u32,
+        height: height as u32,
+        bit_depth: 16,
+    };
     producer::write_frame(
         path,
-        width as u32,
-        height as u32,
-        16,
+        dims,
         pixels,
         producer::ImageFormatOut::Png16,
         &mut Vec::new(),

@@ -107,11 +107,14 @@ fn stretch_against_a_reference_file() {
     let (motion0, _) = translation(0.0, 0.0);
     let reference = render(W, H, &motion0, 1);
     let reference_path = dir.join("reference.png");
+    let dims = producer::FrameDims {
+        width: W as u32,
+        height: H as u32,
+        bit_depth: 16,
+    };
     producer::write_frame(
         &reference_path,
-        W as u32,
-        H as u32,
-        16,
+        dims,
         &reference,
         producer::ImageFormatOut::Png16,
         &mut Vec::new(),

@@ -20,30 +20,34 @@ pub fn apply(m: Mat2, v: (f64, f64)) -> (f64, f64) {
     (m[0][0] * v.0 + m[0][1] * v.1, m[1][0] * v.0 + m[1][1] * v.1)
 }
 
-/// Where the n x n block with centre `centre` lands under x → centre + shift + a (x − centre):
-/// true when all four corners (hence, the map being affine, every sample) lie within
-/// `[lo, size − 1 − hi]` on both axes.
-pub fn block_inside(
-    image: Image,
-    centre: (f64, f64),
-    shift: (f64, f64),
-    a: Mat2,
-    n: usize,
-    lo: f64,
-    hi: f64,
-) -> bool {
-    let half = (n as f64 - 1.0) / 2.0;
-    let (max_x, max_y) = (
-        image.width_px as f64 - 1.0 - hi,
-        image.height_px as f64 - 1.0 - hi,
-    );
-    [(-half, -half), (half, -half), (-half, half), (half, half)]
-        .into_iter()
-        .all(|r| {
-            let d = apply(a, r);
-            let (x, y) = (centre.0 + shift.0 + d.0, centre.1 + shift.1 + d.1);
-            x >= lo && y >= lo && x <= max_x && y <= max_y
-        })
+/// The n x n block with centre `centre_px` (px), mapped by
+/// x → centre + shift + a (x − centre).
+#[derive(Clone, Copy, Debug)]
+pub struct WarpedBlock {
+    pub centre_px: (f64, f64),
+    pub shift_px: (f64, f64),
+    pub a: Mat2,
+    pub n: usize,
+}
+
+impl WarpedBlock {
+    /// Where the block lands in `image`: true when all four corners (hence, the map being
+    /// affine, every sample) lie within `[lo_px, size − 1 − hi_px]` on both axes.
+    pub fn inside(&self, image: Image, lo_px: f64, hi_px: f64) -> bool {
+        let (centre, shift, a) = (self.centre_px, self.shift_px, self.a);
+        let half = (self.n as f64 - 1.0) / 2.0;
+        let (max_x, max_y) = (
+            image.width_px as f64 - 1.0 - hi_px,
+            image.height_px as f64 - 1.0 - hi_px,
+        );
+        [(-half, -half), (half, -half), (-half, half), (half, half)]
+            .into_iter()
+            .all(|r| {
+                let d = apply(a, r);
+                let (x, y) = (centre.0 + shift.0 + d.0, centre.1 + shift.1 + d.1);
+                x >= lo_px && y >= lo_px && x <= max_x && y <= max_y
+            })
+    }
 }
 
 /// Keys cubic convolution weights (a = −0.5) of the four samples at −1, 0, 1, 2 for a
@@ -140,12 +144,17 @@ mod tests {
             width_px: 64,
             height_px: 64,
         };
-        let c = (31.5, 31.5);
-        assert!(block_inside(image, c, (0.0, 0.0), IDENTITY, 64, 0.0, 0.0));
-        assert!(!block_inside(image, c, (0.5, 0.0), IDENTITY, 64, 0.0, 0.0));
+        let block = |shift_px, a, n| WarpedBlock {
+            centre_px: (31.5, 31.5),
+            shift_px,
+            a,
+            n,
+        };
+        assert!(block((0.0, 0.0), IDENTITY, 64).inside(image, 0.0, 0.0));
+        assert!(!block((0.5, 0.0), IDENTITY, 64).inside(image, 0.0, 0.0));
         let (s, co) = 0.3f64.sin_cos();
         let rotation = [[co, -s], [s, co]];
-        assert!(!block_inside(image, c, (0.0, 0.0), rotation, 64, 0.0, 0.0));
-        assert!(block_inside(image, c, (0.0, 0.0), rotation, 32, 1.0, 2.0));
+        assert!(!block((0.0, 0.0), rotation, 64).inside(image, 0.0, 0.0));
+        assert!(block((0.0, 0.0), rotation, 32).inside(image, 1.0, 2.0));
     }
 }

@@ -10,7 +10,7 @@
 
 use crate::field::NodeStatus;
 pub use crate::image::Image;
-use crate::interpolate::{apply, bicubic, bicubic_clamped, block_inside, identity_plus, Mat2};
+use crate::interpolate::{apply, bicubic, bicubic_clamped, identity_plus, Mat2, WarpedBlock};
 use crate::peak::quadratic_peak_3x3;
 use crate::real_fft2d::RealFft2d;
 use crate::simd::{dot, F32x4};
@@ -95,6 +95,53 @@ pub struct ZoiResult {
     /// The displacement gradient the deformed ZOI was sampled through (zero: a rigid ZOI cut
     /// from the pixel grid). The rigid-ZOI bias then only concerns the gradient beyond it.
     pub warp_gradient: Mat2,
+}
+
+impl ZoiResult {
+    /// A ZOI that was not measured, for `status`, after `iterations` sub-pixel iterations.
+    fn with_status(status: NodeStatus, iterations: u32) -> ZoiResult {
+        ZoiResult {
+            status,
+            iterations,
+            ..ZoiResult::default()
+        }
+    }
+}
+
+/// What one ZOI is correlated from: the reference ZOI's top-left pixel in the image, the
+/// displacement guess (px), the gradient to sample the deformed ZOI through, if any, and how
+/// far the sub-pixel iterations go.
+#[derive(Clone, Copy, Debug)]
+pub struct ZoiSearch {
+    pub top_left_px: (usize, usize),
+    pub guess_px: (f64, f64),
+    pub warp: Option<Mat2>,
+    pub iterations: SubpixelIterations,
+}
+
+/// Where the integer step cuts the deformed ZOI: its integer move (px, image axes) and where
+/// its centre lands relative to the reference centre (px; in the warped ZOI's axes moved by
+/// A, rigid: the integer move itself).
+struct Placement {
+    ix: i64,
+    iy: i64,
+    origin_px: (f64, f64),
+}
+
+/// Where the sub-pixel iterations got to: the best shift (px, the ZOI's axes), its windowed
+/// correlation value, the last correction (px), whether they stopped on their own, and how many
+/// ran.
+struct SubpixelEstimate {
+    shift_px: (f64, f64),
+    value: f64,
+    last_step_px: f64,
+    converged: bool,
+    iterations: u32,
+}
+
+/// The windowed deformed ZOI went flat after `iterations` sub-pixel iterations.
+struct Flat {
+    iterations: u32,
 }
 
 /// A gradient smaller than this (its largest entry times the ZOI half-size, px) is not worth
@@ -386,21 +433,21 @@ impl ZoiEngine {
     }
 
     /// Samples (bicubic) the deformed image through x → x + shift + (a − I)(x − centre) over
-    /// the n x n block centred on `centre` into `g_spatial`, minus its mean. None when a
+    /// the n x n `block` centred on `centre` into `g_spatial`, minus its mean. None when a
     /// sample is more than a pixel past the border (as the rigid ZOI, which is pulled back
     /// inside from there), Some(false) when the samples are flat. Near and past the border the
     /// interpolation repeats the border pixels.
-    fn extract_warped(
-        &mut self,
-        image: Image,
-        centre: (f64, f64),
-        shift: (f64, f64),
-        a: Mat2,
-    ) -> Option<bool> {
+    fn extract_warped(&mut self, image: Image, block: WarpedBlock) -> Option<bool> {
         let n = self.n;
-        let sample = if block_inside(image, centre, shift, a, n, 1.0, 2.0) {
+        let WarpedBlock {
+            centre_px: centre,
+            shift_px: shift,
+            a,
+            ..
+        } = block;
+        let sample = if block.inside(image, 1.0, 2.0) {
             bicubic
-        } else if block_inside(image, centre, shift, a, n, -1.0, -1.0) {
+        } else if block.inside(image, -1.0, -1.0) {
             bicubic_clamped
         } else {
             return None;
@@ -494,91 +541,87 @@ impl ZoiEngine {
         Some(norm)
     }
 
-    /// Correlates the deformed image around the reference ZOI at (x0, y0), starting from the
-    /// guess (px). The returned displacement is total (guess included). With a `warp`
-    /// gradient G worth it ([`warp_worth_it`]), the deformed ZOI is sampled (bicubic) through
-    /// x → x + guess + G (x − c) instead of cut from the pixel grid, so that only the residual
-    /// is measured: a ZOI rotated by 170° or stretched by 50 % is correlated against a deformed
-    /// ZOI that looks like it.
-    #[allow(clippy::too_many_arguments)] // one ZOI's inputs: its data, where, and the guess
+    /// Correlates the deformed image around the reference ZOI at `search.top_left_px`,
+    /// starting from the guess. The returned displacement is total (guess included). With a
+    /// `warp` gradient G worth it ([`warp_worth_it`]), the deformed ZOI is sampled (bicubic)
+    /// through x → x + guess + G (x − c) instead of cut from the pixel grid, so that only the
+    /// residual is measured: a ZOI rotated by 170° or stretched by 50 % is correlated against a
+    /// deformed ZOI that looks like it.
     pub fn correlate(
         &mut self,
         reference: &ReferenceSpectra,
         deformed: Image,
-        x0: usize,
-        y0: usize,
-        guess_px: (f64, f64),
-        warp: Option<Mat2>,
-        iterations: SubpixelIterations,
+        search: ZoiSearch,
     ) -> ZoiResult {
-        let n = self.n;
         let mut timer = Timer::start(self.profile);
-        let mut result = ZoiResult {
-            status: NodeStatus::NotConverged,
-            ..ZoiResult::default()
-        };
+        let guess_px = search.guess_px;
         if !(guess_px.0.is_finite() && guess_px.1.is_finite()) {
-            result.status = NodeStatus::NoGuess;
-            return result;
+            return ZoiResult::with_status(NodeStatus::NoGuess, 0);
         }
-        let warp =
-            warp.filter(|&g| g.iter().flatten().all(|v| v.is_finite()) && warp_worth_it(g, n));
-        // Integer step (paper): one unwindowed FFT correlation, then move the deformed ZOI.
-        // Warped, the move is in the ZOI's own (warped) axes: `origin` is where its centre
-        // lands, relative to the reference centre.
+        let warp = search
+            .warp
+            .filter(|&g| g.iter().flatten().all(|v| v.is_finite()) && warp_worth_it(g, self.n));
         let a = warp.map(identity_plus);
-        let mut ix = guess_px.0.round() as i64;
-        let mut iy = guess_px.1.round() as i64;
-        let mut origin = (ix as f64, iy as f64);
+        let origin = match self.integer_step(reference.plain, deformed, &search, a, &mut timer) {
+            Ok(origin) => origin,
+            Err(status) => return ZoiResult::with_status(status, 0),
+        };
+        let estimate = match self.subpixel(reference.windowed, search.iterations.max, &mut timer) {
+            Ok(estimate) => estimate,
+            Err(Flat { iterations }) => {
+                return ZoiResult::with_status(NodeStatus::LowContrast, iterations)
+            }
+        };
+        // The sub-pixel estimate is in the ZOI's axes: a step s there is A s in the image.
+        let best = estimate.shift_px;
+        let step = a.map_or(best, |a| apply(a, best));
+        let drifted = best.0.abs() > MAX_SUBPIXEL_DRIFT_PX || best.1.abs() > MAX_SUBPIXEL_DRIFT_PX;
+        let settled =
+            estimate.converged || estimate.last_step_px < search.iterations.not_converged_step_px;
+        ZoiResult {
+            u_px: origin.0 + step.0,
+            v_px: origin.1 + step.1,
+            score: estimate.value.clamp(-1.0, 1.0),
+            iterations: estimate.iterations,
+            status: if !drifted && settled {
+                NodeStatus::Ok
+            } else {
+                NodeStatus::NotConverged
+            },
+            warp_gradient: warp.unwrap_or_default(),
+        }
+    }
+
+    /// The integer step (paper): one unwindowed FFT correlation against the reference
+    /// spectrum `plain`, then the deformed ZOI moved by the peak and cut again, its spectrum
+    /// left in `g_spectrum`. Warped (`a` = I + G), the move is in the ZOI's own (warped) axes.
+    /// Returns where the deformed ZOI's centre lands, relative to the reference centre (px).
+    fn integer_step(
+        &mut self,
+        plain: &[Complex32],
+        deformed: Image,
+        search: &ZoiSearch,
+        a: Option<Mat2>,
+        timer: &mut Timer,
+    ) -> Result<(f64, f64), NodeStatus> {
+        let (ix, iy) = (
+            search.guess_px.0.round() as i64,
+            search.guess_px.1.round() as i64,
+        );
+        let mut place = Placement {
+            ix,
+            iy,
+            origin_px: (ix as f64, iy as f64),
+        };
         let mut spectrum_valid = false;
         for pass in 0..2 {
-            if let Some(a) = a {
-                let half = (n as f64 - 1.0) / 2.0;
-                let centre = (x0 as f64 + half, y0 as f64 + half);
-                match self.extract_warped(deformed, centre, origin, a) {
-                    None => {
-                        result.status = NodeStatus::OutsideImage;
-                        return result;
-                    }
-                    Some(false) => {
-                        result.status = NodeStatus::LowContrast;
-                        return result;
-                    }
-                    Some(true) => {}
-                }
-            } else {
-                // A ZOI at most one pixel past the border is pulled back inside: the sub-pixel
-                // stage accepts a residual of up to one pixel.
-                let max_x = deformed.width_px as i64 - n as i64;
-                let max_y = deformed.height_px as i64 - n as i64;
-                let (gx, gy) = (x0 as i64 + ix, y0 as i64 + iy);
-                let (cx, cy) = (gx.clamp(0, max_x), gy.clamp(0, max_y));
-                if (cx - gx).abs() <= 1 && (cy - gy).abs() <= 1 {
-                    ix += cx - gx;
-                    iy += cy - gy;
-                }
-                let (gx, gy) = (x0 as i64 + ix, y0 as i64 + iy);
-                if !deformed.contains_block(gx, gy, n) {
-                    result.status = NodeStatus::OutsideImage;
-                    return result;
-                }
-                if !self.extract_zero_mean(deformed, gx as usize, gy as usize) {
-                    result.status = NodeStatus::LowContrast;
-                    return result;
-                }
-                origin = (ix as f64, iy as f64);
-            }
+            self.extract_placed(deformed, search.top_left_px, a, &mut place)?;
             timer.lap(&mut self.split.other_ns);
             if pass == 1 {
                 break;
             }
             self.fft.forward(&self.g_spatial, &mut self.g_spectrum);
-            for ((w, &g), &f) in self
-                .work
-                .iter_mut()
-                .zip(&self.g_spectrum)
-                .zip(reference.plain)
-            {
+            for ((w, &g), &f) in self.work.iter_mut().zip(&self.g_spectrum).zip(plain) {
                 *w = g * f.conj();
             }
             self.fft.inverse(&mut self.work, &mut self.corr);
@@ -589,24 +632,85 @@ impl ZoiEngine {
                 spectrum_valid = true;
                 break;
             }
-            ix += dx;
-            iy += dy;
+            place.ix += dx;
+            place.iy += dy;
             if let Some(a) = a {
                 let step = apply(a, (dx as f64, dy as f64));
-                origin = (origin.0 + step.0, origin.1 + step.1);
+                place.origin_px = (place.origin_px.0 + step.0, place.origin_px.1 + step.1);
             }
         }
         if !spectrum_valid {
             self.fft.forward(&self.g_spatial, &mut self.g_spectrum);
             timer.lap(&mut self.split.fft_ns);
         }
-        // Sub-pixel iterations: window, correlate, quadratic peak, Fourier shift.
+        Ok(place.origin_px)
+    }
+
+    /// Cuts (rigid) or samples (warped, `a` = I + G) the deformed ZOI at `place` into
+    /// `g_spatial`, zero-mean, for the reference ZOI at `top_left`. A rigid ZOI at most one
+    /// pixel past the border is pulled back inside (`place` moves with it): the sub-pixel stage
+    /// accepts a residual of up to one pixel.
+    fn extract_placed(
+        &mut self,
+        deformed: Image,
+        top_left: (usize, usize),
+        a: Option<Mat2>,
+        place: &mut Placement,
+    ) -> Result<(), NodeStatus> {
+        let n = self.n;
+        if let Some(a) = a {
+            let half = (n as f64 - 1.0) / 2.0;
+            let block = WarpedBlock {
+                centre_px: (top_left.0 as f64 + half, top_left.1 as f64 + half),
+                shift_px: place.origin_px,
+                a,
+                n,
+            };
+            return match self.extract_warped(deformed, block) {
+                None => Err(NodeStatus::OutsideImage),
+                Some(false) => Err(NodeStatus::LowContrast),
+                Some(true) => Ok(()),
+            };
+        }
+        let (x0, y0) = (top_left.0 as i64, top_left.1 as i64);
+        let max_x = deformed.width_px as i64 - n as i64;
+        let max_y = deformed.height_px as i64 - n as i64;
+        let (gx, gy) = (x0 + place.ix, y0 + place.iy);
+        let (cx, cy) = (gx.clamp(0, max_x), gy.clamp(0, max_y));
+        if (cx - gx).abs() <= 1 && (cy - gy).abs() <= 1 {
+            place.ix += cx - gx;
+            place.iy += cy - gy;
+        }
+        let (gx, gy) = (x0 + place.ix, y0 + place.iy);
+        if !deformed.contains_block(gx, gy, n) {
+            return Err(NodeStatus::OutsideImage);
+        }
+        if !self.extract_zero_mean(deformed, gx as usize, gy as usize) {
+            return Err(NodeStatus::LowContrast);
+        }
+        place.origin_px = (place.ix as f64, place.iy as f64);
+        Ok(())
+    }
+
+    /// The sub-pixel iterations (at most `max_iterations`) against the reference's windowed
+    /// ZOI `windowed`: window, correlate, quadratic peak, Fourier shift, while the interpolated
+    /// maximum increases. [`Flat`] when the windowed deformed ZOI is flat.
+    fn subpixel(
+        &mut self,
+        windowed: &[f32],
+        max_iterations: u32,
+        timer: &mut Timer,
+    ) -> Result<SubpixelEstimate, Flat> {
+        let n = self.n;
+        let mut estimate = SubpixelEstimate {
+            shift_px: (0.0, 0.0),
+            value: f64::NEG_INFINITY,
+            last_step_px: f64::INFINITY,
+            converged: false,
+            iterations: 0,
+        };
         let mut shift = (0.0f64, 0.0f64);
-        let mut best_value = f64::NEG_INFINITY;
-        let mut best_estimate = (0.0f64, 0.0f64);
-        let mut last_step = f64::INFINITY;
-        let mut converged = false;
-        for iteration in 0..iterations.max {
+        for iteration in 0..max_iterations {
             if iteration > 0 {
                 self.shift_into_spatial(shift);
                 timer.lap(&mut self.split.shift_ns);
@@ -617,64 +721,48 @@ impl ZoiEngine {
             self.extended = extended;
             timer.lap(&mut self.split.window_ns);
             let Some(norm) = norm else {
-                result.status = NodeStatus::LowContrast;
-                return result;
+                return Err(Flat {
+                    iterations: estimate.iterations,
+                });
             };
             self.wrap_rows();
-            let (px, py, neighbourhood) = self.peak_neighbourhood(reference.windowed, 1.0 / norm);
+            let (px, py, neighbourhood) = self.peak_neighbourhood(windowed, 1.0 / norm);
             let (fx, fy, value) = quadratic_peak_3x3(&neighbourhood);
             timer.lap(&mut self.split.peak_ns);
-            result.iterations = iteration + 1;
-            if value <= best_value {
-                converged = true;
+            estimate.iterations = iteration + 1;
+            if value <= estimate.value {
+                estimate.converged = true;
                 break;
             }
-            best_value = value;
+            estimate.value = value;
             let step = (px as f64 + fx, py as f64 + fy);
-            best_estimate = (shift.0 + step.0, shift.1 + step.1);
-            last_step = step.0.abs().max(step.1.abs());
-            shift = best_estimate;
-            if last_step < CONVERGED_STEP_PX {
-                converged = true;
+            estimate.shift_px = (shift.0 + step.0, shift.1 + step.1);
+            estimate.last_step_px = step.0.abs().max(step.1.abs());
+            shift = estimate.shift_px;
+            if estimate.last_step_px < CONVERGED_STEP_PX {
+                estimate.converged = true;
                 break;
             }
             if shift.0.abs() > MAX_SUBPIXEL_DRIFT_PX || shift.1.abs() > MAX_SUBPIXEL_DRIFT_PX {
                 break;
             }
         }
-        // The sub-pixel estimate is in the ZOI's axes: a step s there is A s in the image.
-        let step = a.map_or(best_estimate, |a| apply(a, best_estimate));
-        result.u_px = origin.0 + step.0;
-        result.v_px = origin.1 + step.1;
-        result.warp_gradient = warp.unwrap_or_default();
-        result.score = best_value.clamp(-1.0, 1.0);
-        let drifted = best_estimate.0.abs() > MAX_SUBPIXEL_DRIFT_PX
-            || best_estimate.1.abs() > MAX_SUBPIXEL_DRIFT_PX;
-        result.status = if !drifted && (converged || last_step < iterations.not_converged_step_px) {
-            NodeStatus::Ok
-        } else {
-            NodeStatus::NotConverged
-        };
-        result
+        Ok(estimate)
     }
 
     /// [`Self::correlate`] for a ZOI of another image than the cached references (a node's
     /// ZOI in the frame its mesh was defined in): its spectra are prepared in the engine's own
     /// buffers first. `LowContrast` when that ZOI is flat.
-    #[allow(clippy::too_many_arguments)] // as `correlate`, with the reference image instead
     pub fn correlate_uncached(
         &mut self,
         reference: Image,
-        x0: usize,
-        y0: usize,
         deformed: Image,
-        guess_px: (f64, f64),
-        warp: Option<Mat2>,
-        iterations: SubpixelIterations,
+        search: ZoiSearch,
     ) -> ZoiResult {
         let mut plain = std::mem::take(&mut self.uncached_plain);
         let mut windowed = std::mem::take(&mut self.uncached_windowed);
         let mut sensitivity = GradientSensitivity::default();
+        let (x0, y0) = search.top_left_px;
         let result = if self.prepare_reference(
             reference,
             x0,
@@ -687,12 +775,9 @@ impl ZoiEngine {
                 plain: &plain,
                 windowed: &windowed,
             };
-            self.correlate(&spectra, deformed, x0, y0, guess_px, warp, iterations)
+            self.correlate(&spectra, deformed, search)
         } else {
-            ZoiResult {
-                status: NodeStatus::LowContrast,
-                ..ZoiResult::default()
-            }
+            ZoiResult::with_status(NodeStatus::LowContrast, 0)
         };
         self.uncached_plain = plain;
         self.uncached_windowed = windowed;

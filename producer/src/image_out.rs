@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use crate::error::ProducerError;
+use crate::FrameDims;
 
 /// Output image formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,17 +53,20 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ProducerError> {
     })
 }
 
-/// Encodes a `width` x `height` frame of `bit_depth` bits in `format` and writes it atomically.
+/// Encodes a frame of `dims` (its size and bit depth) in `format` and writes it atomically.
 /// `encoded` is a reusable byte buffer.
 pub fn write_frame(
     path: &Path,
-    width: u32,
-    height: u32,
-    bit_depth: u8,
+    dims: FrameDims,
     pixels: &[u16],
     format: ImageFormatOut,
     encoded: &mut Vec<u8>,
 ) -> Result<(), ProducerError> {
+    let FrameDims {
+        width,
+        height,
+        bit_depth,
+    } = dims;
     assert_eq!(pixels.len(), width as usize * height as usize, "frame size");
     if format == ImageFormatOut::Png8 && bit_depth > 8 {
         return Err(ProducerError::InvalidParameter {

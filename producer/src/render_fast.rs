@@ -6,7 +6,8 @@
 
 use crate::motion::{inverse, mul_vec, Motion};
 use crate::parallel::for_row_bands;
-use crate::speckle::Speckle;
+use crate::speckle::{Speckle, Spot};
+use std::ops::Range;
 
 /// Margin of texels kept around the covered area for the filter and the interpolant, px.
 const PAD_PX: f64 = 2.0;
@@ -27,6 +28,143 @@ pub struct FastRenderer {
     pub threads: usize,
 }
 
+/// The texels of a texture: `oversample` per px along each axis, texel (0, 0) at `origin_px`
+/// (reference px), `texels_x` x `texels_y` of them, row-major.
+#[derive(Clone, Copy, Debug)]
+struct TexelGrid {
+    oversample: usize,
+    origin_px: [f64; 2],
+    texels_x: usize,
+    texels_y: usize,
+}
+
+impl TexelGrid {
+    /// The grid over `[x0, x1] x [y0, y1]` (reference px) with a margin of [`PAD_PX`].
+    fn covering(x_range_px: [f64; 2], y_range_px: [f64; 2], oversample: usize) -> TexelGrid {
+        let origin_px = [x_range_px[0] - PAD_PX, y_range_px[0] - PAD_PX];
+        let texels = |range: [f64; 2]| {
+            ((range[1] - range[0] + 2.0 * PAD_PX) * oversample as f64).ceil() as usize + 1
+        };
+        let (texels_x, texels_y) = (texels(x_range_px), texels(y_range_px));
+        assert!(
+            texels_x.checked_mul(texels_y).is_some_and(|n| n < 1 << 30),
+            "texture of {texels_x} x {texels_y} texels is too large"
+        );
+        TexelGrid {
+            oversample,
+            origin_px,
+            texels_x,
+            texels_y,
+        }
+    }
+
+    /// Texel size, px.
+    fn h(&self) -> f64 {
+        1.0 / self.oversample as f64
+    }
+
+    /// The spots of `speckle` summed into `band` (the texel rows from `first_row`), then the
+    /// pattern's value of each sum.
+    fn splat(&self, speckle: &Speckle, first_row: usize, band: &mut [f32]) {
+        let (h, origin_px, texels_x) = (self.h(), self.origin_px, self.texels_x);
+        let rows = first_row..first_row + band.len() / texels_x;
+        let mut gx = Vec::with_capacity(64 * self.oversample);
+        let mut dx2 = Vec::with_capacity(64 * self.oversample);
+        for spot in speckle.spots() {
+            let Some((xs, ys)) = self.spot_texels(spot, &rows) else {
+                continue;
+            };
+            gx.clear();
+            dx2.clear();
+            for ix in xs.clone() {
+                let d = origin_px[0] + ix as f64 * h - spot.centre_px[0];
+                dx2.push(d * d);
+                gx.push(spot.amplitude * (-d * d * spot.inv_two_sigma2).exp());
+            }
+            for iy in ys {
+                let d = origin_px[1] + iy as f64 * h - spot.centre_px[1];
+                let gy = (-d * d * spot.inv_two_sigma2).exp();
+                let row = &mut band[(iy - rows.start) * texels_x..][..texels_x];
+                for (k, ix) in xs.clone().enumerate() {
+                    if dx2[k] + d * d < spot.cutoff2_px2 {
+                        row[ix] += (gx[k] * gy) as f32;
+                    }
+                }
+            }
+        }
+        for s in band.iter_mut() {
+            *s = speckle.value_from_sum(f64::from(*s)) as f32;
+        }
+    }
+
+    /// The texel columns and the rows among `rows` within `spot`'s cutoff radius; None when
+    /// there are none.
+    fn spot_texels(
+        &self,
+        spot: &Spot,
+        rows: &Range<usize>,
+    ) -> Option<(Range<usize>, Range<usize>)> {
+        let (h, origin_px) = (self.h(), self.origin_px);
+        let r = spot.cutoff2_px2.sqrt();
+        let ix0 = ((spot.centre_px[0] - r - origin_px[0]) / h).ceil().max(0.0) as usize;
+        let ix1 = (((spot.centre_px[0] + r - origin_px[0]) / h)
+            .floor()
+            .max(-1.0)
+            + 1.0) as usize;
+        let ix1 = ix1.min(self.texels_x);
+        let iy0 = ((spot.centre_px[1] - r - origin_px[1]) / h)
+            .ceil()
+            .max(rows.start as f64) as usize;
+        let iy1 = (((spot.centre_px[1] + r - origin_px[1]) / h)
+            .floor()
+            .max(-1.0)
+            + 1.0) as usize;
+        let iy1 = iy1.min(rows.end);
+        (ix0 < ix1 && iy0 < iy1).then_some((ix0..ix1, iy0..iy1))
+    }
+
+    /// The horizontal pass of the pixel-area integration (Simpson `weights`), in place.
+    fn integrate_rows(&self, texture: &mut [f32], weights: &[f64], threads: usize) {
+        let (texels_x, half) = (self.texels_x, self.oversample / 2);
+        for_row_bands(texture, texels_x, threads, |_, band| {
+            let mut scratch = vec![0f32; texels_x];
+            for row in band.chunks_exact_mut(texels_x) {
+                scratch.copy_from_slice(row);
+                for ix in half..texels_x - half {
+                    let mut sum = 0.0f64;
+                    for (k, w) in weights.iter().enumerate() {
+                        sum += w * f64::from(scratch[ix + k - half]);
+                    }
+                    row[ix] = sum as f32;
+                }
+            }
+        });
+    }
+
+    /// The vertical pass, in place, with a ring of the last `oversample + 1` original rows.
+    fn integrate_columns(&self, texture: &mut [f32], weights: &[f64]) {
+        let (texels_x, oversample, half) = (self.texels_x, self.oversample, self.oversample / 2);
+        let ring_rows = oversample + 1;
+        let mut ring = vec![0f32; ring_rows * texels_x];
+        for iy in 0..self.texels_y {
+            let slot = iy % ring_rows;
+            ring[slot * texels_x..][..texels_x]
+                .copy_from_slice(&texture[iy * texels_x..][..texels_x]);
+            if iy >= oversample {
+                let out_row = iy - half;
+                let row = &mut texture[out_row * texels_x..][..texels_x];
+                row.fill(0.0);
+                for (k, w) in weights.iter().enumerate() {
+                    let src = &ring[((out_row + k - half) % ring_rows) * texels_x..][..texels_x];
+                    for (o, s) in row.iter_mut().zip(src) {
+                        *o += (*w as f32) * s;
+                    }
+                }
+            }
+        }
+    }
+}
+
 impl FastRenderer {
     /// Renders the texture of `speckle` over `[x0, x1] x [y0, y1]` (reference px) at
     /// `oversample` texels per px (even, 2..=8; 4 is the default). Done once, at start.
@@ -41,109 +179,22 @@ impl FastRenderer {
             (2..=8).contains(&oversample) && oversample.is_multiple_of(2),
             "oversample {oversample} must be even in 2..=8"
         );
-        let h = 1.0 / oversample as f64;
-        let origin_px = [x_range_px[0] - PAD_PX, y_range_px[0] - PAD_PX];
-        let texels_x = ((x_range_px[1] - x_range_px[0] + 2.0 * PAD_PX) * oversample as f64).ceil()
-            as usize
-            + 1;
-        let texels_y = ((y_range_px[1] - y_range_px[0] + 2.0 * PAD_PX) * oversample as f64).ceil()
-            as usize
-            + 1;
-        assert!(
-            texels_x.checked_mul(texels_y).is_some_and(|n| n < 1 << 30),
-            "texture of {texels_x} x {texels_y} texels is too large"
-        );
-        let mut texture = vec![0f32; texels_x * texels_y];
+        let grid = TexelGrid::covering(x_range_px, y_range_px, oversample);
+        let mut texture = vec![0f32; grid.texels_x * grid.texels_y];
         // 1. Spot sums by separable splatting, parallel over bands of texel rows.
-        for_row_bands(&mut texture, texels_x, threads, |first_row, band| {
-            let rows = band.len() / texels_x;
-            let mut gx = Vec::with_capacity(64 * oversample);
-            let mut dx2 = Vec::with_capacity(64 * oversample);
-            for spot in speckle.spots() {
-                let r = spot.cutoff2_px2.sqrt();
-                let ix0 = ((spot.centre_px[0] - r - origin_px[0]) / h).ceil().max(0.0) as usize;
-                let ix1 = (((spot.centre_px[0] + r - origin_px[0]) / h)
-                    .floor()
-                    .max(-1.0)
-                    + 1.0) as usize;
-                let ix1 = ix1.min(texels_x);
-                let iy0 = ((spot.centre_px[1] - r - origin_px[1]) / h)
-                    .ceil()
-                    .max(first_row as f64) as usize;
-                let iy1 = (((spot.centre_px[1] + r - origin_px[1]) / h)
-                    .floor()
-                    .max(-1.0)
-                    + 1.0) as usize;
-                let iy1 = iy1.min(first_row + rows);
-                if ix0 >= ix1 || iy0 >= iy1 {
-                    continue;
-                }
-                gx.clear();
-                dx2.clear();
-                for ix in ix0..ix1 {
-                    let d = origin_px[0] + ix as f64 * h - spot.centre_px[0];
-                    dx2.push(d * d);
-                    gx.push(spot.amplitude * (-d * d * spot.inv_two_sigma2).exp());
-                }
-                for iy in iy0..iy1 {
-                    let d = origin_px[1] + iy as f64 * h - spot.centre_px[1];
-                    let gy = (-d * d * spot.inv_two_sigma2).exp();
-                    let row = &mut band[(iy - first_row) * texels_x..][..texels_x];
-                    for (k, ix) in (ix0..ix1).enumerate() {
-                        if dx2[k] + d * d < spot.cutoff2_px2 {
-                            row[ix] += (gx[k] * gy) as f32;
-                        }
-                    }
-                }
-            }
-            for s in band.iter_mut() {
-                *s = speckle.value_from_sum(f64::from(*s)) as f32;
-            }
+        for_row_bands(&mut texture, grid.texels_x, threads, |first_row, band| {
+            grid.splat(speckle, first_row, band)
         });
         // 2. Pixel-area integration: Simpson over ±0.5 px (oversample intervals) per axis.
         let weights = simpson_weights(oversample);
-        let half = oversample / 2;
-        for_row_bands(&mut texture, texels_x, threads, |_, band| {
-            let mut scratch = vec![0f32; texels_x];
-            for row in band.chunks_exact_mut(texels_x) {
-                scratch.copy_from_slice(row);
-                for ix in half..texels_x - half {
-                    let mut sum = 0.0f64;
-                    for (k, w) in weights.iter().enumerate() {
-                        sum += w * f64::from(scratch[ix + k - half]);
-                    }
-                    row[ix] = sum as f32;
-                }
-            }
-        });
-        {
-            // Vertical pass with a ring of the last `oversample + 1` original rows.
-            let ring_rows = oversample + 1;
-            let mut ring = vec![0f32; ring_rows * texels_x];
-            for iy in 0..texels_y {
-                let slot = iy % ring_rows;
-                ring[slot * texels_x..][..texels_x]
-                    .copy_from_slice(&texture[iy * texels_x..][..texels_x]);
-                if iy >= oversample {
-                    let out_row = iy - half;
-                    let row = &mut texture[out_row * texels_x..][..texels_x];
-                    row.fill(0.0);
-                    for (k, w) in weights.iter().enumerate() {
-                        let src =
-                            &ring[((out_row + k - half) % ring_rows) * texels_x..][..texels_x];
-                        for (o, s) in row.iter_mut().zip(src) {
-                            *o += (*w as f32) * s;
-                        }
-                    }
-                }
-            }
-        }
+        grid.integrate_rows(&mut texture, &weights, threads);
+        grid.integrate_columns(&mut texture, &weights);
         let background = speckle.value_from_sum(0.0) as f32;
         FastRenderer {
             oversample,
-            origin_px,
-            texels_x,
-            texels_y,
+            origin_px: grid.origin_px,
+            texels_x: grid.texels_x,
+            texels_y: grid.texels_y,
             texture,
             background,
             threads,

@@ -126,6 +126,30 @@ struct Params<'a> {
 }
 
 impl<'a> Params<'a> {
+    /// The `key=value` pairs of `rest`, what follows the scenario `name` in `spec`.
+    fn parse(spec: &str, name: &'a str, rest: &'a str) -> Result<Params<'a>, ProducerError> {
+        let mut pairs = Vec::new();
+        for item in rest.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let Some((k, v)) = item.split_once('=') else {
+                return Err(ProducerError::InvalidParameter {
+                    name: item.to_owned(),
+                    value: String::new(),
+                    expected: format!("key=value in scenario spec '{spec}'"),
+                });
+            };
+            pairs.push((k.trim(), v.trim(), false));
+        }
+        Ok(Params { spec: name, pairs })
+    }
+
+    /// (`cx_px`, `cy_px`), `default` where not given.
+    fn centre(&mut self, default: Vec2) -> Result<Vec2, ProducerError> {
+        Ok([
+            self.get("cx_px", default[0])?,
+            self.get("cy_px", default[1])?,
+        ])
+    }
+
     fn get(&mut self, key: &str, default: f64) -> Result<f64, ProducerError> {
         let Some(pair) = self.pairs.iter_mut().find(|(k, _, _)| *k == key) else {
             return Ok(default);
@@ -177,6 +201,124 @@ fn positive(name: &str, value: f64) -> Result<f64, ProducerError> {
     }
 }
 
+/// A scenario kind parsed from its parameters, with the list of its keys.
+type Parsed = Result<(ScenarioKind, &'static str), ProducerError>;
+
+/// `rotation`: `angle_deg` about (`cx_px`, `cy_px`), which replace `centre`.
+fn parse_rotation(p: &mut Params, centre: &mut Vec2) -> Parsed {
+    *centre = p.centre(*centre)?;
+    let angle_deg = p.get("angle_deg", 5.0)?;
+    if angle_deg.abs() >= 90.0 {
+        return Err(invalid("angle_deg", angle_deg, "|angle| < 90"));
+    }
+    Ok((
+        ScenarioKind::Rotation {
+            angle_rad: angle_deg.to_radians(),
+        },
+        "angle_deg, cx_px, cy_px",
+    ))
+}
+
+/// `gradient`: F = [[f11, f12], [f21, f22]] about (`cx_px`, `cy_px`), which replace `centre`,
+/// and a translation; F's linear ramp from I must stay invertible.
+fn parse_gradient(p: &mut Params, centre: &mut Vec2) -> Parsed {
+    *centre = p.centre(*centre)?;
+    let f = [
+        [p.get("f11", 1.01)?, p.get("f12", 0.005)?],
+        [p.get("f21", -0.003)?, p.get("f22", 0.99)?],
+    ];
+    // Every ramped F = I + s (F - I), s in [0, 1], must stay invertible.
+    for step in 0..=100 {
+        let s = f64::from(step) / 100.0;
+        let fs = lerp_mat(s, &f);
+        if det(&fs) <= 0.05 {
+            return Err(invalid(
+                "f11,f12,f21,f22",
+                det(&f),
+                "a gradient whose linear ramp from I keeps det F > 0.05",
+            ));
+        }
+    }
+    Ok((
+        ScenarioKind::Gradient {
+            f,
+            translation_px: [p.get("tx_px", 0.0)?, p.get("ty_px", 0.0)?],
+        },
+        "f11, f12, f21, f22, tx_px, ty_px, cx_px, cy_px",
+    ))
+}
+
+/// `chirp` over an image `width_px` wide: it must start inside and stay invertible.
+fn parse_chirp(p: &mut Params, width_px: f64) -> Parsed {
+    let amplitude_px = p.get("amplitude_px", 0.1)?;
+    let start_px = p.get("start_px", 100.0_f64.min(width_px / 4.0))?;
+    let periods = positive("periods", p.get("periods", 6.0)?)?;
+    if start_px >= width_px - 1.0 {
+        return Err(invalid("start_px", start_px, "a start inside the image"));
+    }
+    let chirp = Chirp {
+        amplitude_px,
+        start_px,
+        length_px: width_px - 1.0 - start_px,
+        periods,
+    };
+    // Max slope |u'| = A 4π n / L at the end: keep 1 + u' > 0 with a margin.
+    let max_slope = amplitude_px.abs() * 4.0 * std::f64::consts::PI * periods / chirp.length_px;
+    if max_slope >= 0.5 {
+        return Err(invalid(
+            "amplitude_px",
+            amplitude_px,
+            "amplitude * 4π * periods / length < 0.5 (an invertible chirp)",
+        ));
+    }
+    Ok((
+        ScenarioKind::Chirp {
+            amplitude_px,
+            start_px,
+            periods,
+        },
+        "amplitude_px, start_px, periods",
+    ))
+}
+
+/// `bulge` about (`cx_px`, `cy_px`), which replace `centre`; its default width is a quarter
+/// of the image's smaller side `side_px`.
+fn parse_bulge(p: &mut Params, centre: &mut Vec2, side_px: f64) -> Parsed {
+    *centre = p.centre(*centre)?;
+    let strain = p.get("strain", 0.05)?;
+    if !(-0.5..=1.0).contains(&strain) {
+        return Err(invalid("strain", strain, "a strain in [-0.5, 1]"));
+    }
+    Ok((
+        ScenarioKind::Bulge {
+            strain,
+            width_px: positive("width_px", p.get("width_px", side_px / 4.0)?)?,
+        },
+        "strain, width_px, cx_px, cy_px",
+    ))
+}
+
+/// `bad-positioning`: a stretch, a rotation and a translation about a centre moved from
+/// `centre` by (`centre_dx_px`, `centre_dy_px`).
+fn parse_bad_positioning(p: &mut Params, centre: &mut Vec2) -> Parsed {
+    *centre = [
+        centre[0] + p.get("centre_dx_px", 40.0)?,
+        centre[1] + p.get("centre_dy_px", -25.0)?,
+    ];
+    let angle_deg = p.get("angle_deg", 1.0)?;
+    if angle_deg.abs() >= 90.0 {
+        return Err(invalid("angle_deg", angle_deg, "|angle| < 90"));
+    }
+    Ok((
+        ScenarioKind::BadPositioning {
+            lambda: positive("lambda", p.get("lambda", 1.1)?)?,
+            angle_rad: angle_deg.to_radians(),
+            translation_px: [p.get("tx_px", 3.3)?, p.get("ty_px", -2.7)?],
+        },
+        "lambda, angle_deg, tx_px, ty_px, centre_dx_px, centre_dy_px",
+    ))
+}
+
 impl Scenario {
     /// Parses `name` or `name:key=value,...` for an image of `width` x `height` px.
     /// An unknown name is an error listing the known ones; an unknown key lists the valid keys.
@@ -184,21 +326,9 @@ impl Scenario {
         assert!(width > 0 && height > 0, "empty image");
         let (name, rest) = spec.split_once(':').unwrap_or((spec, ""));
         let name = name.trim();
-        let mut pairs = Vec::new();
-        for item in rest.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            let Some((k, v)) = item.split_once('=') else {
-                return Err(ProducerError::InvalidParameter {
-                    name: item.to_owned(),
-                    value: String::new(),
-                    expected: format!("key=value in scenario spec '{spec}'"),
-                });
-            };
-            pairs.push((k.trim(), v.trim(), false));
-        }
-        let mut p = Params { spec: name, pairs };
+        let mut p = Params::parse(spec, name, rest)?;
         let (w, h) = (f64::from(width), f64::from(height));
-        let image_centre = [(w - 1.0) / 2.0, (h - 1.0) / 2.0];
-        let mut centre = image_centre;
+        let mut centre = [(w - 1.0) / 2.0, (h - 1.0) / 2.0];
         let (kind, known) = match name {
             "static" => (ScenarioKind::Static, ""),
             "translation" => (
@@ -207,45 +337,8 @@ impl Scenario {
                 },
                 "tx_px, ty_px",
             ),
-            "rotation" => {
-                centre = [p.get("cx_px", centre[0])?, p.get("cy_px", centre[1])?];
-                let angle_deg = p.get("angle_deg", 5.0)?;
-                if angle_deg.abs() >= 90.0 {
-                    return Err(invalid("angle_deg", angle_deg, "|angle| < 90"));
-                }
-                (
-                    ScenarioKind::Rotation {
-                        angle_rad: angle_deg.to_radians(),
-                    },
-                    "angle_deg, cx_px, cy_px",
-                )
-            }
-            "gradient" => {
-                centre = [p.get("cx_px", centre[0])?, p.get("cy_px", centre[1])?];
-                let f = [
-                    [p.get("f11", 1.01)?, p.get("f12", 0.005)?],
-                    [p.get("f21", -0.003)?, p.get("f22", 0.99)?],
-                ];
-                // Every ramped F = I + s (F - I), s in [0, 1], must stay invertible.
-                for step in 0..=100 {
-                    let s = f64::from(step) / 100.0;
-                    let fs = lerp_mat(s, &f);
-                    if det(&fs) <= 0.05 {
-                        return Err(invalid(
-                            "f11,f12,f21,f22",
-                            det(&f),
-                            "a gradient whose linear ramp from I keeps det F > 0.05",
-                        ));
-                    }
-                }
-                (
-                    ScenarioKind::Gradient {
-                        f,
-                        translation_px: [p.get("tx_px", 0.0)?, p.get("ty_px", 0.0)?],
-                    },
-                    "f11, f12, f21, f22, tx_px, ty_px, cx_px, cy_px",
-                )
-            }
+            "rotation" => parse_rotation(&mut p, &mut centre)?,
+            "gradient" => parse_gradient(&mut p, &mut centre)?,
             "uniaxial" => (
                 ScenarioKind::Uniaxial {
                     lambda: positive("lambda", p.get("lambda", 1.1)?)?,
@@ -258,70 +351,9 @@ impl Scenario {
                 },
                 "lambda",
             ),
-            "chirp" => {
-                let amplitude_px = p.get("amplitude_px", 0.1)?;
-                let start_px = p.get("start_px", 100.0_f64.min(w / 4.0))?;
-                let periods = positive("periods", p.get("periods", 6.0)?)?;
-                if start_px >= w - 1.0 {
-                    return Err(invalid("start_px", start_px, "a start inside the image"));
-                }
-                let chirp = Chirp {
-                    amplitude_px,
-                    start_px,
-                    length_px: w - 1.0 - start_px,
-                    periods,
-                };
-                // Max slope |u'| = A 4π n / L at the end: keep 1 + u' > 0 with a margin.
-                let max_slope =
-                    amplitude_px.abs() * 4.0 * std::f64::consts::PI * periods / chirp.length_px;
-                if max_slope >= 0.5 {
-                    return Err(invalid(
-                        "amplitude_px",
-                        amplitude_px,
-                        "amplitude * 4π * periods / length < 0.5 (an invertible chirp)",
-                    ));
-                }
-                (
-                    ScenarioKind::Chirp {
-                        amplitude_px,
-                        start_px,
-                        periods,
-                    },
-                    "amplitude_px, start_px, periods",
-                )
-            }
-            "bulge" => {
-                centre = [p.get("cx_px", centre[0])?, p.get("cy_px", centre[1])?];
-                let strain = p.get("strain", 0.05)?;
-                if !(-0.5..=1.0).contains(&strain) {
-                    return Err(invalid("strain", strain, "a strain in [-0.5, 1]"));
-                }
-                (
-                    ScenarioKind::Bulge {
-                        strain,
-                        width_px: positive("width_px", p.get("width_px", w.min(h) / 4.0)?)?,
-                    },
-                    "strain, width_px, cx_px, cy_px",
-                )
-            }
-            "bad-positioning" => {
-                centre = [
-                    centre[0] + p.get("centre_dx_px", 40.0)?,
-                    centre[1] + p.get("centre_dy_px", -25.0)?,
-                ];
-                let angle_deg = p.get("angle_deg", 1.0)?;
-                if angle_deg.abs() >= 90.0 {
-                    return Err(invalid("angle_deg", angle_deg, "|angle| < 90"));
-                }
-                (
-                    ScenarioKind::BadPositioning {
-                        lambda: positive("lambda", p.get("lambda", 1.1)?)?,
-                        angle_rad: angle_deg.to_radians(),
-                        translation_px: [p.get("tx_px", 3.3)?, p.get("ty_px", -2.7)?],
-                    },
-                    "lambda, angle_deg, tx_px, ty_px, centre_dx_px, centre_dy_px",
-                )
-            }
+            "chirp" => parse_chirp(&mut p, w)?,
+            "bulge" => parse_bulge(&mut p, &mut centre, w.min(h))?,
+            "bad-positioning" => parse_bad_positioning(&mut p, &mut centre)?,
             _ => {
                 return Err(ProducerError::UnknownScenario {
                     name: name.to_owned(),

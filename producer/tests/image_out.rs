@@ -1,7 +1,7 @@
 //! Writing frames (PNG 8/16, TIFF) and reading them back gives the same pixels; png8 refuses a
 //! deeper camera; writes leave no temporary file behind.
 
-use producer::{read_image, write_frame, ImageFormatOut};
+use producer::{read_image, write_frame, FrameDims, ImageFormatOut};
 
 #[test]
 fn frames_round_trip_through_every_format() {
@@ -19,7 +19,12 @@ fn frames_round_trip_through_every_format() {
         let max = (1u32 << bits) - 1;
         let pixels: Vec<u16> = (0..w * h).map(|i| ((i * 37) % (max + 1)) as u16).collect();
         let path = dir.join(format!("f{bits}.{}", format.extension()));
-        write_frame(&path, w, h, bits, &pixels, format, &mut encoded).unwrap();
+        let dims = FrameDims {
+            width: w,
+            height: h,
+            bit_depth: bits,
+        };
+        write_frame(&path, dims, &pixels, format, &mut encoded).unwrap();
         let back = read_image(&path).unwrap();
         assert_eq!(
             (back.width, back.height, back.bit_depth),
@@ -27,11 +32,14 @@ fn frames_round_trip_through_every_format() {
         );
         assert_eq!(back.pixels, pixels, "{format:?} at {bits} bit");
     }
+    let dims = FrameDims {
+        width: w,
+        height: h,
+        bit_depth: 12,
+    };
     let error = write_frame(
         &dir.join("x.png"),
-        w,
-        h,
-        12,
+        dims,
         &vec![0; (w * h) as usize],
         ImageFormatOut::Png8,
         &mut encoded,

@@ -160,22 +160,10 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
     correlator.set_reference(&reference.pixels)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
-    let progress = if std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new(args.deformed.len() as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} frames, {elapsed} elapsed, eta {eta} {msg}",
-            )
-            .expect("valid progress template"),
-        );
-        Some(bar)
-    } else {
-        None
-    };
+    let progress = progress_bar(args.deformed.len());
     let settings_value = settings_json(&args, &correlator);
     let mut frames = Vec::new();
     let mut frames_with_valid_nodes = 0usize;
-    let mut text = String::new();
     for (i, path) in args.deformed.iter().enumerate() {
         let index = i + 1;
         let image = load(path)?;
@@ -192,60 +180,9 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
         let field = correlator.correlate(&image.pixels)?;
         let elapsed_ms = t.elapsed().as_secs_f64() * 1e3;
         frames_with_valid_nodes += usize::from(field.valid > 0);
-        if 2 * field.valid < field.nodes.len() {
-            let warning = format!(
-                "warning: {}: only {} of {} nodes valid ({})",
-                path.display(),
-                field.valid,
-                field.nodes.len(),
-                field.refusals()
-            );
-            match &progress {
-                Some(bar) => bar.println(warning),
-                None => eprintln!("{warning}"),
-            }
-        }
-        correlator::output::field_csv(field, &mut text);
-        write(
-            &args.out.join(format!("field_{index:04}.csv")),
-            text.as_bytes(),
-        )?;
-        if args.vtk {
-            correlator::output::field_vtk(
-                field,
-                &format!("dicstream correlate field {index:04}"),
-                &mut text,
-            );
-            write(
-                &args.out.join(format!("field_{index:04}.vtk")),
-                text.as_bytes(),
-            )?;
-        }
-        if args.png {
-            let magnitude = |n: &correlator::Node| n.u_px.hypot(n.v_px);
-            write(
-                &args.out.join(format!("u_{index:04}.png")),
-                &colour_map(&reference, field, magnitude)?,
-            )?;
-            write(
-                &args.out.join(format!("exx_{index:04}.png")),
-                &colour_map(&reference, field, |n| n.exx)?,
-            )?;
-        }
-        frames.push(serde_json::json!({
-            "index": index,
-            "file": path.display().to_string(),
-            "nodes": field.nodes.len(),
-            "valid": field.valid,
-            "u_mean": field.u_mean_px,
-            "v_mean": field.v_mean_px,
-            "gauge": gauge_json(&field.gauge),
-            "elapsed_ms": elapsed_ms,
-            "reference_updated": field.reference_updated,
-            "statuses": status_json(field),
-            "global_px": field.global_px.map(|(u, v)| [u, v]),
-            "keypoints_used": field.keypoints_used,
-        }));
+        warn_if_few_valid(path, field, progress.as_ref());
+        write_field_files(&args, &reference, field, index)?;
+        frames.push(frame_json(index, path, field, elapsed_ms));
         let summary = serde_json::json!({ "frames": frames, "settings": settings_value });
         write(
             &args.out.join("summary.json"),
@@ -260,21 +197,114 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
         bar.finish();
     }
     if frames_with_valid_nodes == 0 {
-        let hint = match args.correlation.guess {
-            GuessMode::Auto => "unrelated or flat images?",
-            GuessMode::Correli | GuessMode::Predict => {
-                "unrelated or flat images, or a motion beyond this guess (--guess auto also tries keypoints)?"
-            }
-        };
-        bail!(
-            "no node of any of the {} deformed images passed the final check against {}: \
-             nothing was measured ({hint} the fields in {} say why per node)",
-            args.deformed.len(),
-            args.reference.display(),
-            args.out.display()
-        );
+        return Err(nothing_measured(&args));
     }
     Ok(())
+}
+
+/// A progress bar over `frames` frames, on a terminal only.
+fn progress_bar(frames: usize) -> Option<indicatif::ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(frames as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} frames, {elapsed} elapsed, eta {eta} {msg}",
+        )
+        .expect("valid progress template"),
+    );
+    Some(bar)
+}
+
+/// A warning (above the progress bar, if any) when fewer than half of the nodes are valid.
+fn warn_if_few_valid(path: &Path, field: &Field, progress: Option<&indicatif::ProgressBar>) {
+    if 2 * field.valid < field.nodes.len() {
+        let warning = format!(
+            "warning: {}: only {} of {} nodes valid ({})",
+            path.display(),
+            field.valid,
+            field.nodes.len(),
+            field.refusals()
+        );
+        match progress {
+            Some(bar) => bar.println(warning),
+            None => eprintln!("{warning}"),
+        }
+    }
+}
+
+/// The files of frame `index`: its field as CSV, and as VTK and colour maps if asked for.
+fn write_field_files(
+    args: &CorrelateArgs,
+    reference: &producer::Image16,
+    field: &Field,
+    index: usize,
+) -> Result<()> {
+    let mut text = String::new();
+    correlator::output::field_csv(field, &mut text);
+    write(
+        &args.out.join(format!("field_{index:04}.csv")),
+        text.as_bytes(),
+    )?;
+    if args.vtk {
+        correlator::output::field_vtk(
+            field,
+            &format!("dicstream correlate field {index:04}"),
+            &mut text,
+        );
+        write(
+            &args.out.join(format!("field_{index:04}.vtk")),
+            text.as_bytes(),
+        )?;
+    }
+    if args.png {
+        let magnitude = |n: &correlator::Node| n.u_px.hypot(n.v_px);
+        write(
+            &args.out.join(format!("u_{index:04}.png")),
+            &colour_map(reference, field, magnitude)?,
+        )?;
+        write(
+            &args.out.join(format!("exx_{index:04}.png")),
+            &colour_map(reference, field, |n| n.exx)?,
+        )?;
+    }
+    Ok(())
+}
+
+/// Frame `index`'s entry of `summary.json`.
+fn frame_json(index: usize, path: &Path, field: &Field, elapsed_ms: f64) -> serde_json::Value {
+    serde_json::json!({
+        "index": index,
+        "file": path.display().to_string(),
+        "nodes": field.nodes.len(),
+        "valid": field.valid,
+        "u_mean": field.u_mean_px,
+        "v_mean": field.v_mean_px,
+        "gauge": gauge_json(&field.gauge),
+        "elapsed_ms": elapsed_ms,
+        "reference_updated": field.reference_updated,
+        "statuses": status_json(field),
+        "global_px": field.global_px.map(|(u, v)| [u, v]),
+        "keypoints_used": field.keypoints_used,
+    })
+}
+
+/// The error when no node of any frame passed the final check, with a hint at why.
+fn nothing_measured(args: &CorrelateArgs) -> anyhow::Error {
+    let hint = match args.correlation.guess {
+        GuessMode::Auto => "unrelated or flat images?",
+        GuessMode::Correli | GuessMode::Predict => {
+            "unrelated or flat images, or a motion beyond this guess (--guess auto also tries keypoints)?"
+        }
+    };
+    anyhow!(
+        "no node of any of the {} deformed images passed the final check against {}: \
+         nothing was measured ({hint} the fields in {} say why per node)",
+        args.deformed.len(),
+        args.reference.display(),
+        args.out.display()
+    )
 }
 
 /// Nodes per status, by status word.

@@ -10,11 +10,11 @@
 use anyhow::{bail, Context};
 use identifier::data::{read_biaxial_csv, read_curve_csv, BiaxialState, Curve, LoadCase};
 use identifier::fit::{
-    evaluate_data, fit_ranked_data, Fit, FitData, FitOptions, FitStage, ResidualKind,
+    evaluate_data, fit_ranked_data, Fit, FitData, FitError, FitOptions, FitStage, ResidualKind,
 };
 use identifier::models::{parse_model_list, Model};
 use identifier::report::fit_json;
-use identifier::route::paper_route;
+use identifier::route::{paper_route, RouteResult};
 use identifier::subsample::{subsample_data, Subsample, DEFAULT_MAX_FIT_POINTS};
 use serde_json::{json, Value};
 use std::io::{IsTerminal, Write};
@@ -88,6 +88,49 @@ pub fn run_with(
     err: &mut dyn Write,
     progress: bool,
 ) -> anyhow::Result<()> {
+    let (curves, states) = read_data(&args)?;
+    let all = FitData {
+        curves: &curves,
+        states: &states,
+    };
+    let outcome = fit(&args, all, err, progress)?;
+    if args.json {
+        write_json(out, &outcome)?;
+    } else {
+        print_table(out, &outcome.fits, &curves, !states.is_empty())?;
+        for (m, e) in &outcome.failures {
+            writeln!(err, "not fitted: {m}: {e}")?;
+        }
+        if let Some(r) = &outcome.route {
+            writeln!(
+                out,
+                "\npaper route (eqs 20-25, n = 2): ln f: a = {:?}; ln g: b = {:?}; g = Σ c_i/I2^i: c = {:?}",
+                r.a, r.b, r.c
+            )?;
+        }
+    }
+    if let (Some(_), false) = (&args.plot, states.is_empty()) {
+        writeln!(
+            err,
+            "plots: the canonical curves only; the general biaxial states are not drawn"
+        )?;
+    }
+    if let Some(dir) = &args.plot {
+        let written =
+            identifier::plot::write_plots(dir, &curves, &outcome.fits, outcome.route.as_ref())
+                .with_context(|| format!("writing plots into {}", dir.display()))?;
+        for path in written {
+            writeln!(err, "wrote {}", path.display())?;
+        }
+    }
+    if outcome.fits.is_empty() {
+        bail!("no model could be fitted");
+    }
+    Ok(())
+}
+
+/// The load cases' curves and the general biaxial states the arguments name; at least one.
+fn read_data(args: &IdentifyArgs) -> anyhow::Result<(Vec<Curve>, Vec<BiaxialState>)> {
     let mut curves: Vec<Curve> = Vec::new();
     for (path, case) in [
         (&args.uniaxial, LoadCase::Uniaxial),
@@ -108,18 +151,37 @@ pub fn run_with(
             "no data: give at least one of --uniaxial, --biaxial, --pure-shear, --biaxial-general"
         );
     }
+    Ok((curves, states))
+}
+
+/// What the fits gave: the ranked fits, the models that failed, the paper's route (if it
+/// could run) and the subsample fitted (if the data were too many).
+struct Outcome {
+    fits: Vec<Fit>,
+    failures: Vec<(Model, FitError)>,
+    route: Option<RouteResult>,
+    subsample: Option<Subsample>,
+}
+
+/// Fits the models of `args` to `all` (or to its subsample above `--max-fit-points`; RMS and
+/// R² then over every point), with its notes and progress lines on `err`.
+fn fit(
+    args: &IdentifyArgs,
+    all: FitData,
+    err: &mut dyn Write,
+    progress: bool,
+) -> anyhow::Result<Outcome> {
     let models = parse_model_list(&args.model)?;
-    let threads = usize::try_from(args.threads).unwrap_or(1);
     let options = FitOptions {
         residual: match args.residual {
             ResidualArg::Absolute => ResidualKind::Absolute,
             ResidualArg::Relative => ResidualKind::Relative,
         },
-        threads,
+        threads: usize::try_from(args.threads).unwrap_or(1),
         ..FitOptions::default()
     };
     let max_fit_points = usize::try_from(args.max_fit_points).unwrap_or(usize::MAX);
-    let subsampled = subsample_data(&curves, &states, max_fit_points);
+    let subsampled = subsample_data(all.curves, all.states, max_fit_points);
     if let Some((_, _, s)) = &subsampled {
         writeln!(
             err,
@@ -127,10 +189,6 @@ pub fn run_with(
             s.points_total, s.max_points, s.points_fitted
         )?;
     }
-    let all = FitData {
-        curves: &curves,
-        states: &states,
-    };
     let fitted = subsampled.as_ref().map_or(all, |(c, s, _)| FitData {
         curves: c,
         states: s,
@@ -145,57 +203,37 @@ pub fn run_with(
             (fit.rms_mpa, fit.cases) = evaluate_data(&fit.model, &fit.params, all);
         }
     }
-    let route = match paper_route(&curves, 2, 2) {
+    let route = match paper_route(all.curves, 2, 2) {
         Ok(route) => Some(route),
         Err(e) => {
             writeln!(err, "paper route (eqs. 20-25) not run: {e}")?;
             None
         }
     };
+    Ok(Outcome {
+        fits,
+        failures,
+        route,
+        subsample: subsampled.map(|(_, _, s)| s),
+    })
+}
 
-    if args.json {
-        let fits_json: Vec<Value> = fits.iter().map(fit_json).collect();
-        let failures_json: Vec<Value> = failures
-            .iter()
-            .map(|(m, e)| json!({"model": m.name(), "error": e.to_string()}))
-            .collect();
-        let mut json_out = json!({"fits": fits_json, "failures": failures_json});
-        if let Some(r) = &route {
-            json_out["paper_route"] = json!({"a": r.a, "b": r.b, "c": r.c});
-        }
-        if let Some((_, _, s)) = &subsampled {
-            json_out["subsample"] = subsample_json(s);
-        }
-        writeln!(out, "{}", serde_json::to_string_pretty(&json_out)?)?;
-    } else {
-        print_table(out, &fits, &curves, !states.is_empty())?;
-        for (m, e) in &failures {
-            writeln!(err, "not fitted: {m}: {e}")?;
-        }
-        if let Some(r) = &route {
-            writeln!(
-                out,
-                "\npaper route (eqs 20-25, n = 2): ln f: a = {:?}; ln g: b = {:?}; g = Σ c_i/I2^i: c = {:?}",
-                r.a, r.b, r.c
-            )?;
-        }
+/// `--json`: the fits, the failures, the paper's route and the subsample as one object.
+fn write_json(out: &mut dyn Write, outcome: &Outcome) -> anyhow::Result<()> {
+    let fits_json: Vec<Value> = outcome.fits.iter().map(fit_json).collect();
+    let failures_json: Vec<Value> = outcome
+        .failures
+        .iter()
+        .map(|(m, e)| json!({"model": m.name(), "error": e.to_string()}))
+        .collect();
+    let mut json_out = json!({"fits": fits_json, "failures": failures_json});
+    if let Some(r) = &outcome.route {
+        json_out["paper_route"] = json!({"a": r.a, "b": r.b, "c": r.c});
     }
-    if let (Some(_), false) = (&args.plot, states.is_empty()) {
-        writeln!(
-            err,
-            "plots: the canonical curves only; the general biaxial states are not drawn"
-        )?;
+    if let Some(s) = &outcome.subsample {
+        json_out["subsample"] = subsample_json(s);
     }
-    if let Some(dir) = &args.plot {
-        let written = identifier::plot::write_plots(dir, &curves, &fits, route.as_ref())
-            .with_context(|| format!("writing plots into {}", dir.display()))?;
-        for path in written {
-            writeln!(err, "wrote {}", path.display())?;
-        }
-    }
-    if fits.is_empty() {
-        bail!("no model could be fitted");
-    }
+    writeln!(out, "{}", serde_json::to_string_pretty(&json_out)?)?;
     Ok(())
 }
 

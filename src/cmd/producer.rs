@@ -6,7 +6,7 @@
 //! and prints one final line on stdout (also after SIGINT/SIGTERM, then exits 0).
 
 use super::sim_args::SimArgs;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use producer::stream::{
@@ -88,6 +88,53 @@ pub struct ProducerArgs {
 const DEFAULT_SCENARIO_FRAMES: u64 = 100;
 
 pub fn run(args: ProducerArgs) -> anyhow::Result<()> {
+    check(&args)?;
+    let instance = wire::Instance::new(&args.instance)?;
+    let settings = StreamSettings {
+        fps: (args.fps > 0.0).then_some(args.fps),
+        max_frames: args.frames,
+        first_frame_id: args.first_frame_id,
+    };
+    let mut printer = EventPrinter {
+        instance: &instance,
+        warned_beyond: false,
+    };
+    let mut on_event = |event: StreamEvent| printer.print(event);
+    let (report, source_line) = if args.follow_rig {
+        follow_rig(&args, &instance, &settings, &mut on_event)?
+    } else if let Some(dir) = &args.watch {
+        let watch = super::producer_watch::WatchArgs {
+            dir,
+            from_start: args.from_start,
+            idle_timeout_s: args.idle_timeout_s,
+            settle_ms: args.settle_ms,
+            log: args.log.as_ref(),
+        };
+        super::producer_watch::run(watch, &instance, &settings, &mut on_event)?
+    } else if let Some(spec) = &args.genicam.camera {
+        let camera = super::producer_genicam::GenicamArgs {
+            spec,
+            camera: &args.genicam,
+            fps: args.fps,
+            log: args.log.as_ref(),
+        };
+        super::producer_genicam::run(camera, &instance, &settings, &mut on_event)?
+    } else if let Some(source) = &args.replay {
+        replay(&args, source, &instance, &settings, &mut on_event)?
+    } else {
+        scenario(&args, &instance, &settings, &mut on_event)?
+    };
+    let fps = if args.watch.is_some() || args.genicam.camera.is_some() {
+        0.0
+    } else {
+        args.fps
+    };
+    println!("{}", final_line(&report, fps, &source_line));
+    Ok(())
+}
+
+/// The checks of the options no parser makes.
+fn check(args: &ProducerArgs) -> anyhow::Result<()> {
     anyhow::ensure!(
         args.fps.is_finite() && args.fps >= 0.0,
         "--fps {}: expected a rate in frames per second, or 0 for as fast as possible",
@@ -101,138 +148,134 @@ pub fn run(args: ProducerArgs) -> anyhow::Result<()> {
         args.log.is_none() || args.watch.is_some() || args.genicam.camera.is_some(),
         "--log: only with --watch (one row per file) or --camera (one row per frame's timestamps)"
     );
-    let instance = wire::Instance::new(&args.instance)?;
-    let settings = StreamSettings {
-        fps: (args.fps > 0.0).then_some(args.fps),
-        max_frames: args.frames,
-        first_frame_id: args.first_frame_id,
-    };
-    let mut warned_beyond = false;
-    let mut on_event = |event: StreamEvent| match event {
-        StreamEvent::Ready {
-            dims,
-            dead_nodes_cleaned,
-        } => {
-            if dead_nodes_cleaned > 0 {
-                eprintln!(
-                    "producer: cleaned {dead_nodes_cleaned} dead node(s) of instance {}",
-                    instance.name()
-                );
-            }
-            eprintln!(
-                "producer: ready (instance {}, {}x{} px, {} bit)",
-                instance.name(),
-                dims.width,
-                dims.height,
-                dims.bit_depth
-            );
-        }
-        StreamEvent::WaitingForRig => eprintln!(
-            "producer: waiting for the first rig/state sample of instance {} (start `dicstream \
-             rig --instance {}`)",
-            instance.name(),
-            instance.name()
-        ),
-        StreamEvent::RigArrived { sample_id } => {
-            eprintln!("producer: following the rig from sample {sample_id}")
-        }
-        StreamEvent::RigBeyond {
-            sample_id, reason, ..
-        } => {
-            if !warned_beyond {
-                warned_beyond = true;
-                eprintln!(
-                    "producer: warning: rig sample {sample_id} is beyond what the camera can \
-                     show: {reason}; such frames are skipped and counted (this warning is shown \
-                     once)"
-                );
-            }
-        }
-        StreamEvent::Frame(_) => {}
-    };
-
-    let (report, source_line) = if args.follow_rig {
-        let config = args.sim.config()?;
-        check_shm_for_frames(config.width, config.height)?;
-        let follow = RigFollowConfig {
-            mm_per_px: args.mm_per_px,
-            envelope: RigEnvelope {
-                max_stretch: args.max_stretch,
-                max_rotation_rad: args.max_rotation_deg.to_radians(),
-                max_offset_mm: args.max_offset_mm,
-            },
-        };
-        let mut camera =
-            RigCamera::new(config, follow).context("building the rig-driven camera")?;
-        let report = stream_following_rig(&mut camera, &instance, &settings, &mut on_event)?;
-        let line = format!(
-            "{} rig samples received, last frame at rig sample {}",
-            report.rig_samples_received,
-            report
-                .last_rig_sample_id
-                .map_or_else(|| "-".to_string(), |id| id.to_string())
-        );
-        (report, line)
-    } else if let Some(dir) = &args.watch {
-        let watch = super::producer_watch::WatchArgs {
-            dir,
-            from_start: args.from_start,
-            idle_timeout_s: args.idle_timeout_s,
-            settle_ms: args.settle_ms,
-            log: args.log.as_ref(),
-        };
-        super::producer_watch::run(watch, &instance, &settings, &mut on_event)?
-    } else if let Some(spec) = &args.genicam.camera {
-        super::producer_genicam::run(
-            spec,
-            &args.genicam,
-            args.fps,
-            args.log.as_ref(),
-            &instance,
-            &settings,
-            &mut on_event,
-        )?
-    } else if let Some(source) = &args.replay {
-        let mut replay = Replay::open(source)?;
-        let dims = replay.dims();
-        check_shm_for_frames(dims.width, dims.height)?;
-        replay.set_looping(args.looping);
-        let line = format!(
-            "replay of {} image(s) from {}{}",
-            replay.files().len(),
-            source.display(),
-            if args.looping { ", looping" } else { "" }
-        );
-        let report = stream(&mut replay, &instance, &settings, &mut on_event)?;
-        (report, line)
-    } else {
-        // Cheap checks first (scenario, camera, /dev/shm), then the costly pattern.
-        let scenario = args.sim.scenario()?;
-        args.sim.config()?;
-        check_shm_for_frames(args.sim.width, args.sim.height)?;
-        let frames = args.frames.unwrap_or(DEFAULT_SCENARIO_FRAMES);
-        let mut camera = args
-            .sim
-            .build(frames)
-            .context("building the simulated camera")?;
-        let report = stream(&mut camera, &instance, &settings, &mut on_event)?;
-        let line = format!(
-            "scenario {} over {frames} frames",
-            if args.sim.params.is_empty() {
-                scenario.kind.name().to_string()
-            } else {
-                args.sim.scenario_spec()
-            }
-        );
-        (report, line)
-    };
-    let fps = if args.watch.is_some() || args.genicam.camera.is_some() {
-        0.0
-    } else {
-        args.fps
-    };
-    println!("{}", final_line(&report, fps, &source_line));
     Ok(())
+}
+
+/// The stream's events on stderr; a rig state beyond the envelope is told once.
+struct EventPrinter<'a> {
+    instance: &'a wire::Instance,
+    warned_beyond: bool,
+}
+
+impl EventPrinter<'_> {
+    fn print(&mut self, event: StreamEvent) {
+        let name = self.instance.name();
+        match event {
+            StreamEvent::Ready {
+                dims,
+                dead_nodes_cleaned,
+            } => {
+                if dead_nodes_cleaned > 0 {
+                    eprintln!(
+                        "producer: cleaned {dead_nodes_cleaned} dead node(s) of instance {name}"
+                    );
+                }
+                eprintln!(
+                    "producer: ready (instance {name}, {}x{} px, {} bit)",
+                    dims.width, dims.height, dims.bit_depth
+                );
+            }
+            StreamEvent::WaitingForRig => eprintln!(
+                "producer: waiting for the first rig/state sample of instance {name} (start \
+                 `dicstream rig --instance {name}`)"
+            ),
+            StreamEvent::RigArrived { sample_id } => {
+                eprintln!("producer: following the rig from sample {sample_id}")
+            }
+            StreamEvent::RigBeyond {
+                sample_id, reason, ..
+            } => {
+                if !self.warned_beyond {
+                    self.warned_beyond = true;
+                    eprintln!(
+                        "producer: warning: rig sample {sample_id} is beyond what the camera can \
+                         show: {reason}; such frames are skipped and counted (this warning is \
+                         shown once)"
+                    );
+                }
+            }
+            StreamEvent::Frame(_) => {}
+        }
+    }
+}
+
+/// `--follow-rig`: frames rendered from the rig's state; the report and the final line's part.
+fn follow_rig(
+    args: &ProducerArgs,
+    instance: &wire::Instance,
+    settings: &StreamSettings,
+    on_event: impl FnMut(StreamEvent),
+) -> anyhow::Result<(StreamReport, String)> {
+    let config = args.sim.config()?;
+    check_shm_for_frames(config.width, config.height)?;
+    let follow = RigFollowConfig {
+        mm_per_px: args.mm_per_px,
+        envelope: RigEnvelope {
+            max_stretch: args.max_stretch,
+            max_rotation_rad: args.max_rotation_deg.to_radians(),
+            max_offset_mm: args.max_offset_mm,
+        },
+    };
+    let mut camera = RigCamera::new(config, follow).context("building the rig-driven camera")?;
+    let report = stream_following_rig(&mut camera, instance, settings, on_event)?;
+    let line = format!(
+        "{} rig samples received, last frame at rig sample {}",
+        report.rig_samples_received,
+        report
+            .last_rig_sample_id
+            .map_or_else(|| "-".to_string(), |id| id.to_string())
+    );
+    Ok((report, line))
+}
+
+/// `--replay`: the images of `source`; the report and the final line's part.
+fn replay(
+    args: &ProducerArgs,
+    source: &Path,
+    instance: &wire::Instance,
+    settings: &StreamSettings,
+    on_event: impl FnMut(StreamEvent),
+) -> anyhow::Result<(StreamReport, String)> {
+    let mut replay = Replay::open(source)?;
+    let dims = replay.dims();
+    check_shm_for_frames(dims.width, dims.height)?;
+    replay.set_looping(args.looping);
+    let line = format!(
+        "replay of {} image(s) from {}{}",
+        replay.files().len(),
+        source.display(),
+        if args.looping { ", looping" } else { "" }
+    );
+    let report = stream(&mut replay, instance, settings, on_event)?;
+    Ok((report, line))
+}
+
+/// A simulated scenario; the report and the final line's part.
+fn scenario(
+    args: &ProducerArgs,
+    instance: &wire::Instance,
+    settings: &StreamSettings,
+    on_event: impl FnMut(StreamEvent),
+) -> anyhow::Result<(StreamReport, String)> {
+    // Cheap checks first (scenario, camera, /dev/shm), then the costly pattern.
+    let scenario = args.sim.scenario()?;
+    args.sim.config()?;
+    check_shm_for_frames(args.sim.width, args.sim.height)?;
+    let frames = args.frames.unwrap_or(DEFAULT_SCENARIO_FRAMES);
+    let mut camera = args
+        .sim
+        .build(frames)
+        .context("building the simulated camera")?;
+    let report = stream(&mut camera, instance, settings, on_event)?;
+    let line = format!(
+        "scenario {} over {frames} frames",
+        if args.sim.params.is_empty() {
+            scenario.kind.name().to_string()
+        } else {
+            args.sim.scenario_spec()
+        }
+    );
+    Ok((report, line))
 }
 
 /// The one line a run ends with.

@@ -52,13 +52,20 @@ pub struct CameraArgs {
     pub trigger: Trigger,
 }
 
+/// What `--camera` takes from the command line.
+#[cfg_attr(not(feature = "genicam"), allow(dead_code))]
+pub struct GenicamArgs<'a> {
+    pub spec: &'a CameraSpec,
+    pub camera: &'a CameraArgs,
+    /// `--fps`: the camera's frame rate or software trigger rate (0: the camera's own).
+    pub fps: f64,
+    pub log: Option<&'a PathBuf>,
+}
+
 /// Streams the camera; returns the report with the final line's source part.
 #[cfg(not(feature = "genicam"))]
 pub fn run(
-    _spec: &CameraSpec,
-    _args: &CameraArgs,
-    _fps: f64,
-    _log: Option<&PathBuf>,
+    _args: GenicamArgs,
     _instance: &wire::Instance,
     _settings: &StreamSettings,
     _on_event: impl FnMut(StreamEvent),
@@ -69,96 +76,86 @@ pub fn run(
 /// Streams the camera; returns the report with the final line's source part.
 #[cfg(feature = "genicam")]
 pub fn run(
-    spec: &CameraSpec,
-    args: &CameraArgs,
-    fps: f64,
-    log: Option<&PathBuf>,
+    args: GenicamArgs,
     instance: &wire::Instance,
     settings: &StreamSettings,
     on_event: impl FnMut(StreamEvent),
 ) -> anyhow::Result<(StreamReport, String)> {
-    use anyhow::Context;
-    use producer::genicam::{CameraSettings, FIRST_RETRY, MAX_RETRY};
-    use producer::stream::{stream_genicam, CameraNote};
-    use std::time::{Duration, Instant};
-    use wire::files::RowFile;
+    use producer::stream::stream_genicam;
 
-    /// Seconds between two status lines while frames flow.
-    const STATUS_EVERY: Duration = Duration::from_secs(5);
-
-    let camera = CameraSettings {
-        exposure_us: args.exposure_us,
-        gain_db: args.gain_db,
-        fps: (fps > 0.0 && args.trigger != Trigger::Hardware).then_some(fps),
-        pixel_format: args.pixel_format,
-        roi: args.roi,
-        trigger: args.trigger,
-    };
+    let camera = camera_settings(&args);
     camera.check()?;
-    let mut rows = match log {
-        Some(path) => Some(
-            RowFile::create(path, LOG_HEADER)
-                .with_context(|| format!("creating the --log file {}", path.display()))?,
-        ),
-        None => None,
+    let mut notes = NotePrinter {
+        args: &args,
+        camera: &camera,
+        log: super::log_rows::LogRows::create(args.log, LOG_HEADER)?,
+        last_status: std::time::Instant::now(),
+        published: 0,
+        last_frame_id: None,
+        id: String::new(),
+        first_frame_id: settings.first_frame_id,
     };
-    let mut log_error = None;
-    let mut last_status = Instant::now();
-    let mut published = 0u64;
-    let mut last_frame_id = None;
-    let mut id = String::new();
-    let (report, camera_report) = stream_genicam(
-        spec,
-        &camera,
-        instance,
-        settings,
-        on_event,
-        |note| match note {
+    let (report, camera_report) =
+        stream_genicam(args.spec, &camera, instance, settings, on_event, |note| {
+            notes.print(note)
+        })?;
+    let id = std::mem::take(&mut notes.id);
+    notes.log.finish()?;
+    Ok((report, summary_line(&id, &camera_report)))
+}
+
+/// The camera's settings from the command line (`--fps` 0, or a hardware trigger: none).
+#[cfg(feature = "genicam")]
+fn camera_settings(args: &GenicamArgs) -> producer::genicam::CameraSettings {
+    let camera = args.camera;
+    producer::genicam::CameraSettings {
+        exposure_us: camera.exposure_us,
+        gain_db: camera.gain_db,
+        fps: (args.fps > 0.0 && camera.trigger != Trigger::Hardware).then_some(args.fps),
+        pixel_format: camera.pixel_format,
+        roi: camera.roi,
+        trigger: camera.trigger,
+    }
+}
+
+/// Prints the camera loop's notes on stderr and writes the frames' rows in the `--log` file.
+#[cfg(feature = "genicam")]
+struct NotePrinter<'a> {
+    args: &'a GenicamArgs<'a>,
+    camera: &'a producer::genicam::CameraSettings,
+    log: super::log_rows::LogRows,
+    last_status: std::time::Instant,
+    published: u64,
+    last_frame_id: Option<u64>,
+    /// The camera's id, once open.
+    id: String,
+    first_frame_id: u64,
+}
+
+#[cfg(feature = "genicam")]
+impl NotePrinter<'_> {
+    fn print(&mut self, note: &producer::stream::CameraNote) {
+        use producer::genicam::{FIRST_RETRY, MAX_RETRY};
+        use producer::stream::CameraNote;
+        match note {
             CameraNote::Opened {
-                id: opened,
+                id,
                 format,
                 width_px,
                 height_px,
-            } => {
-                id = opened.to_string();
-                eprintln!(
-                    "producer: camera {opened} open: {width_px}x{height_px} px {format}, trigger \
-                     {}{}; header t_capture_ns = host receive time (monotonic clock), camera \
-                     timestamps (the camera's clock) {}",
-                    args.trigger,
-                    camera
-                        .fps
-                        .map_or_else(String::new, |fps| format!(" at {fps} fps")),
-                    if log.is_some() {
-                        "in --log"
-                    } else {
-                        "not kept (pass --log FILE)"
-                    }
-                )
-            }
+            } => self.opened(id, format, (*width_px, *height_px)),
             CameraNote::Frame {
                 frame_id,
                 camera_frame_id,
                 camera_timestamp_ns,
                 host_receive_ns,
             } => {
-                published += 1;
-                last_frame_id = Some(*frame_id);
-                if let (Some(rows), None) = (rows.as_mut(), log_error.as_ref()) {
-                    let row = format!(
+                self.log.append(|| {
+                    format!(
                         "{frame_id},{camera_frame_id},{camera_timestamp_ns},{host_receive_ns}\n"
-                    );
-                    if let Err(e) = rows.append(&row) {
-                        log_error = Some(e);
-                    }
-                }
-                if last_status.elapsed() >= STATUS_EVERY {
-                    last_status = Instant::now();
-                    eprintln!(
-                        "producer: camera status: streaming, {published} frame(s) published, \
-                         last frame {frame_id}"
-                    );
-                }
+                    )
+                });
+                self.frame(*frame_id);
             }
             CameraNote::Skipped { counts } => {
                 let skipped = counts.skipped();
@@ -178,7 +175,7 @@ pub fn run(
                  then backing off up to {} s between attempts); frame ids will go on from {}",
                 FIRST_RETRY.as_secs_f64(),
                 MAX_RETRY.as_secs(),
-                last_frame_id.map_or(settings.first_frame_id, |f| f + 1)
+                self.last_frame_id.map_or(self.first_frame_id, |f| f + 1)
             ),
             CameraNote::RetryFailed {
                 attempt,
@@ -192,13 +189,51 @@ pub fn run(
                 "producer: camera {id} reconnected after {:.1} s away",
                 away.as_secs_f64()
             ),
-        },
-    )?;
-    if let Some(e) = log_error {
-        return Err(anyhow::Error::new(e).context("writing the --log file"));
+        }
     }
-    let c = camera_report.counts;
-    let line = format!(
+
+    fn opened(&mut self, id: &str, format: &PixelFormat, (width_px, height_px): (u32, u32)) {
+        self.id = id.to_string();
+        eprintln!(
+            "producer: camera {id} open: {width_px}x{height_px} px {format}, trigger \
+             {}{}; header t_capture_ns = host receive time (monotonic clock), camera \
+             timestamps (the camera's clock) {}",
+            self.args.camera.trigger,
+            self.camera
+                .fps
+                .map_or_else(String::new, |fps| format!(" at {fps} fps")),
+            if self.args.log.is_some() {
+                "in --log"
+            } else {
+                "not kept (pass --log FILE)"
+            }
+        )
+    }
+
+    /// A published frame: counted, and a status line every [`STATUS_EVERY`].
+    fn frame(&mut self, frame_id: u64) {
+        self.published += 1;
+        self.last_frame_id = Some(frame_id);
+        if self.last_status.elapsed() >= STATUS_EVERY {
+            self.last_status = std::time::Instant::now();
+            eprintln!(
+                "producer: camera status: streaming, {} frame(s) published, last frame \
+                 {frame_id}",
+                self.published
+            );
+        }
+    }
+}
+
+/// Seconds between two status lines while frames flow.
+#[cfg(feature = "genicam")]
+const STATUS_EVERY: std::time::Duration = std::time::Duration::from_secs(5);
+
+/// The final line's source part: the camera's buffers, losses and reconnections.
+#[cfg(feature = "genicam")]
+fn summary_line(id: &str, report: &producer::stream::CameraReport) -> String {
+    let c = report.counts;
+    format!(
         "camera {id}: {} buffer(s) published, {} skipped ({} incomplete, {} failed, {} of the \
          wrong size or format), {} dropped by the driver (no free buffer), lost {} time(s), \
          reconnected {} time(s){}",
@@ -207,16 +242,15 @@ pub fn run(
         c.incomplete,
         c.failed,
         c.wrong_shape,
-        camera_report.driver_underruns,
-        camera_report.losses,
-        camera_report.reconnections,
-        if camera_report.ended_lost {
+        report.driver_underruns,
+        report.losses,
+        report.reconnections,
+        if report.ended_lost {
             "; ended while the camera was lost"
         } else {
             ""
         }
-    );
-    Ok((report, line))
+    )
 }
 
 /// 1, 10, 100, ...: when a count is worth a line.

@@ -7,10 +7,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use anyhow::Context;
+use super::log_rows::LogRows;
 use producer::stream::{stream_watched, StreamEvent, StreamReport, StreamSettings};
 use producer::{WatchNote, WatchSettings, Watcher, DEFAULT_POLL_MS};
-use wire::files::RowFile;
 
 /// The header of the `--log` CSV.
 const LOG_HEADER: &str = "frame_id,file,modified_unix_ns,size_bytes,renamed";
@@ -31,23 +30,8 @@ pub fn run(
     settings: &StreamSettings,
     on_event: impl FnMut(StreamEvent),
 ) -> anyhow::Result<(StreamReport, String)> {
-    let idle_timeout = match args.idle_timeout_s {
-        Some(s) => {
-            anyhow::ensure!(
-                s.is_finite() && s > 0.0,
-                "--idle-timeout-s {s}: expected a duration above 0 s"
-            );
-            Some(Duration::from_secs_f64(s))
-        }
-        None => None,
-    };
-    let mut log = match args.log {
-        Some(path) => Some(
-            RowFile::create(path, LOG_HEADER)
-                .with_context(|| format!("creating the --log file {}", path.display()))?,
-        ),
-        None => None,
-    };
+    let idle_timeout = idle_timeout(args.idle_timeout_s)?;
+    let mut log = LogRows::create(args.log, LOG_HEADER)?;
     let mut watcher = Watcher::open(WatchSettings {
         from_start: args.from_start,
         settle: Duration::from_millis(args.settle_ms),
@@ -66,53 +50,66 @@ pub fn run(
         },
         args.settle_ms
     );
-    let mut log_error = None;
-    let report = stream_watched(
-        &mut watcher,
-        instance,
-        settings,
-        on_event,
-        |note| match note {
-            WatchNote::Unreadable { path, reason, wait } => eprintln!(
-                "producer: {} not readable: {reason}; decoded again if it changes within {} ms, \
-                 else skipped",
-                path.display(),
-                wait.as_millis()
-            ),
-            WatchNote::Skipped { path, reason } => {
-                eprintln!(
-                    "producer: skipped {}, not published: {reason}",
-                    path.display()
-                )
-            }
-            WatchNote::Published { frame_id, file } => {
-                eprintln!(
-                    "producer: frame {frame_id} <- {} (modified {} ns after 1970 UTC, {} bytes{})",
-                    file.name,
+    let report = stream_watched(&mut watcher, instance, settings, on_event, |note| {
+        print_note(note, &mut log)
+    })?;
+    log.finish()?;
+    Ok((report, summary_line(&args, &watcher)))
+}
+
+/// `--idle-timeout-s`, checked.
+fn idle_timeout(seconds: Option<f64>) -> anyhow::Result<Option<Duration>> {
+    seconds
+        .map(|s| {
+            anyhow::ensure!(
+                s.is_finite() && s > 0.0,
+                "--idle-timeout-s {s}: expected a duration above 0 s"
+            );
+            Ok(Duration::from_secs_f64(s))
+        })
+        .transpose()
+}
+
+/// One note of the watcher on stderr, and a published frame's row in the `--log` file.
+fn print_note(note: &WatchNote, log: &mut LogRows) {
+    match note {
+        WatchNote::Unreadable { path, reason, wait } => eprintln!(
+            "producer: {} not readable: {reason}; decoded again if it changes within {} ms, \
+             else skipped",
+            path.display(),
+            wait.as_millis()
+        ),
+        WatchNote::Skipped { path, reason } => {
+            eprintln!(
+                "producer: skipped {}, not published: {reason}",
+                path.display()
+            )
+        }
+        WatchNote::Published { frame_id, file } => {
+            eprintln!(
+                "producer: frame {frame_id} <- {} (modified {} ns after 1970 UTC, {} bytes{})",
+                file.name,
+                file.modified_unix_ns(),
+                file.size_bytes,
+                if file.renamed { ", renamed" } else { "" }
+            );
+            log.append(|| {
+                format!(
+                    "{frame_id},{},{},{},{}\n",
+                    csv_field(&file.name),
                     file.modified_unix_ns(),
                     file.size_bytes,
-                    if file.renamed { ", renamed" } else { "" }
-                );
-                if let (Some(rows), None) = (log.as_mut(), log_error.as_ref()) {
-                    let row = format!(
-                        "{frame_id},{},{},{},{}\n",
-                        csv_field(&file.name),
-                        file.modified_unix_ns(),
-                        file.size_bytes,
-                        file.renamed
-                    );
-                    if let Err(e) = rows.append(&row) {
-                        log_error = Some(e);
-                    }
-                }
-            }
-        },
-    )?;
-    if let Some(e) = log_error {
-        return Err(anyhow::Error::new(e).context("writing the --log file"));
+                    file.renamed
+                )
+            });
+        }
     }
+}
+
+/// The final line's source part: what the watcher published, skipped and retried.
+fn summary_line(args: &WatchArgs, watcher: &Watcher) -> String {
     let counts = watcher.counts();
-    let line = format!(
+    format!(
         "watched {}: {} image(s) published, {} skipped, {} retried decode(s){}",
         args.dir.display(),
         counts.published,
@@ -126,8 +123,7 @@ pub fn run(
         } else {
             String::new()
         }
-    );
-    Ok((report, line))
+    )
 }
 
 /// A CSV field, quoted when it holds a comma, a quote or a line break.

@@ -72,15 +72,7 @@ pub fn run(args: SynthArgs) -> anyhow::Result<()> {
         let truth = frame.truth.expect("simulated frames carry their truth");
         let name = format!("frame_{:05}.{}", frame.index, format.extension());
         let path = args.out.join(&name);
-        write_frame(
-            &path,
-            dims.width,
-            dims.height,
-            dims.bit_depth,
-            &pixels,
-            format,
-            &mut encoded,
-        )?;
+        write_frame(&path, dims, &pixels, format, &mut encoded)?;
         // `+ 0.0` turns -0 into 0 in the file.
         let [[f11, f12], [f21, f22]] = truth.f.map(|row| row.map(|v| v + 0.0));
         writeln!(

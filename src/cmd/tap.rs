@@ -155,23 +155,7 @@ impl Tap {
 }
 
 pub fn run(args: TapArgs) -> anyhow::Result<()> {
-    let kind = Kind::of(&args.service).ok_or_else(|| {
-        anyhow::anyhow!(
-            "unknown service {:?}: expected one of {}",
-            args.service,
-            services::TAPPABLE.map(|s| s.name).join(", ")
-        )
-    })?;
-    anyhow::ensure!(
-        args.count != Some(0),
-        "--count 0: expected at least 1 sample"
-    );
-    if let Some(seconds) = args.seconds {
-        anyhow::ensure!(
-            seconds.is_finite() && seconds > 0.0,
-            "--seconds {seconds}: expected a positive duration"
-        );
-    }
+    let kind = check(&args)?;
     let instance = Instance::new(&args.instance)?;
     let (node, cleaned) = instance.create_node("tap")?;
     if cleaned > 0 {
@@ -194,37 +178,8 @@ pub fn run(args: TapArgs) -> anyhow::Result<()> {
         kind.name(),
         instance.name()
     );
-
-    let started = Instant::now();
-    let deadline = args.seconds.map(|s| started + Duration::from_secs_f64(s));
-    let limit = args.count.unwrap_or(u64::MAX);
-    let mut stats = TapStats::new(kind);
-    let mut window_started = started;
-    let print_window = |stats: &mut TapStats, window_started: &mut Instant| {
-        let line = stats.window_line(window_started.elapsed().as_secs_f64());
-        *window_started = Instant::now();
-        if args.json {
-            eprintln!("{line}");
-        } else {
-            println!("{line}");
-        }
-    };
-    // History samples (rig/state, fields, identification keep the last one) need no event.
-    tap.drain(&mut stats, limit)?;
-    let stopped_by = loop {
-        if stats.received >= limit {
-            break "count";
-        }
-        let timeout = match deadline {
-            Some(deadline) => {
-                let left = deadline.saturating_duration_since(Instant::now());
-                if left.is_zero() {
-                    break "seconds";
-                }
-                left
-            }
-            None => Duration::MAX,
-        };
+    // One wait: (a sample is ready, the tick came).
+    let wait = |timeout: Duration| {
         let (mut sample_ready, mut tick) = (false, false);
         waitset
             .wait_and_process_once_with_timeout(
@@ -236,19 +191,19 @@ pub fn run(args: TapArgs) -> anyhow::Result<()> {
                 timeout,
             )
             .map_err(|e| anyhow::anyhow!("waiting on the WaitSet: {e:?}"))?;
-        if sample_ready || !tick {
-            let budget = limit - stats.received;
-            tap.drain(&mut stats, budget)
-                .with_context(|| format!("receiving from {}", kind.name()))?;
-        }
-        if tick {
-            print_window(&mut stats, &mut window_started);
-        }
-        // The 1 s tick bounds the wait, so a request is seen within a second.
-        if wire::signals::requested().is_some() {
-            break "signal";
-        }
+        Ok((sample_ready, tick))
     };
+    let started = Instant::now();
+    let mut stats = TapStats::new(kind);
+    let stop = Stop {
+        deadline: args.seconds.map(|s| started + Duration::from_secs_f64(s)),
+        limit: args.count.unwrap_or(u64::MAX),
+    };
+    let window = Window {
+        started,
+        json: args.json,
+    };
+    let stopped_by = watch(&tap, &mut stats, stop, window, wait)?;
     let elapsed_s = started.elapsed().as_secs_f64();
     if args.json {
         println!("{}", stats.json(instance.name(), elapsed_s, stopped_by));
@@ -256,4 +211,91 @@ pub fn run(args: TapArgs) -> anyhow::Result<()> {
         println!("{}", stats.summary_line(elapsed_s));
     }
     Ok(())
+}
+
+/// The service's kind, and the checks of the options no parser makes.
+fn check(args: &TapArgs) -> anyhow::Result<Kind> {
+    let kind = Kind::of(&args.service).ok_or_else(|| {
+        anyhow::anyhow!(
+            "unknown service {:?}: expected one of {}",
+            args.service,
+            services::TAPPABLE.map(|s| s.name).join(", ")
+        )
+    })?;
+    anyhow::ensure!(
+        args.count != Some(0),
+        "--count 0: expected at least 1 sample"
+    );
+    if let Some(seconds) = args.seconds {
+        anyhow::ensure!(
+            seconds.is_finite() && seconds > 0.0,
+            "--seconds {seconds}: expected a positive duration"
+        );
+    }
+    Ok(kind)
+}
+
+/// When the tap stops: at `deadline` (`--seconds`), after `limit` samples (`--count`).
+struct Stop {
+    deadline: Option<Instant>,
+    limit: u64,
+}
+
+/// The once-a-second lines: on stdout, or on stderr when stdout is for `--json`.
+struct Window {
+    started: Instant,
+    json: bool,
+}
+
+impl Window {
+    fn print(&mut self, stats: &mut TapStats) {
+        let line = stats.window_line(self.started.elapsed().as_secs_f64());
+        self.started = Instant::now();
+        if self.json {
+            eprintln!("{line}");
+        } else {
+            println!("{line}");
+        }
+    }
+}
+
+/// Receives into `stats` until a stop, waking on `wait` (a sample ready, the tick); returns
+/// what stopped it: "count", "seconds" or "signal".
+fn watch(
+    tap: &Tap,
+    stats: &mut TapStats,
+    stop: Stop,
+    mut window: Window,
+    mut wait: impl FnMut(Duration) -> anyhow::Result<(bool, bool)>,
+) -> anyhow::Result<&'static str> {
+    // History samples (rig/state, fields, identification keep the last one) need no event.
+    tap.drain(stats, stop.limit)?;
+    loop {
+        if stats.received >= stop.limit {
+            return Ok("count");
+        }
+        let timeout = match stop.deadline {
+            Some(deadline) => {
+                let left = deadline.saturating_duration_since(Instant::now());
+                if left.is_zero() {
+                    return Ok("seconds");
+                }
+                left
+            }
+            None => Duration::MAX,
+        };
+        let (sample_ready, tick) = wait(timeout)?;
+        if sample_ready || !tick {
+            let budget = stop.limit - stats.received;
+            tap.drain(stats, budget)
+                .with_context(|| format!("receiving from {}", stats.kind.name()))?;
+        }
+        if tick {
+            window.print(stats);
+        }
+        // The 1 s tick bounds the wait, so a request is seen within a second.
+        if wire::signals::requested().is_some() {
+            return Ok("signal");
+        }
+    }
 }

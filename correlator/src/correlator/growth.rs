@@ -22,7 +22,7 @@ use crate::interpolate::Mat2;
 use crate::keypoints::KeypointMatcher;
 use crate::pool::SharedSlice;
 use crate::verify;
-use crate::zoi::{spectrum_len, warp_worth_it, Image, ReferenceSpectra};
+use crate::zoi::{spectrum_len, warp_worth_it, Image, ReferenceSpectra, ZoiSearch};
 
 /// Keypoints run when fewer than this fraction of the nodes that could verify (textured, not
 /// outside the image) do after growth.
@@ -265,15 +265,13 @@ impl Correlator {
                 plain: &plain[k * n2..(k + 1) * n2],
                 windowed: &windowed[k * fft * fft..(k + 1) * fft * fft],
             };
-            let mut result = engine.correlate(
-                &spectra,
-                image,
-                r.top_left.0 + pad,
-                r.top_left.1 + pad,
-                entry.guess_px,
-                Some(entry.gradient),
+            let search = ZoiSearch {
+                top_left_px: (r.top_left.0 + pad, r.top_left.1 + pad),
+                guess_px: entry.guess_px,
+                warp: Some(entry.gradient),
                 iterations,
-            );
+            };
+            let mut result = engine.correlate(&spectra, image, search);
             let mut score = 0.0;
             if result.status == NodeStatus::Ok {
                 score = verify::zncc(

@@ -15,7 +15,9 @@ use crate::interpolate::Mat2;
 use crate::mesh::Mesh;
 use crate::pool::{Pool, SharedSlice};
 use crate::settings::GuessMode;
-use crate::zoi::{spectrum_len, Image, ReferenceSpectra, SubpixelIterations, ZoiEngine, ZoiResult};
+use crate::zoi::{
+    spectrum_len, Image, ReferenceSpectra, SubpixelIterations, ZoiEngine, ZoiResult, ZoiSearch,
+};
 
 impl Correlator {
     pub(super) fn run_zois(&mut self, image: Image) {
@@ -170,15 +172,13 @@ impl NodeJob<'_> {
                 plain: &self.reference.plain_spectra[k * n2..(k + 1) * n2],
                 windowed: &self.reference.windowed[k * n * n..(k + 1) * n * n],
             };
-            engine.correlate(
-                &spectra,
-                self.image,
-                r.top_left.0 + self.pad_px,
-                r.top_left.1 + self.pad_px,
-                guess,
-                self.warps.get(k).copied().flatten(),
-                self.iterations,
-            )
+            let search = ZoiSearch {
+                top_left_px: (r.top_left.0 + self.pad_px, r.top_left.1 + self.pad_px),
+                guess_px: guess,
+                warp: self.warps.get(k).copied().flatten(),
+                iterations: self.iterations,
+            };
+            engine.correlate(&spectra, self.image, search)
         };
         // SAFETY: each node is written by exactly one item of the job, and only when the
         // new result is better than what is there (the first pass writes every node).

@@ -93,15 +93,12 @@ impl Correlator {
             let mut s = subset::SubsetStats::default();
             // SAFETY: node k's planes, stats and reference slot are written by item k alone.
             let planes = unsafe { planes.slice_mut(k * values, values) };
-            if !subset::prepare(
-                reference,
-                coefficients,
-                r.top_left,
-                n,
+            let spec = subset::SubsetSpec {
+                top_left_px: r.top_left,
+                side_px: n,
                 order,
-                planes,
-                &mut s,
-            ) {
+            };
+            if !subset::prepare(reference, coefficients, spec, planes, &mut s) {
                 r.status = NodeStatus::LowContrast;
                 unsafe { ref_nodes.write(k, r) };
             }
@@ -233,12 +230,15 @@ impl OriginIcgn<'_> {
     ) -> ZoiResult {
         let n = self.n;
         let mut stats = subset::SubsetStats::default();
+        let spec = subset::SubsetSpec {
+            top_left_px: top_left,
+            side_px: n,
+            order: self.order,
+        };
         if !subset::prepare(
             self.origin,
             self.origin_coefficients,
-            top_left,
-            n,
-            self.order,
+            spec,
             scratch,
             &mut stats,
         ) {

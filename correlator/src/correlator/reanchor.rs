@@ -17,7 +17,7 @@ use crate::field::NodeStatus;
 use crate::interpolate::Mat2;
 use crate::pool::SharedSlice;
 use crate::verify;
-use crate::zoi::{Image, ZoiResult};
+use crate::zoi::{Image, ZoiResult, ZoiSearch};
 
 impl Correlator {
     /// Measures the returned nodes against the origin (see the module documentation).
@@ -143,15 +143,13 @@ impl Correlator {
                 unsafe { out.write(i, (result, score)) };
                 return;
             }
-            let result = engine.correlate_uncached(
-                origin,
-                x0 + pad,
-                y0 + pad,
-                image,
-                entry.guess_px,
-                Some(entry.gradient),
+            let search = ZoiSearch {
+                top_left_px: (x0 + pad, y0 + pad),
+                guess_px: entry.guess_px,
+                warp: Some(entry.gradient),
                 iterations,
-            );
+            };
+            let result = engine.correlate_uncached(origin, image, search);
             // The FFT ZOI's centre is `offset` px from the node's when an odd subset holds an
             // even FFT ZOI: the node's own displacement is the gradient's step from there.
             let mut result = result;

@@ -78,18 +78,26 @@ pub fn steepest_descent(order: Order, fx: f64, fy: f64, dx: f64, dy: f64, out: &
     }
 }
 
-/// Prepares the n x n subset with top-left `top_left` of the reference image (`coefficients`
-/// are that image's): fills `planes` (3 n² values) and `stats`. False when the subset is flat
-/// (standard deviation below [`MIN_STD_COUNTS`]) or its Hessian is singular.
+/// Which subset of a reference image: its top-left pixel, its side n (px) and the order of
+/// the shape function fitted to it.
+#[derive(Clone, Copy, Debug)]
+pub struct SubsetSpec {
+    pub top_left_px: (usize, usize),
+    pub side_px: usize,
+    pub order: Order,
+}
+
+/// Prepares the subset `spec` of the reference image (`coefficients` are that image's): fills
+/// `planes` (3 n² values) and `stats`. False when the subset is flat (standard deviation below
+/// [`MIN_STD_COUNTS`]) or its Hessian is singular.
 pub fn prepare(
     reference: Image,
     coefficients: &Coefficients,
-    top_left: (usize, usize),
-    n: usize,
-    order: Order,
+    spec: SubsetSpec,
     planes: &mut [f32],
     stats: &mut SubsetStats,
 ) -> bool {
+    let (top_left, n) = (spec.top_left_px, spec.side_px);
     let nn = n * n;
     assert_eq!(planes.len(), PLANES * nn);
     assert!(reference.contains_block(top_left.0 as i64, top_left.1 as i64, n));
@@ -122,6 +130,24 @@ pub fn prepare(
     for g in gx.iter_mut().chain(gy.iter_mut()) {
         *g = (*g as f64 * inv_norm) as f32;
     }
+    let Some(inverse) = inverse_hessian(spec, [&*values, &*gx, &*gy], stats) else {
+        return false;
+    };
+    stats.inverse_hessian = inverse;
+    stats.mean = mean as f32;
+    true
+}
+
+/// H⁻¹ of the normalised subset of `spec` (its planes f̂, ∂f̂/∂x, ∂f̂/∂y), accumulating Σ J and
+/// Σ J f̂ into `stats` on the way; None when H is singular.
+fn inverse_hessian(
+    spec: SubsetSpec,
+    [values, gx, gy]: [&[f32]; 3],
+    stats: &mut SubsetStats,
+) -> Option<[f64; 144]> {
+    let (n, order) = (spec.side_px, spec.order);
+    let nn = n * n;
+    let (values, gx, gy) = (&values[..nn], &gx[..nn], &gy[..nn]);
     let count = order.parameters();
     let half = (n as f64 - 1.0) / 2.0;
     let mut hessian = [0.0f64; 144];
@@ -164,16 +190,10 @@ pub fn prepare(
             hessian[a * count + b] = hessian[b * count + a];
         }
     }
-    let inverse = match order {
+    match order {
         Order::First => invert::<6>(&hessian),
         Order::Second => invert::<12>(&hessian),
-    };
-    let Some(inverse) = inverse else {
-        return false;
-    };
-    stats.inverse_hessian = inverse;
-    stats.mean = mean as f32;
-    true
+    }
 }
 
 /// The gradient of `image` at pixel `p` by sixth-order central differences, (−f₋₃ + 9 f₋₂ −
@@ -248,12 +268,15 @@ pub(crate) mod test_support {
         ) -> Self {
             let mut planes = vec![0.0; PLANES * n * n];
             let mut stats = SubsetStats::default();
+            let spec = SubsetSpec {
+                top_left_px: top_left,
+                side_px: n,
+                order,
+            };
             assert!(prepare(
                 reference,
                 coefficients,
-                top_left,
-                n,
-                order,
+                spec,
                 &mut planes,
                 &mut stats
             ));

@@ -148,6 +148,180 @@ impl Frame {
     }
 }
 
+/// The camera `spec` names and its id (as `dicstream cameras` lists it): the one asked for,
+/// or the first found, which is the one `Camera::new(None)` opens.
+fn connect(spec: &CameraSpec) -> Result<(Camera, String), GenicamError> {
+    let camera = Camera::new(spec.id.as_deref()).map_err(|e| {
+        let found = list_ids();
+        if found.is_empty() || spec.id.is_some() {
+            GenicamError::NotFound {
+                id: spec.id.clone(),
+                found: format!(
+                    "{e}; found: {}",
+                    if found.is_empty() {
+                        "none".into()
+                    } else {
+                        found.join(", ")
+                    }
+                ),
+            }
+        } else {
+            GenicamError::Open {
+                id: "(first found)".into(),
+                detail: e.to_string(),
+            }
+        }
+    })?;
+    let id = spec
+        .id
+        .clone()
+        .or_else(|| list_ids().into_iter().next())
+        .unwrap_or_else(|| "(first found)".into());
+    Ok((camera, id))
+}
+
+/// A camera acquiring: its stream, the control-lost flag the driver raises, and its image size.
+struct Started {
+    stream: Stream,
+    control_lost: Arc<AtomicBool>,
+    size_px: (u32, u32),
+}
+
+/// An opened camera being set up; its errors name it by `id`.
+struct Setup<'a> {
+    camera: &'a Camera,
+    id: &'a str,
+}
+
+impl Setup<'_> {
+    /// A refused setting `what` as an error.
+    fn set(&self, what: &str, result: Result<(), aravis::glib::Error>) -> Result<(), GenicamError> {
+        result.map_err(|e| self.setting(what, e))
+    }
+
+    fn setting(&self, what: &str, e: aravis::glib::Error) -> GenicamError {
+        GenicamError::Setting {
+            id: self.id.to_string(),
+            what: what.to_string(),
+            detail: e.to_string(),
+        }
+    }
+
+    fn stream_error(&self, what: &'static str, e: aravis::glib::Error) -> GenicamError {
+        GenicamError::Stream {
+            id: self.id.to_string(),
+            what,
+            detail: e.to_string(),
+        }
+    }
+
+    /// Sets the pixel format `asked` if any (one the camera offers); the camera's format then,
+    /// one dicstream publishes.
+    fn pixel_format(&self, asked: Option<PixelFormat>) -> Result<PixelFormat, GenicamError> {
+        let camera = self.camera;
+        if let Some(asked) = asked {
+            let offered = offered_formats(camera);
+            if !offered.iter().any(|f| f == asked.name()) {
+                return Err(GenicamError::PixelFormat {
+                    id: self.id.to_string(),
+                    asked: asked.name().into(),
+                    offered: offered.join(", "),
+                });
+            }
+            self.set(
+                "--pixel-format",
+                camera.set_pixel_format_from_string(asked.name()),
+            )?;
+        }
+        let current = camera
+            .pixel_format()
+            .map_err(|e| self.setting("reading PixelFormat", e))?;
+        PixelFormat::from_code(current.raw()).ok_or_else(|| GenicamError::PixelFormat {
+            id: self.id.to_string(),
+            asked: format!(
+                "{} (its current one; pass --pixel-format)",
+                camera
+                    .pixel_format_as_string()
+                    .map(|s| s.to_string())
+                    .unwrap_or_else(|_| format!("0x{:08X}", current.raw()))
+            ),
+            offered: offered_formats(camera).join(", "),
+        })
+    }
+
+    /// The region, exposure, gain, acquisition mode and trigger of `settings`.
+    fn apply(&self, settings: &CameraSettings) -> Result<(), GenicamError> {
+        let camera = self.camera;
+        if let Some(roi) = settings.roi {
+            roi.check(&roi_limits(camera, self.id)?)?;
+            self.set(
+                "--roi",
+                camera.set_region(
+                    roi.x_px as i32,
+                    roi.y_px as i32,
+                    roi.width_px as i32,
+                    roi.height_px as i32,
+                ),
+            )?;
+        }
+        if let Some(exposure_us) = settings.exposure_us {
+            let _ = camera.set_exposure_time_auto(Auto::Off);
+            self.set("--exposure-us", camera.set_exposure_time(exposure_us))?;
+        }
+        if let Some(gain_db) = settings.gain_db {
+            let _ = camera.set_gain_auto(Auto::Off);
+            self.set("--gain-db", camera.set_gain(gain_db))?;
+        }
+        self.set(
+            "AcquisitionMode Continuous",
+            camera.set_acquisition_mode(AcquisitionMode::Continuous),
+        )?;
+        match settings.trigger {
+            Trigger::Free => {
+                self.set("--trigger free (TriggerMode Off)", camera.clear_triggers())?;
+                if let Some(fps) = settings.fps {
+                    self.set("--fps", camera.set_frame_rate(fps))?;
+                }
+                Ok(())
+            }
+            Trigger::Software => self.set("--trigger software", camera.set_trigger("Software")),
+            Trigger::Hardware => {
+                self.set("--trigger hardware (Line1)", camera.set_trigger("Line1"))
+            }
+        }
+    }
+
+    /// Queues the buffers and starts acquiring.
+    fn start(&self) -> Result<Started, GenicamError> {
+        let camera = self.camera;
+        let (_, _, width, height) = camera
+            .region()
+            .map_err(|e| self.setting("reading the region", e))?;
+        let payload = camera
+            .payload()
+            .map_err(|e| self.setting("reading PayloadSize", e))?;
+        let stream = camera
+            .create_stream()
+            .map_err(|e| self.stream_error("creating the stream", e))?;
+        for _ in 0..QUEUED_BUFFERS {
+            stream.push_buffer(Buffer::new_allocate(payload as usize));
+        }
+        let control_lost = Arc::new(AtomicBool::new(false));
+        if let Some(device) = camera.device() {
+            let flag = Arc::clone(&control_lost);
+            device.connect_control_lost(move |_| flag.store(true, Ordering::SeqCst));
+        }
+        camera
+            .start_acquisition()
+            .map_err(|e| self.stream_error("starting the acquisition", e))?;
+        Ok(Started {
+            stream,
+            control_lost,
+            size_px: (width.max(0) as u32, height.max(0) as u32),
+        })
+    }
+}
+
 /// An open, configured, streaming camera.
 pub struct Acquisition {
     id: String,
@@ -164,147 +338,26 @@ impl Acquisition {
     /// Opens the camera, applies `settings` (each refused setting is a clear error), queues
     /// the buffers and starts acquiring.
     pub fn open(spec: &CameraSpec, settings: &CameraSettings) -> Result<Acquisition, GenicamError> {
-        let camera = Camera::new(spec.id.as_deref()).map_err(|e| {
-            let found = list_ids();
-            if found.is_empty() || spec.id.is_some() {
-                GenicamError::NotFound {
-                    id: spec.id.clone(),
-                    found: format!(
-                        "{e}; found: {}",
-                        if found.is_empty() {
-                            "none".into()
-                        } else {
-                            found.join(", ")
-                        }
-                    ),
-                }
-            } else {
-                GenicamError::Open {
-                    id: "(first found)".into(),
-                    detail: e.to_string(),
-                }
-            }
-        })?;
-        // Aravis' id (as `dicstream cameras` lists it): the one asked for, or the first found,
-        // which is the one `Camera::new(None)` opens.
-        let id = spec
-            .id
-            .clone()
-            .or_else(|| list_ids().into_iter().next())
-            .unwrap_or_else(|| "(first found)".into());
-        let set = |what: &str, result: Result<(), aravis::glib::Error>| {
-            result.map_err(|e| GenicamError::Setting {
-                id: id.clone(),
-                what: what.to_string(),
-                detail: e.to_string(),
-            })
+        let (camera, id) = connect(spec)?;
+        let setup = Setup {
+            camera: &camera,
+            id: &id,
         };
-
         let _ = camera.stop_acquisition();
-        if let Some(asked) = settings.pixel_format {
-            let offered = offered_formats(&camera);
-            if !offered.iter().any(|f| f == asked.name()) {
-                return Err(GenicamError::PixelFormat {
-                    id,
-                    asked: asked.name().into(),
-                    offered: offered.join(", "),
-                });
-            }
-            set(
-                "--pixel-format",
-                camera.set_pixel_format_from_string(asked.name()),
-            )?;
-        }
-        let current = camera.pixel_format().map_err(|e| GenicamError::Setting {
-            id: id.clone(),
-            what: "reading PixelFormat".into(),
-            detail: e.to_string(),
-        })?;
-        let format =
-            PixelFormat::from_code(current.raw()).ok_or_else(|| GenicamError::PixelFormat {
-                id: id.clone(),
-                asked: format!(
-                    "{} (its current one; pass --pixel-format)",
-                    camera
-                        .pixel_format_as_string()
-                        .map(|s| s.to_string())
-                        .unwrap_or_else(|_| format!("0x{:08X}", current.raw()))
-                ),
-                offered: offered_formats(&camera).join(", "),
-            })?;
-
-        if let Some(roi) = settings.roi {
-            roi.check(&roi_limits(&camera, &id)?)?;
-            set(
-                "--roi",
-                camera.set_region(
-                    roi.x_px as i32,
-                    roi.y_px as i32,
-                    roi.width_px as i32,
-                    roi.height_px as i32,
-                ),
-            )?;
-        }
-        if let Some(exposure_us) = settings.exposure_us {
-            let _ = camera.set_exposure_time_auto(Auto::Off);
-            set("--exposure-us", camera.set_exposure_time(exposure_us))?;
-        }
-        if let Some(gain_db) = settings.gain_db {
-            let _ = camera.set_gain_auto(Auto::Off);
-            set("--gain-db", camera.set_gain(gain_db))?;
-        }
-        set(
-            "AcquisitionMode Continuous",
-            camera.set_acquisition_mode(AcquisitionMode::Continuous),
-        )?;
-        match settings.trigger {
-            Trigger::Free => {
-                set("--trigger free (TriggerMode Off)", camera.clear_triggers())?;
-                if let Some(fps) = settings.fps {
-                    set("--fps", camera.set_frame_rate(fps))?;
-                }
-            }
-            Trigger::Software => set("--trigger software", camera.set_trigger("Software"))?,
-            Trigger::Hardware => set("--trigger hardware (Line1)", camera.set_trigger("Line1"))?,
-        }
-
-        let (_, _, width, height) = camera.region().map_err(|e| GenicamError::Setting {
-            id: id.clone(),
-            what: "reading the region".into(),
-            detail: e.to_string(),
-        })?;
-        let payload = camera.payload().map_err(|e| GenicamError::Setting {
-            id: id.clone(),
-            what: "reading PayloadSize".into(),
-            detail: e.to_string(),
-        })?;
-        let stream = camera.create_stream().map_err(|e| GenicamError::Stream {
-            id: id.clone(),
-            what: "creating the stream",
-            detail: e.to_string(),
-        })?;
-        for _ in 0..QUEUED_BUFFERS {
-            stream.push_buffer(Buffer::new_allocate(payload as usize));
-        }
-        let control_lost = Arc::new(AtomicBool::new(false));
-        if let Some(device) = camera.device() {
-            let flag = Arc::clone(&control_lost);
-            device.connect_control_lost(move |_| flag.store(true, Ordering::SeqCst));
-        }
-        camera
-            .start_acquisition()
-            .map_err(|e| GenicamError::Stream {
-                id: id.clone(),
-                what: "starting the acquisition",
-                detail: e.to_string(),
-            })?;
+        let format = setup.pixel_format(settings.pixel_format)?;
+        setup.apply(settings)?;
+        let Started {
+            stream,
+            control_lost,
+            size_px: (width_px, height_px),
+        } = setup.start()?;
         Ok(Acquisition {
             id,
             camera,
             stream,
             format,
-            width_px: width.max(0) as u32,
-            height_px: height.max(0) as u32,
+            width_px,
+            height_px,
             trigger: settings.trigger,
             control_lost,
         })

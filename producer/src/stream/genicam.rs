@@ -16,7 +16,7 @@
 use std::time::{Duration, Instant};
 
 use super::{Shell, StreamError, StreamEvent, StreamReport, StreamSettings};
-use crate::genicam::device::{Acquisition, GenicamError};
+use crate::genicam::device::{Acquisition, Frame, GenicamError};
 use crate::genicam::{
     convert_into, BufferCounts, CameraSettings, CameraSpec, Link, PixelFormat, Trigger,
 };
@@ -102,152 +102,215 @@ pub fn stream_genicam(
         ..settings.clone()
     };
     let mut shell = Shell::open(instance, dims, &unpaced, &mut on_event)?;
-    let mut report = CameraReport {
-        id: first.id().to_string(),
-        ..CameraReport::default()
+    let mut cam = CameraLoop {
+        spec,
+        camera,
+        dims,
+        format,
+        period: camera.expected_period(),
+        link: Link::new(Instant::now()),
+        next_trigger: Instant::now(),
+        report: CameraReport {
+            id: first.id().to_string(),
+            ..CameraReport::default()
+        },
+        acquisition: Some(first),
     };
-    let period = camera.expected_period();
-    let mut link = Link::new(Instant::now());
-    let mut acquisition = Some(first);
-    let mut next_trigger = Instant::now();
-
     while !shell.done() {
         if wire::signals::requested().is_some() {
             shell.report.interrupted = true;
             break;
         }
-        let Some(acq) = acquisition.as_ref() else {
-            // Lost: wait for the next attempt (in slices, so a signal is seen), then try.
-            let now = Instant::now();
-            let wait = link.until_attempt(now).unwrap_or_default();
-            if !wait.is_zero() {
-                std::thread::sleep(wait.min(POLL));
-                continue;
-            }
-            match Acquisition::open(spec, camera) {
-                Ok(acq) => {
-                    if acq.size_px() != (width_px, height_px) || acq.format() != format {
-                        return Err(StreamError::CameraChanged {
-                            id: acq.id().to_string(),
-                            before: format!("{width_px}x{height_px} {format}"),
-                            now: format!(
-                                "{}x{} {}",
-                                acq.size_px().0,
-                                acq.size_px().1,
-                                acq.format()
-                            ),
-                        });
-                    }
-                    let away = link.reconnected(Instant::now());
-                    on_note(&CameraNote::Reconnected { id: acq.id(), away });
-                    next_trigger = Instant::now();
-                    acquisition = Some(acq);
-                }
-                Err(error) => {
-                    let (attempt, retry_in) = link.attempt_failed(Instant::now());
-                    on_note(&CameraNote::RetryFailed {
-                        attempt,
-                        retry_in,
-                        error: &error,
-                    });
-                }
-            }
+        let Some(acq) = cam.acquisition.take() else {
+            cam.reconnect(&mut on_note)?;
             continue;
         };
-
-        let mut timeout = POLL;
-        let mut lost_reason = None;
-        if camera.trigger == Trigger::Software {
-            let now = Instant::now();
-            if now >= next_trigger {
-                if let Err(e) = acq.software_trigger() {
-                    lost_reason = Some(e.to_string());
-                }
-                let step = period.unwrap_or(POLL);
-                next_trigger += step;
-                if next_trigger < now {
-                    next_trigger = now + step;
-                }
-            }
-            timeout = timeout.min(next_trigger.saturating_duration_since(now));
+        match cam.serve(&acq, &mut shell, &mut on_event, &mut on_note)? {
+            None => cam.acquisition = Some(acq),
+            Some(reason) => cam.lose(acq, &reason, &mut on_note),
         }
-        if lost_reason.is_none() {
-            if let Some(frame) = acq.next_frame(timeout) {
-                let host_receive_ns = wire::monotonic_ns();
-                link.buffer_arrived(Instant::now());
-                let mut publish = report.counts.count(frame.status, frame.shape_ok);
-                if publish {
-                    let index = report.counts.published - 1;
-                    let mut converted = true;
-                    let sent = shell.publish_stamped(
-                        Some(host_receive_ns),
-                        frame.camera_timestamp_ns,
-                        |pixels| {
-                            if convert_into(format, frame.bytes(), width_px, height_px, pixels)
-                                .is_err()
-                            {
-                                converted = false;
-                                return Ok(None);
-                            }
-                            Ok(Some(FrameInfo {
-                                index,
-                                truth: None,
-                                rig_sample_id: None,
-                                sequence_id: 0,
-                            }))
-                        },
-                    )?;
-                    match sent {
-                        Some(header) => {
-                            on_event(StreamEvent::Frame(&header));
-                            on_note(&CameraNote::Frame {
-                                frame_id: header.frame_id,
-                                camera_frame_id: frame.camera_frame_id,
-                                camera_timestamp_ns: frame.camera_timestamp_ns,
-                                host_receive_ns,
-                            });
-                        }
-                        None => {
-                            // Counted as published, found short while copying: move it.
-                            debug_assert!(!converted);
-                            report.counts.published -= 1;
-                            report.counts.wrong_shape += 1;
-                            publish = false;
-                        }
-                    }
-                }
-                if !publish {
-                    on_note(&CameraNote::Skipped {
-                        counts: report.counts,
+    }
+    let camera_report = cam.finish();
+    Ok((shell.finish(), camera_report))
+}
+
+/// The camera side of the loop: the camera asked for and its shape, the link's state, the
+/// open acquisition (none while lost) and the counts.
+struct CameraLoop<'a> {
+    spec: &'a CameraSpec,
+    camera: &'a CameraSettings,
+    /// The stream's frame size, fixed by the first opening.
+    dims: FrameDims,
+    format: PixelFormat,
+    /// The camera's expected frame period, if known.
+    period: Option<Duration>,
+    link: Link,
+    acquisition: Option<Acquisition>,
+    /// When the software trigger fires next.
+    next_trigger: Instant,
+    report: CameraReport,
+}
+
+impl CameraLoop<'_> {
+    /// Lost: waits for the next attempt (in slices, so a signal is seen), then tries to open
+    /// the camera again. A camera back with another shape is an error.
+    fn reconnect(&mut self, on_note: &mut impl FnMut(&CameraNote)) -> Result<(), StreamError> {
+        let now = Instant::now();
+        let wait = self.link.until_attempt(now).unwrap_or_default();
+        if !wait.is_zero() {
+            std::thread::sleep(wait.min(POLL));
+            return Ok(());
+        }
+        match Acquisition::open(self.spec, self.camera) {
+            Ok(acq) => {
+                let (width_px, height_px) = (self.dims.width, self.dims.height);
+                if acq.size_px() != (width_px, height_px) || acq.format() != self.format {
+                    return Err(StreamError::CameraChanged {
+                        id: acq.id().to_string(),
+                        before: format!("{width_px}x{height_px} {}", self.format),
+                        now: format!("{}x{} {}", acq.size_px().0, acq.size_px().1, acq.format()),
                     });
                 }
-                acq.requeue(frame);
+                let away = self.link.reconnected(Instant::now());
+                on_note(&CameraNote::Reconnected { id: acq.id(), away });
+                self.next_trigger = Instant::now();
+                self.acquisition = Some(acq);
             }
-            if acq.control_lost() {
-                lost_reason = Some("the driver lost control of it (no heartbeat reply)".into());
-            } else if link.silent_too_long(Instant::now(), period) {
-                lost_reason = Some(format!(
-                    "no buffer for {} s while it should be sending",
-                    crate::genicam::SILENCE.as_secs()
-                ));
+            Err(error) => {
+                let (attempt, retry_in) = self.link.attempt_failed(Instant::now());
+                on_note(&CameraNote::RetryFailed {
+                    attempt,
+                    retry_in,
+                    error: &error,
+                });
             }
         }
-        if let Some(reason) = lost_reason {
-            link.lost(Instant::now());
-            report.driver_underruns += acq.underruns();
-            on_note(&CameraNote::Lost {
-                id: acq.id(),
-                reason: &reason,
-            });
-            acquisition = None;
+        Ok(())
+    }
+
+    /// One turn with the camera open: triggers if it is time, publishes the buffer that
+    /// arrives within the wait, if any. Some(reason) when the camera is lost.
+    fn serve(
+        &mut self,
+        acq: &Acquisition,
+        shell: &mut Shell,
+        on_event: &mut impl FnMut(StreamEvent),
+        on_note: &mut impl FnMut(&CameraNote),
+    ) -> Result<Option<String>, StreamError> {
+        let (timeout, trigger_failed) = self.trigger(acq);
+        if trigger_failed.is_some() {
+            return Ok(trigger_failed);
         }
+        if let Some(frame) = acq.next_frame(timeout) {
+            let host_receive_ns = wire::monotonic_ns();
+            self.link.buffer_arrived(Instant::now());
+            let published = self.publish(&frame, host_receive_ns, shell, on_event, on_note)?;
+            if !published {
+                on_note(&CameraNote::Skipped {
+                    counts: self.report.counts,
+                });
+            }
+            acq.requeue(frame);
+        }
+        Ok(if acq.control_lost() {
+            Some("the driver lost control of it (no heartbeat reply)".into())
+        } else if self.link.silent_too_long(Instant::now(), self.period) {
+            Some(format!(
+                "no buffer for {} s while it should be sending",
+                crate::genicam::SILENCE.as_secs()
+            ))
+        } else {
+            None
+        })
     }
-    if let Some(acq) = acquisition.as_ref() {
-        report.driver_underruns += acq.underruns();
+
+    /// With the software trigger, fires it when due; the longest wait for a buffer, and the
+    /// reason the camera is lost if the trigger failed.
+    fn trigger(&mut self, acq: &Acquisition) -> (Duration, Option<String>) {
+        if self.camera.trigger != Trigger::Software {
+            return (POLL, None);
+        }
+        let mut lost_reason = None;
+        let now = Instant::now();
+        if now >= self.next_trigger {
+            if let Err(e) = acq.software_trigger() {
+                lost_reason = Some(e.to_string());
+            }
+            let step = self.period.unwrap_or(POLL);
+            self.next_trigger += step;
+            if self.next_trigger < now {
+                self.next_trigger = now + step;
+            }
+        }
+        let timeout = POLL.min(self.next_trigger.saturating_duration_since(now));
+        (timeout, lost_reason)
     }
-    report.ended_lost = acquisition.is_none();
-    report.losses = link.losses;
-    report.reconnections = link.reconnections;
-    drop(acquisition);
-    Ok((shell.finish(), report))
+
+    /// Counts `frame` and, if complete and of the stream's shape, converts it into a loaned
+    /// slice and sends it; true when it was published.
+    fn publish(
+        &mut self,
+        frame: &Frame,
+        host_receive_ns: u64,
+        shell: &mut Shell,
+        on_event: &mut impl FnMut(StreamEvent),
+        on_note: &mut impl FnMut(&CameraNote),
+    ) -> Result<bool, StreamError> {
+        if !self.report.counts.count(frame.status, frame.shape_ok) {
+            return Ok(false);
+        }
+        let index = self.report.counts.published - 1;
+        let (format, dims) = (self.format, self.dims);
+        let mut converted = true;
+        let sent =
+            shell.publish_stamped(Some(host_receive_ns), frame.camera_timestamp_ns, |pixels| {
+                if convert_into(format, frame.bytes(), dims.width, dims.height, pixels).is_err() {
+                    converted = false;
+                    return Ok(None);
+                }
+                Ok(Some(FrameInfo {
+                    index,
+                    truth: None,
+                    rig_sample_id: None,
+                    sequence_id: 0,
+                }))
+            })?;
+        let Some(header) = sent else {
+            // Counted as published, found short while copying: move it.
+            debug_assert!(!converted);
+            self.report.counts.published -= 1;
+            self.report.counts.wrong_shape += 1;
+            return Ok(false);
+        };
+        on_event(StreamEvent::Frame(&header));
+        on_note(&CameraNote::Frame {
+            frame_id: header.frame_id,
+            camera_frame_id: frame.camera_frame_id,
+            camera_timestamp_ns: frame.camera_timestamp_ns,
+            host_receive_ns,
+        });
+        Ok(true)
+    }
+
+    /// The camera is lost for `reason`: its acquisition is closed, reconnection follows.
+    fn lose(&mut self, acq: Acquisition, reason: &str, on_note: &mut impl FnMut(&CameraNote)) {
+        self.link.lost(Instant::now());
+        self.report.driver_underruns += acq.underruns();
+        on_note(&CameraNote::Lost {
+            id: acq.id(),
+            reason,
+        });
+        drop(acq);
+    }
+
+    /// The report; the acquisition is closed on return.
+    fn finish(mut self) -> CameraReport {
+        if let Some(acq) = &self.acquisition {
+            self.report.driver_underruns += acq.underruns();
+        }
+        self.report.ended_lost = self.acquisition.is_none();
+        self.report.losses = self.link.losses;
+        self.report.reconnections = self.link.reconnections;
+        self.report
+    }
 }

@@ -7,10 +7,12 @@
 use super::clock::{rig_state, MachineClock};
 use super::counts_file::CountsFile;
 use super::report::MalformedReport;
-use super::{CsvColumns, CsvError, FileTail, FollowCounters, Follower, LineEvent, TailRead};
+use super::{CsvColumns, CsvError, FileTail, FollowCounters, Follower, LineEvent, Row, TailRead};
 use crate::process::StatePort;
 use std::path::PathBuf;
 use std::time::{Duration, Instant, SystemTime};
+use wire::pubsub::ValuePublisher;
+use wire::RigState;
 
 #[derive(Clone, Debug)]
 pub struct FollowOptions {
@@ -78,104 +80,37 @@ pub struct FollowSummary {
 
 /// Follows until a termination signal or the idle timeout.
 pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
-    let path = options.path.clone();
-    let mut follower =
-        Follower::new(options.columns.clone()).map_err(|e| FollowError::columns(&path, e))?;
-    let mut tail = FileTail::new(&path);
+    let mut follow = CsvFollow::new(&options)?;
     let StatePort {
         instance,
         _owner,
         node: _node,
         publisher,
     } = StatePort::open(&options.instance)?;
-    let mut clock = MachineClock::new(options.offset_s);
     let mut summary = FollowSummary::default();
-    let mut report = MalformedReport::new(path.display().to_string());
     let mut counts = options.counts_json.as_deref().map(CountsFile::new);
-    let mut rows_published = 0;
-    let mut waiting_reported = false;
     let mut last_row_at = Instant::now();
     let mut ready = false;
     loop {
-        let read = tail.poll().map_err(|reason| FollowError::Read {
-            path: path.display().to_string(),
-            reason,
-        })?;
-        let mut batch = Vec::new();
-        let mut modified = None;
-        match read {
-            TailRead::Missing => {
-                if !waiting_reported {
-                    eprintln!("rig: waiting for {} to exist", path.display());
-                    waiting_reported = true;
-                }
-            }
-            TailRead::StartedOver { why } => {
-                eprintln!(
-                    "rig: {} was {why}: reading it again from its header (rows published so \
-                     far: {rows_published})",
-                    path.display(),
-                );
-                follower.start_over();
-            }
-            TailRead::Appended { bytes, modified: m } => {
-                modified = Some(m);
-                for event in follower
-                    .feed(&bytes)
-                    .map_err(|e| FollowError::columns(&path, e))?
-                {
-                    match event {
-                        LineEvent::Header => eprintln!(
-                            "rig: following {} (columns {})",
-                            path.display(),
-                            follower.layout().map_or(String::new(), |l| l.describe())
-                        ),
-                        LineEvent::Row(row) => batch.push(row),
-                        LineEvent::Malformed { line_no, text, why } => {
-                            if let Some(line) =
-                                report.malformed(line_no, &text, &why, Instant::now())
-                            {
-                                eprintln!("{line}");
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        if let Some(line) = report.tick(Instant::now()) {
+        let (batch, modified) = follow.read()?;
+        if let Some(line) = follow.report.tick(Instant::now()) {
             eprintln!("{line}");
         }
         if !ready {
             // Ready once the header, if the file has one already, has been checked, and the
             // counts file is there.
             if let Some(counts) = &mut counts {
-                counts.update(follower.counters, Instant::now(), false)?;
+                counts.update(follow.follower.counters, Instant::now(), false)?;
             }
             eprintln!("rig: ready (instance {})", instance.name());
             ready = true;
         }
-        if let (Some(last), Some(modified)) = (batch.last(), modified) {
-            let age_ns = SystemTime::now()
-                .duration_since(modified)
-                .map_or(0, |d| d.as_nanos() as u64);
-            clock.anchor(last.t_s, wire::monotonic_ns(), age_ns);
-        }
-        for row in &batch {
-            let host_ns = clock.host_ns(row.t_s).expect("anchored above");
-            publisher.publish(rig_state(
-                row,
-                rows_published,
-                host_ns,
-                options.offset_s,
-                options.sections_mm2,
-            ))?;
-            rows_published += 1;
-        }
+        follow.publish(&batch, modified, &publisher)?;
         if !batch.is_empty() {
             last_row_at = Instant::now();
         }
         if let Some(counts) = &mut counts {
-            counts.update(follower.counters, Instant::now(), false)?;
+            counts.update(follow.follower.counters, Instant::now(), false)?;
         }
         if wire::signals::requested().is_some() {
             summary.stopped_by_signal = true;
@@ -183,25 +118,146 @@ pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
         }
         if options
             .idle_timeout
-            .is_some_and(|t| rows_published > 0 && last_row_at.elapsed() > t)
+            .is_some_and(|t| follow.rows_published > 0 && last_row_at.elapsed() > t)
         {
             break;
         }
         std::thread::sleep(options.poll);
     }
-    if let Some(line) = report.finish() {
-        eprintln!("{line}");
-    }
-    let unfinished = follower.unfinished_line_bytes();
-    if unfinished > 0 {
-        eprintln!(
-            "rig: {}: a last line of {unfinished} bytes without its newline was not read",
-            path.display()
-        );
-    }
+    follow.finish();
     if let Some(counts) = &mut counts {
-        counts.update(follower.counters, Instant::now(), true)?;
+        counts.update(follow.follower.counters, Instant::now(), true)?;
     }
-    summary.counters = follower.counters;
+    summary.counters = follow.follower.counters;
     Ok(summary)
+}
+
+/// The file followed: its tail, the rows it gave, the machine's clock and the malformed-line
+/// report.
+struct CsvFollow<'a> {
+    options: &'a FollowOptions,
+    follower: Follower,
+    tail: FileTail,
+    clock: MachineClock,
+    report: MalformedReport,
+    rows_published: u64,
+    waiting_reported: bool,
+}
+
+impl<'a> CsvFollow<'a> {
+    /// A columns error is refused here, before anything is opened.
+    fn new(options: &'a FollowOptions) -> Result<CsvFollow<'a>, FollowError> {
+        let path = &options.path;
+        Ok(CsvFollow {
+            options,
+            follower: Follower::new(options.columns.clone())
+                .map_err(|e| FollowError::columns(path, e))?,
+            tail: FileTail::new(path),
+            clock: MachineClock::new(options.offset_s),
+            report: MalformedReport::new(path.display().to_string()),
+            rows_published: 0,
+            waiting_reported: false,
+        })
+    }
+
+    /// One look at the file: the whole rows appended since the last, and the file's
+    /// modification time when something was appended.
+    fn read(&mut self) -> Result<(Vec<Row>, Option<SystemTime>), FollowError> {
+        let path = &self.options.path;
+        let read = self.tail.poll().map_err(|reason| FollowError::Read {
+            path: path.display().to_string(),
+            reason,
+        })?;
+        match read {
+            TailRead::Missing => {
+                if !self.waiting_reported {
+                    eprintln!("rig: waiting for {} to exist", path.display());
+                    self.waiting_reported = true;
+                }
+                Ok((Vec::new(), None))
+            }
+            TailRead::StartedOver { why } => {
+                eprintln!(
+                    "rig: {} was {why}: reading it again from its header (rows published so \
+                     far: {})",
+                    path.display(),
+                    self.rows_published
+                );
+                self.follower.start_over();
+                Ok((Vec::new(), None))
+            }
+            TailRead::Appended { bytes, modified } => Ok((self.feed(&bytes)?, Some(modified))),
+        }
+    }
+
+    /// The rows of `bytes`; the header and the malformed lines are told on stderr.
+    fn feed(&mut self, bytes: &[u8]) -> Result<Vec<Row>, FollowError> {
+        let path = &self.options.path;
+        let mut batch = Vec::new();
+        for event in self
+            .follower
+            .feed(bytes)
+            .map_err(|e| FollowError::columns(path, e))?
+        {
+            match event {
+                LineEvent::Header => eprintln!(
+                    "rig: following {} (columns {})",
+                    path.display(),
+                    self.follower
+                        .layout()
+                        .map_or(String::new(), |l| l.describe())
+                ),
+                LineEvent::Row(row) => batch.push(row),
+                LineEvent::Malformed { line_no, text, why } => {
+                    if let Some(line) = self.report.malformed(line_no, &text, &why, Instant::now())
+                    {
+                        eprintln!("{line}");
+                    }
+                }
+            }
+        }
+        Ok(batch)
+    }
+
+    /// Publishes `batch` on `rig/state`, its host times from the machine's clock anchored on
+    /// its last row (written at `modified`).
+    fn publish(
+        &mut self,
+        batch: &[Row],
+        modified: Option<SystemTime>,
+        publisher: &ValuePublisher<RigState>,
+    ) -> Result<(), FollowError> {
+        if let (Some(last), Some(modified)) = (batch.last(), modified) {
+            let age_ns = SystemTime::now()
+                .duration_since(modified)
+                .map_or(0, |d| d.as_nanos() as u64);
+            self.clock.anchor(last.t_s, wire::monotonic_ns(), age_ns);
+        }
+        for row in batch {
+            let host_ns = self.clock.host_ns(row.t_s).expect("anchored above");
+            publisher.publish(rig_state(
+                row,
+                self.rows_published,
+                host_ns,
+                self.options.offset_s,
+                self.options.sections_mm2,
+            ))?;
+            self.rows_published += 1;
+        }
+        Ok(())
+    }
+
+    /// The last malformed-line report, and a last line left without its newline.
+    fn finish(&mut self) {
+        if let Some(line) = self.report.finish() {
+            eprintln!("{line}");
+        }
+        let unfinished = self.follower.unfinished_line_bytes();
+        if unfinished > 0 {
+            eprintln!(
+                "rig: {}: a last line of {unfinished} bytes without its newline was not read",
+                self.options.path.display()
+            );
+        }
+    }
 }
