@@ -38,6 +38,8 @@ enum Command {
     Rig(Box<cmd::rig::RigArgs>),
     /// The whole simulated bench: rig, camera, correlator, identifier; live status; results.
     Run(cmd::run::RunArgs),
+    /// Solve the specimen as a finite-element structure for a path of grip stretches (offline).
+    Specimen(cmd::specimen::SpecimenArgs),
     /// Write simulated speckle images with their exact ground truth (truth.csv).
     Synth(cmd::synth::SynthArgs),
     /// Watch a service (frames, fields, rig/state, identification): rate, drops, latency.
@@ -83,6 +85,7 @@ fn main() -> std::process::ExitCode {
         Command::Producer(args) => ok(cmd::producer::run(*args)),
         Command::Rig(args) => ok(cmd::rig::run(*args)),
         Command::Run(args) => cmd::run::run(args),
+        Command::Specimen(args) => ok(cmd::specimen::run(args)),
         Command::Synth(args) => ok(cmd::synth::run(args)),
         Command::Tap(args) => ok(cmd::tap::run(args)),
     };

@@ -75,28 +75,17 @@ impl<'a, L: SheetLaw + ?Sized> Membrane<'a, L> {
         })
     }
 
-    fn deformation_gradient(&self, element: usize, point: &GaussPoint, u: &[f64]) -> [[f64; 2]; 2] {
-        let mut f = [[1.0, 0.0], [0.0, 1.0]];
-        for (&node, g) in self.mesh.elements[element]
-            .iter()
-            .zip(point.gradients_per_mm.iter())
-        {
-            for i in 0..2 {
-                for j in 0..2 {
-                    f[i][j] += u[2 * node + i] * g[j];
-                }
-            }
-        }
-        f
-    }
-
     fn point_response(
         &self,
         element: usize,
         index: usize,
         u: &[f64],
     ) -> Result<([[f64; 2]; 2], constitutive::PointResponse), FailureAt> {
-        let f = self.deformation_gradient(element, &self.points[element][index], u);
+        let f = deformation_gradient(
+            &self.mesh.elements[element],
+            &self.points[element][index].gradients_per_mm,
+            u,
+        );
         let c = [
             f[0][0] * f[0][0] + f[1][0] * f[1][0],
             f[0][1] * f[0][1] + f[1][1] * f[1][1],
@@ -186,6 +175,24 @@ impl<'a, L: SheetLaw + ?Sized> Membrane<'a, L> {
         }
         Ok(out)
     }
+}
+
+/// The in-plane F[i][J] = δiJ + Σ u_a,i ∂N_a/∂X_J of an element with nodes `element_nodes`
+/// and shape-function gradients `gradients_per_mm` at a point, under displacement `u` (mm).
+pub(crate) fn deformation_gradient(
+    element_nodes: &[usize; NODES],
+    gradients_per_mm: &[[f64; 2]; NODES],
+    u: &[f64],
+) -> [[f64; 2]; 2] {
+    let mut f = [[1.0, 0.0], [0.0, 1.0]];
+    for (&node, g) in element_nodes.iter().zip(gradients_per_mm.iter()) {
+        for i in 0..2 {
+            for j in 0..2 {
+                f[i][j] += u[2 * node + i] * g[j];
+            }
+        }
+    }
+    f
 }
 
 /// σ = F S Fᵀ (Voigt in and out).

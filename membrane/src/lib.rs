@@ -7,7 +7,8 @@
 //! [`InvariantDerivatives`]) or a law by its principal stresses ([`PrincipalStresses`]: Ogden). A sheet carries no compression: tension-field relaxation
 //! ([`Wrinkling`]). The specimens of the paper are meshed in code ([`specimens`]), clamped by
 //! grips moving as rigid bodies ([`Clamp`]), and solved by Newton with line search and load
-//! stepping ([`solve`]); a failure names its state and reason ([`SolveError`]).
+//! stepping ([`solve`]); a failure names its state and reason ([`SolveError`]). A path of grip
+//! stretches ([`solve_path`]) gives nodal fields ([`nodal`]) written as VTK and CSV ([`output`]).
 //! Units: mm, N, MPa.
 
 #![forbid(unsafe_code)]
@@ -18,6 +19,9 @@ pub mod constitutive;
 pub mod error;
 pub mod law;
 pub mod mesh;
+pub mod nodal;
+pub mod output;
+pub mod path;
 pub mod principal;
 pub mod solver;
 pub mod specimens;
@@ -30,6 +34,8 @@ pub use constitutive::{MembraneState, Wrinkling};
 pub use error::{GeometryError, SolveError};
 pub use law::{InvariantDerivatives, MembraneLaw, SheetLaw};
 pub use mesh::Mesh;
+pub use nodal::{NodalField, NodeFailure};
+pub use path::{solve_path, Path, PathReport, PathState, PathStop, StateFigures};
 pub use principal::PrincipalStresses;
 pub use solver::{solve, solve_until_stopped, Equilibrium, NewtonSettings, Outcome, StepRecord};
-pub use specimens::Specimen;
+pub use specimens::{GripStretch, Specimen, SpecimenChoice, SpecimenShape};

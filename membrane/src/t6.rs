@@ -54,6 +54,50 @@ pub struct GaussPoint {
     pub area_mm2: f64,
 }
 
+/// Natural coordinates (ξ, η) of the six nodes, in node order.
+pub const NODE_COORDINATES: [(f64, f64); NODES] = [
+    (0.0, 0.0),
+    (1.0, 0.0),
+    (0.0, 1.0),
+    (0.5, 0.0),
+    (0.5, 0.5),
+    (0.0, 0.5),
+];
+
+/// ∂N/∂X (mm⁻¹) at (ξ, η) of an element with reference node positions `nodes_mm`, and the
+/// Jacobian determinant (mm²); `Err(det)` where it is not positive.
+pub fn gradients_at(
+    nodes_mm: &[[f64; 2]; NODES],
+    xi: f64,
+    eta: f64,
+) -> Result<([[f64; 2]; NODES], f64), f64> {
+    let dn = shape_gradients(xi, eta);
+    let mut jac = [[0.0; 2]; 2]; // jac[i][k] = ∂X_i/∂ξ_k
+    for (x, d) in nodes_mm.iter().zip(dn.iter()) {
+        for i in 0..2 {
+            for k in 0..2 {
+                jac[i][k] += x[i] * d[k];
+            }
+        }
+    }
+    let det = jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0];
+    if det.is_nan() || det <= 0.0 {
+        return Err(det);
+    }
+    // ∂N/∂X = J⁻ᵀ ∂N/∂ξ
+    let inv = [
+        [jac[1][1] / det, -jac[0][1] / det],
+        [-jac[1][0] / det, jac[0][0] / det],
+    ];
+    let gradients = dn.map(|d| {
+        [
+            inv[0][0] * d[0] + inv[1][0] * d[1],
+            inv[0][1] * d[0] + inv[1][1] * d[1],
+        ]
+    });
+    Ok((gradients, det))
+}
+
 /// The Gauss points of an element with reference node positions `nodes_mm`; `Err(det)` with the
 /// Jacobian determinant (mm²) of the first point where it is not positive.
 pub fn gauss_points(nodes_mm: &[[f64; 2]; NODES]) -> Result<[GaussPoint; 6], f64> {
@@ -62,30 +106,8 @@ pub fn gauss_points(nodes_mm: &[[f64; 2]; NODES]) -> Result<[GaussPoint; 6], f64
         area_mm2: 0.0,
     }; 6];
     for (point, &(xi, eta, weight)) in out.iter_mut().zip(GAUSS_POINTS.iter()) {
-        let dn = shape_gradients(xi, eta);
-        let mut jac = [[0.0; 2]; 2]; // jac[i][k] = ∂X_i/∂ξ_k
-        for (x, d) in nodes_mm.iter().zip(dn.iter()) {
-            for i in 0..2 {
-                for k in 0..2 {
-                    jac[i][k] += x[i] * d[k];
-                }
-            }
-        }
-        let det = jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0];
-        if det.is_nan() || det <= 0.0 {
-            return Err(det);
-        }
-        // ∂N/∂X = J⁻ᵀ ∂N/∂ξ
-        let inv = [
-            [jac[1][1] / det, -jac[0][1] / det],
-            [-jac[1][0] / det, jac[0][0] / det],
-        ];
-        for (g, d) in point.gradients_per_mm.iter_mut().zip(dn.iter()) {
-            *g = [
-                inv[0][0] * d[0] + inv[1][0] * d[1],
-                inv[0][1] * d[0] + inv[1][1] * d[1],
-            ];
-        }
+        let (gradients, det) = gradients_at(nodes_mm, xi, eta)?;
+        point.gradients_per_mm = gradients;
         point.area_mm2 = det * weight;
     }
     Ok(out)

@@ -17,5 +17,6 @@ pub mod rig;
 pub mod rig_follow_csv;
 pub mod run;
 pub mod sim_args;
+pub mod specimen;
 pub mod synth;
 pub mod tap;

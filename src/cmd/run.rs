@@ -43,15 +43,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
         print!("{}", RunConfig::commented_defaults());
         return Ok(std::process::ExitCode::SUCCESS);
     }
-    let config = match &args.config {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("--config {}", path.display()))?;
-            RunConfig::from_toml(&text, &path.display().to_string())?
-        }
-        None => RunConfig::default(),
-    };
-    let mut config = config;
+    let mut config = RunConfig::read(args.config.as_deref())?;
     config.run.vtk |= args.vtk;
     if let Some(address) = args.dashboard {
         config.run.dashboard = address;

@@ -246,6 +246,9 @@ pub struct SpecimenSection {
     pub law_f: Vec<f64>,
     /// ln g(I2) = Σ b_i (I2 − 3)^i (eq. 25), g in MPa.
     pub law_g: Vec<f64>,
+    /// The specimen as a structure (`[specimen.geometry]`): its shape and the geometry of each
+    /// shape, meshed by `membrane` (`dicstream specimen` solves it).
+    pub geometry: membrane::SpecimenChoice,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -343,6 +346,7 @@ impl Default for SpecimenSection {
         SpecimenSection {
             law_f: law.f.coefficients().to_vec(),
             law_g: law.g.coefficients().to_vec(),
+            geometry: membrane::SpecimenChoice::default(),
         }
     }
 }
@@ -362,6 +366,17 @@ impl RunConfig {
     pub fn from_toml(text: &str, source: &str) -> anyhow::Result<RunConfig> {
         use anyhow::Context as _;
         toml::from_str(text).with_context(|| source.to_string())
+    }
+
+    /// The configuration of `--config FILE`, or the defaults without one.
+    pub fn read(path: Option<&std::path::Path>) -> anyhow::Result<RunConfig> {
+        use anyhow::Context as _;
+        let Some(path) = path else {
+            return Ok(RunConfig::default());
+        };
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("--config {}", path.display()))?;
+        RunConfig::from_toml(&text, &path.display().to_string())
     }
 
     pub fn to_toml(&self) -> String {

@@ -13,7 +13,8 @@ use crate::error::GeometryError;
 use crate::mesh::MeshBuilder;
 use std::f64::consts::{FRAC_1_SQRT_2, PI};
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct CruciformGeometry {
     /// Width of each arm and side of the central square.
     pub arm_width_mm: f64,

@@ -3,8 +3,11 @@
 //! and optional slits ([`cruciform`]). Each names its grips: the nodes a grip holds, its centre
 //! and the axis along which it pulls.
 
+mod choice;
 pub mod cruciform;
 pub mod strip;
+
+pub use choice::{GripStretch, GripStretchError, SpecimenChoice, SpecimenShape};
 
 use crate::boundary::{Clamp, Held, RigidMotion};
 use crate::error::GeometryError;

@@ -6,7 +6,8 @@ use super::{cells, check_size, positive, tolerance_mm, Grip, Specimen};
 use crate::error::GeometryError;
 use crate::mesh::MeshBuilder;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StripGeometry {
     /// Free length between the clamps (along x, the pull).
     pub length_mm: f64,
