@@ -238,22 +238,23 @@ impl KeypointMatcher {
             return KeypointSet::empty();
         };
         resample(&mut self.resampled, image, rect, &frame, self.threads);
+        let resampled = Raster {
+            pixels: &self.resampled,
+            width_px: frame.w,
+            height_px: frame.h,
+        };
         gaussian_blur(
-            &self.resampled,
+            resampled,
+            DOG_SIGMA_1,
             &mut self.blur1,
             &mut self.tmp,
-            frame.w,
-            frame.h,
-            DOG_SIGMA_1,
             self.threads,
         );
         gaussian_blur(
-            &self.resampled,
+            resampled,
+            DOG_SIGMA_2,
             &mut self.blur2,
             &mut self.tmp,
-            frame.w,
-            frame.h,
-            DOG_SIGMA_2,
             self.threads,
         );
         let cands = self.find_blobs(&frame, rect);

@@ -110,16 +110,25 @@ pub(super) fn resample(
     });
 }
 
-/// Separable Gaussian blur with clamped borders.
+/// A row-major single-channel image, borrowed with its size.
+#[derive(Clone, Copy)]
+pub(super) struct Raster<'a> {
+    pub pixels: &'a [f32],
+    pub width_px: usize,
+    pub height_px: usize,
+}
+
+/// Separable Gaussian blur of `src` (standard deviation `sigma` px) into `dst`, with clamped
+/// borders; `tmp` holds the horizontal pass.
 pub(super) fn gaussian_blur(
-    src: &[f32],
+    src: Raster<'_>,
+    sigma: f64,
     dst: &mut Vec<f32>,
     tmp: &mut Vec<f32>,
-    w: usize,
-    h: usize,
-    sigma: f64,
     threads: usize,
 ) {
+    let (w, h) = (src.width_px, src.height_px);
+    let src = src.pixels;
     let r = (3.0 * sigma).ceil() as usize;
     let mut k: Vec<f32> = (0..=2 * r)
         .map(|i| {
