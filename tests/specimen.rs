@@ -33,8 +33,11 @@ fn coarse_config(run: &Run) -> std::path::PathBuf {
     config
 }
 
-/// The CSV's rows as maps from column name to cell.
-fn rows(csv: &Path) -> Vec<std::collections::HashMap<String, String>> {
+/// A CSV row: column name to cell.
+type Row = std::collections::HashMap<String, String>;
+
+/// The CSV's rows.
+fn rows(csv: &Path) -> Vec<Row> {
     let text = std::fs::read_to_string(csv).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -49,28 +52,39 @@ fn rows(csv: &Path) -> Vec<std::collections::HashMap<String, String>> {
         .collect()
 }
 
-fn number(row: &std::collections::HashMap<String, String>, key: &str) -> f64 {
+fn number(row: &Row, key: &str) -> f64 {
     row[key].parse().unwrap()
+}
+
+/// The node nearest the specimen's centre (its reference position).
+fn nearest_centre(nodes: &[Row]) -> &Row {
+    let radius = |n: &Row| number(n, "x_mm").hypot(number(n, "y_mm"));
+    nodes
+        .iter()
+        .min_by(|a, b| radius(a).total_cmp(&radius(b)))
+        .unwrap()
+}
+
+/// `dicstream specimen --config <coarse_config> ARGS --out <a fresh folder>`, which must
+/// succeed: the test's bench (kept alive for its folder), the folder and the output.
+fn solved(test: &str, args: &[&str]) -> (Run, std::path::PathBuf, Output) {
+    let run = Run::new(test, env!("CARGO_BIN_EXE_dicstream"));
+    let config = coarse_config(&run);
+    let out = run.dir.join("out");
+    let mut all = vec!["specimen", "--config", text(&config)];
+    all.extend_from_slice(args);
+    all.extend(["--out", text(&out)]);
+    let o = dicstream(&all);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    (run, out, o)
 }
 
 #[test]
 fn a_cruciform_path_writes_balanced_symmetric_states() {
-    let run = Run::new("specimen_cruciform", env!("CARGO_BIN_EXE_dicstream"));
-    let config = coarse_config(&run);
-    let out = run.dir.join("out");
-    let o = dicstream(&[
-        "specimen",
-        "--config",
-        text(&config),
-        "--stretch",
-        "1.4",
-        "--states",
-        "2",
-        "--out",
-        text(&out),
-        "--json",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_run, out, o) = solved(
+        "specimen_cruciform",
+        &["--stretch", "1.4", "--states", "2", "--json"],
+    );
     // --json: the summary alone on stdout, the same as summary.json.
     let printed: Value = serde_json::from_slice(&o.stdout).expect("stdout is JSON alone");
     let summary: Value =
@@ -119,15 +133,7 @@ fn a_cruciform_path_writes_balanced_symmetric_states() {
     // equibiaxial.
     let nodes = rows(&out.join("state_002.csv"));
     assert_eq!(nodes.len() as u64, summary["nodes"].as_u64().unwrap());
-    let centre = nodes
-        .iter()
-        .min_by(|a, b| {
-            let r = |n: &std::collections::HashMap<String, String>| {
-                number(n, "x_mm").hypot(number(n, "y_mm"))
-            };
-            r(a).total_cmp(&r(b))
-        })
-        .unwrap();
+    let centre = nearest_centre(&nodes);
     assert_eq!(number(centre, "x_mm").hypot(number(centre, "y_mm")), 0.0);
     let (l1, l2) = (number(centre, "stretch_1"), number(centre, "stretch_2"));
     assert!(
@@ -141,21 +147,10 @@ fn a_cruciform_path_writes_balanced_symmetric_states() {
 
 #[test]
 fn a_strip_far_from_its_clamps_carries_the_analytic_uniaxial_stress() {
-    let run = Run::new("specimen_strip", env!("CARGO_BIN_EXE_dicstream"));
-    let config = coarse_config(&run);
-    let out = run.dir.join("out");
-    let o = dicstream(&[
-        "specimen",
-        "--config",
-        text(&config),
-        "--shape",
-        "uniaxial_strip",
-        "--stretch",
-        "2",
-        "--out",
-        text(&out),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_run, out, o) = solved(
+        "specimen_strip",
+        &["--shape", "uniaxial_strip", "--stretch", "2"],
+    );
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
         stdout.contains("state 1: grip stretch x 2.0000 y 1.0000"),
@@ -164,13 +159,7 @@ fn a_strip_far_from_its_clamps_carries_the_analytic_uniaxial_stress() {
     let nodes = rows(&out.join("state_001.csv"));
     let law = material::InvariantLaw::smactane();
     // The node nearest the centre, 50 mm (5 widths) from either clamp.
-    let centre = nodes
-        .iter()
-        .min_by(|a, b| {
-            (number(a, "x_mm").hypot(number(a, "y_mm")))
-                .total_cmp(&number(b, "x_mm").hypot(number(b, "y_mm")))
-        })
-        .unwrap();
+    let centre = nearest_centre(&nodes);
     let lambda = number(centre, "stretch_1");
     let expected = law.uniaxial_cauchy_stress_mpa(lambda);
     let measured = number(centre, "cauchy_xx_mpa");
@@ -185,75 +174,62 @@ fn a_strip_far_from_its_clamps_carries_the_analytic_uniaxial_stress() {
     assert!(number(at_clamp, "cauchy_yy_mpa") > 0.05 * expected);
 }
 
+/// Runs `dicstream ARGS`, which must fail with `expected` in its error.
+fn refused(args: &[&str], expected: &str) {
+    let o = dicstream(args);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{args:?} succeeded");
+    assert!(stderr.contains(expected), "{args:?}: {stderr}");
+}
+
 #[test]
 fn what_cannot_be_solved_is_refused_naming_why() {
     let run = Run::new("specimen_refusals", env!("CARGO_BIN_EXE_dicstream"));
     let config = coarse_config(&run);
-    let err = |o: &Output| String::from_utf8_lossy(&o.stderr).into_owned();
-
-    let o = dicstream(&[
-        "specimen",
-        "--config",
-        text(&config),
-        "--shape",
-        "uniaxial_strip",
-        "--stretch-y",
-        "1.2",
-        "--out",
-        text(&run.dir.join("a")),
-    ]);
-    assert!(!o.status.success());
-    assert!(err(&o).contains("no grip along y"), "{}", err(&o));
+    let out = |label: &str| run.dir.join(label);
+    let (strip, out_a) = ("uniaxial_strip", out("a"));
+    refused(
+        &[
+            "specimen",
+            "--config",
+            text(&config),
+            "--shape",
+            strip,
+            "--stretch-y",
+            "1.2",
+            "--out",
+            text(&out_a),
+        ],
+        "no grip along y",
+    );
 
     let busy = run.temp_dir("busy");
     std::fs::write(busy.join("keep.txt"), "mine").unwrap();
-    let o = dicstream(&["specimen", "--config", text(&config), "--out", text(&busy)]);
-    assert!(!o.status.success());
-    assert!(
-        err(&o).contains("is not empty (it holds keep.txt)"),
-        "{}",
-        err(&o)
+    refused(
+        &["specimen", "--config", text(&config), "--out", text(&busy)],
+        "is not empty (it holds keep.txt)",
     );
     assert_eq!(
         std::fs::read_to_string(busy.join("keep.txt")).unwrap(),
         "mine"
     );
 
-    let bad = run.dir.join("bad.toml");
-    std::fs::write(
-        &bad,
-        "[specimen.geometry.cruciform]\narm_width_mm = 20.0\nfillet_radius_mm = -5.0\n",
-    )
-    .unwrap();
-    let o = dicstream(&[
-        "specimen",
-        "--config",
-        text(&bad),
-        "--out",
-        text(&run.dir.join("b")),
-    ]);
-    assert!(!o.status.success());
-    assert!(
-        err(&o).contains("[specimen.geometry] cruciform refused"),
-        "{}",
-        err(&o)
-    );
-
-    let typo = run.dir.join("typo.toml");
-    std::fs::write(
-        &typo,
-        "[specimen.geometry.cruciform]\narm_widht_mm = 20.0\n",
-    )
-    .unwrap();
-    let o = dicstream(&[
-        "specimen",
-        "--config",
-        text(&typo),
-        "--out",
-        text(&run.dir.join("c")),
-    ]);
-    assert!(!o.status.success());
-    assert!(err(&o).contains("arm_widht_mm"), "{}", err(&o));
+    for (label, table, expected) in [
+        (
+            "bad",
+            "arm_width_mm = 20.0\nfillet_radius_mm = -5.0\n",
+            "[specimen.geometry] cruciform refused",
+        ),
+        ("typo", "arm_widht_mm = 20.0\n", "arm_widht_mm"),
+    ] {
+        let file = run.dir.join(format!("{label}.toml"));
+        std::fs::write(&file, format!("[specimen.geometry.cruciform]\n{table}")).unwrap();
+        let folder = out(label);
+        refused(
+            &["specimen", "--config", text(&file), "--out", text(&folder)],
+            expected,
+        );
+    }
 }
 
 /// A law that softens (ln f falling with I1: not stable in Drucker's sense at large strain)
