@@ -86,25 +86,13 @@ impl<'a, L: SheetLaw + ?Sized> Membrane<'a, L> {
             &self.points[element][index].gradients_per_mm,
             u,
         );
-        let c = [
-            f[0][0] * f[0][0] + f[1][0] * f[1][0],
-            f[0][1] * f[0][1] + f[1][1] * f[1][1],
-            f[0][0] * f[0][1] + f[1][0] * f[1][1],
-        ];
-        let det_f = f[0][0] * f[1][1] - f[0][1] * f[1][0];
-        let failure = |failure| FailureAt {
-            element,
-            point: index,
-            failure,
-        };
-        if det_f.is_nan() || det_f <= 0.0 {
-            return Err(failure(PointFailure::Inverted {
-                det_c: det_f * det_f.abs(),
-            }));
-        }
-        constitutive::response(self.law, &c, &self.wrinkling)
+        response_to(self.law, &self.wrinkling, &f)
             .map(|r| (f, r))
-            .map_err(failure)
+            .map_err(|failure| FailureAt {
+                element,
+                point: index,
+                failure,
+            })
     }
 
     /// Internal forces at displacement `u` (mm, two per node), and the element tangents when
@@ -193,6 +181,31 @@ pub(crate) fn deformation_gradient(
         }
     }
     f
+}
+
+/// C = Fᵀ F of an in-plane F, Voigt [C11, C22, C12].
+pub(crate) fn right_cauchy_green(f: &[[f64; 2]; 2]) -> Voigt {
+    [
+        f[0][0] * f[0][0] + f[1][0] * f[1][0],
+        f[0][1] * f[0][1] + f[1][1] * f[1][1],
+        f[0][0] * f[0][1] + f[1][0] * f[1][1],
+    ]
+}
+
+/// The law's response (with tension-field relaxation) to an in-plane F; an inverted F (det F
+/// ≤ 0 or not a number) has none.
+pub(crate) fn response_to<L: SheetLaw + ?Sized>(
+    law: &L,
+    wrinkling: &Wrinkling,
+    f: &[[f64; 2]; 2],
+) -> Result<constitutive::PointResponse, PointFailure> {
+    let det_f = f[0][0] * f[1][1] - f[0][1] * f[1][0];
+    if det_f.is_nan() || det_f <= 0.0 {
+        return Err(PointFailure::Inverted {
+            det_c: det_f * det_f.abs(),
+        });
+    }
+    constitutive::response(law, &right_cauchy_green(f), wrinkling)
 }
 
 /// σ = F S Fᵀ (Voigt in and out).

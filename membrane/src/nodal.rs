@@ -4,8 +4,10 @@
 //! stretches, Cauchy stress and the tension-field state. The Gauss points stay what the solver
 //! uses; these values are for people and the camera's truth.
 
-use crate::assembly::{deformation_gradient, push_forward, Membrane};
-use crate::constitutive::{self, principal_values, MembraneState, PointFailure, Voigt};
+use crate::assembly::{
+    deformation_gradient, push_forward, response_to, right_cauchy_green, Membrane,
+};
+use crate::constitutive::{principal_values, MembraneState, PointFailure, Voigt};
 use crate::law::SheetLaw;
 use crate::t6::{gradients_at, NODE_COORDINATES};
 
@@ -69,19 +71,9 @@ impl<L: SheetLaw + ?Sized> Membrane<'_, L> {
         displacement_mm: [f64; 2],
         reference_mm: [f64; 2],
     ) -> Result<NodalField, PointFailure> {
-        let c = [
-            f[0][0] * f[0][0] + f[1][0] * f[1][0],
-            f[0][1] * f[0][1] + f[1][1] * f[1][1],
-            f[0][0] * f[0][1] + f[1][0] * f[1][1],
-        ];
+        let response = response_to(self.law, &self.wrinkling, &f)?;
         let det_f = f[0][0] * f[1][1] - f[0][1] * f[1][0];
-        if det_f.is_nan() || det_f <= 0.0 {
-            return Err(PointFailure::Inverted {
-                det_c: det_f * det_f.abs(),
-            });
-        }
-        let response = constitutive::response(self.law, &c, &self.wrinkling)?;
-        let (c_major, c_minor) = principal_values(&c);
+        let (c_major, c_minor) = principal_values(&right_cauchy_green(&f));
         let (l1, l2) = (c_major.sqrt(), c_minor.max(0.0).sqrt());
         Ok(NodalField {
             reference_mm,
