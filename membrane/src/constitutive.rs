@@ -31,6 +31,17 @@ pub enum MembraneState {
     Slack,
 }
 
+impl MembraneState {
+    /// The state's name in files (`taut`, `wrinkled`, `slack`).
+    pub fn name(self) -> &'static str {
+        match self {
+            MembraneState::Taut => "taut",
+            MembraneState::Wrinkled => "wrinkled",
+            MembraneState::Slack => "slack",
+        }
+    }
+}
+
 /// Count of Gauss points per state, to report how much of the sheet wrinkled.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StateCount {

@@ -5,7 +5,6 @@
 
 use crate::mesh::Mesh;
 use crate::nodal::NodalField;
-use crate::path::state_name;
 use crate::t6::NODES;
 use std::fmt::Write as _;
 
@@ -44,7 +43,7 @@ pub fn nodes_csv(nodes: &[NodalField]) -> String {
             s[2],
             s1,
             s2,
-            state_name(n.state)
+            n.state.name()
         );
     }
     text

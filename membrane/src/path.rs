@@ -4,7 +4,7 @@
 //! kept, its reason is said, and no force of it is reported.
 
 use crate::assembly::Membrane;
-use crate::constitutive::{MembraneState, StateCount};
+use crate::constitutive::StateCount;
 use crate::error::SolveError;
 use crate::law::SheetLaw;
 use crate::nodal::{NodalField, NodeFailure};
@@ -182,15 +182,6 @@ fn figures(
             .map(|n| n.stretches[1])
             .fold(f64::INFINITY, f64::min),
         solve_ms,
-    }
-}
-
-/// A state's name in files (`taut`, `wrinkled`, `slack`).
-pub fn state_name(state: MembraneState) -> &'static str {
-    match state {
-        MembraneState::Taut => "taut",
-        MembraneState::Wrinkled => "wrinkled",
-        MembraneState::Slack => "slack",
     }
 }
 
