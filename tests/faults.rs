@@ -438,8 +438,8 @@ fn a_run_over_an_earlier_one_moves_it_aside_and_says_running_when_killed() {
 /// was identified" with `faults: []`, the error only in the identifier's log).
 const FEW_DESCRIPTORS: u32 = 64;
 
-/// `dicstream run` under `ulimit -n 64`: a process whose subscriber cannot connect stops with
-/// exit code 71 naming the descriptors and their limit, and the run fails naming it in
+/// `dicstream run` under `ulimit -n 64`: a process whose subscriber cannot connect, or that
+/// cannot open a results file, stops with exit code 71 naming the descriptors and their limit, and the run fails naming it in
 /// `faults`, not restarted.
 #[test]
 fn too_few_file_descriptors_are_a_fault_naming_the_process_and_the_limit() {
@@ -460,9 +460,22 @@ fn too_few_file_descriptors_are_a_fault_naming_the_process_and_the_limit() {
         .iter()
         .find(|f| f.ends_with("exit status 71"))
         .unwrap_or_else(|| panic!("no process ended for its descriptors: {s}"));
+    // Which process runs out first, and whether at a connection ("cannot connect to a
+    // publisher of") or at a results file ("cannot write"), depends on the machine's iceoryx2
+    // segments: both say the same of the descriptors.
     let failure = s["failure"].as_str().unwrap();
+    assert!(
+        [
+            "cannot connect to a publisher of",
+            "cannot write",
+            "cannot open",
+            "cannot create"
+        ]
+        .iter()
+        .any(|what| failure.contains(what)),
+        "{failure}"
+    );
     for part in [
-        "cannot connect to a publisher of",
         "file descriptors exhausted",
         &format!("of the limit {FEW_DESCRIPTORS} (RLIMIT_NOFILE"),
         "not restarted",

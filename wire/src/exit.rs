@@ -7,7 +7,8 @@ pub const OUTPUT_FAILED: u8 = 74;
 /// The rig could not resume its test safely from its journal: it unloaded and stopped.
 pub const CANNOT_RESUME: u8 = 75;
 /// The process could not get a system resource it needs (a subscriber that cannot connect to
-/// a publisher: no file descriptor left, `/dev/shm` full): a restart would fail the same way.
+/// a publisher, a file that cannot be opened: no file descriptor left, `/dev/shm` full): a
+/// restart would fail the same way.
 pub const RESOURCES: u8 = 71;
 /// The process's configuration does not fit its input (a followed CSV without the configured
 /// columns): a restart would fail the same way.
@@ -22,8 +23,8 @@ pub struct ExitWith {
     pub message: String,
 }
 
-/// The exit code an error asks for: an [`ExitWith`]'s, or [`OUTPUT_FAILED`] for a file that
-/// could not be written.
+/// The exit code an error asks for: an [`ExitWith`]'s, [`OUTPUT_FAILED`] for a file that
+/// could not be written, [`RESOURCES`] for one that could not be for want of descriptors.
 /// The error's sources are looked at too.
 pub fn code_of(error: &(dyn std::error::Error + 'static)) -> Option<u8> {
     let mut next = Some(error);
@@ -31,8 +32,12 @@ pub fn code_of(error: &(dyn std::error::Error + 'static)) -> Option<u8> {
         if let Some(exit) = error.downcast_ref::<ExitWith>() {
             return Some(exit.code);
         }
-        if error.downcast_ref::<crate::files::FileError>().is_some() {
-            return Some(OUTPUT_FAILED);
+        if let Some(file) = error.downcast_ref::<crate::files::FileError>() {
+            return Some(if file.is_out_of_descriptors() {
+                RESOURCES
+            } else {
+                OUTPUT_FAILED
+            });
         }
         #[cfg(feature = "ipc")]
         if error
@@ -75,6 +80,24 @@ mod tests {
         assert!(exit
             .message
             .starts_with("rig process: cannot write rig.csv"));
+        // Out of descriptors: the process's resources, not the output, and said with the limit.
+        let no_descriptor = crate::files::FileError {
+            path: "identification.json".into(),
+            what: "write",
+            reason: std::io::Error::from_raw_os_error(libc::EMFILE),
+        };
+        let exit = in_context("identifier process", &no_descriptor);
+        assert_eq!(exit.code, RESOURCES);
+        assert!(
+            exit.message
+                .contains("cannot write identification.json: Too many open files")
+                && exit.message.contains("file descriptors exhausted")
+                && exit
+                    .message
+                    .contains("(RLIMIT_NOFILE; raise it with `ulimit -n`)"),
+            "{}",
+            exit.message
+        );
         let other: Box<dyn std::error::Error + Send + Sync> = "no".into();
         assert_eq!(in_context("rig", &*other).code, 1);
     }

@@ -8,9 +8,10 @@ use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 /// A failed file operation, naming the file. The I/O error is part of the message, not a
-/// `source()` (an error chain printed with `{:#}` says it once).
+/// `source()` (an error chain printed with `{:#}` says it once); a process out of file
+/// descriptors says so with its limit.
 #[derive(Debug, thiserror::Error)]
-#[error("cannot {what} {}: {reason}", .path.display())]
+#[error("cannot {what} {}: {reason}{}", .path.display(), descriptors_note(.reason))]
 pub struct FileError {
     pub path: PathBuf,
     /// `write`, `create`, `open`, `rename to`...
@@ -33,6 +34,28 @@ impl FileError {
             self.reason.raw_os_error(),
             Some(libc::ENOSPC) | Some(libc::EDQUOT)
         ) || self.reason.kind() == std::io::ErrorKind::StorageFull
+    }
+
+    /// The process (EMFILE) or the system (ENFILE) has no file descriptor left: not the
+    /// output's fault, a restart would fail the same way.
+    pub fn is_out_of_descriptors(&self) -> bool {
+        matches!(
+            self.reason.raw_os_error(),
+            Some(libc::EMFILE) | Some(libc::ENFILE)
+        )
+    }
+}
+
+/// After an I/O error of running out of descriptors, which and their limit ("" otherwise).
+fn descriptors_note(reason: &std::io::Error) -> String {
+    match reason.raw_os_error() {
+        // EMFILE: this process holds as many as its limit allows.
+        Some(libc::EMFILE) => {
+            let limit = crate::descriptors::limit();
+            format!("; {}", crate::descriptors::exhausted_text(limit, limit))
+        }
+        Some(libc::ENFILE) => "; the system's table of open files is full (ENFILE)".into(),
+        _ => String::new(),
     }
 }
 

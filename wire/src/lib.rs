@@ -13,6 +13,7 @@
 //! origin at the centre of the top-left pixel; u, v are Lagrangian displacements in pixels.
 
 pub mod clock;
+pub mod descriptors;
 pub mod exit;
 pub mod field;
 pub mod files;

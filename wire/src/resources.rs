@@ -22,17 +22,9 @@ pub struct Resources {
 impl Resources {
     /// Reads them now.
     pub fn now() -> Resources {
-        let descriptor_limit = descriptor_limit();
-        let open_descriptors = match std::fs::read_dir("/proc/self/fd") {
-            // Less the listing's own descriptor.
-            Ok(entries) => Some((entries.count() as u64).saturating_sub(1)),
-            // Not even one left to list them.
-            Err(e) if e.raw_os_error() == Some(libc::EMFILE) => descriptor_limit,
-            Err(_) => None,
-        };
         Resources {
-            open_descriptors,
-            descriptor_limit,
+            open_descriptors: crate::descriptors::open(),
+            descriptor_limit: crate::descriptors::limit(),
             shm_free_bytes: crate::shm::free_bytes(crate::shm::SHM_PATH).ok(),
         }
     }
@@ -46,33 +38,19 @@ impl Resources {
     }
 }
 
-/// The soft limit of open file descriptors, None when unlimited.
-fn descriptor_limit() -> Option<u64> {
-    let mut limit = libc::rlimit {
-        rlim_cur: 0,
-        rlim_max: 0,
-    };
-    // SAFETY: getrlimit writes into the struct we own.
-    let rc = unsafe { libc::getrlimit(libc::RLIMIT_NOFILE, &mut limit) };
-    (rc == 0 && limit.rlim_cur != libc::RLIM_INFINITY).then_some(limit.rlim_cur)
-}
-
 impl fmt::Display for Resources {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let known = |n: Option<u64>| n.map_or("?".to_string(), |n| n.to_string());
         if self.descriptors_exhausted() {
-            write!(
-                f,
-                "file descriptors exhausted: {} open of the limit {} (RLIMIT_NOFILE; raise it \
-                 with `ulimit -n`)",
-                known(self.open_descriptors),
-                known(self.descriptor_limit)
-            )?;
+            f.write_str(&crate::descriptors::exhausted_text(
+                self.open_descriptors,
+                self.descriptor_limit,
+            ))?;
         } else {
             write!(
                 f,
                 "file descriptors: {} open of the limit {} (RLIMIT_NOFILE)",
-                known(self.open_descriptors),
+                self.open_descriptors
+                    .map_or("?".to_string(), |n| n.to_string()),
                 self.descriptor_limit
                     .map_or("unlimited".to_string(), |n| n.to_string())
             )?;
