@@ -162,8 +162,8 @@ mod tests {
         assert_eq!(exit_code_of(&error), OUTPUT_FAILED);
     }
 
-    /// `dicstream run` gives each child the arguments of `live::run::child_args`: every one is
-    /// one its subcommand accepts.
+    /// `dicstream run` gives each child the arguments of `live::run::child_launch`: every one
+    /// is one its subcommand accepts.
     #[test]
     fn every_child_of_a_run_is_given_arguments_its_command_accepts() {
         use clap::Parser;
@@ -172,7 +172,13 @@ mod tests {
             root: "/results/run".into(),
         };
         for role in live::children::Role::ALL {
-            let args = live::run::child_args(role, &config, "bench_7", &results, 5);
+            let args = match live::run::child_launch(role, &config, "bench_7", &results, 5) {
+                Ok(live::run::ChildLaunch::Args(args)) => args,
+                Ok(live::run::ChildLaunch::Settings { file, .. }) => {
+                    vec!["--settings".into(), file.display().to_string()]
+                }
+                Err(e) => panic!("{role:?}: {e:#}"),
+            };
             let line = ["dicstream", role.name()]
                 .into_iter()
                 .map(String::from)

@@ -66,12 +66,16 @@ pub struct ReferenceImage {
     pub label: String,
 }
 
-/// Settings of the process.
-#[derive(Clone, Debug)]
+/// Settings of the process: what `dicstream run` writes for its correlator (`--settings`),
+/// and what the command line's flags make.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ProcessConfig {
     pub instance: String,
     pub settings: CorrelatorSettings,
-    /// Reference image; None: the first valid frame is the reference.
+    /// Reference image; None: the first valid frame is the reference. Given in memory (the
+    /// command line's `--reference` file), not in a settings file.
+    #[serde(skip)]
     pub reference: Option<ReferenceImage>,
     /// Folder where the reference and what is needed to resume are saved whenever the reference
     /// changes; a process started on a folder holding a saved reference resumes against it.
@@ -79,8 +83,10 @@ pub struct ProcessConfig {
     /// Stop after this many fields were published.
     pub max_frames: Option<u64>,
     /// Stop after this long without any frame (None: never).
+    #[serde(with = "wire::seconds::option", rename = "idle_timeout_s", default)]
     pub idle_timeout: Option<Duration>,
     /// Least time between two status lines (a line is printed only when frames arrived).
+    #[serde(with = "wire::seconds", rename = "status_interval_s")]
     pub status_interval: Duration,
 }
 

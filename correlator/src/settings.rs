@@ -3,7 +3,7 @@
 use thiserror::Error;
 
 /// Region of interest in the reference image, in pixels (x = column, y = row of the top-left pixel).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Roi {
     pub x_px: usize,
     pub y_px: usize,
@@ -27,7 +27,8 @@ impl std::fmt::Display for Roi {
 pub use wire::StrainMeasure;
 
 /// Which image the deformed images are compared with.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ReferenceMode {
     /// The reference given to `set_reference` stays for every frame.
     #[default]
@@ -136,7 +137,8 @@ pub const MAX_ZOI_PX: usize = 256;
 pub const DEFAULT_MIN_ZNCC: f64 = 0.7;
 
 /// Everything the correlator needs to know before the first frame.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CorrelatorSettings {
     /// ZOI (subset) side in pixels: a power of two from 8 to 256 for `correli`, any size from
     /// 9 to 256 for the IC-GN methods.

@@ -378,6 +378,20 @@ impl fmt::Display for Model {
     }
 }
 
+/// In a settings file, a model is its name (`ogden:3`), as [`Model::parse`] reads it.
+impl serde::Serialize for Model {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(&self.name())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Model {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Model, D::Error> {
+        let name = String::deserialize(deserializer)?;
+        Model::parse(&name).map_err(serde::de::Error::custom)
+    }
+}
+
 /// Parses `NAME[,NAME...]` or `all`. Rivlin and LDR arguments use commas too, so a name is
 /// split only before a token that starts with a letter.
 pub fn parse_model_list(list: &str) -> Result<Vec<Model>, ModelError> {

@@ -67,7 +67,8 @@ pub struct FieldSample {
 }
 
 /// Settings.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct OnlineConfig {
     pub rig_history: usize,
     pub pending_fields: usize,

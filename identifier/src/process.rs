@@ -16,8 +16,10 @@ use wire::{
 
 mod shell;
 
-/// Settings of the process.
-#[derive(Clone, Debug)]
+/// Settings of the process: what `dicstream run` writes for its identifier (`--settings`),
+/// and what the command line's flags make.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ProcessConfig {
     pub instance: String,
     /// The fits as JSON, written atomically at most once a second while points come in and
@@ -29,7 +31,9 @@ pub struct ProcessConfig {
     /// Stop after this many fields (None: until SIGINT/SIGTERM or idle timeout).
     pub max_fields: Option<u64>,
     /// Stop after this long without any sample (None: never).
+    #[serde(with = "wire::seconds::option", rename = "idle_timeout_s", default)]
     pub idle_timeout: Option<Duration>,
+    #[serde(default)]
     pub online: OnlineConfig,
 }
 

@@ -87,6 +87,10 @@ impl ResultsDir {
     pub fn journal(&self) -> PathBuf {
         self.path("identification_points.csv")
     }
+    /// The settings a child of the run was started with (`settings/<role>.json`).
+    pub fn settings_file(&self, role: &str) -> PathBuf {
+        self.root.join("settings").join(format!("{role}.json"))
+    }
     pub fn correlator_state(&self) -> PathBuf {
         self.path("correlator_state")
     }

@@ -17,7 +17,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Duration;
 
-mod child_args;
+mod child_launch;
 mod deaths;
 mod drain;
 mod event_loop;
@@ -35,7 +35,7 @@ pub mod start;
 mod stop;
 mod verdict;
 
-pub use child_args::child_args;
+pub use child_launch::{child_launch, correlator_settings, identifier_settings, ChildLaunch};
 pub use prepare::{remove_dead_runs, shm_needed_bytes};
 pub use report::{RunReport, StrainMapInfo};
 

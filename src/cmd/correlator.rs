@@ -12,6 +12,10 @@ use std::time::Duration;
 
 #[derive(clap::Args, Debug)]
 pub struct CorrelatorArgs {
+    /// Every setting from this JSON file (as `dicstream run` writes them in
+    /// `<results>/settings/correlator.json`), instead of the other options.
+    #[arg(long, exclusive = true)]
+    pub settings: Option<PathBuf>,
     /// Instance name (shared-memory prefix); runs with different names never meet.
     #[arg(long, default_value_t = wire::Instance::default_name())]
     pub instance: String,
@@ -42,8 +46,19 @@ impl CorrelatorArgs {
 }
 
 pub fn run(args: CorrelatorArgs) -> Result<()> {
-    let settings = args.settings();
-    settings.validate().context("correlator settings")?;
+    let config = match &args.settings {
+        Some(file) => super::settings_file::read(file)?,
+        None => process_config(&args)?,
+    };
+    config.settings.validate().context("correlator settings")?;
+    let summary =
+        run_process(config).map_err(|e| wire::exit::in_context("correlator process", &e))?;
+    eprintln!("{}", summary.final_line());
+    Ok(())
+}
+
+/// The process's settings of the command line's flags.
+fn process_config(args: &CorrelatorArgs) -> Result<ProcessConfig> {
     let idle_timeout = match args.idle_timeout_s {
         Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
         Some(s) => bail!("--idle-timeout-s must be a positive number of seconds, got {s}"),
@@ -61,15 +76,11 @@ pub fn run(args: CorrelatorArgs) -> Result<()> {
         }
         None => None,
     };
-    let config = ProcessConfig {
+    Ok(ProcessConfig {
         reference,
         state_dir: args.state_dir.clone(),
         max_frames: args.max_frames,
         idle_timeout,
-        ..ProcessConfig::new(&args.instance, settings)
-    };
-    let summary =
-        run_process(config).map_err(|e| wire::exit::in_context("correlator process", &e))?;
-    eprintln!("{}", summary.final_line());
-    Ok(())
+        ..ProcessConfig::new(&args.instance, args.settings())
+    })
 }

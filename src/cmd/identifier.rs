@@ -9,6 +9,10 @@ use std::time::Duration;
 
 #[derive(clap::Args, Debug)]
 pub struct IdentifierArgs {
+    /// Every setting from this JSON file (as `dicstream run` writes them in
+    /// `<results>/settings/identifier.json`), instead of the other options.
+    #[arg(long, exclusive = true)]
+    pub settings: Option<PathBuf>,
     /// Instance name (shared-memory prefix); runs with different names never meet.
     #[arg(long, default_value_t = wire::Instance::default_name())]
     pub instance: String,
@@ -34,37 +38,24 @@ pub struct IdentifierArgs {
 }
 
 pub fn run(args: IdentifierArgs) -> anyhow::Result<()> {
-    let models = parse_model_list(&args.model)?;
-    let idle_timeout = match args.idle_timeout_s {
-        Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
-        Some(s) => anyhow::bail!("--idle-timeout-s must be a positive number of seconds, got {s}"),
-        None => None,
+    let config = match &args.settings {
+        Some(file) => super::settings_file::read(file)?,
+        None => process_config(args)?,
     };
     // The fits are written at the end (and every second): a folder that is not there is
     // refused now, not after the whole test.
-    let folder = args
-        .output
+    let output = config.output_json.clone();
+    let folder = output
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(std::path::Path::new("."));
     if !folder.is_dir() {
         anyhow::bail!(
-            "--output {}: the folder {} does not exist",
-            args.output.display(),
+            "output {}: the folder {} does not exist",
+            output.display(),
             folder.display()
         );
     }
-    let config = ProcessConfig {
-        instance: args.instance,
-        output_json: args.output.clone(),
-        journal: args.journal.clone(),
-        max_fields: args.max_fields,
-        idle_timeout,
-        online: OnlineConfig {
-            models,
-            ..OnlineConfig::default()
-        },
-    };
     let summary =
         run_process(config).map_err(|e| wire::exit::in_context("identifier process", &e))?;
     eprintln!(
@@ -74,7 +65,28 @@ pub fn run(args: IdentifierArgs) -> anyhow::Result<()> {
         summary.reports_published,
         summary.points,
         summary.best_model.as_deref().unwrap_or("none"),
-        args.output.display()
+        output.display()
     );
     Ok(())
+}
+
+/// The process's settings of the command line's flags.
+fn process_config(args: IdentifierArgs) -> anyhow::Result<ProcessConfig> {
+    let models = parse_model_list(&args.model)?;
+    let idle_timeout = match args.idle_timeout_s {
+        Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
+        Some(s) => anyhow::bail!("--idle-timeout-s must be a positive number of seconds, got {s}"),
+        None => None,
+    };
+    Ok(ProcessConfig {
+        instance: args.instance,
+        output_json: args.output,
+        journal: args.journal,
+        max_fields: args.max_fields,
+        idle_timeout,
+        online: OnlineConfig {
+            models,
+            ..OnlineConfig::default()
+        },
+    })
 }

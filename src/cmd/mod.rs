@@ -16,6 +16,7 @@ pub mod producer_watch;
 pub mod rig;
 pub mod rig_follow_csv;
 pub mod run;
+pub mod settings_file;
 pub mod sim_args;
 pub mod specimen;
 pub mod synth;

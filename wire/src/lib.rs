@@ -29,6 +29,7 @@ pub mod pubsub;
 #[cfg(feature = "ipc")]
 pub mod resources;
 pub mod rig;
+pub mod seconds;
 pub mod services;
 #[cfg(feature = "ipc")]
 pub mod shm;

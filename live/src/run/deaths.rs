@@ -69,7 +69,7 @@ impl Run<'_> {
         }
         self.incidents.restart_counts[role as usize] += 1;
         let next_frame_id = self.recorder.last_frame_id.map_or(0, |id| id + 1);
-        let args = self.child_args(role, next_frame_id);
+        let args = self.child_args(role, next_frame_id)?;
         let pid = self.supervisor.restart(role, Some(args))?;
         if waits_for_ready(role, config) && !self.supervisor.wait_ready(role, READY_TIMEOUT)? {
             return Ok(());

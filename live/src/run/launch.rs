@@ -28,7 +28,8 @@ impl Run<'_> {
             if wire::signals::requested().is_some() {
                 return Ok(false);
             }
-            self.supervisor.spawn(role, self.child_args(role, 0))?;
+            let args = self.child_args(role, 0)?;
+            self.supervisor.spawn(role, args)?;
             let waits = waits_for_ready(role, self.config());
             if waits && !self.wait_ready_at_start(role)? {
                 return Ok(false);

@@ -104,15 +104,21 @@ impl<'a> Run<'a> {
         Duration::from_secs_f64(self.config().run.stop_timeout_s)
     }
 
-    /// The command line of `role` in this run (see [`super::child_args`]).
-    pub(super) fn child_args(&self, role: Role, first_frame_id: u64) -> Vec<String> {
+    /// The arguments of `role` in this run after its settings file, if any, was written (see
+    /// [`super::child_launch`]).
+    pub(super) fn child_args(
+        &self,
+        role: Role,
+        first_frame_id: u64,
+    ) -> anyhow::Result<Vec<String>> {
         let prepared = &self.prepared;
-        super::child_args(
+        let launch = super::child_launch(
             role,
             self.config(),
             &prepared.name,
             &prepared.results,
             first_frame_id,
-        )
+        )?;
+        Ok(launch.into_args()?)
     }
 }

@@ -1,11 +1,13 @@
-//! The command line of each child process of a run (`dicstream <role> <args...>`), from the
-//! run's configuration alone: pure, so a restart gets the same arguments but for where the
-//! camera's frame ids start.
+//! How each child process of a run is started (`dicstream <role> ...`), from the run's
+//! configuration alone: pure, so a restart gets the same settings but for where the camera's
+//! frame ids start. The correlator and the identifier get their process's settings, typed, as a
+//! JSON file (`--settings FILE`, the struct their command line's flags make too); the rig and
+//! the camera still get flags.
 
 use crate::children::Role;
 use crate::config::{CameraSection, CameraSource, RigSource, RunConfig};
 use crate::results::ResultsDir;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Relative margin of the camera's stretch envelope beyond the campaign's largest stretch.
 const STRETCH_MARGIN: f64 = 0.05;
@@ -47,27 +49,79 @@ fn strain_args(test: &rig::strain::StrainTest) -> Vec<String> {
     args
 }
 
-/// The command line of each child. `first_frame_id` is where the camera's frame ids start
-/// (past the last id seen when a camera is restarted, so ids never go back).
-pub fn child_args(
+/// What a child is started with.
+#[derive(Clone, Debug)]
+pub enum ChildLaunch {
+    /// Its process's settings: written as JSON to `file`, passed as `--settings FILE`.
+    Settings { file: PathBuf, json: String },
+    /// Flags of its subcommand.
+    Args(Vec<String>),
+}
+
+impl ChildLaunch {
+    /// The settings of `settings` in the results' settings file of `role`.
+    fn settings(role: Role, results: &ResultsDir, settings: &impl serde::Serialize) -> ChildLaunch {
+        ChildLaunch::Settings {
+            file: results.settings_file(role.name()),
+            json: serde_json::to_string_pretty(settings)
+                .expect("process settings serialise to JSON"),
+        }
+    }
+
+    /// The arguments after the role (writing the settings file first, if any).
+    pub fn into_args(self) -> Result<Vec<String>, wire::files::FileError> {
+        match self {
+            ChildLaunch::Args(args) => Ok(args),
+            ChildLaunch::Settings { file, json } => {
+                if let Some(folder) = file.parent() {
+                    std::fs::create_dir_all(folder).map_err(|reason| wire::files::FileError {
+                        path: folder.to_path_buf(),
+                        what: "create",
+                        reason,
+                    })?;
+                }
+                wire::files::write_atomic(&file, json.as_bytes())?;
+                Ok(vec!["--settings".into(), text(&file)])
+            }
+        }
+    }
+}
+
+/// How each child is started. `first_frame_id` is where the camera's frame ids start (past the
+/// last id seen when a camera is restarted, so ids never go back). Refused for settings the
+/// run's validation refuses.
+pub fn child_launch(
     role: Role,
     config: &RunConfig,
     instance: &str,
     results: &ResultsDir,
     first_frame_id: u64,
-) -> Vec<String> {
-    let mut args = vec!["--instance".to_string(), instance.to_string()];
-    args.extend(match role {
-        Role::Rig if config.rig.source == RigSource::CsvFollow => csv_follow_args(config, results),
-        Role::Producer if config.camera.source != CameraSource::Simulated => {
-            real_camera_args(config, results, first_frame_id)
+) -> anyhow::Result<ChildLaunch> {
+    let flags = |more: Vec<String>| {
+        let mut args = vec!["--instance".to_string(), instance.to_string()];
+        args.extend(more);
+        ChildLaunch::Args(args)
+    };
+    Ok(match role {
+        Role::Rig if config.rig.source == RigSource::CsvFollow => {
+            flags(csv_follow_args(config, results))
         }
-        Role::Rig => rig_args(config, results),
-        Role::Producer => simulated_camera_args(config, first_frame_id),
-        Role::Correlator => correlator_args(config, results),
-        Role::Identifier => identifier_args(config, results),
-    });
-    args
+        Role::Producer if config.camera.source != CameraSource::Simulated => {
+            flags(real_camera_args(config, results, first_frame_id))
+        }
+        Role::Rig => flags(rig_args(config, results)),
+        Role::Producer => flags(simulated_camera_args(config, first_frame_id)),
+        Role::Correlator => ChildLaunch::settings(
+            role,
+            results,
+            &correlator_settings(config, instance, results)?,
+        ),
+        Role::Identifier => ChildLaunch::settings(
+            role,
+            results,
+            &identifier_settings(config, instance, results),
+        ),
+    })
 }
 
 /// A path as an argument.
@@ -132,43 +186,36 @@ fn simulated_camera_args(config: &RunConfig, first_frame_id: u64) -> Vec<String>
     ]
 }
 
-/// The correlator's settings, its state in the results.
-fn correlator_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
-    let k = &config.correlator;
-    vec![
-        "--method".into(),
-        k.method.to_string(),
-        "--zoi".into(),
-        k.zoi_px.to_string(),
-        "--step".into(),
-        k.step_px.to_string(),
-        "--threads".into(),
-        k.threads.to_string(),
-        "--strain".into(),
-        k.strain.to_string(),
-        "--reference-mode".into(),
-        k.reference.to_string(),
-        "--guess".into(),
-        k.guess.to_string(),
-        "--min-zncc".into(),
-        k.min_zncc.to_string(),
-        "--gradient-correction".into(),
-        k.gradient_correction.to_string(),
-        "--state-dir".into(),
-        text(&results.correlator_state()),
-    ]
+/// The correlator's settings, its state in the results (refused as the run's validation
+/// refuses them).
+pub fn correlator_settings(
+    config: &RunConfig,
+    instance: &str,
+    results: &ResultsDir,
+) -> anyhow::Result<correlator::process::ProcessConfig> {
+    Ok(correlator::process::ProcessConfig {
+        state_dir: Some(results.correlator_state()),
+        ..correlator::process::ProcessConfig::new(instance, config.correlator_settings()?)
+    })
 }
 
 /// The identifier's models, its output and journal in the results.
-fn identifier_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
-    vec![
-        "--output".into(),
-        text(&results.identification_json()),
-        "--journal".into(),
-        text(&results.journal()),
-        "--model".into(),
-        config.identifier.models.to_string(),
-    ]
+pub fn identifier_settings(
+    config: &RunConfig,
+    instance: &str,
+    results: &ResultsDir,
+) -> identifier::process::ProcessConfig {
+    identifier::process::ProcessConfig {
+        instance: instance.to_string(),
+        output_json: results.identification_json(),
+        journal: Some(results.journal()),
+        max_fields: None,
+        idle_timeout: None,
+        online: identifier::online::OnlineConfig {
+            models: config.identifier.models.0.clone(),
+            ..Default::default()
+        },
+    }
 }
 
 /// `rig --follow-csv FILE ...`: the machine's log of `[rig.csv]`, its counts kept beside the
@@ -300,16 +347,65 @@ mod tests {
         }
     }
 
+    /// The flags of a child started with flags.
     fn args(role: Role, config: &RunConfig, first_frame_id: u64) -> Vec<String> {
-        child_args(role, config, "bench_7", &results(), first_frame_id)
+        match child_launch(role, config, "bench_7", &results(), first_frame_id).unwrap() {
+            ChildLaunch::Args(args) => args,
+            settings => panic!("{role:?} started with {settings:?}"),
+        }
+    }
+
+    /// The JSON settings of a child started with a settings file, and the file.
+    fn settings(role: Role, config: &RunConfig) -> (PathBuf, serde_json::Value) {
+        match child_launch(role, config, "bench_7", &results(), 0).unwrap() {
+            ChildLaunch::Settings { file, json } => (file, serde_json::from_str(&json).unwrap()),
+            args => panic!("{role:?} started with {args:?}"),
+        }
     }
 
     #[test]
     fn every_child_runs_on_the_instance() {
-        for role in Role::ALL {
+        for role in [Role::Rig, Role::Producer] {
             let args = args(role, &RunConfig::default(), 0);
             assert_eq!(args[..2], ["--instance", "bench_7"], "{role:?}");
         }
+        for role in [Role::Correlator, Role::Identifier] {
+            let (file, json) = settings(role, &RunConfig::default());
+            assert_eq!(json["instance"], "bench_7", "{role:?}");
+            assert_eq!(
+                file,
+                PathBuf::from(format!("/results/run/settings/{}.json", role.name()))
+            );
+        }
+    }
+
+    #[test]
+    fn a_settings_file_is_written_and_named_on_the_command_line() {
+        let dir = std::env::temp_dir().join(format!("child_launch_{}", std::process::id()));
+        let results = ResultsDir { root: dir.clone() };
+        let launch =
+            child_launch(Role::Correlator, &RunConfig::default(), "i", &results, 0).unwrap();
+        let args = launch.into_args().unwrap();
+        let file = results.settings_file("correlator");
+        assert_eq!(args, ["--settings".to_string(), text(&file)]);
+        let back: correlator::process::ProcessConfig =
+            serde_json::from_slice(&std::fs::read(&file).unwrap()).unwrap();
+        assert_eq!(
+            back.settings,
+            RunConfig::default().correlator_settings().unwrap()
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+        // A folder that cannot be made is an error naming it.
+        let results = ResultsDir {
+            root: PathBuf::from("/proc/no_such_run"),
+        };
+        let launch =
+            child_launch(Role::Identifier, &RunConfig::default(), "i", &results, 0).unwrap();
+        let error = launch.into_args().unwrap_err().to_string();
+        assert!(
+            error.starts_with("cannot create /proc/no_such_run/settings"),
+            "{error}"
+        );
     }
 
     #[test]
@@ -378,38 +474,60 @@ mod tests {
         config.correlator.threads = 5;
         config.correlator.zoi_px = 31;
         config.correlator.gradient_correction = false;
-        let args = args(Role::Correlator, &config, 0);
-        assert_eq!(value(&args, "--method"), "icgn2");
-        assert_eq!(value(&args, "--threads"), "5");
-        assert_eq!(value(&args, "--zoi"), "31");
-        assert_eq!(value(&args, "--gradient-correction"), "false");
+        let typed = correlator_settings(&config, "bench_7", &results()).unwrap();
+        assert_eq!(typed.settings.method, correlator::Method::Icgn2);
+        assert_eq!(typed.settings.threads, 5);
+        assert_eq!(typed.settings.zoi_px, 31);
+        assert!(!typed.settings.gradient_correction);
+        assert_eq!(typed.settings.reference.kind(), config.correlator.reference);
+        assert_eq!(typed.settings.guess, config.correlator.guess);
         assert_eq!(
-            value(&args, "--reference-mode"),
-            config.correlator.reference.name()
+            typed.state_dir.as_deref(),
+            Some(Path::new("/results/run/correlator_state"))
         );
-        assert_eq!(value(&args, "--guess"), config.correlator.guess.name());
-        assert_eq!(value(&args, "--state-dir"), "/results/run/correlator_state");
+        // As the file says it: units in the names, names for the enums.
+        let (_, json) = settings(Role::Correlator, &config);
+        assert_eq!(json["settings"]["method"], "icgn2");
+        assert_eq!(json["settings"]["zoi_px"], 31);
+        assert_eq!(json["status_interval_s"], 1.0);
+        assert_eq!(json["idle_timeout_s"], serde_json::Value::Null);
+        // Settings the run's validation refuses are refused here too.
+        config.correlator.zoi_px = 4;
+        assert!(child_launch(Role::Correlator, &config, "i", &results(), 0).is_err());
     }
 
     #[test]
     fn the_identifier_writes_and_journals_in_the_results() {
         let mut config = RunConfig::default();
         config.identifier.models = "yeoh,gent".parse().unwrap();
-        let args = args(Role::Identifier, &config, 0);
-        assert_eq!(value(&args, "--output"), "/results/run/identification.json");
+        let typed = identifier_settings(&config, "bench_7", &results());
         assert_eq!(
-            value(&args, "--journal"),
-            "/results/run/identification_points.csv"
+            typed.output_json,
+            Path::new("/results/run/identification.json")
         );
-        assert_eq!(value(&args, "--model"), "yeoh,gent");
+        assert_eq!(
+            typed.journal.as_deref(),
+            Some(Path::new("/results/run/identification_points.csv"))
+        );
+        assert_eq!(typed.online.models, config.identifier.models.0);
+        let (_, json) = settings(Role::Identifier, &config);
+        assert_eq!(
+            json["online"]["models"],
+            serde_json::json!(["yeoh", "gent"])
+        );
     }
 
     #[test]
     fn only_the_camera_depends_on_the_first_frame_id() {
         let config = RunConfig::default();
         for role in Role::ALL {
-            let same = args(role, &config, 0) == args(role, &config, 99);
-            assert_eq!(same, role != Role::Producer, "{role:?}");
+            let launch = |first| {
+                format!(
+                    "{:?}",
+                    child_launch(role, &config, "bench_7", &results(), first).unwrap()
+                )
+            };
+            assert_eq!(launch(0) == launch(99), role != Role::Producer, "{role:?}");
         }
     }
 
