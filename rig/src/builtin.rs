@@ -18,7 +18,8 @@ pub enum TestError {
     Program(#[from] ProgramError),
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum BuiltinTest {
     Uniaxial,
     Equibiaxial,

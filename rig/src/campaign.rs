@@ -14,7 +14,8 @@ use crate::specimen::SpecimenConfig;
 use material::InvariantLaw;
 
 /// One test of a campaign: a built-in test to a stretch at a stretch rate.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CampaignTest {
     pub test: BuiltinTest,
     /// Final stretch λ of the loading ramp.

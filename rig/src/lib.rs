@@ -26,6 +26,7 @@ pub mod program;
 pub mod refusal;
 pub mod rig;
 pub mod session;
+pub mod settings;
 pub mod snapshot;
 pub mod specimen;
 pub mod strain;

@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 use wire::rig::RigState;
 
 mod command;
+mod from_settings;
 mod resume;
 mod shell;
 
@@ -62,8 +63,6 @@ impl StatePort {
 /// `wire::exit::code_of` finds the exit code they ask for.
 #[derive(Debug, thiserror::Error)]
 pub enum ProcessError {
-    #[error("--speed {text:?}: expected realtime, max or a positive factor")]
-    Speed { text: String },
     #[error("{name} {hz}: expected a rate in (0, {control_hz}] Hz")]
     Rate {
         name: &'static str,
@@ -167,27 +166,7 @@ pub enum CommandRefused {
     Rig(#[from] Refusal),
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Speed {
-    Realtime,
-    /// N× real time.
-    Factor(f64),
-    /// As fast as the core steps while a program runs; real time once it has ended.
-    Max,
-}
-
-impl Speed {
-    pub fn parse(text: &str) -> Result<Speed, ProcessError> {
-        match text {
-            "realtime" => Ok(Speed::Realtime),
-            "max" => Ok(Speed::Max),
-            n => match n.parse::<f64>() {
-                Ok(f) if f.is_finite() && f > 0.0 => Ok(Speed::Factor(f)),
-                _ => Err(ProcessError::Speed { text: n.into() }),
-            },
-        }
-    }
-}
+pub use crate::settings::Speed;
 
 #[derive(Clone, Debug)]
 pub struct ProcessOptions {

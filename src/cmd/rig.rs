@@ -3,14 +3,19 @@
 
 use anyhow::Context;
 use rig::builtin::BuiltinTest;
-use rig::process::{run as run_process, ProcessOptions, Speed};
+use rig::process::{run as run_process, ProcessOptions};
+use rig::settings::{LawCoefficients, RigSettings, RigStart, Speed};
 use rig::strain::control::OnRestore;
 use rig::strain::{StrainKind, TestControl};
-use rig::{Campaign, Program, RigConfig};
+use rig::{Campaign, CampaignTest};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
 pub struct RigArgs {
+    /// Every setting from this JSON file (as `dicstream run` writes them in
+    /// `<results>/settings/rig.json`), instead of the other options.
+    #[arg(long, exclusive = true)]
+    pub settings: Option<PathBuf>,
     /// Instance name (shared-memory prefix); runs with different names never meet.
     #[arg(long, default_value_t = wire::Instance::default_name())]
     pub instance: String,
@@ -34,11 +39,11 @@ pub struct RigArgs {
     pub law_g: Option<Vec<f64>>,
     /// Stretch rate of the built-in test (/s); under --control strain, the rate of the larger
     /// log strain (/s).
-    #[arg(long, alias = "rate-per-s", default_value_t = 1e-3)]
+    #[arg(long, alias = "rate-per-s", default_value_t = RigSettings::default().test_rate_per_s)]
     pub rate: f64,
     /// Final stretch λ of the built-in test; under --control strain, the target of the larger
     /// measured stretch.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = RigSettings::default().test_stretch)]
     pub stretch: f64,
     /// displacement (the grips follow the program) or strain: the correlator's `fields` close
     /// the loop on the gauge zone's log strains (a cruciform specimen, --kind, --ratio).
@@ -62,19 +67,19 @@ pub struct RigArgs {
     #[arg(long, default_value_t = OnRestore::Resume)]
     pub on_interlock: OnRestore,
     /// realtime, a factor N (N× real time) or max.
-    #[arg(long, default_value = "realtime")]
-    pub speed: String,
+    #[arg(long, default_value_t = RigSettings::default().speed)]
+    pub speed: Speed,
     /// CSV log of the rig state, flushed as it goes.
     #[arg(long)]
     pub log: Option<PathBuf>,
     /// Log rate (Hz of simulated time).
-    #[arg(long, default_value_t = 100.0)]
+    #[arg(long, default_value_t = RigSettings::default().log_hz)]
     pub log_hz: f64,
     /// Publication rate of rig/state (Hz of simulated time).
-    #[arg(long, default_value_t = 500.0)]
+    #[arg(long, default_value_t = RigSettings::default().publish_hz)]
     pub publish_hz: f64,
     /// Seed of the simulation (valve offsets, load-cell noise).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = RigSettings::default().seed)]
     pub seed: u64,
     /// Stop after this much simulated time (s).
     #[arg(long)]
@@ -96,36 +101,11 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
     if args.follow.follow_csv.is_some() {
         return super::rig_follow_csv::run(args.follow, args.instance);
     }
-    let speed = Speed::parse(&args.speed)?;
-    let mut config = RigConfig::default();
-    let strain = strain_test(&args)?;
-    let campaign = campaign_of(&args, strain.is_some())?;
-    let program = program_of(&args, &mut config)?;
-    // The cruciform a strain-controlled test mounts, of --law-f / --law-g if given.
-    let mut strain_specimen = BuiltinTest::Equibiaxial.specimen();
-    if let Some(law) = law_of(&args)? {
-        strain_specimen.law = law;
-    }
-    let options = ProcessOptions {
-        instance: args.instance,
-        config,
-        seed: args.seed,
-        program,
-        campaign,
-        test_rate_per_s: args.rate,
-        test_stretch: args.stretch,
-        speed,
-        publish_hz: args.publish_hz,
-        log_path: args.log.clone(),
-        log_hz: args.log_hz,
-        duration_s: args.duration_s,
-        exit_when_done: args.exit_when_done,
-        state_dir: args.state_dir.clone(),
-        strain: strain.map(|test| rig::process::StrainOptions {
-            test,
-            specimen: strain_specimen,
-        }),
+    let settings = match &args.settings {
+        Some(file) => super::settings_file::read(file)?,
+        None => settings_of(args)?,
     };
+    let options = ProcessOptions::from_settings(&settings)?;
     // The process's messages name their causes; `in_context` keeps the exit code its error
     // asks for (a results file, a journal it cannot follow).
     let summary = run_process(options).map_err(|e| wire::exit::in_context("rig process", &e))?;
@@ -133,61 +113,58 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The campaign of `--campaign` or `--test campaign`, with the law of `--law-f` / `--law-g`
-/// when given (which only a campaign or, with `strain`, a strain-controlled test takes).
-fn campaign_of(args: &RigArgs, strain: bool) -> anyhow::Result<Option<Campaign>> {
-    let campaign = match (&args.campaign, args.test.as_deref()) {
-        (Some(spec), _) => Some(Campaign::parse(spec)?),
-        (None, Some("campaign")) => Some(Campaign::paper()),
-        _ => None,
-    };
-    Ok(match (campaign, &args.law_f, &args.law_g) {
-        (Some(c), f, g) if f.is_some() || g.is_some() => {
-            let (a, b) = law_coefficients(args);
-            // The same refusals as a run's [specimen].
-            let law = identifier::law::InvariantLaw::exp_poly(&a, &b).map_err(|e| match e {
-                identifier::law::LawError::Coefficients {
-                    which,
-                    coefficients,
-                } => anyhow::anyhow!(
-                    "--law-{which} {coefficients:?}: expected one or more finite numbers"
-                ),
-                identifier::law::LawError::Stiffness { .. } => {
-                    anyhow::anyhow!("--law-f/--law-g: {e}")
-                }
-            })?;
-            Some(c.with_law(law))
-        }
-        (None, Some(_), _) | (None, _, Some(_)) if !strain => {
-            anyhow::bail!(
-                "--law-f / --law-g apply to a campaign (--campaign or --test campaign) or a \
-                 strain-controlled test (--control strain)"
-            )
-        }
-        (c, _, _) => c,
+/// The settings of the command line's flags, refused with the flag named.
+fn settings_of(args: RigArgs) -> anyhow::Result<RigSettings> {
+    let start = start_of(&args)?;
+    let law = law_of(&args, &start)?;
+    Ok(RigSettings {
+        instance: args.instance,
+        start,
+        law,
+        test_rate_per_s: args.rate,
+        test_stretch: args.stretch,
+        speed: args.speed,
+        publish_hz: args.publish_hz,
+        log: args.log,
+        log_hz: args.log_hz,
+        seed: args.seed,
+        duration_s: args.duration_s,
+        exit_when_done: args.exit_when_done,
+        state_dir: args.state_dir,
     })
 }
 
-/// The program of `--program FILE` or of a built-in `--test` (which mounts its specimen in
-/// `config`).
-fn program_of(args: &RigArgs, config: &mut RigConfig) -> anyhow::Result<Option<Program>> {
-    let test = args.test.as_deref().filter(|t| *t != "campaign");
-    Ok(match (&args.program, test) {
-        (Some(path), _) => {
-            let program = || format!("program {}", path.display());
-            let text = std::fs::read_to_string(path).with_context(program)?;
-            let base = path.parent().map(PathBuf::from).unwrap_or_default();
-            Some(Program::from_toml(&text, &base).with_context(program)?)
-        }
-        (None, Some(name)) => {
-            let test = BuiltinTest::parse(name).ok_or_else(|| {
-                anyhow::anyhow!("--test {name:?}: expected uniaxial, equibiaxial or campaign")
-            })?;
-            config.specimen = Some(test.specimen());
-            Some(test.program(args.rate, args.stretch)?)
-        }
-        (None, None) => None,
-    })
+/// What the flags start: a strain-controlled test, a program, a built-in test or a campaign.
+fn start_of(args: &RigArgs) -> anyhow::Result<RigStart> {
+    if let Some(test) = strain_test(args)? {
+        return Ok(RigStart::Strain { test });
+    }
+    Ok(
+        match (&args.program, args.test.as_deref(), &args.campaign) {
+            (Some(file), _, _) => RigStart::Program { file: file.clone() },
+            (None, Some("campaign"), _) => RigStart::Campaign {
+                tests: Campaign::paper().tests().to_vec(),
+            },
+            (None, Some(name), _) => {
+                let test = BuiltinTest::parse(name).ok_or_else(|| {
+                    anyhow::anyhow!("--test {name:?}: expected uniaxial, equibiaxial or campaign")
+                })?;
+                // Its program now, so that a bad --stretch or --rate is said with its flag.
+                test.program(args.rate, args.stretch)?;
+                RigStart::Builtin {
+                    test: CampaignTest {
+                        test,
+                        stretch: args.stretch,
+                        rate_per_s: args.rate,
+                    },
+                }
+            }
+            (None, None, Some(spec)) => RigStart::Campaign {
+                tests: Campaign::parse(spec)?.tests().to_vec(),
+            },
+            (None, None, None) => RigStart::Idle,
+        },
+    )
 }
 
 fn print_summary(summary: &rig::process::ProcessSummary) {
@@ -237,27 +214,30 @@ fn strain_test(args: &RigArgs) -> anyhow::Result<Option<rig::strain::StrainTest>
     }
 }
 
-/// The coefficients of `--law-f` and `--law-g`, each SMACTANE's when not given.
-fn law_coefficients(args: &RigArgs) -> (Vec<f64>, Vec<f64>) {
-    let smactane = identifier::law::InvariantLaw::smactane();
-    let a = args
-        .law_f
-        .clone()
-        .unwrap_or_else(|| smactane.f.coefficients().to_vec());
-    let b = args
-        .law_g
-        .clone()
-        .unwrap_or_else(|| smactane.g.coefficients().to_vec());
-    (a, b)
-}
-
-/// The law of --law-f / --law-g (None: the specimen's own).
-fn law_of(args: &RigArgs) -> anyhow::Result<Option<identifier::law::InvariantLaw>> {
+/// The law of `--law-f` / `--law-g` (each SMACTANE's when not given; None when neither is),
+/// which only a campaign or a strain-controlled test takes.
+fn law_of(args: &RigArgs, start: &RigStart) -> anyhow::Result<Option<LawCoefficients>> {
     if args.law_f.is_none() && args.law_g.is_none() {
         return Ok(None);
     }
-    let (a, b) = law_coefficients(args);
-    identifier::law::InvariantLaw::exp_poly(&a, &b)
-        .map(Some)
-        .map_err(|e| anyhow::anyhow!("--law-f/--law-g: {e}"))
+    if !matches!(start, RigStart::Campaign { .. } | RigStart::Strain { .. }) {
+        anyhow::bail!(
+            "--law-f / --law-g apply to a campaign (--campaign or --test campaign) or a \
+             strain-controlled test (--control strain)"
+        );
+    }
+    let smactane = identifier::law::InvariantLaw::smactane();
+    let law = LawCoefficients {
+        f: (args.law_f.clone()).unwrap_or_else(|| smactane.f.coefficients().to_vec()),
+        g: (args.law_g.clone()).unwrap_or_else(|| smactane.g.coefficients().to_vec()),
+    };
+    // The same refusals as a run's [specimen].
+    law.law().map_err(|e| match e {
+        identifier::law::LawError::Coefficients {
+            which,
+            coefficients,
+        } => anyhow::anyhow!("--law-{which} {coefficients:?}: expected one or more finite numbers"),
+        identifier::law::LawError::Stiffness { .. } => anyhow::anyhow!("--law-f/--law-g: {e}"),
+    })?;
+    Ok(Some(law))
 }

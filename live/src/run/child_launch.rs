@@ -1,8 +1,8 @@
 //! How each child process of a run is started (`dicstream <role> ...`), from the run's
 //! configuration alone: pure, so a restart gets the same settings but for where the camera's
-//! frame ids start. The correlator and the identifier get their process's settings, typed, as a
-//! JSON file (`--settings FILE`, the struct their command line's flags make too); the rig and
-//! the camera still get flags.
+//! frame ids start. The rig, the correlator and the identifier get their process's settings,
+//! typed, as a JSON file (`--settings FILE`, the struct their command line's flags make too);
+//! the camera still gets flags.
 
 use crate::children::Role;
 use crate::config::{CameraSection, CameraSource, RigSource, RunConfig};
@@ -11,43 +11,6 @@ use std::path::{Path, PathBuf};
 
 /// Relative margin of the camera's stretch envelope beyond the campaign's largest stretch.
 const STRETCH_MARGIN: f64 = 0.05;
-
-fn fmt_list(values: &[f64]) -> String {
-    values
-        .iter()
-        .map(|v| format!("{v:e}"))
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-/// The rig's arguments of a strain-controlled test (in place of `--campaign`).
-fn strain_args(test: &rig::strain::StrainTest) -> Vec<String> {
-    let mut args = vec![
-        "--control".to_string(),
-        "strain".into(),
-        "--kind".into(),
-        test.kind.name().into(),
-    ];
-    if test.kind == rig::strain::StrainKind::Biaxial {
-        args.push(format!("--ratio={}", test.ratio));
-    }
-    args.extend([
-        "--stretch".into(),
-        test.stretch.to_string(),
-        "--rate-per-s".into(),
-        test.rate_log_per_s.to_string(),
-        "--stale-s".into(),
-        test.limits.stale_s.to_string(),
-        "--min-valid-nodes".into(),
-        test.limits.min_valid_nodes.to_string(),
-        "--on-interlock".into(),
-        match test.on_interlock {
-            rig::strain::control::OnRestore::Resume => "resume".into(),
-            rig::strain::control::OnRestore::Stop => "stop".into(),
-        },
-    ]);
-    args
-}
 
 /// What a child is started with.
 #[derive(Clone, Debug)]
@@ -109,7 +72,9 @@ pub fn child_launch(
         Role::Producer if config.camera.source != CameraSource::Simulated => {
             flags(real_camera_args(config, results, first_frame_id))
         }
-        Role::Rig => flags(rig_args(config, results)),
+        Role::Rig => {
+            ChildLaunch::settings(role, results, &rig_settings(config, instance, results)?)
+        }
         Role::Producer => flags(simulated_camera_args(config, first_frame_id)),
         Role::Correlator => ChildLaunch::settings(
             role,
@@ -131,30 +96,35 @@ fn text(path: &Path) -> String {
 
 /// The simulated rig: the campaign (or a strain-controlled test) on the specimen's law, its
 /// log and journal in the results.
-fn rig_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
+pub fn rig_settings(
+    config: &RunConfig,
+    instance: &str,
+    results: &ResultsDir,
+) -> anyhow::Result<rig::settings::RigSettings> {
+    use rig::settings::{LawCoefficients, RigSettings, RigStart, Speed};
     let g = &config.rig;
-    let mut args = match config.strain_test() {
-        Ok(Some(test)) => strain_args(&test),
-        _ => vec!["--campaign".into(), config.campaign_spec()],
+    let start = match config.strain_test()? {
+        Some(test) => RigStart::Strain { test },
+        None => RigStart::Campaign {
+            tests: config.campaign()?.tests().to_vec(),
+        },
     };
-    args.extend([
-        format!("--law-f={}", fmt_list(&config.specimen.law_f)),
-        format!("--law-g={}", fmt_list(&config.specimen.law_g)),
-        "--speed".into(),
-        g.speed.to_string(),
-        "--publish-hz".into(),
-        g.publish_hz.to_string(),
-        "--log".into(),
-        text(&results.rig_csv()),
-        "--log-hz".into(),
-        g.log_hz.to_string(),
-        "--seed".into(),
-        g.seed.to_string(),
-        "--state-dir".into(),
-        text(&results.rig_state()),
-        "--exit-when-done".into(),
-    ]);
-    args
+    Ok(RigSettings {
+        instance: instance.to_string(),
+        start,
+        law: Some(LawCoefficients {
+            f: config.specimen.law_f.clone(),
+            g: config.specimen.law_g.clone(),
+        }),
+        speed: Speed::Factor(g.speed),
+        publish_hz: g.publish_hz,
+        log: Some(results.rig_csv()),
+        log_hz: g.log_hz,
+        seed: g.seed,
+        state_dir: Some(results.rig_state()),
+        exit_when_done: true,
+        ..RigSettings::default()
+    })
 }
 
 /// The simulated camera, following the rig.
@@ -365,11 +335,9 @@ mod tests {
 
     #[test]
     fn every_child_runs_on_the_instance() {
-        for role in [Role::Rig, Role::Producer] {
-            let args = args(role, &RunConfig::default(), 0);
-            assert_eq!(args[..2], ["--instance", "bench_7"], "{role:?}");
-        }
-        for role in [Role::Correlator, Role::Identifier] {
+        let args = args(Role::Producer, &RunConfig::default(), 0);
+        assert_eq!(args[..2], ["--instance", "bench_7"]);
+        for role in [Role::Rig, Role::Correlator, Role::Identifier] {
             let (file, json) = settings(role, &RunConfig::default());
             assert_eq!(json["instance"], "bench_7", "{role:?}");
             assert_eq!(
@@ -410,28 +378,43 @@ mod tests {
 
     #[test]
     fn the_rig_runs_the_campaign_on_the_specimen_and_journals_in_the_results() {
+        use rig::settings::{RigStart, Speed};
         let mut config = RunConfig::default();
         config.rig.speed = 4.0;
         config.rig.seed = 11;
         config.specimen.law_f = vec![0.5, -0.25];
-        let args = args(Role::Rig, &config, 0);
+        let typed = rig_settings(&config, "bench_7", &results()).unwrap();
+        let RigStart::Campaign { tests } = &typed.start else {
+            panic!("{:?}", typed.start)
+        };
+        let campaign: Vec<String> = tests
+            .iter()
+            .map(|t| format!("{}:{}@{}", t.test.name(), t.stretch, t.rate_per_s))
+            .collect();
+        assert_eq!(campaign, ["uniaxial:3@0.08", "equibiaxial:2@0.04"]);
+        assert_eq!(typed.law.as_ref().unwrap().f, [0.5, -0.25]);
+        assert_eq!(typed.speed, Speed::Factor(4.0));
+        assert_eq!(typed.seed, 11);
         assert_eq!(
-            value(&args, "--campaign"),
-            "uniaxial:3@0.08,equibiaxial:2@0.04"
+            typed.log.as_deref(),
+            Some(Path::new("/results/run/rig.csv"))
         );
-        assert!(
-            args.contains(&"--law-f=5e-1,-2.5e-1".to_string()),
-            "{args:?}"
+        assert_eq!(
+            typed.state_dir.as_deref(),
+            Some(Path::new("/results/run/rig_state"))
         );
-        assert_eq!(value(&args, "--speed"), "4");
-        assert_eq!(value(&args, "--seed"), "11");
-        assert_eq!(value(&args, "--log"), "/results/run/rig.csv");
-        assert_eq!(value(&args, "--state-dir"), "/results/run/rig_state");
-        assert_eq!(args.last().map(String::as_str), Some("--exit-when-done"));
+        assert!(typed.exit_when_done);
+        // The process's options of them: the campaign on the law.
+        let options = rig::process::ProcessOptions::from_settings(&typed).unwrap();
+        assert_eq!(options.campaign.unwrap().tests().len(), 2);
+        let (_, json) = settings(Role::Rig, &config);
+        assert_eq!(json["start"]["kind"], "campaign");
+        assert_eq!(json["speed"], "4");
     }
 
     #[test]
-    fn a_strain_controlled_test_gives_the_rig_its_strain_flags_instead_of_a_campaign() {
+    fn a_strain_controlled_test_gives_the_rig_its_strain_test_instead_of_a_campaign() {
+        use rig::settings::RigStart;
         let config = RunConfig::from_toml(
             "[[rig.tests]]\nkind = \"biaxial\"\ncontrol = \"strain\"\nratio = 0.5\n\
              stretch = 1.6\nrate_per_s = 0.02\non_interlock = \"stop\"\nstale_s = 0.8\n",
@@ -439,18 +422,23 @@ mod tests {
         )
         .unwrap();
         config.validate().unwrap();
-        let args = args(Role::Rig, &config, 0);
-        assert!(!args.contains(&"--campaign".to_string()), "{args:?}");
-        assert_eq!(value(&args, "--control"), "strain");
-        assert_eq!(value(&args, "--kind"), "biaxial");
-        assert!(args.contains(&"--ratio=0.5".to_string()), "{args:?}");
-        assert_eq!(value(&args, "--stretch"), "1.6");
-        assert_eq!(value(&args, "--rate-per-s"), "0.02");
-        assert_eq!(value(&args, "--stale-s"), "0.8");
-        assert_eq!(value(&args, "--min-valid-nodes"), "16");
-        assert_eq!(value(&args, "--on-interlock"), "stop");
-        assert_eq!(value(&args, "--state-dir"), "/results/run/rig_state");
-        assert_eq!(args.last().map(String::as_str), Some("--exit-when-done"));
+        let typed = rig_settings(&config, "bench_7", &results()).unwrap();
+        let RigStart::Strain { test } = typed.start else {
+            panic!("{:?}", typed.start)
+        };
+        assert_eq!(test.kind, rig::strain::StrainKind::Biaxial);
+        assert_eq!(test.ratio, 0.5);
+        assert_eq!(test.stretch, 1.6);
+        assert_eq!(test.rate_log_per_s, 0.02);
+        assert_eq!(test.limits.stale_s, 0.8);
+        assert_eq!(test.limits.min_valid_nodes, 16);
+        assert_eq!(test.on_interlock, rig::strain::control::OnRestore::Stop);
+        let (_, json) = settings(Role::Rig, &config);
+        assert_eq!(json["start"]["kind"], "strain");
+        assert_eq!(json["start"]["test"]["kind"], "biaxial");
+        assert_eq!(json["start"]["test"]["on_interlock"], "stop");
+        let back: rig::settings::RigSettings = serde_json::from_value(json).unwrap();
+        assert_eq!(back.strain().unwrap().unwrap().0, test);
     }
 
     #[test]

@@ -4,7 +4,8 @@
 use crate::bad_setting::BadSetting;
 use crate::strain::outer::GaugeMeasurement;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct InterlockLimits {
     /// Largest age of the newest field (rig time now − its capture time), s.
     pub stale_s: f64,

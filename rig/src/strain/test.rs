@@ -49,8 +49,10 @@ impl StrainKind {
     }
 }
 
-/// A checked strain-controlled test.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A checked strain-controlled test (one read from a settings file is checked again by
+/// [`StrainTest::check`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StrainTest {
     pub kind: StrainKind,
     /// ρ = ln λy / ln λx held along the path.
@@ -72,6 +74,8 @@ pub enum StrainTestError {
     RatioMissing,
     #[error("stale limit {stale_s} s: expected a positive number of seconds")]
     Stale { stale_s: f64 },
+    #[error("jump limit {jump_log} (log strain): expected a positive number")]
+    Jump { jump_log: f64 },
     #[error(transparent)]
     Path(#[from] StrainPathError),
 }
@@ -125,6 +129,30 @@ impl StrainTest {
         self.limits.min_valid_nodes = min_valid_nodes;
         self.on_interlock = on_interlock;
         Ok(self)
+    }
+
+    /// The checks of [`StrainTest::new`] and [`StrainTest::with_interlocks`] again, on a test
+    /// that did not come from them (a settings file).
+    pub fn check(&self) -> Result<(), StrainTestError> {
+        let ratio = (self.kind.fixed_ratio().is_none()).then_some(self.ratio);
+        if let Some(fixed) = self.kind.fixed_ratio() {
+            if fixed != self.ratio {
+                return Err(StrainTestError::RatioNotTaken {
+                    kind: self.kind.name(),
+                    ratio: self.ratio,
+                });
+            }
+        }
+        StrainTest::new(self.kind, ratio, self.stretch, self.rate_log_per_s)?.with_interlocks(
+            self.limits.stale_s,
+            self.limits.min_valid_nodes,
+            self.on_interlock,
+        )?;
+        let jump_log = self.limits.jump_log;
+        if !(jump_log.is_finite() && jump_log > 0.0) {
+            return Err(StrainTestError::Jump { jump_log });
+        }
+        Ok(())
     }
 
     /// Hold 1 s, the constant-ratio ramp to the stretch, hold 1 s.
