@@ -162,31 +162,60 @@ mod tests {
         assert_eq!(exit_code_of(&error), OUTPUT_FAILED);
     }
 
-    /// `dicstream run` gives each child the arguments of `live::run::child_launch`: every one
-    /// is one its subcommand accepts.
+    /// `dicstream run` starts each child with `--settings FILE` (`live::run::child_launch`):
+    /// its command accepts the flag and reads the file as its own settings, for every source
+    /// of camera and rig.
     #[test]
-    fn every_child_of_a_run_is_given_arguments_its_command_accepts() {
+    fn every_child_of_a_run_reads_the_settings_the_run_writes() {
+        use crate::cmd::settings_file::read;
         use clap::Parser;
-        let config = live::RunConfig::default();
-        let results = live::results::ResultsDir {
-            root: "/results/run".into(),
-        };
-        for role in live::children::Role::ALL {
-            let args = match live::run::child_launch(role, &config, "bench_7", &results, 5) {
-                Ok(live::run::ChildLaunch::Args(args)) => args,
-                Ok(live::run::ChildLaunch::Settings { file, .. }) => {
-                    vec!["--settings".into(), file.display().to_string()]
+        let dir = std::env::temp_dir().join(format!("child_settings_{}", std::process::id()));
+        let results = live::results::ResultsDir { root: dir.clone() };
+        let mut configs = vec![live::RunConfig::default()];
+        for (camera, rig) in [
+            ("watch", "csv-follow"),
+            ("replay", "simulated"),
+            ("genicam", "simulated"),
+        ] {
+            let mut config = live::RunConfig::default();
+            config.camera.source = camera.parse().unwrap();
+            config.camera.replay_files = "/lab/*.tif".into();
+            config.rig.source = rig.parse().unwrap();
+            config.rig.csv.time_column = "Time".into();
+            config.rig.csv.force_x_column = "Fx".into();
+            configs.push(config);
+        }
+        for config in &configs {
+            for role in live::children::Role::ALL {
+                let launch = live::run::child_launch(role, config, "bench_7", &results, 5)
+                    .unwrap_or_else(|e| panic!("{role:?}: {e:#}"));
+                let args = launch.into_args().unwrap();
+                let line = ["dicstream", role.name()]
+                    .into_iter()
+                    .map(String::from)
+                    .chain(args.clone());
+                if let Err(e) = super::Cli::try_parse_from(line) {
+                    panic!("{role:?}: {e}");
                 }
-                Err(e) => panic!("{role:?}: {e:#}"),
-            };
-            let line = ["dicstream", role.name()]
-                .into_iter()
-                .map(String::from)
-                .chain(args);
-            if let Err(e) = super::Cli::try_parse_from(line) {
-                panic!("{role:?}: {e}");
+                let file = std::path::Path::new(&args[1]);
+                let read = match role {
+                    live::children::Role::Rig => {
+                        read::<rig::process::RigProcessSettings>(file).map(|_| ())
+                    }
+                    live::children::Role::Producer => {
+                        read::<producer::settings::ProducerSettings>(file).map(|_| ())
+                    }
+                    live::children::Role::Correlator => {
+                        read::<correlator::process::ProcessConfig>(file).map(|_| ())
+                    }
+                    live::children::Role::Identifier => {
+                        read::<identifier::process::ProcessConfig>(file).map(|_| ())
+                    }
+                };
+                read.unwrap_or_else(|e| panic!("{role:?}: {e:#}"));
             }
         }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

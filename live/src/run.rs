@@ -36,7 +36,8 @@ mod stop;
 mod verdict;
 
 pub use child_launch::{
-    child_launch, correlator_settings, identifier_settings, rig_settings, ChildLaunch,
+    child_launch, correlator_settings, identifier_settings, producer_settings, rig_settings,
+    ChildLaunch,
 };
 pub use prepare::{remove_dead_runs, shm_needed_bytes};
 pub use report::{RunReport, StrainMapInfo};

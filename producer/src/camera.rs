@@ -16,7 +16,8 @@ use crate::parallel::for_row_bands;
 pub const BIT_DEPTHS: [u8; 4] = [8, 10, 12, 16];
 
 /// Camera settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CameraModel {
     /// 8, 10, 12 or 16.
     pub bit_depth: u8,

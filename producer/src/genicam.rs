@@ -64,6 +64,16 @@ pub enum CameraArgError {
     SoftwareTriggerWithoutFps,
 }
 
+/// As `--camera` takes it.
+impl std::fmt::Display for CameraSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.id {
+            None => f.write_str("genicam"),
+            Some(id) => write!(f, "genicam:{id}"),
+        }
+    }
+}
+
 impl FromStr for CameraSpec {
     type Err = CameraArgError;
 
@@ -84,13 +94,15 @@ impl FromStr for CameraSpec {
 
 /// How to set the camera up (`dicstream producer --camera` options). `None` leaves the
 /// camera's own setting.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CameraSettings {
     pub exposure_us: Option<f64>,
     pub gain_db: Option<f64>,
     /// Frame rate (free-running) or trigger rate (software trigger), frames per second.
     pub fps: Option<f64>,
     pub pixel_format: Option<PixelFormat>,
+    #[serde(with = "wire::names::empty_is_none")]
     pub roi: Option<Roi>,
     pub trigger: Trigger,
 }

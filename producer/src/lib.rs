@@ -22,6 +22,7 @@ mod render_fast;
 mod replay;
 mod rig_follow;
 mod scenario;
+pub mod settings;
 mod simulated;
 mod source;
 pub mod speckle;

@@ -44,7 +44,8 @@ const ROTATION_SAMPLES: u32 = 9;
 const ENVELOPE_TOLERANCE: f64 = 1e-9;
 
 /// The states the camera can render: its pattern covers φ⁻¹ of every image pixel for all of them.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RigEnvelope {
     /// Largest stretch along either axis (≥ 1); the smallest admitted is `max_stretch^-1/2`.
     pub max_stretch: f64,
@@ -169,7 +170,8 @@ pub enum BeyondEnvelope {
 }
 
 /// How the camera follows the rig.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RigFollowConfig {
     /// Image scale, mm per px (> 0).
     pub mm_per_px: f64,

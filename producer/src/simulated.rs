@@ -97,11 +97,14 @@ pub enum RendererKind {
 wire::named!(RendererKind, "renderer", { Fast => "fast", Exact => "exact" });
 
 /// Settings of a simulated camera.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SimulatedConfig {
     /// Width, px.
+    #[serde(rename = "width_px")]
     pub width: u32,
     /// Height, px.
+    #[serde(rename = "height_px")]
     pub height: u32,
     /// The pattern.
     pub speckle: SpeckleParams,

@@ -16,7 +16,8 @@ pub const CUTOFF_SIGMAS: f64 = 5.0;
 const FWHM_PER_SIGMA: f64 = 2.354_820_045_030_949;
 
 /// Tunable pattern parameters.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SpeckleParams {
     /// Mean speckle size (spot full width at half maximum), px. Spots vary ±20 % around it.
     pub size_px: f64,

@@ -38,6 +38,17 @@ pub struct StreamSettings {
     pub first_frame_id: u64,
 }
 
+impl crate::settings::ProducerSettings {
+    /// How its frames are streamed.
+    pub fn stream(&self) -> StreamSettings {
+        StreamSettings {
+            fps: self.fps,
+            max_frames: self.max_frames,
+            first_frame_id: self.first_frame_id,
+        }
+    }
+}
+
 /// What a stream did.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct StreamReport {

@@ -21,6 +21,7 @@ use wire::rig::RigState;
 
 mod command;
 mod from_settings;
+pub use from_settings::RigProcessSettings;
 mod resume;
 mod shell;
 

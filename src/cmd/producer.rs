@@ -9,17 +9,22 @@ use super::sim_args::SimArgs;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use producer::settings::{ProducerSettings, SourceSettings};
 use producer::stream::{
     check_shm_for_frames, stream, stream_following_rig, StreamEvent, StreamReport, StreamSettings,
 };
 use producer::{
-    FrameSource, Replay, RigCamera, RigEnvelope, RigFollowConfig, DEFAULT_MAX_OFFSET_MM,
-    DEFAULT_MAX_ROTATION_DEG, DEFAULT_MAX_STRETCH, DEFAULT_MM_PER_PX,
+    FrameSource, Replay, RigCamera, RigEnvelope, RigFollowConfig, SimulatedConfig,
+    DEFAULT_MAX_OFFSET_MM, DEFAULT_MAX_ROTATION_DEG, DEFAULT_MAX_STRETCH, DEFAULT_MM_PER_PX,
 };
 
 /// Options of `dicstream producer`.
 #[derive(Debug, clap::Args)]
 pub struct ProducerArgs {
+    /// Every setting from this JSON file (as `dicstream run` writes them in
+    /// `<results>/settings/producer.json`), instead of the other options
+    #[arg(long, exclusive = true)]
+    pub settings: Option<PathBuf>,
     #[command(flatten)]
     pub sim: SimArgs,
     /// Replay images instead of simulating: a folder (every .png/.tif/.tiff/.bmp, natural
@@ -88,49 +93,116 @@ pub struct ProducerArgs {
 const DEFAULT_SCENARIO_FRAMES: u64 = 100;
 
 pub fn run(args: ProducerArgs) -> anyhow::Result<()> {
-    check(&args)?;
-    let instance = wire::Instance::new(&args.instance)?;
-    let settings = StreamSettings {
-        fps: (args.fps > 0.0).then_some(args.fps),
-        max_frames: args.frames,
-        first_frame_id: args.first_frame_id,
+    let settings = match &args.settings {
+        Some(file) => super::settings_file::read(file)?,
+        None => settings_of(&args)?,
     };
+    let instance = wire::Instance::new(&settings.instance)?;
+    let stream = settings.stream();
     let mut printer = EventPrinter {
         instance: &instance,
         warned_beyond: false,
     };
     let mut on_event = |event: StreamEvent| printer.print(event);
-    let (report, source_line) = if args.follow_rig {
-        follow_rig(&args, &instance, &settings, &mut on_event)?
-    } else if let Some(dir) = &args.watch {
-        let watch = super::producer_watch::WatchArgs {
+    let (report, source_line) = match &settings.source {
+        SourceSettings::FollowRig { camera, follow } => {
+            follow_rig(camera, follow, &instance, &stream, &mut on_event)?
+        }
+        SourceSettings::Watch {
             dir,
+            from_start,
+            idle_timeout_s,
+            settle_ms,
+            log,
+        } => {
+            let watch = super::producer_watch::WatchArgs {
+                dir,
+                from_start: *from_start,
+                idle_timeout_s: *idle_timeout_s,
+                settle_ms: *settle_ms,
+                log: log.as_ref(),
+            };
+            super::producer_watch::run(watch, &instance, &stream, &mut on_event)?
+        }
+        SourceSettings::Genicam {
+            camera,
+            settings,
+            log,
+        } => {
+            let camera = super::producer_genicam::GenicamArgs {
+                spec: camera,
+                camera: settings,
+                log: log.as_ref(),
+            };
+            super::producer_genicam::run(camera, &instance, &stream, &mut on_event)?
+        }
+        SourceSettings::Replay { files, looping } => {
+            replay(files, *looping, &instance, &stream, &mut on_event)?
+        }
+        SourceSettings::Scenario {
+            camera,
+            scenario: spec,
+            frames,
+        } => scenario(camera, spec, *frames, &instance, &stream, &mut on_event)?,
+    };
+    let paced = match settings.source {
+        SourceSettings::Watch { .. } | SourceSettings::Genicam { .. } => None,
+        _ => settings.fps,
+    };
+    println!("{}", final_line(&report, paced, &source_line));
+    Ok(())
+}
+
+/// The settings of the command line's flags, refused with the flag named.
+fn settings_of(args: &ProducerArgs) -> anyhow::Result<ProducerSettings> {
+    check(args)?;
+    let source = if args.follow_rig {
+        SourceSettings::FollowRig {
+            camera: args.sim.config()?,
+            follow: RigFollowConfig {
+                mm_per_px: args.mm_per_px,
+                envelope: RigEnvelope {
+                    max_stretch: args.max_stretch,
+                    max_rotation_rad: args.max_rotation_deg.to_radians(),
+                    max_offset_mm: args.max_offset_mm,
+                },
+            },
+        }
+    } else if let Some(dir) = &args.watch {
+        SourceSettings::Watch {
+            dir: dir.clone(),
             from_start: args.from_start,
             idle_timeout_s: args.idle_timeout_s,
             settle_ms: args.settle_ms,
-            log: args.log.as_ref(),
-        };
-        super::producer_watch::run(watch, &instance, &settings, &mut on_event)?
+            log: args.log.clone(),
+        }
     } else if let Some(spec) = &args.genicam.camera {
-        let camera = super::producer_genicam::GenicamArgs {
-            spec,
-            camera: &args.genicam,
-            fps: args.fps,
-            log: args.log.as_ref(),
-        };
-        super::producer_genicam::run(camera, &instance, &settings, &mut on_event)?
-    } else if let Some(source) = &args.replay {
-        replay(&args, source, &instance, &settings, &mut on_event)?
+        SourceSettings::Genicam {
+            camera: spec.clone(),
+            settings: args.genicam.settings(args.fps),
+            log: args.log.clone(),
+        }
+    } else if let Some(files) = &args.replay {
+        SourceSettings::Replay {
+            files: files.clone(),
+            looping: args.looping,
+        }
     } else {
-        scenario(&args, &instance, &settings, &mut on_event)?
+        // Cheap checks first (scenario, camera), then the costly pattern when it runs.
+        args.sim.scenario()?;
+        SourceSettings::Scenario {
+            camera: args.sim.config()?,
+            scenario: args.sim.scenario_spec(),
+            frames: args.frames.unwrap_or(DEFAULT_SCENARIO_FRAMES),
+        }
     };
-    let fps = if args.watch.is_some() || args.genicam.camera.is_some() {
-        0.0
-    } else {
-        args.fps
-    };
-    println!("{}", final_line(&report, fps, &source_line));
-    Ok(())
+    Ok(ProducerSettings {
+        instance: args.instance.clone(),
+        source,
+        fps: (args.fps > 0.0).then_some(args.fps),
+        max_frames: args.frames,
+        first_frame_id: args.first_frame_id,
+    })
 }
 
 /// The checks of the options no parser makes.
@@ -201,22 +273,14 @@ impl EventPrinter<'_> {
 
 /// `--follow-rig`: frames rendered from the rig's state; the report and the final line's part.
 fn follow_rig(
-    args: &ProducerArgs,
+    config: &SimulatedConfig,
+    follow: &RigFollowConfig,
     instance: &wire::Instance,
     settings: &StreamSettings,
     on_event: impl FnMut(StreamEvent),
 ) -> anyhow::Result<(StreamReport, String)> {
-    let config = args.sim.config()?;
     check_shm_for_frames(config.width, config.height)?;
-    let follow = RigFollowConfig {
-        mm_per_px: args.mm_per_px,
-        envelope: RigEnvelope {
-            max_stretch: args.max_stretch,
-            max_rotation_rad: args.max_rotation_deg.to_radians(),
-            max_offset_mm: args.max_offset_mm,
-        },
-    };
-    let mut camera = RigCamera::new(config, follow).context("building the rig-driven camera")?;
+    let mut camera = RigCamera::new(*config, *follow).context("building the rig-driven camera")?;
     let report = stream_following_rig(&mut camera, instance, settings, on_event)?;
     let line = format!(
         "{} rig samples received, last frame at rig sample {}",
@@ -230,8 +294,8 @@ fn follow_rig(
 
 /// `--replay`: the images of `source`; the report and the final line's part.
 fn replay(
-    args: &ProducerArgs,
     source: &Path,
+    looping: bool,
     instance: &wire::Instance,
     settings: &StreamSettings,
     on_event: impl FnMut(StreamEvent),
@@ -239,12 +303,12 @@ fn replay(
     let mut replay = Replay::open(source)?;
     let dims = replay.dims();
     check_shm_for_frames(dims.width, dims.height)?;
-    replay.set_looping(args.looping);
+    replay.set_looping(looping);
     let line = format!(
         "replay of {} image(s) from {}{}",
         replay.files().len(),
         source.display(),
-        if args.looping { ", looping" } else { "" }
+        if looping { ", looping" } else { "" }
     );
     let report = stream(&mut replay, instance, settings, on_event)?;
     Ok((report, line))
@@ -252,38 +316,25 @@ fn replay(
 
 /// A simulated scenario; the report and the final line's part.
 fn scenario(
-    args: &ProducerArgs,
+    config: &SimulatedConfig,
+    spec: &str,
+    frames: u64,
     instance: &wire::Instance,
     settings: &StreamSettings,
     on_event: impl FnMut(StreamEvent),
 ) -> anyhow::Result<(StreamReport, String)> {
-    // Cheap checks first (scenario, camera, /dev/shm), then the costly pattern.
-    let scenario = args.sim.scenario()?;
-    args.sim.config()?;
-    check_shm_for_frames(args.sim.width, args.sim.height)?;
-    let frames = args.frames.unwrap_or(DEFAULT_SCENARIO_FRAMES);
-    let mut camera = args
-        .sim
-        .build(frames)
+    check_shm_for_frames(config.width, config.height)?;
+    let mut camera = super::sim_args::scenario_camera(config, spec, frames)
         .context("building the simulated camera")?;
     let report = stream(&mut camera, instance, settings, on_event)?;
-    let line = format!(
-        "scenario {} over {frames} frames",
-        if args.sim.params.is_empty() {
-            scenario.kind.name().to_string()
-        } else {
-            args.sim.scenario_spec()
-        }
-    );
-    Ok((report, line))
+    Ok((report, format!("scenario {spec} over {frames} frames")))
 }
 
 /// The one line a run ends with.
-fn final_line(report: &StreamReport, fps: f64, source: &str) -> String {
-    let asked = if fps > 0.0 {
-        format!("{fps} asked")
-    } else {
-        "unpaced".to_string()
+fn final_line(report: &StreamReport, fps: Option<f64>, source: &str) -> String {
+    let asked = match fps {
+        Some(fps) => format!("{fps} asked"),
+        None => "unpaced".to_string(),
     };
     let mut line = format!(
         "producer: {} frames sent in {:.2} s ({:.1} fps measured, {asked}), {} received by \

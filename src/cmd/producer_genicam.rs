@@ -10,7 +10,7 @@
 
 use std::path::PathBuf;
 
-use producer::genicam::{CameraSpec, PixelFormat, Roi, Trigger};
+use producer::genicam::{CameraSettings, CameraSpec, PixelFormat, Roi, Trigger};
 use producer::stream::{StreamEvent, StreamReport, StreamSettings};
 
 /// The header of the `--log` CSV for a camera.
@@ -52,14 +52,27 @@ pub struct CameraArgs {
     pub trigger: Trigger,
 }
 
-/// What `--camera` takes from the command line.
+/// What the camera process streams from a GenICam camera.
 #[cfg_attr(not(feature = "genicam"), allow(dead_code))]
 pub struct GenicamArgs<'a> {
     pub spec: &'a CameraSpec,
-    pub camera: &'a CameraArgs,
-    /// `--fps`: the camera's frame rate or software trigger rate (0: the camera's own).
-    pub fps: f64,
+    pub camera: &'a CameraSettings,
     pub log: Option<&'a PathBuf>,
+}
+
+impl CameraArgs {
+    /// The camera's settings of the flags, `fps` the rate asked (`--fps`; 0, or a hardware
+    /// trigger: the camera's own).
+    pub fn settings(&self, fps: f64) -> CameraSettings {
+        CameraSettings {
+            exposure_us: self.exposure_us,
+            gain_db: self.gain_db,
+            fps: (fps > 0.0 && self.trigger != Trigger::Hardware).then_some(fps),
+            pixel_format: self.pixel_format,
+            roi: self.roi,
+            trigger: self.trigger,
+        }
+    }
 }
 
 /// Streams the camera; returns the report with the final line's source part.
@@ -83,11 +96,11 @@ pub fn run(
 ) -> anyhow::Result<(StreamReport, String)> {
     use producer::stream::stream_genicam;
 
-    let camera = camera_settings(&args);
+    let camera = args.camera;
     camera.check()?;
     let mut notes = NotePrinter {
         args: &args,
-        camera: &camera,
+        camera,
         log: super::log_rows::LogRows::create(args.log, LOG_HEADER)?,
         last_status: std::time::Instant::now(),
         published: 0,
@@ -96,26 +109,12 @@ pub fn run(
         first_frame_id: settings.first_frame_id,
     };
     let (report, camera_report) =
-        stream_genicam(args.spec, &camera, instance, settings, on_event, |note| {
+        stream_genicam(args.spec, camera, instance, settings, on_event, |note| {
             notes.print(note)
         })?;
     let id = std::mem::take(&mut notes.id);
     notes.log.finish()?;
     Ok((report, summary_line(&id, &camera_report)))
-}
-
-/// The camera's settings from the command line (`--fps` 0, or a hardware trigger: none).
-#[cfg(feature = "genicam")]
-fn camera_settings(args: &GenicamArgs) -> producer::genicam::CameraSettings {
-    let camera = args.camera;
-    producer::genicam::CameraSettings {
-        exposure_us: camera.exposure_us,
-        gain_db: camera.gain_db,
-        fps: (args.fps > 0.0 && camera.trigger != Trigger::Hardware).then_some(args.fps),
-        pixel_format: camera.pixel_format,
-        roi: camera.roi,
-        trigger: camera.trigger,
-    }
 }
 
 /// Prints the camera loop's notes on stderr and writes the frames' rows in the `--log` file.
@@ -198,7 +197,7 @@ impl NotePrinter<'_> {
             "producer: camera {id} open: {width_px}x{height_px} px {format}, trigger \
              {}{}; header t_capture_ns = host receive time (monotonic clock), camera \
              timestamps (the camera's clock) {}",
-            self.args.camera.trigger,
+            self.camera.trigger,
             self.camera
                 .fps
                 .map_or_else(String::new, |fps| format!(" at {fps} fps")),

@@ -3,7 +3,7 @@
 
 use anyhow::Context;
 use rig::builtin::BuiltinTest;
-use rig::process::{run as run_process, ProcessOptions};
+use rig::process::{run as run_process, ProcessOptions, RigProcessSettings};
 use rig::settings::{LawCoefficients, RigSettings, RigStart, Speed};
 use rig::strain::control::OnRestore;
 use rig::strain::{StrainKind, TestControl};
@@ -98,12 +98,16 @@ pub struct RigArgs {
 }
 
 pub fn run(args: RigArgs) -> anyhow::Result<()> {
-    if args.follow.follow_csv.is_some() {
-        return super::rig_follow_csv::run(args.follow, args.instance);
-    }
     let settings = match &args.settings {
         Some(file) => super::settings_file::read(file)?,
-        None => settings_of(args)?,
+        None if args.follow.follow_csv.is_some() => RigProcessSettings::CsvFollow(Box::new(
+            super::rig_follow_csv::options_of(&args.follow, args.instance.clone())?,
+        )),
+        None => RigProcessSettings::Simulated(Box::new(settings_of(args)?)),
+    };
+    let settings = match settings {
+        RigProcessSettings::CsvFollow(options) => return super::rig_follow_csv::run(*options),
+        RigProcessSettings::Simulated(settings) => *settings,
     };
     let options = ProcessOptions::from_settings(&settings)?;
     // The process's messages name their causes; `in_context` keeps the exit code its error

@@ -2,6 +2,7 @@
 //! log a real test machine's software appends to, and publish its rows on `rig/state` in the
 //! simulated rig's layout (see `rig::csv_follow`).
 
+use anyhow::Context;
 use rig::csv_follow::columns::{ForceUnit, LengthUnit, TimeUnit};
 use rig::csv_follow::delimiter::Delimiter;
 use rig::csv_follow::process::{run as follow, FollowOptions};
@@ -60,7 +61,7 @@ pub struct FollowCsvArgs {
     #[arg(long, default_value_t = 0.0, requires = "follow_csv")]
     pub section_y_mm2: f64,
     /// How often the file is looked at, ms
-    #[arg(long, default_value_t = 10, requires = "follow_csv")]
+    #[arg(long, default_value_t = rig::csv_follow::process::DEFAULT_POLL_MS, requires = "follow_csv")]
     pub poll_ms: u64,
     /// End (exit 0) after this many seconds without a new row, once rows have come
     #[arg(long, value_name = "S", requires = "follow_csv")]
@@ -71,7 +72,7 @@ pub struct FollowCsvArgs {
     pub counts_json: Option<PathBuf>,
 }
 
-/// The columns to follow, checked (names, units, delimiter) before anything starts.
+/// The columns to follow (checked with the other options by `FollowOptions::check`).
 pub fn columns(args: &FollowCsvArgs) -> anyhow::Result<CsvColumns> {
     let spec = |name: &Option<String>| name.as_deref().map(|n| ColumnSpec::new(n, None));
     let delimiter = args.delimiter.as_char();
@@ -97,48 +98,33 @@ pub fn columns(args: &FollowCsvArgs) -> anyhow::Result<CsvColumns> {
         displacement_unit: args.displacement_unit,
         delimiter,
     };
-    columns
-        .validate()
-        .map_err(|e| anyhow::anyhow!("--follow-csv: {e}"))?;
     Ok(columns)
 }
 
-pub fn run(args: FollowCsvArgs, instance: String) -> anyhow::Result<()> {
+/// The follower's settings of the command line's flags.
+pub fn options_of(args: &FollowCsvArgs, instance: String) -> anyhow::Result<FollowOptions> {
     let path = args.follow_csv.clone().expect("called with --follow-csv");
-    anyhow::ensure!(
-        args.offset_s.is_finite(),
-        "--offset-s {}: expected a number of seconds",
-        args.offset_s
-    );
-    for (flag, v) in [
-        ("--section-x-mm2", args.section_x_mm2),
-        ("--section-y-mm2", args.section_y_mm2),
-    ] {
-        anyhow::ensure!(
-            v.is_finite() && v >= 0.0,
-            "{flag} {v}: expected a section in mm² (0: unknown)"
-        );
-    }
-    anyhow::ensure!(
-        (1..=10_000).contains(&args.poll_ms),
-        "--poll-ms {}: expected 1 to 10000",
-        args.poll_ms
-    );
     let idle_timeout = match args.idle_timeout_s {
         Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
         Some(s) => anyhow::bail!("--idle-timeout-s {s}: expected a positive number of seconds"),
         None => None,
     };
-    let options = FollowOptions {
+    Ok(FollowOptions {
         instance,
-        path: path.clone(),
-        columns: columns(&args)?,
+        path,
+        columns: columns(args)?,
         offset_s: args.offset_s,
         sections_mm2: [args.section_x_mm2, args.section_y_mm2],
         poll: Duration::from_millis(args.poll_ms),
         idle_timeout,
         counts_json: args.counts_json.clone(),
-    };
+    })
+}
+
+/// Follows the log of `options`, checked first.
+pub fn run(options: FollowOptions) -> anyhow::Result<()> {
+    options.check().context("--follow-csv")?;
+    let path = options.path.clone();
     let summary = follow(options).map_err(|e| wire::exit::in_context("rig", &e))?;
     eprintln!(
         "rig: followed {}: {} rows published, {} malformed lines skipped, {} truncation(s) or \

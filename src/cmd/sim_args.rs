@@ -129,17 +129,29 @@ impl SimArgs {
 
     /// A simulated camera playing the scenario over `frames` frames.
     pub fn build(&self, frames: u64) -> Result<SimulatedCamera, ProducerError> {
-        if frames == 0 {
-            return Err(ProducerError::InvalidParameter {
-                name: "frames".to_owned(),
-                value: "0".to_owned(),
-                expected: "at least 1 frame".to_owned(),
-            });
-        }
-        let timeline = ScenarioTimeline {
-            scenario: self.scenario()?,
-            frames,
-        };
-        SimulatedCamera::new(self.config()?, Box::new(timeline))
+        self.scenario()?;
+        scenario_camera(&self.config()?, &self.scenario_spec(), frames)
     }
+}
+
+/// A simulated camera of `config` playing the scenario `spec` (`NAME` or `NAME:key=value,...`)
+/// over `frames` frames.
+pub fn scenario_camera(
+    config: &SimulatedConfig,
+    spec: &str,
+    frames: u64,
+) -> Result<SimulatedCamera, ProducerError> {
+    if frames == 0 {
+        return Err(ProducerError::InvalidParameter {
+            name: "frames".to_owned(),
+            value: "0".to_owned(),
+            expected: "at least 1 frame".to_owned(),
+        });
+    }
+    check_frame_size(config.width, config.height)?;
+    let timeline = ScenarioTimeline {
+        scenario: Scenario::parse(spec, config.width, config.height)?,
+        frames,
+    };
+    SimulatedCamera::new(*config, Box::new(timeline))
 }

@@ -1,8 +1,8 @@
 //! How each child process of a run is started (`dicstream <role> ...`), from the run's
 //! configuration alone: pure, so a restart gets the same settings but for where the camera's
-//! frame ids start. The rig, the correlator and the identifier get their process's settings,
-//! typed, as a JSON file (`--settings FILE`, the struct their command line's flags make too);
-//! the camera still gets flags.
+//! frame ids start. Each child gets its process's settings, typed, as a JSON file
+//! (`--settings FILE`, the struct its command line's flags make too); a rig following a
+//! machine's CSV log still gets flags.
 
 use crate::children::Role;
 use crate::config::{CameraSection, CameraSource, RigSource, RunConfig};
@@ -12,41 +12,35 @@ use std::path::{Path, PathBuf};
 /// Relative margin of the camera's stretch envelope beyond the campaign's largest stretch.
 const STRETCH_MARGIN: f64 = 0.05;
 
-/// What a child is started with.
-#[derive(Clone, Debug)]
-pub enum ChildLaunch {
-    /// Its process's settings: written as JSON to `file`, passed as `--settings FILE`.
-    Settings { file: PathBuf, json: String },
-    /// Flags of its subcommand.
-    Args(Vec<String>),
+/// What a child is started with: its process's settings, written as JSON to `file` and
+/// passed as `--settings FILE`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChildLaunch {
+    pub file: PathBuf,
+    pub json: String,
 }
 
 impl ChildLaunch {
     /// The settings of `settings` in the results' settings file of `role`.
-    fn settings(role: Role, results: &ResultsDir, settings: &impl serde::Serialize) -> ChildLaunch {
-        ChildLaunch::Settings {
+    fn new(role: Role, results: &ResultsDir, settings: &impl serde::Serialize) -> ChildLaunch {
+        ChildLaunch {
             file: results.settings_file(role.name()),
             json: serde_json::to_string_pretty(settings)
                 .expect("process settings serialise to JSON"),
         }
     }
 
-    /// The arguments after the role (writing the settings file first, if any).
+    /// The arguments after the role, once the settings file is written.
     pub fn into_args(self) -> Result<Vec<String>, wire::files::FileError> {
-        match self {
-            ChildLaunch::Args(args) => Ok(args),
-            ChildLaunch::Settings { file, json } => {
-                if let Some(folder) = file.parent() {
-                    std::fs::create_dir_all(folder).map_err(|reason| wire::files::FileError {
-                        path: folder.to_path_buf(),
-                        what: "create",
-                        reason,
-                    })?;
-                }
-                wire::files::write_atomic(&file, json.as_bytes())?;
-                Ok(vec!["--settings".into(), text(&file)])
-            }
+        if let Some(folder) = self.file.parent() {
+            std::fs::create_dir_all(folder).map_err(|reason| wire::files::FileError {
+                path: folder.to_path_buf(),
+                what: "create",
+                reason,
+            })?;
         }
+        wire::files::write_atomic(&self.file, self.json.as_bytes())?;
+        Ok(vec!["--settings".into(), text(&self.file)])
     }
 }
 
@@ -60,28 +54,30 @@ pub fn child_launch(
     results: &ResultsDir,
     first_frame_id: u64,
 ) -> anyhow::Result<ChildLaunch> {
-    let flags = |more: Vec<String>| {
-        let mut args = vec!["--instance".to_string(), instance.to_string()];
-        args.extend(more);
-        ChildLaunch::Args(args)
-    };
+    use rig::process::RigProcessSettings;
     Ok(match role {
-        Role::Rig if config.rig.source == RigSource::CsvFollow => {
-            flags(csv_follow_args(config, results))
-        }
-        Role::Producer if config.camera.source != CameraSource::Simulated => {
-            flags(real_camera_args(config, results, first_frame_id))
-        }
         Role::Rig => {
-            ChildLaunch::settings(role, results, &rig_settings(config, instance, results)?)
+            let settings = match config.rig.source {
+                RigSource::CsvFollow => RigProcessSettings::CsvFollow(Box::new(
+                    csv_follow_settings(config, instance, results),
+                )),
+                RigSource::Simulated => RigProcessSettings::Simulated(Box::new(rig_settings(
+                    config, instance, results,
+                )?)),
+            };
+            ChildLaunch::new(role, results, &settings)
         }
-        Role::Producer => flags(simulated_camera_args(config, first_frame_id)),
-        Role::Correlator => ChildLaunch::settings(
+        Role::Producer => ChildLaunch::new(
+            role,
+            results,
+            &producer_settings(config, instance, results, first_frame_id),
+        ),
+        Role::Correlator => ChildLaunch::new(
             role,
             results,
             &correlator_settings(config, instance, results)?,
         ),
-        Role::Identifier => ChildLaunch::settings(
+        Role::Identifier => ChildLaunch::new(
             role,
             results,
             &identifier_settings(config, instance, results),
@@ -127,33 +123,80 @@ pub fn rig_settings(
     })
 }
 
-/// The simulated camera, following the rig.
-fn simulated_camera_args(config: &RunConfig, first_frame_id: u64) -> Vec<String> {
+/// The camera: the simulated one following the rig (its pattern and model as
+/// `dicstream producer`'s defaults, but for what `[camera]` sets), a watched folder, a replay
+/// or a GenICam camera.
+pub fn producer_settings(
+    config: &RunConfig,
+    instance: &str,
+    results: &ResultsDir,
+    first_frame_id: u64,
+) -> producer::settings::ProducerSettings {
+    use producer::settings::{ProducerSettings, SourceSettings};
     let c = &config.camera;
-    vec![
-        "--follow-rig".into(),
-        "--fps".into(),
-        c.fps.to_string(),
-        "--width".into(),
-        c.width_px.to_string(),
-        "--height".into(),
-        c.height_px.to_string(),
-        "--bit-depth".into(),
-        c.bit_depth.to_string(),
-        "--mm-per-px".into(),
-        c.mm_per_px.to_string(),
-        "--max-stretch".into(),
-        // The rig overshoots a level by a little: the camera covers a margin beyond it.
-        (config.max_stretch() * (1.0 + STRETCH_MARGIN)).to_string(),
-        "--speckle-size-px".into(),
-        c.speckle_size_px.to_string(),
-        "--seed".into(),
-        c.seed.to_string(),
-        "--threads".into(),
-        c.threads.to_string(),
-        "--first-frame-id".into(),
-        first_frame_id.to_string(),
-    ]
+    let source = match c.source {
+        CameraSource::Simulated => SourceSettings::FollowRig {
+            camera: simulated_camera(c),
+            follow: producer::RigFollowConfig {
+                mm_per_px: c.mm_per_px,
+                envelope: producer::RigEnvelope {
+                    // The rig overshoots a level by a little: the camera covers a margin
+                    // beyond it.
+                    max_stretch: config.max_stretch() * (1.0 + STRETCH_MARGIN),
+                    ..producer::RigEnvelope::default()
+                },
+            },
+        },
+        CameraSource::Watch => SourceSettings::Watch {
+            dir: c.watch_dir.clone(),
+            from_start: c.watch_from_start,
+            idle_timeout_s: (c.watch_idle_timeout_s > 0.0).then_some(c.watch_idle_timeout_s),
+            settle_ms: c.watch_settle_ms,
+            log: Some(results.path("watched_frames.csv")),
+        },
+        CameraSource::Replay => SourceSettings::Replay {
+            files: PathBuf::from(&c.replay_files),
+            looping: false,
+        },
+        CameraSource::Genicam => SourceSettings::Genicam {
+            camera: producer::genicam::CameraSpec {
+                id: Some(c.genicam_id.trim().to_string()).filter(|id| !id.is_empty()),
+            },
+            settings: producer::genicam::CameraSettings {
+                exposure_us: c.genicam_exposure_us,
+                gain_db: c.genicam_gain_db,
+                fps: (c.fps > 0.0
+                    && c.genicam_trigger != Some(producer::genicam::Trigger::Hardware))
+                .then_some(c.fps),
+                pixel_format: c.genicam_pixel_format,
+                roi: c.genicam_roi,
+                trigger: c.genicam_trigger.unwrap_or_default(),
+            },
+            log: None,
+        },
+    };
+    ProducerSettings {
+        instance: instance.to_string(),
+        source,
+        fps: (c.fps > 0.0 && matches!(c.source, CameraSource::Simulated | CameraSource::Replay))
+            .then_some(c.fps),
+        max_frames: None,
+        first_frame_id,
+    }
+}
+
+/// The simulated camera of `[camera]`: `dicstream producer`'s defaults (pattern, noise, the
+/// fast renderer) for what it does not set.
+fn simulated_camera(c: &CameraSection) -> producer::SimulatedConfig {
+    let mut camera = producer::SimulatedConfig::new(c.width_px, c.height_px);
+    camera.speckle.size_px = c.speckle_size_px;
+    camera.speckle.seed = c.seed;
+    camera.camera = producer::CameraModel {
+        seed: c.seed,
+        ..producer::CameraModel::with_bit_depth(c.bit_depth)
+    };
+    camera.threads = c.threads.max(1);
+    camera
 }
 
 /// The correlator's settings, its state in the results (refused as the run's validation
@@ -188,115 +231,42 @@ pub fn identifier_settings(
     }
 }
 
-/// `rig --follow-csv FILE ...`: the machine's log of `[rig.csv]`, its counts kept beside the
-/// results.
-fn csv_follow_args(config: &RunConfig, results: &ResultsDir) -> Vec<String> {
+/// A rig following the machine's CSV log of `[rig.csv]`, its counts kept beside the results.
+pub fn csv_follow_settings(
+    config: &RunConfig,
+    instance: &str,
+    results: &ResultsDir,
+) -> rig::csv_follow::process::FollowOptions {
+    use rig::csv_follow::ColumnSpec;
     let v = &config.rig.csv;
-    let mut args = vec!["--follow-csv".to_string(), text(&v.file)];
-    let mut named = |flag: &str, value: &str| {
-        if !value.trim().is_empty() {
-            args.push(flag.to_string());
-            args.push(value.to_string());
-        }
-    };
-    named("--time-column", &v.time_column);
-    named("--force-x-column", &v.force_x_column);
-    named("--force-y-column", &v.force_y_column);
-    named("--force-z-column", &v.force_z_column);
-    named("--displacement-x-column", &v.displacement_x_column);
-    named("--displacement-y-column", &v.displacement_y_column);
-    named("--displacement-z-column", &v.displacement_z_column);
-    let unit = |u: Option<&str>| u.unwrap_or("").to_string();
-    named("--time-unit", &unit(v.time_unit.map(|u| u.name())));
-    named("--force-unit", &unit(v.force_unit.map(|u| u.name())));
-    named(
-        "--displacement-unit",
-        &unit(v.displacement_unit.map(|u| u.name())),
-    );
-    named("--delimiter", v.delimiter.name());
-    args.extend([
-        format!("--offset-s={}", v.offset_s),
-        "--section-x-mm2".into(),
-        v.section_x_mm2.to_string(),
-        "--section-y-mm2".into(),
-        v.section_y_mm2.to_string(),
-        "--idle-timeout-s".into(),
-        v.idle_timeout_s.to_string(),
-        "--counts-json".into(),
-        text(&results.machine_csv_json()),
-    ]);
-    args
-}
-
-/// The producer's options for a watched folder, a replay or a GenICam camera.
-fn real_camera_args(config: &RunConfig, results: &ResultsDir, first_frame_id: u64) -> Vec<String> {
-    let c = &config.camera;
-    let mut args = match c.source {
-        CameraSource::Watch => watch_args(c, results),
-        CameraSource::Replay => vec![
-            "--replay".into(),
-            c.replay_files.clone(),
-            "--fps".into(),
-            c.fps.to_string(),
-        ],
-        CameraSource::Genicam | CameraSource::Simulated => genicam_args(c),
-    };
-    args.extend(["--first-frame-id".into(), first_frame_id.to_string()]);
-    args
-}
-
-/// A watched folder, which file each frame is written beside the results.
-fn watch_args(c: &CameraSection, results: &ResultsDir) -> Vec<String> {
-    let mut args = vec![
-        "--watch".to_string(),
-        text(&c.watch_dir),
-        "--settle-ms".into(),
-        c.watch_settle_ms.to_string(),
-        "--log".into(),
-        text(&results.path("watched_frames.csv")),
-    ];
-    if c.watch_from_start {
-        args.push("--from-start".into());
-    }
-    if c.watch_idle_timeout_s > 0.0 {
-        args.extend([
-            "--idle-timeout-s".into(),
-            c.watch_idle_timeout_s.to_string(),
-        ]);
-    }
-    args
-}
-
-/// A GenICam camera (the first one, or the one named) with the settings given.
-fn genicam_args(c: &CameraSection) -> Vec<String> {
-    let mut args = vec![
-        "--camera".to_string(),
-        match c.genicam_id.trim() {
-            "" => "genicam".to_string(),
-            id => format!("genicam:{id}"),
+    let column = |name: &str| (!name.trim().is_empty()).then(|| ColumnSpec::new(name, None));
+    rig::csv_follow::process::FollowOptions {
+        instance: instance.to_string(),
+        path: v.file.clone(),
+        columns: rig::csv_follow::CsvColumns {
+            time: ColumnSpec::new(&v.time_column, None),
+            force: [
+                column(&v.force_x_column),
+                column(&v.force_y_column),
+                column(&v.force_z_column),
+            ],
+            displacement: [
+                column(&v.displacement_x_column),
+                column(&v.displacement_y_column),
+                column(&v.displacement_z_column),
+            ],
+            time_unit: v.time_unit,
+            force_unit: v.force_unit,
+            displacement_unit: v.displacement_unit,
+            delimiter: v.delimiter.as_char(),
         },
-        "--fps".into(),
-        c.fps.to_string(),
-    ];
-    if let Some(us) = c.genicam_exposure_us {
-        args.extend(["--exposure-us".into(), us.to_string()]);
+        offset_s: v.offset_s,
+        sections_mm2: [v.section_x_mm2, v.section_y_mm2],
+        poll: std::time::Duration::from_millis(rig::csv_follow::process::DEFAULT_POLL_MS),
+        idle_timeout: (v.idle_timeout_s > 0.0)
+            .then(|| std::time::Duration::from_secs_f64(v.idle_timeout_s)),
+        counts_json: Some(results.machine_csv_json()),
     }
-    if let Some(db) = c.genicam_gain_db {
-        args.push(format!("--gain-db={db}"));
-    }
-    for (flag, value) in [
-        (
-            "--pixel-format",
-            c.genicam_pixel_format.map(|f| f.to_string()),
-        ),
-        ("--roi", c.genicam_roi.map(|r| r.to_string())),
-        ("--trigger", c.genicam_trigger.map(|t| t.to_string())),
-    ] {
-        if let Some(value) = value {
-            args.extend([flag.to_string(), value]);
-        }
-    }
-    args
 }
 
 #[cfg(test)]
@@ -304,40 +274,29 @@ mod tests {
     use super::*;
     use std::path::PathBuf;
 
-    /// The value after `flag` (exactly one occurrence).
-    fn value<'a>(args: &'a [String], flag: &str) -> &'a str {
-        let at: Vec<usize> = (0..args.len()).filter(|&i| args[i] == flag).collect();
-        assert_eq!(at.len(), 1, "{flag} in {args:?}");
-        &args[at[0] + 1]
-    }
-
     fn results() -> ResultsDir {
         ResultsDir {
             root: PathBuf::from("/results/run"),
         }
     }
 
-    /// The flags of a child started with flags.
-    fn args(role: Role, config: &RunConfig, first_frame_id: u64) -> Vec<String> {
-        match child_launch(role, config, "bench_7", &results(), first_frame_id).unwrap() {
-            ChildLaunch::Args(args) => args,
-            settings => panic!("{role:?} started with {settings:?}"),
-        }
-    }
-
-    /// The JSON settings of a child started with a settings file, and the file.
+    /// The settings file of a child and its settings' JSON (a rig's under its source).
     fn settings(role: Role, config: &RunConfig) -> (PathBuf, serde_json::Value) {
-        match child_launch(role, config, "bench_7", &results(), 0).unwrap() {
-            ChildLaunch::Settings { file, json } => (file, serde_json::from_str(&json).unwrap()),
-            args => panic!("{role:?} started with {args:?}"),
+        let launch = child_launch(role, config, "bench_7", &results(), 0).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&launch.json).unwrap();
+        match role {
+            Role::Rig => {
+                let source = config.rig.source.name();
+                assert_eq!(json["source"], source.replace('-', "_"), "{json}");
+                (launch.file, json["settings"].clone())
+            }
+            _ => (launch.file, json),
         }
     }
 
     #[test]
     fn every_child_runs_on_the_instance() {
-        let args = args(Role::Producer, &RunConfig::default(), 0);
-        assert_eq!(args[..2], ["--instance", "bench_7"]);
-        for role in [Role::Rig, Role::Correlator, Role::Identifier] {
+        for role in Role::ALL {
             let (file, json) = settings(role, &RunConfig::default());
             assert_eq!(json["instance"], "bench_7", "{role:?}");
             assert_eq!(
@@ -443,15 +402,28 @@ mod tests {
 
     #[test]
     fn the_camera_follows_the_rig_beyond_the_largest_stretch_from_the_given_frame_id() {
+        use producer::settings::SourceSettings;
         let mut config = RunConfig::default();
         config.camera.threads = 3;
         config.camera.width_px = 640;
-        let args = args(Role::Producer, &config, 1234);
-        assert!(args.contains(&"--follow-rig".to_string()));
-        assert_eq!(value(&args, "--threads"), "3");
-        assert_eq!(value(&args, "--width"), "640");
-        assert_eq!(value(&args, "--first-frame-id"), "1234");
-        let max_stretch: f64 = value(&args, "--max-stretch").parse().unwrap();
+        config.camera.bit_depth = 12;
+        let typed = producer_settings(&config, "bench_7", &results(), 1234);
+        let SourceSettings::FollowRig { camera, follow } = typed.source else {
+            panic!("{:?}", typed.source)
+        };
+        assert_eq!(camera.threads, 3);
+        assert_eq!(camera.width, 640);
+        // The simulated camera's own defaults for the rest, as `dicstream producer` has them.
+        assert_eq!(
+            camera.camera,
+            producer::CameraModel {
+                seed: config.camera.seed,
+                ..producer::CameraModel::with_bit_depth(12)
+            }
+        );
+        assert_eq!(typed.first_frame_id, 1234);
+        assert_eq!(typed.fps, Some(10.0));
+        let max_stretch = follow.envelope.max_stretch;
         assert!((max_stretch - 3.0 * (1.0 + STRETCH_MARGIN)).abs() < 1e-12);
     }
 
@@ -530,42 +502,55 @@ mod tests {
         v.force_unit = Some("kN".parse().unwrap());
         v.offset_s = -0.5;
         v.section_x_mm2 = 40.0;
-        let args = args(Role::Rig, &config, 0);
-        assert_eq!(value(&args, "--follow-csv"), "/lab/test.csv");
-        assert_eq!(value(&args, "--time-column"), "Time");
-        assert_eq!(value(&args, "--force-x-column"), "Fx");
-        assert_eq!(value(&args, "--force-unit"), "kN");
-        assert!(!args.contains(&"--force-y-column".to_string()), "{args:?}");
-        assert!(args.contains(&"--offset-s=-0.5".to_string()), "{args:?}");
-        assert_eq!(value(&args, "--section-x-mm2"), "40");
+        let typed = csv_follow_settings(&config, "bench_7", &results());
+        assert_eq!(typed.path, Path::new("/lab/test.csv"));
+        assert_eq!(typed.columns.time.name, "Time");
+        assert_eq!(typed.columns.force[0].as_ref().unwrap().name, "Fx");
+        assert_eq!(typed.columns.force[1], None);
+        assert_eq!(typed.columns.force_unit.unwrap().name(), "kN");
+        assert_eq!(typed.offset_s, -0.5);
+        assert_eq!(typed.sections_mm2, [40.0, 0.0]);
         assert_eq!(
-            value(&args, "--counts-json"),
-            "/results/run/machine_csv.json"
+            typed.counts_json.as_deref(),
+            Some(Path::new("/results/run/machine_csv.json"))
         );
-        assert!(!args.contains(&"--campaign".to_string()));
+        typed.check().unwrap();
+        let (_, json) = settings(Role::Rig, &config);
+        assert_eq!(json["poll_s"], 0.01);
+        assert_eq!(json["columns"]["force_unit"], "kN");
     }
 
     #[test]
     fn real_cameras_get_their_source_options_and_no_rendering_ones() {
+        use producer::settings::SourceSettings;
         let mut config = RunConfig::default();
         config.camera.source = "watch".parse().unwrap();
         config.camera.watch_dir = "/lab/images".into();
         config.camera.watch_from_start = true;
         config.camera.watch_idle_timeout_s = 3.0;
-        let watch = args(Role::Producer, &config, 7);
-        assert_eq!(value(&watch, "--watch"), "/lab/images");
-        assert_eq!(value(&watch, "--idle-timeout-s"), "3");
-        assert_eq!(value(&watch, "--log"), "/results/run/watched_frames.csv");
-        assert_eq!(value(&watch, "--first-frame-id"), "7");
-        assert!(watch.contains(&"--from-start".to_string()));
-        for flag in ["--follow-rig", "--fps", "--max-stretch", "--width"] {
-            assert!(!watch.contains(&flag.to_string()), "{flag} in {watch:?}");
-        }
+        let watch = producer_settings(&config, "bench_7", &results(), 7);
+        assert_eq!(
+            watch.source,
+            SourceSettings::Watch {
+                dir: "/lab/images".into(),
+                from_start: true,
+                idle_timeout_s: Some(3.0),
+                settle_ms: config.camera.watch_settle_ms,
+                log: Some("/results/run/watched_frames.csv".into()),
+            }
+        );
+        assert_eq!((watch.first_frame_id, watch.fps), (7, None));
         config.camera.source = "replay".parse().unwrap();
         config.camera.replay_files = "/lab/images/*.tif".into();
-        let replay = args(Role::Producer, &config, 0);
-        assert_eq!(value(&replay, "--replay"), "/lab/images/*.tif");
-        assert_eq!(value(&replay, "--fps"), "10");
+        let replay = producer_settings(&config, "bench_7", &results(), 0);
+        assert_eq!(
+            replay.source,
+            SourceSettings::Replay {
+                files: "/lab/images/*.tif".into(),
+                looping: false
+            }
+        );
+        assert_eq!(replay.fps, Some(10.0));
         config.camera.source = "genicam".parse().unwrap();
         config.camera.genicam_id = "Fake_1".into();
         config.camera.genicam_exposure_us = Some(2000.0);
@@ -573,12 +558,20 @@ mod tests {
         config.camera.genicam_pixel_format = Some("Mono12".parse().unwrap());
         config.camera.genicam_roi = Some("0,0,512,512".parse().unwrap());
         config.camera.genicam_trigger = Some("software".parse().unwrap());
-        let genicam = args(Role::Producer, &config, 0);
-        assert_eq!(value(&genicam, "--camera"), "genicam:Fake_1");
-        assert_eq!(value(&genicam, "--exposure-us"), "2000");
-        assert!(genicam.contains(&"--gain-db=-1.5".to_string()));
-        assert_eq!(value(&genicam, "--pixel-format"), "Mono12");
-        assert_eq!(value(&genicam, "--roi"), "0,0,512,512");
-        assert_eq!(value(&genicam, "--trigger"), "software");
+        let genicam = producer_settings(&config, "bench_7", &results(), 0);
+        let SourceSettings::Genicam {
+            camera, settings, ..
+        } = genicam.source
+        else {
+            panic!("{:?}", genicam.source)
+        };
+        assert_eq!(camera.to_string(), "genicam:Fake_1");
+        assert_eq!(settings.exposure_us, Some(2000.0));
+        assert_eq!(settings.gain_db, Some(-1.5));
+        assert_eq!(settings.fps, Some(10.0));
+        assert_eq!(settings.pixel_format.unwrap().to_string(), "Mono12");
+        assert_eq!(settings.roi.unwrap().to_string(), "0,0,512,512");
+        assert_eq!(settings.trigger, producer::genicam::Trigger::Software);
+        assert_eq!(genicam.fps, None);
     }
 }

@@ -101,7 +101,8 @@ impl LengthUnit {
 }
 
 /// One configured column: the name as in the header, without its unit.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ColumnSpec {
     pub name: String,
     /// The unit the configuration states (None: the header must).
@@ -118,7 +119,8 @@ impl ColumnSpec {
 }
 
 /// The columns to follow: time, force per axis X, Y, Z and, if logged, displacement per axis.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CsvColumns {
     pub time: ColumnSpec,
     pub force: [Option<ColumnSpec>; 3],

@@ -14,7 +14,13 @@ use std::time::{Duration, Instant, SystemTime};
 use wire::pubsub::ValuePublisher;
 use wire::RigState;
 
-#[derive(Clone, Debug)]
+/// How often the followed file is looked at unless told, ms.
+pub const DEFAULT_POLL_MS: u64 = 10;
+
+/// The follower's settings: what `dicstream run` writes for a `csv-follow` rig and what the
+/// `rig --follow-csv` flags make; [`FollowOptions::check`] checks them.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FollowOptions {
     pub instance: String,
     pub path: PathBuf,
@@ -23,9 +29,11 @@ pub struct FollowOptions {
     pub offset_s: f64,
     /// Initial sections of the specimen normal to X and Y, mm² (0: unknown).
     pub sections_mm2: [f64; 2],
-    /// How often the file is looked at.
+    /// How often the file is looked at (1 ms to 10 s).
+    #[serde(with = "wire::seconds", rename = "poll_s")]
     pub poll: Duration,
     /// End (successfully) after this long without a new row, once rows have come.
+    #[serde(with = "wire::seconds::option", rename = "idle_timeout_s", default)]
     pub idle_timeout: Option<Duration>,
     /// Where the counters are kept as JSON while the follow goes on.
     pub counts_json: Option<PathBuf>,
@@ -79,6 +87,41 @@ pub struct FollowSummary {
 }
 
 /// Follows until a termination signal or the idle timeout.
+/// Settings of the follower that cannot be followed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum OptionsError {
+    #[error("offset_s {0}: expected a number of seconds")]
+    Offset(f64),
+    #[error("sections_mm2 {0:?}: expected sections in mm² (0: unknown)")]
+    Sections([f64; 2]),
+    #[error("poll {0:?}: expected 1 ms to 10 s")]
+    Poll(Duration),
+    #[error("idle timeout {0:?}: expected a positive time")]
+    IdleTimeout(Duration),
+    #[error("{0}")]
+    Columns(#[from] CsvError),
+}
+
+impl FollowOptions {
+    /// The checks no parser makes: a finite offset, sections ≥ 0, a poll of 1 ms to 10 s, a
+    /// positive idle timeout, columns that can be followed.
+    pub fn check(&self) -> Result<(), OptionsError> {
+        if !self.offset_s.is_finite() {
+            return Err(OptionsError::Offset(self.offset_s));
+        }
+        if !self.sections_mm2.iter().all(|s| s.is_finite() && *s >= 0.0) {
+            return Err(OptionsError::Sections(self.sections_mm2));
+        }
+        if !(Duration::from_millis(1)..=Duration::from_secs(10)).contains(&self.poll) {
+            return Err(OptionsError::Poll(self.poll));
+        }
+        if let Some(idle) = self.idle_timeout.filter(|d| d.is_zero()) {
+            return Err(OptionsError::IdleTimeout(idle));
+        }
+        Ok(self.columns.validate()?)
+    }
+}
+
 pub fn run(options: FollowOptions) -> Result<FollowSummary, FollowError> {
     let mut follow = CsvFollow::new(&options)?;
     let StatePort {

@@ -1,9 +1,21 @@
-//! The process's options of its settings ([`RigSettings`]), checked: the program read, the
-//! campaign and the strain-controlled test on the law given.
+//! What `dicstream rig --settings FILE` reads ([`RigProcessSettings`]: a simulated rig's
+//! settings or a followed CSV log's), and the simulated rig's process options of its settings
+//! ([`RigSettings`]), checked: the program read, the campaign and the strain-controlled test on
+//! the law given.
 
 use super::{ProcessOptions, StrainOptions};
 use crate::config::RigConfig;
 use crate::settings::{RigSettings, SettingsError};
+
+/// The settings of a rig process, as `dicstream run` writes them (`settings/rig.json`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "source", content = "settings", rename_all = "snake_case")]
+pub enum RigProcessSettings {
+    /// The simulated machine.
+    Simulated(Box<RigSettings>),
+    /// A real machine's CSV log, followed.
+    CsvFollow(Box<crate::csv_follow::process::FollowOptions>),
+}
 
 impl ProcessOptions {
     pub fn from_settings(settings: &RigSettings) -> Result<ProcessOptions, SettingsError> {
