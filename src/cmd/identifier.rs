@@ -1,7 +1,7 @@
 //! `dicstream identifier`: the live identification process (subscribes to `fields` and
 //! `rig/state`, publishes `identification`, writes the final fits as JSON).
 
-use identifier::models::parse_model_list;
+use identifier::models::ModelList;
 use identifier::online::OnlineConfig;
 use identifier::process::{run as run_process, ProcessConfig};
 use std::path::PathBuf;
@@ -24,11 +24,8 @@ pub struct IdentifierArgs {
     #[arg(long)]
     pub journal: Option<PathBuf>,
     /// Models ranked at each refit: NAME[,NAME...] or `all` (slow: refits run per point).
-    #[arg(
-        long,
-        default_value = "lambert-diani-rey,neo-hookean,mooney,yeoh,gent,hart-smith"
-    )]
-    pub model: String,
+    #[arg(long, default_value_t = ModelList(OnlineConfig::default().models))]
+    pub model: ModelList,
     /// Stop after this many fields.
     #[arg(long)]
     pub max_fields: Option<u64>,
@@ -72,7 +69,7 @@ pub fn run(args: IdentifierArgs) -> anyhow::Result<()> {
 
 /// The process's settings of the command line's flags.
 fn process_config(args: IdentifierArgs) -> anyhow::Result<ProcessConfig> {
-    let models = parse_model_list(&args.model)?;
+    let models = args.model.0;
     let idle_timeout = match args.idle_timeout_s {
         Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
         Some(s) => anyhow::bail!("--idle-timeout-s must be a positive number of seconds, got {s}"),

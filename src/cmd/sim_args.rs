@@ -24,19 +24,19 @@ pub struct SimArgs {
     #[arg(long, default_value_t = 1024)]
     pub height: u32,
     /// Seed of the speckle pattern and of the noise
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = SpeckleParams::default().seed)]
     pub seed: u64,
     /// Speckle size (spot FWHM), px
-    #[arg(long, default_value_t = 4.0)]
+    #[arg(long, default_value_t = SpeckleParams::default().size_px)]
     pub speckle_size_px: f64,
     /// Speckle density (spots per spot area)
-    #[arg(long, default_value_t = 0.35)]
+    #[arg(long, default_value_t = SpeckleParams::default().density)]
     pub speckle_density: f64,
     /// Speckle contrast in (0, 1]
-    #[arg(long, default_value_t = 0.9)]
+    #[arg(long, default_value_t = SpeckleParams::default().contrast)]
     pub contrast: f64,
     /// Camera bit depth: 8, 10, 12 or 16
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = SimulatedConfig::new(1, 1).camera.bit_depth)]
     pub bit_depth: u8,
     /// Read noise standard deviation, DN [default: 0.2 % of full scale]
     #[arg(long = "noise", alias = "read-noise-dn")]
@@ -45,7 +45,7 @@ pub struct SimArgs {
     #[arg(long)]
     pub no_shot_noise: bool,
     /// Photo-electrons at pattern value 1
-    #[arg(long, default_value_t = 10_000.0)]
+    #[arg(long, default_value_t = CameraModel::with_bit_depth(8).illumination_e)]
     pub illumination_e: f64,
     /// Gain, DN per electron [default: white at 90 % of full scale]
     #[arg(long)]
@@ -61,7 +61,7 @@ pub struct SimArgs {
     #[arg(long, value_parser = named::<RendererKind>(), default_value_t = RendererKind::Fast)]
     pub renderer: RendererKind,
     /// Texels per px of the fast renderer (2, 4, 6, 8)
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = SimulatedConfig::new(1, 1).oversample)]
     pub oversample: usize,
     /// Rendering threads [default: all cores]
     #[arg(long)]

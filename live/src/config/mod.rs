@@ -354,9 +354,9 @@ impl Default for SpecimenSection {
 impl Default for IdentifierSection {
     fn default() -> Self {
         IdentifierSection {
-            models: "lambert-diani-rey,neo-hookean,mooney,yeoh,gent,hart-smith"
-                .parse()
-                .expect("the default models parse"),
+            models: identifier::models::ModelList(
+                identifier::online::OnlineConfig::default().models,
+            ),
         }
     }
 }
