@@ -118,6 +118,45 @@ impl Latency {
     }
 }
 
+/// Where a field's latency (capture to seen by the run's monitor) goes, per frame: waiting
+/// (capture to the correlator taking the frame, queueing included), correlating (taken to
+/// published) and delivering (published to seen).
+#[derive(Clone, Debug, Default)]
+pub struct FieldLatencyParts {
+    pub waiting: Latency,
+    pub correlating: Latency,
+    pub delivering: Latency,
+}
+
+/// Their percentiles, ms.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct FieldLatencyPartsMs {
+    pub waiting: Percentiles,
+    pub correlating: Percentiles,
+    pub delivering: Percentiles,
+}
+
+impl FieldLatencyParts {
+    /// The parts of one field: captured, taken by the correlator, published, seen (monotonic
+    /// ns; a clock that went backwards counts 0).
+    pub fn record(&mut self, captured_ns: u64, received_ns: u64, published_ns: u64, seen_ns: u64) {
+        self.waiting
+            .record_ns(received_ns.saturating_sub(captured_ns));
+        self.correlating
+            .record_ns(published_ns.saturating_sub(received_ns));
+        self.delivering
+            .record_ns(seen_ns.saturating_sub(published_ns));
+    }
+
+    pub fn percentiles(&self) -> FieldLatencyPartsMs {
+        FieldLatencyPartsMs {
+            waiting: self.waiting.percentiles(),
+            correlating: self.correlating.percentiles(),
+            delivering: self.delivering.percentiles(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -146,5 +185,24 @@ mod tests {
             "{last}"
         );
         assert!(!l.distribution().is_empty());
+    }
+
+    #[test]
+    fn a_fields_latency_splits_into_waiting_correlating_and_delivering() {
+        let mut parts = FieldLatencyParts::default();
+        // Captured at 0, taken at 40 ms, published at 70 ms, seen at 71 ms.
+        parts.record(0, 40_000_000, 70_000_000, 71_000_000);
+        // A clock read out of order counts 0, not a wrap-around.
+        parts.record(50_000_000, 40_000_000, 80_000_000, 81_000_000);
+        let ms = parts.percentiles();
+        assert_eq!(ms.waiting.count, 2);
+        assert!((ms.waiting.max - 40.0).abs() < 0.1, "{ms:?}");
+        assert!(
+            ms.waiting.p50 < 0.1 || (ms.waiting.p50 - 40.0).abs() < 0.1,
+            "{ms:?}"
+        );
+        assert!((ms.correlating.max - 40.0).abs() < 0.1, "{ms:?}");
+        assert!((ms.correlating.p50 - 30.0).abs() < 0.1, "{ms:?}");
+        assert!((ms.delivering.max - 1.0).abs() < 0.01, "{ms:?}");
     }
 }

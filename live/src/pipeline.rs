@@ -6,7 +6,7 @@
 //! `--fps max` trials at increasing rates find the highest rate without a dropped frame.
 
 use crate::config::{RunConfig, TestSection};
-use crate::latency::Percentiles;
+use crate::latency::{FieldLatencyPartsMs, Percentiles};
 use crate::run::{run, Ending, RunOptions, RunReport};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -37,8 +37,20 @@ pub struct PipelineResult {
     pub frames: u64,
     pub dropped: u64,
     pub latency_ms: BTreeMap<String, Percentiles>,
+    /// Where the field latency goes per frame: waiting for the correlator (queueing
+    /// included), correlating, delivering to the run's monitor.
+    pub latency_field_parts_ms: FieldLatencyPartsMs,
     pub cpu_cores: BTreeMap<String, f64>,
     pub results: PathBuf,
+}
+
+impl PipelineResult {
+    /// The field latency's p99 the work allows: the correlator's own p99 per frame plus one
+    /// frame period (a frame that arrives while the previous one is correlated waits at most
+    /// that), ms.
+    pub fn field_p99_budget_ms(&self) -> f64 {
+        self.latency_field_parts_ms.correlating.p99 + 1e3 / self.fps_requested
+    }
 }
 
 /// Rates tried by the search: doubling from here, then bisecting.
@@ -103,6 +115,7 @@ fn result_of(report: &RunReport, fps: f64) -> PipelineResult {
         frames: report.frames_captured,
         dropped: report.frames_captured.saturating_sub(report.fields),
         latency_ms,
+        latency_field_parts_ms: report.latency_field_parts_ms,
         cpu_cores: report.cpu_cores.clone(),
         results: report.results.clone(),
     }

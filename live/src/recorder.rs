@@ -3,7 +3,7 @@
 //! the latencies, and remembers what the status line and the final figures need.
 
 use crate::frames::{FrameRow, RigHistory, TruthHistory};
-use crate::latency::Latency;
+use crate::latency::{FieldLatencyParts, Latency};
 use crate::results::ResultsDir;
 use wire::files::{write_atomic, FileError, RowFile};
 use wire::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, RigState};
@@ -31,6 +31,8 @@ pub struct Recorder {
     rigs: RigHistory,
     truths: TruthHistory,
     pub latency_field: Latency,
+    /// Where the field latency goes: waiting, correlating, delivering.
+    pub latency_field_parts: FieldLatencyParts,
     pub latency_identification: Latency,
     /// Frames seen on `frames` (the monitor may miss some: its queue drops when it is slow).
     pub frames_seen: u64,
@@ -76,6 +78,7 @@ impl Recorder {
             rigs: RigHistory::new(RIG_HISTORY),
             truths: TruthHistory::new(TRUTH_HISTORY),
             latency_field: Latency::new(),
+            latency_field_parts: FieldLatencyParts::default(),
             latency_identification: Latency::new(),
             frames_seen: 0,
             last_frame_id: None,
@@ -136,6 +139,12 @@ impl Recorder {
         self.frames_dropped_by_correlator = header.frames_dropped;
         self.latency_field
             .record_ns(header.t_published_ns.saturating_sub(header.t_capture_ns));
+        self.latency_field_parts.record(
+            header.t_capture_ns,
+            header.t_received_ns,
+            header.t_published_ns,
+            seen_ns,
+        );
         // A frame without a rig sample (a real camera's): the rig state at its capture time.
         let rig = match header.rig_sample_id {
             wire::NO_RIG_SAMPLE => self.rigs.at_time(header.t_capture_ns),

@@ -31,7 +31,8 @@ pub struct PipelineBenchArgs {
     #[arg(long, default_value = "results/bench")]
     pub out: PathBuf,
     /// Print one JSON object (keys fps_sustained, frames, dropped, latency_ms{field,
-    /// identification}{p50,p90,p99,p999,max}, cpu_cores) instead of text.
+    /// identification}{p50,p90,p99,p999,max}, latency_field_parts_ms{waiting, correlating,
+    /// delivering}, cpu_cores) instead of text.
     #[arg(long)]
     pub json: bool,
 }
@@ -50,13 +51,23 @@ fn describe(r: &PipelineResult) -> String {
         .iter()
         .map(|(name, cores)| format!("{name} {:.0} %", 100.0 * cores))
         .collect();
+    let parts = &r.latency_field_parts_ms;
+    let part = |name: &str, p: &live::latency::Percentiles| {
+        format!("{name} p50 {:.1} p99 {:.1}", p.p50, p.p99)
+    };
+    let budget = r.field_p99_budget_ms();
+    let field_p99 = r.latency_ms.get("field").map_or(f64::NAN, |p| p.p99);
     format!(
-        "{:.1} frames/s asked, {:.2} sustained; {} frames, {} dropped\n  latency from capture to {}\n  latency from capture to {}\n  CPU (100 % = one core): {}\n  results: {}",
+        "{:.1} frames/s asked, {:.2} sustained; {} frames, {} dropped\n  latency from capture to {}\n    of which {}, {}, {} ms\n    field p99 {field_p99:.1} ms against the work's {budget:.1} ms (correlating p99 + one period): {}\n  latency from capture to {}\n  CPU (100 % = one core): {}\n  results: {}",
         r.fps_requested,
         r.fps_sustained,
         r.frames,
         r.dropped,
         l("field"),
+        part("waiting", &parts.waiting),
+        part("correlating", &parts.correlating),
+        part("delivering", &parts.delivering),
+        if field_p99 <= budget { "within" } else { "over: frames queue" },
         l("identification"),
         cpu.join(", "),
         r.results.display()

@@ -75,6 +75,7 @@ impl Stopped<'_> {
             cpu_cores: cpu_cores(&self.cpu_s, wall_s),
             cpu_s: self.cpu_s,
             latency_field_ms: recorder.latency_field.percentiles(),
+            latency_field_parts_ms: recorder.latency_field_parts.percentiles(),
             latency_identification_ms: recorder.latency_identification.percentiles(),
             displacement_error_mean_px,
             acceptance: judged.acceptance,

@@ -37,6 +37,8 @@ pub struct RunReport {
     pub cpu_s: std::collections::BTreeMap<String, f64>,
     pub cpu_cores: std::collections::BTreeMap<String, f64>,
     pub latency_field_ms: Percentiles,
+    /// Where the field latency goes: waiting for the correlator, correlating, delivering.
+    pub latency_field_parts_ms: crate::latency::FieldLatencyPartsMs,
     pub latency_identification_ms: Percentiles,
     /// Mean over frames of the mean node displacement error against the truth (px), and the
     /// worst node error of the run.
