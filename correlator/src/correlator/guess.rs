@@ -130,8 +130,12 @@ impl Correlator {
             job.grow_from_centre(&self.pool, &self.mesh, guesses);
             return;
         }
+        // A node with a previous value of its own is predicted from it (within a pixel on a
+        // steady field): its ZOI skips the integer search when the prediction is confirmed.
+        let previous = self.history.previous.as_ref().filter(|_| use_previous);
         self.pool.run(self.mesh.len(), &|engine, k| {
-            job.correlate(engine, k, guesses[k])
+            let predicted = previous.is_some_and(|p| p.last[k].is_some());
+            job.correlate(engine, k, guesses[k], predicted)
         });
         if let Some(previous) = self.history.previous.as_ref().filter(|_| use_previous) {
             let min_relative_score = self.settings.min_relative_score;
@@ -159,7 +163,8 @@ struct NodeJob<'a> {
 }
 
 impl NodeJob<'_> {
-    fn correlate(&self, engine: &mut ZoiEngine, k: usize, guess: (f64, f64)) {
+    /// `predicted`: the guess is the node's own prediction (see [`ZoiSearch::predicted`]).
+    fn correlate(&self, engine: &mut ZoiEngine, k: usize, guess: (f64, f64), predicted: bool) {
         let r = self.reference.nodes[k];
         let result = if r.status != NodeStatus::Ok {
             ZoiResult {
@@ -177,6 +182,7 @@ impl NodeJob<'_> {
                 guess_px: guess,
                 warp: self.warps.get(k).copied().flatten(),
                 iterations: self.iterations,
+                predicted,
             };
             engine.correlate(&spectra, self.image, search)
         };
@@ -221,7 +227,7 @@ impl NodeJob<'_> {
             let k = retry[i];
             let p = previous.last[k].expect("retried nodes have a previous value");
             let base = self.reference.nodes[k].base_px;
-            self.correlate(engine, k, (p.0 - base.0, p.1 - base.1));
+            self.correlate(engine, k, (p.0 - base.0, p.1 - base.1), false);
         });
     }
 
@@ -233,7 +239,7 @@ impl NodeJob<'_> {
             pool.run(members.len(), &|engine, item| {
                 let k = members[item];
                 let guess = self.inner_mean(mesh, k, ring).unwrap_or(guesses[k]);
-                self.correlate(engine, k, guess);
+                self.correlate(engine, k, guess, false);
             });
         }
     }
