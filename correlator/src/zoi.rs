@@ -171,7 +171,8 @@ pub fn warp_worth_it(g: Mat2, n: usize) -> bool {
 /// unless `profile` is set, so the hot loop reads no clock by default.
 /// `fft_ns`: the integer step's transforms; `window_ns`: windowing and normalisation;
 /// `peak_ns`: the 3x3 windowed correlation values (direct sums) and the quadratic fit;
-/// `shift_ns`: the Fourier shift (phase ramp and inverse transform); `other_ns`: extraction.
+/// `shift_ns`: the Fourier shift (phase ramp and inverse transform); `other_ns`: extraction
+/// (and IC-GN's reference subsets, prepared on first need).
 /// IC-GN adds `coefficients_ns` (the frame's B-spline prefilter, counted on the calling
 /// thread over the whole pool's run), `iterations_ns` (the Gauss-Newton iterations) and
 /// `check_ns` (the final ZNCC checks, every method).

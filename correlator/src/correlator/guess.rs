@@ -110,6 +110,7 @@ impl Correlator {
     /// Every node correlated from its guess; with the previous frames a second try for the
     /// nodes the velocity guess failed; guess `predict` without them grows from the centre.
     fn correlate_first_pass(&mut self, image: Image, use_previous: bool) {
+        self.frame.unsearched.fill(false);
         let job = NodeJob {
             reference: &self.reference,
             // IC-GN with the previous field: the FFT ZOI is sampled through the node's last
@@ -124,6 +125,8 @@ impl Correlator {
             fft_px: self.fft_px,
             pad_px: self.fft_pad_px,
             iterations: super::fft_iterations(&self.settings),
+            skip_predicted: self.settings.method.is_icgn(),
+            unsearched: SharedSlice::new(&mut self.frame.unsearched),
         };
         let guesses = &self.frame.guesses;
         if self.settings.guess == GuessMode::Predict && !use_previous {
@@ -149,6 +152,51 @@ impl Correlator {
     }
 }
 
+impl Correlator {
+    /// IC-GN: the predicted nodes whose prediction, taken without the FFT stage, failed the
+    /// final check are correlated from it with the full search (as without a prediction), and
+    /// every result is checked again. Nothing to do on a field the predictions follow.
+    pub(super) fn search_unconfirmed(&mut self, image: Image) {
+        self.scratch.retry.clear();
+        for (k, (result, &unsearched)) in self
+            .frame
+            .results
+            .iter()
+            .zip(&self.frame.unsearched)
+            .enumerate()
+        {
+            if unsearched && result.status != NodeStatus::Ok {
+                self.scratch.retry.push(k);
+            }
+        }
+        if self.scratch.retry.is_empty() {
+            return;
+        }
+        let use_previous = self.history.previous.is_some();
+        let job = NodeJob {
+            reference: &self.reference,
+            warps: if use_previous {
+                &self.history.gradients
+            } else {
+                &[]
+            },
+            results: SharedSlice::new(&mut self.frame.results),
+            image,
+            fft_px: self.fft_px,
+            pad_px: self.fft_pad_px,
+            iterations: super::fft_iterations(&self.settings),
+            skip_predicted: false,
+            unsearched: SharedSlice::new(&mut self.frame.unsearched),
+        };
+        let (retry, guesses) = (&self.scratch.retry, &self.frame.guesses);
+        self.pool.run(retry.len(), &|engine, i| {
+            let k = retry[i];
+            job.correlate(engine, k, guesses[k], false)
+        });
+        self.verify_results(image);
+    }
+}
+
 /// The first pass's correlation of one node from a guess, keeping the better of its result
 /// and what the node has.
 struct NodeJob<'a> {
@@ -160,13 +208,28 @@ struct NodeJob<'a> {
     fft_px: usize,
     pad_px: usize,
     iterations: SubpixelIterations,
+    /// IC-GN: a predicted node takes its prediction as its guess without the FFT stage
+    /// (IC-GN refines it, the final check and [`Correlator::search_unconfirmed`] catch a wrong
+    /// one), marked in `unsearched`.
+    skip_predicted: bool,
+    unsearched: SharedSlice<'a, bool>,
 }
 
 impl NodeJob<'_> {
     /// `predicted`: the guess is the node's own prediction (see [`ZoiSearch::predicted`]).
     fn correlate(&self, engine: &mut ZoiEngine, k: usize, guess: (f64, f64), predicted: bool) {
         let r = self.reference.nodes[k];
-        let result = if r.status != NodeStatus::Ok {
+        let unsearched = predicted && self.skip_predicted && r.status == NodeStatus::Ok;
+        let result = if unsearched {
+            // No score of its own: 0 until IC-GN's.
+            ZoiResult {
+                u_px: guess.0,
+                v_px: guess.1,
+                status: NodeStatus::Ok,
+                warp_gradient: self.warps.get(k).copied().flatten().unwrap_or_default(),
+                ..ZoiResult::default()
+            }
+        } else if r.status != NodeStatus::Ok {
             ZoiResult {
                 status: r.status,
                 ..ZoiResult::default()
@@ -193,7 +256,10 @@ impl NodeJob<'_> {
                 || (result.status == NodeStatus::Ok && result.score > old.score)
         };
         if unsafe { better(&self.results.read(k)) } {
-            unsafe { self.results.write(k, result) };
+            unsafe {
+                self.results.write(k, result);
+                self.unsearched.write(k, unsearched);
+            }
         }
     }
 
@@ -208,13 +274,18 @@ impl NodeJob<'_> {
     ) {
         let nodes = previous.last.len();
         // SAFETY (reads below): the pool is not running.
+        // Predictions taken without the FFT stage have no score and are not retried here
+        // (the final check decides; see `search_unconfirmed`).
+        let searched = |k: &usize| !unsafe { self.unsearched.read(*k) };
         let min_score = min_relative_score
             * median_ok_score(
-                (0..nodes).map(|k| unsafe { self.results.read(k) }),
+                (0..nodes)
+                    .filter(searched)
+                    .map(|k| unsafe { self.results.read(k) }),
                 &mut scratch.scores,
             );
         scratch.retry.clear();
-        for k in 0..nodes {
+        for k in (0..nodes).filter(searched) {
             let result = unsafe { self.results.read(k) };
             // Outside the image too: an overshooting guess can push a border ZOI out.
             let failed = result.status != NodeStatus::Ok || result.score < min_score;
