@@ -24,7 +24,7 @@ use crate::strain::AffineSums;
 use crate::zoi::{
     spectrum_len, GradientSensitivity, Image, SubpixelIterations, TimeSplit, ZoiResult,
 };
-use parts::{FrameResults, History, Origin, Reference, Scratch};
+use parts::{FrameResults, History, Origin, Reference, Scratch, SubsetState};
 use rustfft::num_complex::Complex32;
 
 /// Per-node state of the current reference image.
@@ -254,6 +254,8 @@ impl Correlator {
                 sensitivities: vec![GradientSensitivity::default(); nodes],
                 subset_planes: vec![0.0; nodes * subset_values],
                 subset_stats: vec![SubsetStats::default(); if icgn { nodes } else { 0 }],
+                subset_states: vec![SubsetState::default(); if icgn { nodes } else { 0 }],
+                coefficients: icgn.then(|| Coefficients::new(width_px, height_px)),
                 keypoints: None,
                 global_stale: true,
                 frames_since: 0,
@@ -508,7 +510,7 @@ impl Correlator {
             if !coefficients_hold_pixels {
                 self.prefilter(pixels);
             }
-            self.prepare_subsets();
+            self.keep_reference_coefficients();
         }
         self.reference.frames_since = 0;
     }
@@ -531,6 +533,9 @@ impl Correlator {
         }
         self.run_zois(image);
         self.verify_results(image);
+        if icgn {
+            self.search_unconfirmed(image);
+        }
         if self.settings.guess == GuessMode::Auto {
             self.improve(image);
         }

@@ -109,15 +109,24 @@ impl ZoiResult {
 }
 
 /// What one ZOI is correlated from: the reference ZOI's top-left pixel in the image, the
-/// displacement guess (px), the gradient to sample the deformed ZOI through, if any, and how
-/// far the sub-pixel iterations go.
+/// displacement guess (px), the gradient to sample the deformed ZOI through, if any, how far
+/// the sub-pixel iterations go, and whether the guess is a prediction from the node's own
+/// previous frames (expected within a pixel: see [`ZoiEngine::correlate`]).
 #[derive(Clone, Copy, Debug)]
 pub struct ZoiSearch {
     pub top_left_px: (usize, usize),
     pub guess_px: (f64, f64),
     pub warp: Option<Mat2>,
     pub iterations: SubpixelIterations,
+    pub predicted: bool,
 }
+
+/// A predicted guess is trusted without the integer FFT search only when the windowed
+/// correlation at the prediction is at least this (and is the largest of its 3x3
+/// neighbourhood): matched speckle gives 0.9 and more, a ZOI compared with another area of a
+/// random speckle a few hundredths to a tenth. Below it the full search runs, as without a
+/// prediction.
+pub const PREDICTION_MIN_PEAK: f64 = 0.5;
 
 /// Where the integer step cuts the deformed ZOI: its integer move (px, image axes) and where
 /// its centre lands relative to the reference centre (px; in the warped ZOI's axes moved by
@@ -139,9 +148,13 @@ struct SubpixelEstimate {
     iterations: u32,
 }
 
-/// The windowed deformed ZOI went flat after `iterations` sub-pixel iterations.
-struct Flat {
-    iterations: u32,
+/// Why the sub-pixel iterations stopped without an estimate.
+enum SubpixelStop {
+    /// The windowed deformed ZOI went flat after `iterations` sub-pixel iterations.
+    Flat { iterations: u32 },
+    /// Started from a prediction, the first windowed correlation did not confirm it (its
+    /// 3x3 maximum off the prediction, or below [`PREDICTION_MIN_PEAK`]).
+    Unconfirmed,
 }
 
 /// A gradient smaller than this (its largest entry times the ZOI half-size, px) is not worth
@@ -158,7 +171,8 @@ pub fn warp_worth_it(g: Mat2, n: usize) -> bool {
 /// unless `profile` is set, so the hot loop reads no clock by default.
 /// `fft_ns`: the integer step's transforms; `window_ns`: windowing and normalisation;
 /// `peak_ns`: the 3x3 windowed correlation values (direct sums) and the quadratic fit;
-/// `shift_ns`: the Fourier shift (phase ramp and inverse transform); `other_ns`: extraction.
+/// `shift_ns`: the Fourier shift (phase ramp and inverse transform); `other_ns`: extraction
+/// (and IC-GN's reference subsets, prepared on first need).
 /// IC-GN adds `coefficients_ns` (the frame's B-spline prefilter, counted on the calling
 /// thread over the whole pool's run), `iterations_ns` (the Gauss-Newton iterations) and
 /// `check_ns` (the final ZNCC checks, every method).
@@ -547,6 +561,15 @@ impl ZoiEngine {
     /// through x → x + guess + G (x − c) instead of cut from the pixel grid, so that only the
     /// residual is measured: a ZOI rotated by 170° or stretched by 50 % is correlated against a
     /// deformed ZOI that looks like it.
+    ///
+    /// A `predicted` guess skips the integer FFT search (paper, section 3.b), whose only task
+    /// is to bring the peak within a pixel: the deformed ZOI is cut at the rounded prediction
+    /// (sampled at the prediction itself when warped) and the sub-pixel iterations start from
+    /// the prediction's fraction (one Fourier shift, which the search's own iterations would
+    /// also have made). The first windowed correlation must then confirm the prediction: its
+    /// 3x3 maximum at the prediction and at least [`PREDICTION_MIN_PEAK`]. When it does not
+    /// (a prediction off by a pixel or more, a decorrelated ZOI), or when the ZOI cannot be cut
+    /// there, the full search runs from the same guess, as without a prediction.
     pub fn correlate(
         &mut self,
         reference: &ReferenceSpectra,
@@ -562,16 +585,82 @@ impl ZoiEngine {
             .warp
             .filter(|&g| g.iter().flatten().all(|v| v.is_finite()) && warp_worth_it(g, self.n));
         let a = warp.map(identity_plus);
+        if search.predicted {
+            if let Some(result) =
+                self.correlate_predicted(reference, deformed, &search, warp, &mut timer)
+            {
+                return result;
+            }
+        }
         let origin = match self.integer_step(reference.plain, deformed, &search, a, &mut timer) {
             Ok(origin) => origin,
             Err(status) => return ZoiResult::with_status(status, 0),
         };
-        let estimate = match self.subpixel(reference.windowed, search.iterations.max, &mut timer) {
+        let start = (0.0, 0.0);
+        let max = search.iterations.max;
+        let estimate = match self.subpixel(reference.windowed, start, max, false, &mut timer) {
             Ok(estimate) => estimate,
-            Err(Flat { iterations }) => {
+            Err(SubpixelStop::Flat { iterations }) => {
                 return ZoiResult::with_status(NodeStatus::LowContrast, iterations)
             }
+            Err(SubpixelStop::Unconfirmed) => unreachable!("only a prediction is confirmed"),
         };
+        Self::result(origin, estimate, warp, &search)
+    }
+
+    /// [`Self::correlate`] from a prediction without the integer search; None when the
+    /// prediction is not confirmed or the ZOI cannot be cut there (the full search decides).
+    fn correlate_predicted(
+        &mut self,
+        reference: &ReferenceSpectra,
+        deformed: Image,
+        search: &ZoiSearch,
+        warp: Option<Mat2>,
+        timer: &mut Timer,
+    ) -> Option<ZoiResult> {
+        let guess = search.guess_px;
+        let (ix, iy) = (guess.0.round() as i64, guess.1.round() as i64);
+        // Warped, the ZOI is sampled at the prediction itself; rigid, cut at its rounding.
+        let mut place = Placement {
+            ix,
+            iy,
+            origin_px: if warp.is_some() {
+                guess
+            } else {
+                (ix as f64, iy as f64)
+            },
+        };
+        let a = warp.map(identity_plus);
+        self.extract_placed(deformed, search.top_left_px, a, &mut place)
+            .ok()?;
+        timer.lap(&mut self.split.other_ns);
+        // Rigid: the fraction left to the Fourier shift (more than half a pixel when the ZOI
+        // was pulled back inside at a border: the full search handles those).
+        let start = match a {
+            Some(_) => (0.0, 0.0),
+            None => (guess.0 - place.origin_px.0, guess.1 - place.origin_px.1),
+        };
+        if start.0.abs() > 0.5 || start.1.abs() > 0.5 {
+            return None;
+        }
+        self.fft.forward(&self.g_spatial, &mut self.g_spectrum);
+        timer.lap(&mut self.split.fft_ns);
+        let max = search.iterations.max;
+        let estimate = self
+            .subpixel(reference.windowed, start, max, true, timer)
+            .ok()?;
+        Some(Self::result(place.origin_px, estimate, warp, search))
+    }
+
+    /// The node's result from where the deformed ZOI's centre landed (`origin`, px) and the
+    /// sub-pixel estimate (the ZOI's axes, warped by `warp`).
+    fn result(
+        origin: (f64, f64),
+        estimate: SubpixelEstimate,
+        warp: Option<Mat2>,
+        search: &ZoiSearch,
+    ) -> ZoiResult {
+        let a = warp.map(identity_plus);
         // The sub-pixel estimate is in the ZOI's axes: a step s there is A s in the image.
         let best = estimate.shift_px;
         let step = a.map_or(best, |a| apply(a, best));
@@ -693,25 +782,29 @@ impl ZoiEngine {
     }
 
     /// The sub-pixel iterations (at most `max_iterations`) against the reference's windowed
-    /// ZOI `windowed`: window, correlate, quadratic peak, Fourier shift, while the interpolated
-    /// maximum increases. [`Flat`] when the windowed deformed ZOI is flat.
+    /// ZOI `windowed`, from the shift `start_px` (the ZOI's axes; the first iteration shifts
+    /// there unless it is zero): window, correlate, quadratic peak, Fourier shift, while the
+    /// interpolated maximum increases. `confirm`: the start is a prediction, and the first
+    /// windowed correlation must confirm it ([`SubpixelStop::Unconfirmed`] otherwise).
     fn subpixel(
         &mut self,
         windowed: &[f32],
+        start_px: (f64, f64),
         max_iterations: u32,
+        confirm: bool,
         timer: &mut Timer,
-    ) -> Result<SubpixelEstimate, Flat> {
+    ) -> Result<SubpixelEstimate, SubpixelStop> {
         let n = self.n;
         let mut estimate = SubpixelEstimate {
-            shift_px: (0.0, 0.0),
+            shift_px: start_px,
             value: f64::NEG_INFINITY,
             last_step_px: f64::INFINITY,
             converged: false,
             iterations: 0,
         };
-        let mut shift = (0.0f64, 0.0f64);
+        let mut shift = start_px;
         for iteration in 0..max_iterations {
-            if iteration > 0 {
+            if iteration > 0 || shift != (0.0, 0.0) {
                 self.shift_into_spatial(shift);
                 timer.lap(&mut self.split.shift_ns);
             }
@@ -721,7 +814,7 @@ impl ZoiEngine {
             self.extended = extended;
             timer.lap(&mut self.split.window_ns);
             let Some(norm) = norm else {
-                return Err(Flat {
+                return Err(SubpixelStop::Flat {
                     iterations: estimate.iterations,
                 });
             };
@@ -729,6 +822,12 @@ impl ZoiEngine {
             let (px, py, neighbourhood) = self.peak_neighbourhood(windowed, 1.0 / norm);
             let (fx, fy, value) = quadratic_peak_3x3(&neighbourhood);
             timer.lap(&mut self.split.peak_ns);
+            if confirm
+                && iteration == 0
+                && !((px, py) == (0, 0) && neighbourhood[1][1] as f64 >= PREDICTION_MIN_PEAK)
+            {
+                return Err(SubpixelStop::Unconfirmed);
+            }
             estimate.iterations = iteration + 1;
             if value <= estimate.value {
                 estimate.converged = true;
@@ -900,6 +999,9 @@ impl ZoiEngine {
         }
     }
 }
+
+#[cfg(test)]
+mod prediction_tests;
 
 #[cfg(test)]
 mod tests {

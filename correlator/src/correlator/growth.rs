@@ -270,6 +270,7 @@ impl Correlator {
                 guess_px: entry.guess_px,
                 warp: Some(entry.gradient),
                 iterations,
+                predicted: false,
             };
             let mut result = engine.correlate(&spectra, image, search);
             let mut score = 0.0;

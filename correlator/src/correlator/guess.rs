@@ -110,6 +110,7 @@ impl Correlator {
     /// Every node correlated from its guess; with the previous frames a second try for the
     /// nodes the velocity guess failed; guess `predict` without them grows from the centre.
     fn correlate_first_pass(&mut self, image: Image, use_previous: bool) {
+        self.frame.unsearched.fill(false);
         let job = NodeJob {
             reference: &self.reference,
             // IC-GN with the previous field: the FFT ZOI is sampled through the node's last
@@ -124,14 +125,20 @@ impl Correlator {
             fft_px: self.fft_px,
             pad_px: self.fft_pad_px,
             iterations: super::fft_iterations(&self.settings),
+            skip_predicted: self.settings.method.is_icgn(),
+            unsearched: SharedSlice::new(&mut self.frame.unsearched),
         };
         let guesses = &self.frame.guesses;
         if self.settings.guess == GuessMode::Predict && !use_previous {
             job.grow_from_centre(&self.pool, &self.mesh, guesses);
             return;
         }
+        // A node with a previous value of its own is predicted from it (within a pixel on a
+        // steady field): its ZOI skips the integer search when the prediction is confirmed.
+        let previous = self.history.previous.as_ref().filter(|_| use_previous);
         self.pool.run(self.mesh.len(), &|engine, k| {
-            job.correlate(engine, k, guesses[k])
+            let predicted = previous.is_some_and(|p| p.last[k].is_some());
+            job.correlate(engine, k, guesses[k], predicted)
         });
         if let Some(previous) = self.history.previous.as_ref().filter(|_| use_previous) {
             let min_relative_score = self.settings.min_relative_score;
@@ -142,6 +149,51 @@ impl Correlator {
                 min_relative_score,
             );
         }
+    }
+}
+
+impl Correlator {
+    /// IC-GN: the predicted nodes whose prediction, taken without the FFT stage, failed the
+    /// final check are correlated from it with the full search (as without a prediction), and
+    /// every result is checked again. Nothing to do on a field the predictions follow.
+    pub(super) fn search_unconfirmed(&mut self, image: Image) {
+        self.scratch.retry.clear();
+        for (k, (result, &unsearched)) in self
+            .frame
+            .results
+            .iter()
+            .zip(&self.frame.unsearched)
+            .enumerate()
+        {
+            if unsearched && result.status != NodeStatus::Ok {
+                self.scratch.retry.push(k);
+            }
+        }
+        if self.scratch.retry.is_empty() {
+            return;
+        }
+        let use_previous = self.history.previous.is_some();
+        let job = NodeJob {
+            reference: &self.reference,
+            warps: if use_previous {
+                &self.history.gradients
+            } else {
+                &[]
+            },
+            results: SharedSlice::new(&mut self.frame.results),
+            image,
+            fft_px: self.fft_px,
+            pad_px: self.fft_pad_px,
+            iterations: super::fft_iterations(&self.settings),
+            skip_predicted: false,
+            unsearched: SharedSlice::new(&mut self.frame.unsearched),
+        };
+        let (retry, guesses) = (&self.scratch.retry, &self.frame.guesses);
+        self.pool.run(retry.len(), &|engine, i| {
+            let k = retry[i];
+            job.correlate(engine, k, guesses[k], false)
+        });
+        self.verify_results(image);
     }
 }
 
@@ -156,12 +208,28 @@ struct NodeJob<'a> {
     fft_px: usize,
     pad_px: usize,
     iterations: SubpixelIterations,
+    /// IC-GN: a predicted node takes its prediction as its guess without the FFT stage
+    /// (IC-GN refines it, the final check and [`Correlator::search_unconfirmed`] catch a wrong
+    /// one), marked in `unsearched`.
+    skip_predicted: bool,
+    unsearched: SharedSlice<'a, bool>,
 }
 
 impl NodeJob<'_> {
-    fn correlate(&self, engine: &mut ZoiEngine, k: usize, guess: (f64, f64)) {
+    /// `predicted`: the guess is the node's own prediction (see [`ZoiSearch::predicted`]).
+    fn correlate(&self, engine: &mut ZoiEngine, k: usize, guess: (f64, f64), predicted: bool) {
         let r = self.reference.nodes[k];
-        let result = if r.status != NodeStatus::Ok {
+        let unsearched = predicted && self.skip_predicted && r.status == NodeStatus::Ok;
+        let result = if unsearched {
+            // No score of its own: 0 until IC-GN's.
+            ZoiResult {
+                u_px: guess.0,
+                v_px: guess.1,
+                status: NodeStatus::Ok,
+                warp_gradient: self.warps.get(k).copied().flatten().unwrap_or_default(),
+                ..ZoiResult::default()
+            }
+        } else if r.status != NodeStatus::Ok {
             ZoiResult {
                 status: r.status,
                 ..ZoiResult::default()
@@ -177,6 +245,7 @@ impl NodeJob<'_> {
                 guess_px: guess,
                 warp: self.warps.get(k).copied().flatten(),
                 iterations: self.iterations,
+                predicted,
             };
             engine.correlate(&spectra, self.image, search)
         };
@@ -187,7 +256,10 @@ impl NodeJob<'_> {
                 || (result.status == NodeStatus::Ok && result.score > old.score)
         };
         if unsafe { better(&self.results.read(k)) } {
-            unsafe { self.results.write(k, result) };
+            unsafe {
+                self.results.write(k, result);
+                self.unsearched.write(k, unsearched);
+            }
         }
     }
 
@@ -202,13 +274,18 @@ impl NodeJob<'_> {
     ) {
         let nodes = previous.last.len();
         // SAFETY (reads below): the pool is not running.
+        // Predictions taken without the FFT stage have no score and are not retried here
+        // (the final check decides; see `search_unconfirmed`).
+        let searched = |k: &usize| !unsafe { self.unsearched.read(*k) };
         let min_score = min_relative_score
             * median_ok_score(
-                (0..nodes).map(|k| unsafe { self.results.read(k) }),
+                (0..nodes)
+                    .filter(searched)
+                    .map(|k| unsafe { self.results.read(k) }),
                 &mut scratch.scores,
             );
         scratch.retry.clear();
-        for k in 0..nodes {
+        for k in (0..nodes).filter(searched) {
             let result = unsafe { self.results.read(k) };
             // Outside the image too: an overshooting guess can push a border ZOI out.
             let failed = result.status != NodeStatus::Ok || result.score < min_score;
@@ -221,7 +298,7 @@ impl NodeJob<'_> {
             let k = retry[i];
             let p = previous.last[k].expect("retried nodes have a previous value");
             let base = self.reference.nodes[k].base_px;
-            self.correlate(engine, k, (p.0 - base.0, p.1 - base.1));
+            self.correlate(engine, k, (p.0 - base.0, p.1 - base.1), false);
         });
     }
 
@@ -233,7 +310,7 @@ impl NodeJob<'_> {
             pool.run(members.len(), &|engine, item| {
                 let k = members[item];
                 let guess = self.inner_mean(mesh, k, ring).unwrap_or(guesses[k]);
-                self.correlate(engine, k, guess);
+                self.correlate(engine, k, guess, false);
             });
         }
     }

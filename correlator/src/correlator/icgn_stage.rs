@@ -1,5 +1,6 @@
 //! The IC-GN stage of the correlator (methods `icgn1`, `icgn2`): the frame's B-spline
-//! coefficients (once per frame, on the pool), the reference subsets (once per reference), and
+//! coefficients (once per frame, on the pool), the reference subsets (each on its node's first
+//! IC-GN against a reference, on the pool: a new reference costs no subset until then), and
 //! the refinement of every node whose guess verified: IC-GN from the guess's displacement and
 //! gradient (the node's gradient in the previous frame on a followed mesh, else the
 //! least-squares gradient of its neighbours' guesses), then the final check against
@@ -8,6 +9,7 @@
 //! iterations, and its status (`outside_image` when a sample leaves the image,
 //! `not_converged` at the iteration cap, `low_zncc` when the final check fails).
 
+use super::parts::SubsetState;
 use super::{Correlator, Entry};
 use crate::field::NodeStatus;
 use crate::icgn::bspline::Coefficients;
@@ -69,41 +71,15 @@ impl Correlator {
         });
     }
 
-    /// The reference subset of every textured node (the coefficients hold the reference); a
-    /// flat subset is `low_contrast`.
-    pub(super) fn prepare_subsets(&mut self) {
-        let n = self.settings.zoi_px;
-        let order = self.order();
-        let values = PLANES * n * n;
-        let reference = Image {
-            pixels: super::reference_pixels(&self.reference.pixels),
-            width_px: self.width_px,
-            height_px: self.height_px,
-        };
-        let coefficients = self.coefficients.as_ref().expect("IC-GN coefficients");
-        let planes = SharedSlice::new(&mut self.reference.subset_planes);
-        let stats = SharedSlice::new(&mut self.reference.subset_stats);
-        let ref_nodes = SharedSlice::new(&mut self.reference.nodes);
-        self.pool.run(self.mesh.len(), &|_, k| {
-            // SAFETY: item k touches only node k's slots.
-            let mut r = unsafe { ref_nodes.read(k) };
-            if r.status != NodeStatus::Ok {
-                return;
-            }
-            let mut s = subset::SubsetStats::default();
-            // SAFETY: node k's planes, stats and reference slot are written by item k alone.
-            let planes = unsafe { planes.slice_mut(k * values, values) };
-            let spec = subset::SubsetSpec {
-                top_left_px: r.top_left,
-                side_px: n,
-                order,
-            };
-            if !subset::prepare(reference, coefficients, spec, planes, &mut s) {
-                r.status = NodeStatus::LowContrast;
-                unsafe { ref_nodes.write(k, r) };
-            }
-            unsafe { stats.write(k, s) };
-        });
+    /// The coefficients (which hold the reference's) kept as the reference's, and every
+    /// subset left to prepare on first need (in `refine_icgn`).
+    pub(super) fn keep_reference_coefficients(&mut self) {
+        let frame = self.coefficients.as_ref().expect("IC-GN coefficients");
+        let kept = self.reference.coefficients.as_mut();
+        kept.expect("IC-GN reference coefficients")
+            .data
+            .copy_from_slice(&frame.data);
+        self.reference.subset_states.fill(SubsetState::Unprepared);
     }
 
     /// IC-GN of node k's subset in the origin frame against the frame whose coefficients the
@@ -160,8 +136,12 @@ impl Correlator {
             height_px: self.height_px,
         };
         let coefficients = self.coefficients.as_ref().expect("IC-GN coefficients");
+        let reference_coefficients = self.reference.coefficients.as_ref();
+        let reference_coefficients = reference_coefficients.expect("IC-GN reference coefficients");
         let (entries, ref_nodes) = (&self.scratch.entries, &self.reference.nodes);
-        let (planes, stats) = (&self.reference.subset_planes, &self.reference.subset_stats);
+        let planes = SharedSlice::new(&mut self.reference.subset_planes);
+        let stats = SharedSlice::new(&mut self.reference.subset_stats);
+        let states = SharedSlice::new(&mut self.reference.subset_states);
         let results = SharedSlice::new(&mut self.frame.results);
         let zncc = SharedSlice::new(&mut self.frame.zncc);
         self.pool.run(entries.len(), &|engine, i| {
@@ -169,9 +149,45 @@ impl Correlator {
             let k = entry.node;
             let top_left = ref_nodes[k].top_left;
             let mut timer = Timer::start(engine.profile);
+            // SAFETY: item i touches only node entries[i].node's slots; nodes are distinct.
+            let (planes, stats) =
+                unsafe { (planes.slice_mut(k * values, values), stats.slice_mut(k, 1)) };
+            let mut state = unsafe { states.read(k) };
+            if state == SubsetState::Unprepared {
+                let spec = subset::SubsetSpec {
+                    top_left_px: top_left,
+                    side_px: n,
+                    order,
+                };
+                let ready = subset::prepare(
+                    reference,
+                    reference_coefficients,
+                    spec,
+                    planes,
+                    &mut stats[0],
+                );
+                state = if ready {
+                    SubsetState::Ready
+                } else {
+                    SubsetState::Flat
+                };
+                unsafe { states.write(k, state) };
+                timer.lap(&mut engine.split.other_ns);
+            }
+            if state == SubsetState::Flat {
+                let result = ZoiResult {
+                    status: NodeStatus::LowContrast,
+                    ..ZoiResult::default()
+                };
+                unsafe {
+                    results.write(k, result);
+                    zncc.write(k, 0.0);
+                }
+                return;
+            }
             let subset = Subset {
-                planes: &planes[k * values..(k + 1) * values],
-                stats: &stats[k],
+                planes,
+                stats: &stats[0],
                 n,
                 centre_px: (top_left.0 as f64 + half, top_left.1 as f64 + half),
             };

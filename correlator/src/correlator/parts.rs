@@ -22,9 +22,15 @@ pub(super) struct Reference {
     pub windowed: Vec<f32>,
     /// Per node, how its rigid estimate shifts under a displacement gradient.
     pub sensitivities: Vec<GradientSensitivity>,
-    /// IC-GN: per node, the reference subset's f̂, ∂f̂/∂x, ∂f̂/∂y (3 n² values) and constants.
+    /// IC-GN: per node, the reference subset's f̂, ∂f̂/∂x, ∂f̂/∂y (3 n² values) and constants,
+    /// prepared on first need (the node's first IC-GN against this reference, on the pool),
+    /// so that a new reference costs no subset at all until a frame needs it.
     pub subset_planes: Vec<f32>,
     pub subset_stats: Vec<SubsetStats>,
+    pub subset_states: Vec<SubsetState>,
+    /// IC-GN: the reference's B-spline coefficients (the subsets' values), kept beside the
+    /// frame's for the subsets prepared later.
+    pub coefficients: Option<Coefficients>,
     /// The keypoints of this reference, detected on first need.
     pub keypoints: Option<KeypointSet>,
     /// The global correlator's reference is older than `pixels` (it is renewed only when a
@@ -33,6 +39,16 @@ pub(super) struct Reference {
     pub frames_since: u64,
     /// This reference is still the origin (the image the mesh was defined in).
     pub is_origin: bool,
+}
+
+/// Whether a node's IC-GN reference subset is prepared.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) enum SubsetState {
+    #[default]
+    Unprepared,
+    Ready,
+    /// Flat (or a singular Hessian): the node is `low_contrast` against this reference.
+    Flat,
 }
 
 /// The image the mesh was defined in (given to `set_reference`), for the measurements against
@@ -71,6 +87,9 @@ pub(super) struct FrameResults {
     pub results: Vec<ZoiResult>,
     /// The final check of each node's result (ZNCC, see `verify`), 0 when unchecked.
     pub zncc: Vec<f64>,
+    /// IC-GN: the node's result is its prediction, taken without the FFT search (see
+    /// `guess.rs`); the search runs when the final check refuses it.
+    pub unsearched: Vec<bool>,
 }
 
 /// Buffers reused every frame (capacity: every node).
@@ -124,6 +143,7 @@ impl FrameResults {
             guesses: vec![(0.0, 0.0); nodes],
             results: vec![ZoiResult::default(); nodes],
             zncc: vec![0.0; nodes],
+            unsearched: vec![false; nodes],
         }
     }
 }

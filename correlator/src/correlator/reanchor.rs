@@ -148,6 +148,7 @@ impl Correlator {
                 guess_px: entry.guess_px,
                 warp: Some(entry.gradient),
                 iterations,
+                predicted: false,
             };
             let result = engine.correlate_uncached(origin, image, search);
             // The FFT ZOI's centre is `offset` px from the node's when an odd subset holds an

@@ -293,6 +293,7 @@ impl Coefficients {
 
     /// Value and gradient (∂/∂x, ∂/∂y) of the model at the pixel (ix, iy) with `weights` from
     /// [`pixel_weights`] (mirrored coefficients near the border).
+    #[cfg(test)]
     pub fn pixel_value_gradient(
         &self,
         (ix, iy): (usize, usize),
@@ -313,6 +314,50 @@ impl Coefficients {
             gy += derivative[r] * sv;
         }
         (v, gx, gy)
+    }
+
+    /// The model's values at the n x n pixels from `top_left` into `out` (row-major), with
+    /// `weights` from [`pixel_weights`]: the value of `pixel_value_gradient` (the tests' reference) at each
+    /// pixel, summed in the same order (the same f32 results), without its gradient, and with
+    /// the mirrored indices computed once per row and column instead of per tap.
+    pub fn pixel_values_block(
+        &self,
+        top_left: (usize, usize),
+        n: usize,
+        (value, _): &PixelWeights,
+        out: &mut [f32],
+    ) {
+        let (w, h) = (self.width_px, self.height_px);
+        assert!(top_left.0 + n <= w && top_left.1 + n <= h && out.len() == n * n);
+        // The columns' first tap: the block's columns −2..n + 2 mirrored, kept when they are
+        // contiguous (the block is two pixels from the left and right borders).
+        let interior_x = top_left.0 >= 2 && top_left.0 + n + 2 <= w;
+        for (j, out_row) in out.chunks_exact_mut(n).enumerate() {
+            out_row.fill(0.0);
+            for (r, &weight_r) in value.iter().enumerate() {
+                let yy = mirror((top_left.1 + j) as i64 + r as i64 - 2, h);
+                let row = &self.data[yy * w..(yy + 1) * w];
+                if interior_x {
+                    let taps = &row[top_left.0 - 2..top_left.0 + n + 2];
+                    for (i, v) in out_row.iter_mut().enumerate() {
+                        let mut sv = 0.0f32;
+                        for (c, &weight_c) in value.iter().enumerate() {
+                            sv += weight_c * taps[i + c];
+                        }
+                        *v += weight_r * sv;
+                    }
+                } else {
+                    for (i, v) in out_row.iter_mut().enumerate() {
+                        let mut sv = 0.0f32;
+                        for (c, &weight_c) in value.iter().enumerate() {
+                            let xx = mirror((top_left.0 + i) as i64 + c as i64 - 2, w);
+                            sv += weight_c * row[xx];
+                        }
+                        *v += weight_r * sv;
+                    }
+                }
+            }
+        }
     }
 
     /// Value and gradient (∂/∂x, ∂/∂y) at any (x, y) inside the image or at most
@@ -402,6 +447,40 @@ mod tests {
     }
 
     /// The threaded layout (row items, then column items) gives the same coefficients.
+    /// The block values are the per-pixel values, bit for bit, inside and at the borders.
+    #[test]
+    fn block_values_are_the_pixel_values() {
+        let (w, h) = (40usize, 30usize);
+        let pixels = image(w, h, |x, y| {
+            1000.0 + 500.0 * (0.7 * x).sin() * (0.45 * y + 0.2).cos()
+        });
+        let mut c = Coefficients::new(w, h);
+        c.prefilter(&pixels);
+        let weights = pixel_weights();
+        let n = 9;
+        for top_left in [
+            (10, 8),
+            (0, 0),
+            (w - n, h - n),
+            (1, h - n - 1),
+            (w - n - 1, 3),
+        ] {
+            let mut block = vec![0.0; n * n];
+            c.pixel_values_block(top_left, n, &weights, &mut block);
+            for j in 0..n {
+                for i in 0..n {
+                    let (v, _, _) =
+                        c.pixel_value_gradient((top_left.0 + i, top_left.1 + j), &weights);
+                    assert_eq!(
+                        block[j * n + i].to_bits(),
+                        v.to_bits(),
+                        "{top_left:?} ({i}, {j})"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn row_and_column_items_equal_the_whole_prefilter() {
         let (w, h) = (150, 41);

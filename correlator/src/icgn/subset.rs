@@ -104,20 +104,10 @@ pub fn prepare(
     *stats = SubsetStats::default();
     let (values, rest) = planes.split_at_mut(nn);
     let (gx, gy) = rest.split_at_mut(nn);
-    let mut sum = 0.0f64;
-    let weights = bspline::pixel_weights();
-    for j in 0..n {
-        for i in 0..n {
-            // The model's value (the pixel itself: it interpolates) and the image's gradient.
-            let (f, _, _) =
-                coefficients.pixel_value_gradient((top_left.0 + i, top_left.1 + j), &weights);
-            let (dx, dy) = central_gradient(reference, (top_left.0 + i, top_left.1 + j));
-            values[j * n + i] = f;
-            gx[j * n + i] = dx;
-            gy[j * n + i] = dy;
-            sum += f as f64;
-        }
-    }
+    // The model's values (the pixels themselves: it interpolates) and the image's gradient.
+    coefficients.pixel_values_block(top_left, n, &bspline::pixel_weights(), values);
+    central_gradient_block(reference, top_left, n, gx, gy);
+    let sum: f64 = values.iter().map(|&f| f as f64).sum();
     let mean = sum / nn as f64;
     let norm_sq: f64 = values.iter().map(|&f| (f as f64 - mean).powi(2)).sum();
     if (norm_sq / nn as f64).sqrt() < MIN_STD_COUNTS as f64 {
@@ -142,13 +132,27 @@ pub fn prepare(
 /// Σ J f̂ into `stats` on the way; None when H is singular.
 fn inverse_hessian(
     spec: SubsetSpec,
+    planes: [&[f32]; 3],
+    stats: &mut SubsetStats,
+) -> Option<[f64; 144]> {
+    match spec.order {
+        Order::First => inverse_hessian_of::<6>(spec, planes, stats),
+        Order::Second => inverse_hessian_of::<12>(spec, planes, stats),
+    }
+}
+
+/// [`inverse_hessian`] for an order of `COUNT` parameters (known at compile time, so that the
+/// per-pixel loops over the parameters are unrolled).
+fn inverse_hessian_of<const COUNT: usize>(
+    spec: SubsetSpec,
     [values, gx, gy]: [&[f32]; 3],
     stats: &mut SubsetStats,
 ) -> Option<[f64; 144]> {
     let (n, order) = (spec.side_px, spec.order);
+    assert_eq!(order.parameters(), COUNT);
     let nn = n * n;
     let (values, gx, gy) = (&values[..nn], &gx[..nn], &gy[..nn]);
-    let count = order.parameters();
+    let count = COUNT;
     let half = (n as f64 - 1.0) / 2.0;
     let mut hessian = [0.0f64; 144];
     let mut j_pixel = [0.0f64; 12];
@@ -190,9 +194,45 @@ fn inverse_hessian(
             hessian[a * count + b] = hessian[b * count + a];
         }
     }
-    match order {
-        Order::First => invert::<6>(&hessian),
-        Order::Second => invert::<12>(&hessian),
+    invert::<COUNT>(&hessian)
+}
+
+/// [`central_gradient`] at every pixel of the n x n block from `top_left` into `gx` and `gy`
+/// (row-major), the same sums in the same order; without the clamps where the block is three
+/// pixels from every border.
+fn central_gradient_block(
+    image: Image,
+    top_left: (usize, usize),
+    n: usize,
+    gx: &mut [f32],
+    gy: &mut [f32],
+) {
+    const TAPS: [f32; 3] = [45.0 / 60.0, -9.0 / 60.0, 1.0 / 60.0];
+    let (w, h) = (image.width_px, image.height_px);
+    let (x0, y0) = top_left;
+    if !(x0 >= 3 && y0 >= 3 && x0 + n + 3 <= w && y0 + n + 3 <= h) {
+        for j in 0..n {
+            for i in 0..n {
+                (gx[j * n + i], gy[j * n + i]) = central_gradient(image, (x0 + i, y0 + j));
+            }
+        }
+        return;
+    }
+    let p = image.pixels;
+    for j in 0..n {
+        let centre = (y0 + j) * w + x0;
+        let (gx_row, gy_row) = (&mut gx[j * n..(j + 1) * n], &mut gy[j * n..(j + 1) * n]);
+        for i in 0..n {
+            let at = centre + i;
+            let (mut dx, mut dy) = (0.0f32, 0.0f32);
+            for (k, tap) in TAPS.iter().enumerate() {
+                let d = k + 1;
+                dx += tap * (p[at + d] as f32 - p[at - d] as f32);
+                dy += tap * (p[at + d * w] as f32 - p[at - d * w] as f32);
+            }
+            gx_row[i] = dx;
+            gy_row[i] = dy;
+        }
     }
 }
 
@@ -295,6 +335,43 @@ pub(crate) mod test_support {
                 stats: &self.stats,
                 n: self.n,
                 centre_px: self.centre_px,
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The block gradient is the per-pixel one, bit for bit, inside and at the borders.
+    #[test]
+    fn block_gradient_is_the_pixel_gradient() {
+        let (w, h) = (40usize, 30usize);
+        let pixels: Vec<u16> = (0..w * h)
+            .map(|i| ((i * 7919) % 4093 + 100 * (i % w)) as u16)
+            .collect();
+        let image = Image {
+            pixels: &pixels,
+            width_px: w,
+            height_px: h,
+        };
+        let n = 9;
+        for top_left in [
+            (10, 8),
+            (0, 0),
+            (w - n, h - n),
+            (2, 3),
+            (w - n - 3, h - n - 2),
+        ] {
+            let (mut gx, mut gy) = (vec![0.0; n * n], vec![0.0; n * n]);
+            central_gradient_block(image, top_left, n, &mut gx, &mut gy);
+            for j in 0..n {
+                for i in 0..n {
+                    let (dx, dy) = central_gradient(image, (top_left.0 + i, top_left.1 + j));
+                    assert_eq!(gx[j * n + i].to_bits(), dx.to_bits(), "{top_left:?}");
+                    assert_eq!(gy[j * n + i].to_bits(), dy.to_bits(), "{top_left:?}");
+                }
             }
         }
     }

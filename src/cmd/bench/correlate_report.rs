@@ -44,6 +44,19 @@ impl Measured {
         self.parts().iter().map(|p| p.1).sum()
     }
 
+    /// One real n x n forward plus inverse transform, the unit of a ZOI's cost (µs, this run).
+    fn fft_pair_us(&self) -> f64 {
+        (self.fft.real_forward_ns + self.fft.real_inverse_ns) / 1e3
+    }
+
+    /// The benchmarked ZOI's cost in one-thread wall-clock time (µs, unprofiled) and in FFT
+    /// pairs of this run; None without a one-thread run.
+    fn zoi_cost(&self) -> Option<(f64, f64)> {
+        let one = self.runs.iter().find(|r| r.threads == 1)?;
+        let us = one.median_s * 1e6 / one.nodes as f64;
+        Some((us, us / self.fft_pair_us()))
+    }
+
     /// The run on two threads, if measured.
     fn two_threads(&self) -> Option<&ThreadRun> {
         self.runs.iter().find(|r| r.threads == 2)
@@ -80,6 +93,11 @@ impl CorrelateBench {
                 "us_per_zoi": total_ns as f64 / 1e3 / profiled_zois as f64,
                 "percent": m.parts().iter().map(|(name, ns)| (name.to_string(), serde_json::json!(100.0 * *ns as f64 / total_ns.max(1) as f64))).collect::<serde_json::Map<_, _>>(),
             },
+            "zoi_cost_1_thread": m.zoi_cost().map(|(us, pairs)| serde_json::json!({
+                "us_per_zoi": us,
+                "fft_pairs_per_zoi": pairs,
+                "fft_pair_us": m.fft_pair_us(),
+            })),
             "keypoint_guess_2_threads": {
                 "reference_ms": m.keypoints.reference_ms,
                 "per_frame_ms": m.keypoints.per_frame_ms,
@@ -111,6 +129,13 @@ impl CorrelateBench {
             m.fft.real_inverse_ns / 1e3,
             n = m.fft.n
         );
+        if let Some((us, pairs)) = m.zoi_cost() {
+            println!(
+                "  cost per ZOI (1 thread, unprofiled median): {us:.2} µs = {pairs:.2} FFT pairs ({n}x{n} real forward + inverse: {:.2} µs in this run)",
+                m.fft_pair_us(),
+                n = m.fft.n
+            );
+        }
         self.print_keypoints(&m.keypoints);
         self.print_target(m.two_threads());
     }
@@ -168,6 +193,8 @@ fn run_json(r: &ThreadRun) -> serde_json::Value {
         "mean_iterations": r.mean_iterations,
         "mean_error_px": r.error_px,
         "set_reference_ms": r.set_reference_ms,
+        "set_reference_again_ms": r.set_reference_again_ms,
+        "first_frame_after_again_ms": r.first_frame_ms,
     })
 }
 
@@ -200,7 +227,7 @@ pub(super) fn print_run(r: &ThreadRun) {
         "no truth for image files".to_owned()
     };
     println!(
-        "  {} thread(s): {:8.0} ZOIs/s, {:6.2} frames/s, {:7.2} ms/frame (min {:.2}, max {:.2}); {} ZOIs, {} valid, {:.2} iterations/ZOI, {error}; set_reference {:.1} ms",
+        "  {} thread(s): {:8.0} ZOIs/s, {:6.2} frames/s, {:7.2} ms/frame (min {:.2}, max {:.2}); {} ZOIs, {} valid, {:.2} iterations/ZOI, {error}; set_reference {:.1} ms (again, running: {:.1} ms, then its first frame {:.1} ms)",
         r.threads,
         zois_per_s(r),
         1.0 / r.median_s,
@@ -210,6 +237,8 @@ pub(super) fn print_run(r: &ThreadRun) {
         r.nodes,
         r.valid,
         r.mean_iterations,
-        r.set_reference_ms
+        r.set_reference_ms,
+        r.set_reference_again_ms,
+        r.first_frame_ms
     );
 }
