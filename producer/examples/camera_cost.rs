@@ -2,10 +2,11 @@
 //! `--side N`), the rig-following camera, 8 bits, shot and read noise, the fast renderer, one
 //! thread. Prints the median ms per frame of rendering (φ⁻¹ and bicubic sampling) and of
 //! exposure (noise, quantisation, into the frame buffer), over `--frames N` frames of a
-//! uniaxial stretch growing to 1.9.
+//! uniaxial stretch growing to 1.9 (or held at `--stretch-percent P` %).
 //!
 //! `cargo run --release -p producer --example camera_cost -- --frames 30`; under
-//! `valgrind --tool=callgrind` with `--frames 3` for instruction counts.
+//! `valgrind --tool=callgrind --collect-atstart=no --toggle-collect='camera_cost::whole_frame'`
+//! with `--frames 3` for instruction counts per frame.
 
 use producer::{RigCamera, RigFollowConfig, RigKinematics, SimulatedConfig};
 use std::time::Instant;
@@ -23,9 +24,17 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// One whole frame (render and expose) into `frame`: the function callgrind counts
+/// (`--toggle-collect='camera_cost::whole_frame'`).
+#[inline(never)]
+fn whole_frame(camera: &mut RigCamera, motion: &producer::RigMotion, frame: &mut [u16]) {
+    camera.render(motion, frame).expect("a frame");
+}
+
 fn main() {
     let frames = arg("--frames", 30);
     let side = arg("--side", 1024) as u32;
+    let fixed_stretch_percent = arg("--stretch-percent", 0);
     let mut config = SimulatedConfig::new(side, side);
     config.threads = arg("--threads", 1);
     let mut follow = RigFollowConfig::default();
@@ -39,7 +48,10 @@ fn main() {
     let mut frame = vec![0u16; side as usize * side as usize];
     let (mut render_ms, mut expose_ms, mut total_ms) = (vec![], vec![], vec![]);
     for k in 0..frames {
-        let stretch = 1.0 + 0.9 * k as f64 / frames.max(1) as f64;
+        let stretch = match fixed_stretch_percent {
+            0 => 1.0 + 0.9 * k as f64 / frames.max(1) as f64,
+            percent => percent as f64 / 100.0,
+        };
         camera.push_kinematics(RigKinematics {
             stretch_x: stretch,
             stretch_y: 1.0 / stretch.sqrt(),
@@ -53,7 +65,7 @@ fn main() {
         let t0 = Instant::now();
         camera.render_pattern(&motion);
         let t1 = Instant::now();
-        camera.render(&motion, &mut frame).expect("a frame");
+        whole_frame(&mut camera, &motion, &mut frame);
         let t2 = Instant::now();
         let render = (t1 - t0).as_secs_f64() * 1e3;
         let whole = (t2 - t1).as_secs_f64() * 1e3;
