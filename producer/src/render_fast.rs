@@ -85,11 +85,16 @@ impl TexelGrid {
             for iy in ys {
                 let d = origin_px[1] + iy as f64 * h - spot.centre_px[1];
                 let gy = (-d * d * spot.inv_two_sigma2).exp();
-                let row = &mut band[(iy - rows.start) * texels_x..][..texels_x];
-                for (k, ix) in xs.clone().enumerate() {
-                    if dx2[k] + d * d < spot.cutoff2_px2 {
-                        row[ix] += (gx[k] * gy) as f32;
-                    }
+                let row = &mut band[(iy - rows.start) * texels_x..][..texels_x][xs.clone()];
+                // Branch-free (vectorised): a texel beyond the cutoff adds zero.
+                let d2 = d * d;
+                for ((texel, &g), &dx2) in row.iter_mut().zip(&gx).zip(&dx2) {
+                    let value = if dx2 + d2 < spot.cutoff2_px2 {
+                        g * gy
+                    } else {
+                        0.0
+                    };
+                    *texel += value as f32;
                 }
             }
         }
@@ -131,12 +136,13 @@ impl TexelGrid {
             let mut scratch = vec![0f32; texels_x];
             for row in band.chunks_exact_mut(texels_x) {
                 scratch.copy_from_slice(row);
-                for ix in half..texels_x - half {
+                let inner = &mut row[half..texels_x - half];
+                for (out, window) in inner.iter_mut().zip(scratch.windows(weights.len())) {
                     let mut sum = 0.0f64;
-                    for (k, w) in weights.iter().enumerate() {
-                        sum += w * f64::from(scratch[ix + k - half]);
+                    for (w, s) in weights.iter().zip(window) {
+                        sum += w * f64::from(*s);
                     }
-                    row[ix] = sum as f32;
+                    *out = sum as f32;
                 }
             }
         });
