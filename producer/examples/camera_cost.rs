@@ -79,4 +79,12 @@ fn main() {
         median(expose_ms),
         median(total_ms)
     );
+    // A fingerprint of the last frame, to compare builds: equal sums, most likely equal frames.
+    let sum: u64 = frame.iter().map(|&v| u64::from(v)).sum();
+    let weighted: u64 = frame
+        .iter()
+        .enumerate()
+        .map(|(k, &v)| (k as u64 % 65_521) * u64::from(v))
+        .sum();
+    println!("last frame: sum {sum}, weighted sum {weighted}");
 }

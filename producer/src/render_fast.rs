@@ -85,16 +85,20 @@ impl TexelGrid {
             for iy in ys {
                 let d = origin_px[1] + iy as f64 * h - spot.centre_px[1];
                 let gy = (-d * d * spot.inv_two_sigma2).exp();
-                let row = &mut band[(iy - rows.start) * texels_x..][..texels_x][xs.clone()];
-                // Branch-free (vectorised): a texel beyond the cutoff adds zero.
+                // The texels within the cutoff form one run of the row (dx² is monotone on
+                // each side of the centre): found from both ends, then summed without a test.
                 let d2 = d * d;
-                for ((texel, &g), &dx2) in row.iter_mut().zip(&gx).zip(&dx2) {
-                    let value = if dx2 + d2 < spot.cutoff2_px2 {
-                        g * gy
-                    } else {
-                        0.0
-                    };
-                    *texel += value as f32;
+                let within = |k: &usize| dx2[*k] + d2 < spot.cutoff2_px2;
+                let Some(first) = (0..dx2.len()).find(within) else {
+                    continue;
+                };
+                let end = (first..dx2.len())
+                    .rev()
+                    .find(within)
+                    .map_or(first, |k| k + 1);
+                let row = &mut band[(iy - rows.start) * texels_x..][..texels_x][xs.clone()];
+                for (texel, &g) in row[first..end].iter_mut().zip(&gx[first..end]) {
+                    *texel += (g * gy) as f32;
                 }
             }
         }
