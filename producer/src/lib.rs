@@ -21,6 +21,7 @@ mod render_exact;
 mod render_fast;
 mod replay;
 mod rig_follow;
+pub mod row_inverse;
 mod scenario;
 mod simulated;
 mod source;

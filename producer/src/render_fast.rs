@@ -6,6 +6,7 @@
 
 use crate::motion::{inverse, mul_vec, Affine, Motion};
 use crate::parallel::for_row_bands;
+use crate::row_inverse::RowInverse;
 use crate::speckle::{Speckle, Spot};
 use std::ops::Range;
 
@@ -266,8 +267,9 @@ impl FastRenderer {
                 match motion {
                     Motion::Affine(a) => self.render_affine_row(a, y, row),
                     other => {
+                        let mut inverse = RowInverse::new(other, y);
                         for (col, value) in row.iter_mut().enumerate() {
-                            *value = self.sample(other.inverse([col as f64, y]));
+                            *value = self.sample(inverse.next(col as f64));
                         }
                     }
                 }
