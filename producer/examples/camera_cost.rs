@@ -1,7 +1,8 @@
 //! The simulated camera's cost per frame, split by stage, as the live bench runs it: 1024² (or
 //! `--side N`), the rig-following camera, 8 bits, shot and read noise, the fast renderer, one
-//! thread. Prints the median ms per frame of rendering (φ⁻¹ and bicubic sampling) and of
-//! exposure (noise, quantisation, into the frame buffer), over `--frames N` frames of a
+//! thread. Prints the median ms per frame of rendering (φ⁻¹ and bicubic sampling, the pattern
+//! alone) and of exposure (noise, quantisation, into the frame buffer: the whole frame, rendered
+//! and exposed row by row, minus the rendering), over `--frames N` frames of a
 //! uniaxial stretch growing to 1.9 (or held at `--stretch-percent P` %).
 //!
 //! `cargo run --release -p producer --example camera_cost -- --frames 30`; under

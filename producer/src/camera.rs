@@ -149,6 +149,18 @@ impl CameraModel {
         threads: usize,
     ) {
         assert_eq!(pattern.len(), out.len(), "pattern and frame sizes differ");
+        for_row_bands(out, width, threads, |first_row, band| {
+            for (r, row) in band.chunks_exact_mut(width).enumerate() {
+                let y = first_row + r;
+                self.expose_row(frame_index, y, &pattern[y * width..][..width], row);
+            }
+        });
+    }
+
+    /// Exposes the pattern values `pattern_row` of row `y` of frame `frame_index` into `out`:
+    /// the same grey levels as that row of [`Self::expose`] (one noise stream per row).
+    pub fn expose_row(&self, frame_index: u64, y: usize, pattern_row: &[f32], out: &mut [u16]) {
+        assert_eq!(pattern_row.len(), out.len(), "pattern and row sizes differ");
         let max_dn = f64::from(self.max_dn());
         let gain = self.gain_dn_per_e;
         let read_var_dn2 = self.read_noise_dn * self.read_noise_dn;
@@ -156,22 +168,16 @@ impl CameraModel {
         // draw per pixel carries both (their sum is normal with the summed variance).
         let shot_var_dn2_per_e = if self.shot_noise { gain * gain } else { 0.0 };
         let noisy = self.shot_noise || self.read_noise_dn > 0.0;
-        for_row_bands(out, width, threads, |first_row, band| {
-            for (r, row) in band.chunks_exact_mut(width).enumerate() {
-                let y = first_row + r;
-                let mut rng = ChaCha8Rng::seed_from_u64(mix(self.seed, frame_index, y as u64));
-                let src = &pattern[y * width..][..width];
-                for (o, &p) in row.iter_mut().zip(src) {
-                    let electrons = self.illumination_e * f64::from(p).max(0.0);
-                    let mut dn = self.offset_dn + gain * electrons;
-                    if noisy {
-                        let z: f64 = StandardNormal.sample(&mut rng);
-                        dn += z * (shot_var_dn2_per_e * electrons + read_var_dn2).sqrt();
-                    }
-                    *o = quantise(dn, max_dn);
-                }
+        let mut rng = ChaCha8Rng::seed_from_u64(mix(self.seed, frame_index, y as u64));
+        for (o, &p) in out.iter_mut().zip(pattern_row) {
+            let electrons = self.illumination_e * f64::from(p).max(0.0);
+            let mut dn = self.offset_dn + gain * electrons;
+            if noisy {
+                let z: f64 = StandardNormal.sample(&mut rng);
+                dn += z * (shot_var_dn2_per_e * electrons + read_var_dn2).sqrt();
             }
-        });
+            *o = quantise(dn, max_dn);
+        }
     }
 }
 

@@ -263,18 +263,23 @@ impl FastRenderer {
     pub fn render(&self, motion: &Motion, width: usize, out: &mut [f32]) {
         for_row_bands(out, width, self.threads, |first_row, band| {
             for (r, row) in band.chunks_exact_mut(width).enumerate() {
-                let y = (first_row + r) as f64;
-                match motion {
-                    Motion::Affine(a) => self.render_affine_row(a, y, row),
-                    other => {
-                        let mut inverse = RowInverse::new(other, y);
-                        for (col, value) in row.iter_mut().enumerate() {
-                            *value = self.sample(inverse.next(col as f64));
-                        }
-                    }
-                }
+                self.render_row(motion, first_row + r, row);
             }
         });
+    }
+
+    /// Renders row `y` (pixel row index) of the frame into `row` (values in [0, 1]).
+    pub fn render_row(&self, motion: &Motion, y: usize, row: &mut [f32]) {
+        let y = y as f64;
+        match motion {
+            Motion::Affine(a) => self.render_affine_row(a, y, row),
+            other => {
+                let mut inverse = RowInverse::new(other, y);
+                for (col, value) in row.iter_mut().enumerate() {
+                    *value = self.sample(inverse.next(col as f64));
+                }
+            }
+        }
     }
 
     /// Row `y` of an affine motion: X = c + F⁻¹ (x - c - t) is affine in the column, so the

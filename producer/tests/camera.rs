@@ -190,3 +190,33 @@ fn combined_noise_has_normal_tails() {
     camera.expose(7, &vec![0.0; w * h], w, &mut b, 1);
     assert_eq!(a, b, "no electrons, no shot noise: the same read noise");
 }
+
+/// Without blur the camera renders and exposes row by row (the pattern never stored): the
+/// same grey levels as the pattern rendered whole and then exposed, for an affine and a
+/// heterogeneous motion, on 1 and 3 threads.
+#[test]
+fn row_by_row_frames_equal_the_whole_pattern_exposed() {
+    use producer::{Bulge, Motion};
+    let motions = [
+        Scenario::parse("rotation:angle_deg=3", W as u32, H as u32)
+            .unwrap()
+            .motion_at_fraction(1.0),
+        Motion::Bulge(Bulge {
+            strain: 0.1,
+            width_px: 30.0,
+            centre_px: [60.0, 50.0],
+        }),
+    ];
+    for threads in [1, 3] {
+        let mut config = SimulatedConfig::new(W as u32, H as u32);
+        config.threads = threads;
+        let mut camera = SimulatedCamera::for_reach(config, 20.0).unwrap();
+        for (k, motion) in motions.iter().enumerate() {
+            let mut fused = vec![0u16; W * H];
+            camera.render_frame(motion, k as u64, &mut fused).unwrap();
+            let pattern = camera.render_pattern(motion).to_vec();
+            let whole = config.camera.exposed(k as u64, &pattern, W, 1);
+            assert_eq!(fused, whole, "motion {k}, {threads} thread(s)");
+        }
+    }
+}
