@@ -1,7 +1,8 @@
 //! The camera model: pattern value p in [0, 1] → photo-electrons → grey levels.
 //! N_e = illumination_e p; with shot noise, N_e ~ Normal(N_e, √N_e) (the Gaussian limit of the
 //! Poisson law, accurate above ~20 e⁻); DN = offset_dn + gain_dn_per_e N_e + Normal(0,
-//! read_noise_dn), rounded, clipped to [0, 2^bit_depth - 1] (saturation). Optional Gaussian
+//! read_noise_dn), rounded, clipped to [0, 2^bit_depth - 1] (saturation). The two normals are
+//! drawn as one, of the summed variance gain² N_e + read_noise_dn² (one draw per pixel). Optional Gaussian
 //! blur (optics) of the pattern before exposure. Noise is reproducible: one generator per
 //! (seed, frame, row), so results do not depend on the thread count.
 
@@ -149,32 +150,44 @@ impl CameraModel {
         threads: usize,
     ) {
         assert_eq!(pattern.len(), out.len(), "pattern and frame sizes differ");
-        let max_dn = f64::from(self.max_dn());
-        let noisy = self.shot_noise || self.read_noise_dn > 0.0;
         for_row_bands(out, width, threads, |first_row, band| {
             for (r, row) in band.chunks_exact_mut(width).enumerate() {
                 let y = first_row + r;
-                let mut rng = ChaCha8Rng::seed_from_u64(mix(self.seed, frame_index, y as u64));
-                let src = &pattern[y * width..][..width];
-                for (o, &p) in row.iter_mut().zip(src) {
-                    let mut electrons = self.illumination_e * f64::from(p).max(0.0);
-                    let mut read = 0.0;
-                    if noisy {
-                        if self.shot_noise {
-                            let z: f64 = StandardNormal.sample(&mut rng);
-                            electrons = (electrons + z * electrons.sqrt()).max(0.0);
-                        }
-                        if self.read_noise_dn > 0.0 {
-                            let z: f64 = StandardNormal.sample(&mut rng);
-                            read = z * self.read_noise_dn;
-                        }
-                    }
-                    let dn = self.offset_dn + self.gain_dn_per_e * electrons + read;
-                    *o = dn.round().clamp(0.0, max_dn) as u16;
-                }
+                self.expose_row(frame_index, y, &pattern[y * width..][..width], row);
             }
         });
     }
+
+    /// Exposes the pattern values `pattern_row` of row `y` of frame `frame_index` into `out`:
+    /// the same grey levels as that row of [`Self::expose`] (one noise stream per row).
+    pub fn expose_row(&self, frame_index: u64, y: usize, pattern_row: &[f32], out: &mut [u16]) {
+        assert_eq!(pattern_row.len(), out.len(), "pattern and row sizes differ");
+        let max_dn = f64::from(self.max_dn());
+        let gain = self.gain_dn_per_e;
+        let read_var_dn2 = self.read_noise_dn * self.read_noise_dn;
+        // Shot noise in DN has variance gain² N_e; the read noise's adds to it: one normal
+        // draw per pixel carries both (their sum is normal with the summed variance).
+        let shot_var_dn2_per_e = if self.shot_noise { gain * gain } else { 0.0 };
+        let noisy = self.shot_noise || self.read_noise_dn > 0.0;
+        let mut rng = ChaCha8Rng::seed_from_u64(mix(self.seed, frame_index, y as u64));
+        for (o, &p) in out.iter_mut().zip(pattern_row) {
+            let electrons = self.illumination_e * f64::from(p).max(0.0);
+            let mut dn = self.offset_dn + gain * electrons;
+            if noisy {
+                let z: f64 = StandardNormal.sample(&mut rng);
+                dn += z * (shot_var_dn2_per_e * electrons + read_var_dn2).sqrt();
+            }
+            *o = quantise(dn, max_dn);
+        }
+    }
+}
+
+/// `dn` rounded to the nearest level and clipped to [0, `max_dn`] (saturation). Rounds half
+/// up (`f64::round` is a library call on the baseline x86-64 target; this is two
+/// instructions).
+#[inline]
+fn quantise(dn: f64, max_dn: f64) -> u16 {
+    (dn.clamp(0.0, max_dn) + 0.5) as u16
 }
 
 /// SplitMix64 of the three, for independent per-row streams.

@@ -21,6 +21,7 @@ mod render_exact;
 mod render_fast;
 mod replay;
 mod rig_follow;
+pub mod row_inverse;
 mod scenario;
 pub mod settings;
 mod simulated;

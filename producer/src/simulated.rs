@@ -9,6 +9,7 @@
 use crate::camera::{Blur, CameraModel};
 use crate::error::ProducerError;
 use crate::motion::Motion;
+use crate::parallel::for_row_bands;
 use crate::render_exact::ExactRenderer;
 use crate::render_fast::FastRenderer;
 use crate::scenario::Scenario;
@@ -284,14 +285,26 @@ impl SimulatedCamera {
         out: &mut [u16],
     ) -> Result<(), ProducerError> {
         check_buffer(self.dims(), out)?;
-        self.render_pattern(motion);
-        self.config.camera.expose(
-            frame_index,
-            &self.pattern,
-            self.config.width as usize,
-            out,
-            self.config.threads.max(1),
-        );
+        let (width, threads) = (self.config.width as usize, self.config.threads.max(1));
+        let camera = &self.config.camera;
+        match (&self.renderer, &self.blur) {
+            // Without blur each row is rendered and exposed while it is in cache: the frame's
+            // pattern never goes to memory (one row of scratch per thread).
+            (Renderer::Fast(fast), None) => {
+                for_row_bands(out, width, threads, |first_row, band| {
+                    let mut pattern_row = vec![0f32; width];
+                    for (r, row) in band.chunks_exact_mut(width).enumerate() {
+                        fast.render_row(motion, first_row + r, &mut pattern_row);
+                        camera.expose_row(frame_index, first_row + r, &pattern_row, row);
+                    }
+                })
+            }
+            _ => {
+                self.render_pattern(motion);
+                let camera = &self.config.camera;
+                camera.expose(frame_index, &self.pattern, width, out, threads);
+            }
+        }
         Ok(())
     }
 }
