@@ -39,6 +39,14 @@ wire::named!(Trigger, "trigger", ignore_case, {
     Free => "free", Software => "software", Hardware => "hardware",
 });
 
+impl Trigger {
+    /// The frame or trigger rate to set for `fps` asked: none for 0 (the camera's own rate)
+    /// or under a hardware trigger (the external pulses set it).
+    pub fn rate_fps(self, fps: f64) -> Option<f64> {
+        (fps > 0.0 && self != Trigger::Hardware).then_some(fps)
+    }
+}
+
 /// Which camera `--camera` names: `genicam` (the first found) or `genicam:ID` (an Aravis
 /// device id such as `Basler-21234567`, a serial number, or an address).
 #[derive(Clone, Debug, PartialEq, Eq)]

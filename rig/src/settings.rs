@@ -166,40 +166,33 @@ pub enum SettingsError {
     LawNotTaken,
 }
 
-/// The program a start runs, and the specimen it mounts (a built-in test's).
-fn program_of(
-    start: &RigStart,
-) -> Result<(Option<Program>, Option<crate::specimen::SpecimenConfig>), SettingsError> {
-    Ok(match start {
-        RigStart::Program { file } => {
-            let text =
-                std::fs::read_to_string(file).map_err(|reason| SettingsError::ProgramFile {
-                    file: file.clone(),
-                    reason,
-                })?;
-            let base = file.parent().map(PathBuf::from).unwrap_or_default();
-            let program =
-                Program::from_toml(&text, &base).map_err(|reason| SettingsError::Program {
-                    file: file.clone(),
-                    reason,
-                })?;
-            (Some(program), None)
-        }
-        RigStart::Builtin { test } => (
-            Some(test.test.program(test.rate_per_s, test.stretch)?),
-            Some(test.test.specimen()),
-        ),
-        RigStart::Idle | RigStart::Campaign { .. } | RigStart::Strain { .. } => (None, None),
-    })
-}
-
 impl RigSettings {
     /// The program of the start (a file read, or a built-in test's), and the specimen it
     /// mounts (a built-in test's).
     pub fn program(
         &self,
     ) -> Result<(Option<Program>, Option<crate::specimen::SpecimenConfig>), SettingsError> {
-        program_of(&self.start)
+        Ok(match &self.start {
+            RigStart::Program { file } => {
+                let text =
+                    std::fs::read_to_string(file).map_err(|reason| SettingsError::ProgramFile {
+                        file: file.clone(),
+                        reason,
+                    })?;
+                let base = file.parent().map(PathBuf::from).unwrap_or_default();
+                let program =
+                    Program::from_toml(&text, &base).map_err(|reason| SettingsError::Program {
+                        file: file.clone(),
+                        reason,
+                    })?;
+                (Some(program), None)
+            }
+            RigStart::Builtin { test } => (
+                Some(test.test.program(test.rate_per_s, test.stretch)?),
+                Some(test.test.specimen()),
+            ),
+            RigStart::Idle | RigStart::Campaign { .. } | RigStart::Strain { .. } => (None, None),
+        })
     }
 
     /// The campaign of the start, on the law if given.
@@ -311,10 +304,13 @@ mod tests {
             ..RigSettings::default()
         };
         assert!(settings.campaign().is_err());
-        let missing = RigStart::Program {
-            file: "/no/such/program.toml".into(),
+        let missing = RigSettings {
+            start: RigStart::Program {
+                file: "/no/such/program.toml".into(),
+            },
+            ..RigSettings::default()
         };
-        let error = program_of(&missing).unwrap_err().to_string();
+        let error = missing.program().unwrap_err().to_string();
         assert!(
             error.starts_with("program /no/such/program.toml: "),
             "{error}"

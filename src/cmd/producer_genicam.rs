@@ -67,7 +67,7 @@ impl CameraArgs {
         CameraSettings {
             exposure_us: self.exposure_us,
             gain_db: self.gain_db,
-            fps: (fps > 0.0 && self.trigger != Trigger::Hardware).then_some(fps),
+            fps: self.trigger.rate_fps(fps),
             pixel_format: self.pixel_format,
             roi: self.roi,
             trigger: self.trigger,

@@ -153,8 +153,6 @@ fn start_of(args: &RigArgs) -> anyhow::Result<RigStart> {
                 let test = BuiltinTest::parse(name).ok_or_else(|| {
                     anyhow::anyhow!("--test {name:?}: expected uniaxial, equibiaxial or campaign")
                 })?;
-                // Its program now, so that a bad --stretch or --rate is said with its flag.
-                test.program(args.rate, args.stretch)?;
                 RigStart::Builtin {
                     test: CampaignTest {
                         test,

@@ -158,22 +158,23 @@ pub fn producer_settings(
             files: PathBuf::from(&c.replay_files),
             looping: false,
         },
-        CameraSource::Genicam => SourceSettings::Genicam {
-            camera: producer::genicam::CameraSpec {
-                id: Some(c.genicam_id.trim().to_string()).filter(|id| !id.is_empty()),
-            },
-            settings: producer::genicam::CameraSettings {
-                exposure_us: c.genicam_exposure_us,
-                gain_db: c.genicam_gain_db,
-                fps: (c.fps > 0.0
-                    && c.genicam_trigger != Some(producer::genicam::Trigger::Hardware))
-                .then_some(c.fps),
-                pixel_format: c.genicam_pixel_format,
-                roi: c.genicam_roi,
-                trigger: c.genicam_trigger.unwrap_or_default(),
-            },
-            log: None,
-        },
+        CameraSource::Genicam => {
+            let trigger = c.genicam_trigger.unwrap_or_default();
+            SourceSettings::Genicam {
+                camera: producer::genicam::CameraSpec {
+                    id: Some(c.genicam_id.trim().to_string()).filter(|id| !id.is_empty()),
+                },
+                settings: producer::genicam::CameraSettings {
+                    exposure_us: c.genicam_exposure_us,
+                    gain_db: c.genicam_gain_db,
+                    fps: trigger.rate_fps(c.fps),
+                    pixel_format: c.genicam_pixel_format,
+                    roi: c.genicam_roi,
+                    trigger,
+                },
+                log: None,
+            }
+        }
     };
     ProducerSettings {
         instance: instance.to_string(),
