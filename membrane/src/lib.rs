@@ -38,6 +38,6 @@ pub use mesh::Mesh;
 pub use nodal::{NodalField, NodeFailure};
 pub use path::{solve_path, Path, PathReport, PathState, PathStop, StateFigures};
 pub use principal::PrincipalStresses;
-pub use probe::{Location, PointSample, Probe};
+pub use probe::{point_at, sample_at, ElementGrid, Location, PointSample, Probe};
 pub use solver::{solve, solve_until_stopped, Equilibrium, NewtonSettings, Outcome, StepRecord};
 pub use specimens::{GripStretch, Specimen, SpecimenChoice, SpecimenShape};

@@ -13,8 +13,9 @@ use crate::t6::{self, NODES};
 
 /// Newton iterations of the inverse map at most; it converges in 2-4 on straight elements.
 const INVERSE_MAX_ITERATIONS: usize = 25;
-/// Convergence of the inverse map, in natural coordinates.
-const INVERSE_TOLERANCE: f64 = 1e-13;
+/// Convergence of the inverse map, in natural coordinates: the last Newton step is below it,
+/// so (quadratic convergence) the point found is off by about its square, far below 1e-12.
+const INVERSE_TOLERANCE: f64 = 1e-7;
 /// How far outside [0, 1] a natural coordinate may be and the point still count as inside
 /// (a point on an edge between two elements).
 const EDGE_TOLERANCE: f64 = 1e-9;
@@ -38,10 +39,14 @@ pub struct PointSample {
     pub f: [[f64; 2]; 2],
 }
 
-/// Finds points in a mesh and samples a displacement field there.
+/// A uniform grid of buckets over a mesh's bounding box, each listing the elements whose
+/// bounding box meets it. Owns no mesh: build it from one and locate points in the same one
+/// (its nodes may have moved since only if the grid is rebuilt).
 #[derive(Clone, Debug)]
-pub struct Probe<'m> {
-    mesh: &'m Mesh,
+pub struct ElementGrid {
+    /// Each element's bounding box (of its six nodes), [low, high]: a cheap refusal before
+    /// Newton.
+    boxes: Vec<[[f64; 2]; 2]>,
     origin_mm: [f64; 2],
     bucket_mm: f64,
     columns: usize,
@@ -49,8 +54,8 @@ pub struct Probe<'m> {
     buckets: Vec<Vec<usize>>,
 }
 
-impl<'m> Probe<'m> {
-    pub fn new(mesh: &'m Mesh) -> Probe<'m> {
+impl ElementGrid {
+    pub fn new(mesh: &Mesh) -> ElementGrid {
         let boxes: Vec<[[f64; 2]; 2]> = (0..mesh.elements.len())
             .map(|e| bounding_box(&mesh.element_nodes_mm(e)))
             .collect();
@@ -68,8 +73,8 @@ impl<'m> Probe<'m> {
         let bucket_mm = (size[0] * size[1] / buckets_wanted).sqrt().max(1e-9);
         let columns = ((size[0] / bucket_mm).ceil() as usize).max(1);
         let rows = ((size[1] / bucket_mm).ceil() as usize).max(1);
-        let mut probe = Probe {
-            mesh,
+        let mut grid = ElementGrid {
+            boxes: Vec::new(),
             origin_mm: low,
             bucket_mm,
             columns,
@@ -77,15 +82,16 @@ impl<'m> Probe<'m> {
             buckets: vec![Vec::new(); columns * rows],
         };
         for (e, b) in boxes.iter().enumerate() {
-            let (c0, r0) = probe.cell(b[0]);
-            let (c1, r1) = probe.cell(b[1]);
+            let (c0, r0) = grid.cell(b[0]);
+            let (c1, r1) = grid.cell(b[1]);
             for r in r0..=r1 {
                 for c in c0..=c1 {
-                    probe.buckets[r * columns + c].push(e);
+                    grid.buckets[r * columns + c].push(e);
                 }
             }
         }
-        probe
+        grid.boxes = boxes;
+        grid
     }
 
     /// The bucket of a point, clamped into the grid.
@@ -99,9 +105,9 @@ impl<'m> Probe<'m> {
         )
     }
 
-    /// The element holding the reference point `x_mm` and where in it; None outside the
-    /// mesh.
-    pub fn locate(&self, x_mm: [f64; 2]) -> Option<Location> {
+    /// The element of `mesh` (the one the grid was built from) holding `x_mm` and where in
+    /// it; None outside the mesh.
+    pub fn locate(&self, mesh: &Mesh, x_mm: [f64; 2]) -> Option<Location> {
         let outside = |v: f64, low: f64, count: usize| {
             v < low - self.bucket_mm * 1e-9
                 || v > low + self.bucket_mm * count as f64 + self.bucket_mm * 1e-9
@@ -112,34 +118,103 @@ impl<'m> Probe<'m> {
             return None;
         }
         let (c, r) = self.cell(x_mm);
-        self.buckets[r * self.columns + c].iter().find_map(|&e| {
-            natural_coordinates(&self.mesh.element_nodes_mm(e), x_mm).map(|(xi, eta)| Location {
-                element: e,
-                xi,
-                eta,
+        let slack = self.bucket_mm * 1e-9;
+        let in_box = |e: usize| {
+            let [low, high] = self.boxes[e];
+            x_mm[0] >= low[0] - slack
+                && x_mm[0] <= high[0] + slack
+                && x_mm[1] >= low[1] - slack
+                && x_mm[1] <= high[1] + slack
+        };
+        self.buckets[r * self.columns + c]
+            .iter()
+            .filter(|&&e| in_box(e))
+            .find_map(|&e| {
+                natural_coordinates(&mesh.element_nodes_mm(e), x_mm, CENTROID).map(|(xi, eta)| {
+                    Location {
+                        element: e,
+                        xi,
+                        eta,
+                    }
+                })
             })
+    }
+
+    /// [`Self::locate`], trying first the element of `near` from its natural coordinates
+    /// (a neighbouring point's location: one or two Newton steps when it is the same
+    /// element, as for the next pixel of a row).
+    pub fn locate_near(&self, mesh: &Mesh, x_mm: [f64; 2], near: Location) -> Option<Location> {
+        natural_coordinates(
+            &mesh.element_nodes_mm(near.element),
+            x_mm,
+            (near.xi, near.eta),
+        )
+        .map(|(xi, eta)| Location {
+            element: near.element,
+            xi,
+            eta,
         })
+        .or_else(|| self.locate(mesh, x_mm))
+    }
+}
+
+/// Finds points in a mesh and samples a displacement field there.
+#[derive(Clone, Debug)]
+pub struct Probe<'m> {
+    mesh: &'m Mesh,
+    grid: ElementGrid,
+}
+
+impl<'m> Probe<'m> {
+    pub fn new(mesh: &'m Mesh) -> Probe<'m> {
+        Probe {
+            mesh,
+            grid: ElementGrid::new(mesh),
+        }
+    }
+
+    /// The element holding the reference point `x_mm` and where in it; None outside the
+    /// mesh.
+    pub fn locate(&self, x_mm: [f64; 2]) -> Option<Location> {
+        self.grid.locate(self.mesh, x_mm)
     }
 
     /// The field of the nodal displacements `u` (two per node, mm) at the reference point
     /// `x_mm`; None outside the mesh.
     pub fn sample(&self, u: &[f64], x_mm: [f64; 2]) -> Option<PointSample> {
         let location = self.locate(x_mm)?;
-        let element = &self.mesh.elements[location.element];
-        let nodes_mm = self.mesh.element_nodes_mm(location.element);
-        let (gradients, _) = t6::gradients_at(&nodes_mm, location.xi, location.eta).ok()?;
-        let shape = t6::shape(location.xi, location.eta);
-        let mut displacement_mm = [0.0; 2];
-        for (&node, n) in element.iter().zip(shape.iter()) {
-            displacement_mm[0] += n * u[2 * node];
-            displacement_mm[1] += n * u[2 * node + 1];
-        }
-        Some(PointSample {
-            location,
-            displacement_mm,
-            f: deformation_gradient(element, &gradients, u),
-        })
+        sample_at(self.mesh, u, location)
     }
+}
+
+/// The field of the nodal displacements `u` (two per node, mm) of `mesh` at `location`; None
+/// where the element's Jacobian is not positive.
+pub fn sample_at(mesh: &Mesh, u: &[f64], location: Location) -> Option<PointSample> {
+    let element = &mesh.elements[location.element];
+    let nodes_mm = mesh.element_nodes_mm(location.element);
+    let (gradients, _) = t6::gradients_at(&nodes_mm, location.xi, location.eta).ok()?;
+    let shape = t6::shape(location.xi, location.eta);
+    let mut displacement_mm = [0.0; 2];
+    for (&node, n) in element.iter().zip(shape.iter()) {
+        displacement_mm[0] += n * u[2 * node];
+        displacement_mm[1] += n * u[2 * node + 1];
+    }
+    Some(PointSample {
+        location,
+        displacement_mm,
+        f: deformation_gradient(element, &gradients, u),
+    })
+}
+
+/// The point of `mesh` at `location`: Σ Nᵢ(ξ, η) Xᵢ, mm.
+pub fn point_at(mesh: &Mesh, location: Location) -> [f64; 2] {
+    let shape = t6::shape(location.xi, location.eta);
+    let mut x = [0.0; 2];
+    for (&node, n) in mesh.elements[location.element].iter().zip(shape.iter()) {
+        x[0] += n * mesh.nodes_mm[node][0];
+        x[1] += n * mesh.nodes_mm[node][1];
+    }
+    x
 }
 
 fn bounding_box(nodes_mm: &[[f64; 2]; NODES]) -> [[f64; 2]; 2] {
@@ -154,10 +229,17 @@ fn bounding_box(nodes_mm: &[[f64; 2]; NODES]) -> [[f64; 2]; 2] {
     )
 }
 
+/// The element's centroid in natural coordinates, where Newton starts without a better guess.
+const CENTROID: (f64, f64) = (1.0 / 3.0, 1.0 / 3.0);
+
 /// (ξ, η) of `x_mm` in the element of `nodes_mm` when it lies inside (Newton on the quadratic
-/// map from the centroid); None outside or when Newton does not converge.
-fn natural_coordinates(nodes_mm: &[[f64; 2]; NODES], x_mm: [f64; 2]) -> Option<(f64, f64)> {
-    let (mut xi, mut eta) = (1.0 / 3.0, 1.0 / 3.0);
+/// map from `start`); None outside or when Newton does not converge.
+fn natural_coordinates(
+    nodes_mm: &[[f64; 2]; NODES],
+    x_mm: [f64; 2],
+    start: (f64, f64),
+) -> Option<(f64, f64)> {
+    let (mut xi, mut eta) = start;
     for _ in 0..INVERSE_MAX_ITERATIONS {
         let shape = t6::shape(xi, eta);
         let dn = t6::shape_gradients(xi, eta);

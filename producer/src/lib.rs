@@ -11,6 +11,7 @@
 
 pub mod camera;
 mod error;
+pub mod field_motion;
 pub mod genicam;
 mod image_io;
 mod image_out;
@@ -33,6 +34,7 @@ mod watch;
 
 pub use camera::{CameraModel, BIT_DEPTHS};
 pub use error::ProducerError;
+pub use field_motion::{FieldMotion, ReferenceMesh, View, BACKDROP};
 pub use image_io::{decode_into, read_image, read_shape, Image16, ImageShape};
 pub use image_out::{write_atomic, write_frame, ImageFormatOut};
 pub use motion::{Affine, Bulge, Chirp, Motion};

@@ -2,6 +2,7 @@
 //! camera pixel's area with an n x n Gauss-Legendre rule. Slow; the ground truth.
 
 use crate::camera::CameraModel;
+use crate::field_motion::{FieldMotion, BACKDROP};
 use crate::motion::Motion;
 use crate::parallel::for_row_bands;
 use crate::speckle::{Speckle, SpeckleParams};
@@ -118,6 +119,30 @@ impl ExactRenderer {
     /// Renders the mean of p(φ⁻¹(x)) over each pixel of a `width` x rows frame into `out`
     /// (row-major, values in [0, 1]).
     pub fn render(&self, speckle: &Speckle, motion: &Motion, width: usize, out: &mut [f32]) {
+        self.render_inverse(speckle, width, out, |x| Some(motion.inverse(x)));
+    }
+
+    /// [`Self::render`] under a finite-element field: a point of a pixel that shows no
+    /// material counts as [`BACKDROP`], so a pixel on the specimen's edge is the mean of both.
+    pub fn render_field(
+        &self,
+        speckle: &Speckle,
+        field: &FieldMotion,
+        width: usize,
+        out: &mut [f32],
+    ) {
+        self.render_inverse(speckle, width, out, |x| field.inverse(x));
+    }
+
+    /// The mean over each pixel of p(X) where `inverse` gives X = φ⁻¹(x), [`BACKDROP`] where it
+    /// gives none.
+    fn render_inverse(
+        &self,
+        speckle: &Speckle,
+        width: usize,
+        out: &mut [f32],
+        inverse: impl Fn([f64; 2]) -> Option<[f64; 2]> + Sync,
+    ) {
         let (nodes, weights) = gauss_legendre(self.gauss_order);
         for_row_bands(out, width, self.threads, |first_row, band| {
             for (r, row) in band.chunks_exact_mut(width).enumerate() {
@@ -127,8 +152,11 @@ impl ExactRenderer {
                     let mut sum = 0.0;
                     for (ny, wy) in nodes.iter().zip(weights) {
                         for (nx, wx) in nodes.iter().zip(weights) {
-                            let p = motion.inverse([x + 0.5 * nx, y + 0.5 * ny]);
-                            sum += wx * wy * speckle.value(p);
+                            let point = match inverse([x + 0.5 * nx, y + 0.5 * ny]) {
+                                Some(p) => speckle.value(p),
+                                None => f64::from(BACKDROP),
+                            };
+                            sum += wx * wy * point;
                         }
                     }
                     *value = (0.25 * sum) as f32;

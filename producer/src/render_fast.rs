@@ -4,6 +4,7 @@
 //! interpolation. The footprint is the undeformed pixel: the error this makes under strain is
 //! even (a slight blur difference), not a displacement bias.
 
+use crate::field_motion::{FieldMotion, RowWalker, BACKDROP, BLOCK_SPAN_PX};
 use crate::motion::{inverse, mul_vec, Affine, Motion};
 use crate::parallel::for_row_bands;
 use crate::row_inverse::RowInverse;
@@ -268,6 +269,40 @@ impl FastRenderer {
         });
     }
 
+    /// Renders p over the `width` x rows camera frame `out` under a finite-element field,
+    /// [`BACKDROP`] where the camera sees no material. See [`Self::render_field_row`].
+    pub fn render_field(&self, field: &FieldMotion, width: usize, out: &mut [f32]) {
+        for_row_bands(out, width, self.threads, |first_row, band| {
+            for (r, row) in band.chunks_exact_mut(width).enumerate() {
+                self.render_field_row(field, first_row + r, row);
+            }
+        });
+    }
+
+    /// Row `y` under a finite-element field, block by block ([`RowWalker`]: exact points at
+    /// the ends of each block, interpolated between them inside one element).
+    pub fn render_field_row(&self, field: &FieldMotion, y: usize, row: &mut [f32]) {
+        let os = self.oversample as f64;
+        let mut walker = RowWalker::new(field, y as f64);
+        let mut points = [None; BLOCK_PX];
+        for (b, block) in row.chunks_mut(BLOCK_PX).enumerate() {
+            walker.block(b * BLOCK_PX, &mut points);
+            let (mut fx, mut fy) = ([f64::NAN; BLOCK_PX], [f64::NAN; BLOCK_PX]);
+            for (k, p) in points.iter().enumerate() {
+                if let Some(p) = p {
+                    fx[k] = (p[0] - self.origin_px[0]) * os;
+                    fy[k] = (p[1] - self.origin_px[1]) * os;
+                }
+            }
+            self.sample_positions(&fx, &fy, block);
+            for (value, p) in block.iter_mut().zip(&points) {
+                if p.is_none() {
+                    *value = BACKDROP;
+                }
+            }
+        }
+    }
+
     /// Renders row `y` (pixel row index) of the frame into `row` (values in [0, 1]).
     pub fn render_row(&self, motion: &Motion, y: usize, row: &mut [f32]) {
         let y = y as f64;
@@ -308,20 +343,22 @@ impl FastRenderer {
                 fx[k] = start[0] + col * step[0];
                 fy[k] = start[1] + col * step[1];
             }
-            let inside = |k: usize| {
-                fx[k] >= 1.0
-                    && fy[k] >= 1.0
-                    && fx[k] < self.end_texel[0]
-                    && fy[k] < self.end_texel[1]
-            };
-            // The texture's inner rectangle is convex and the block a segment: both ends
-            // inside, all inside.
-            if block.len() < BLOCK_PX || !(inside(0) && inside(BLOCK_PX - 1)) {
-                for (k, value) in block.iter_mut().enumerate() {
-                    *value = self.sample_texels(fx[k], fy[k]);
-                }
-            } else {
-                self.sample_block(&fx, &fy, block);
+            self.sample_positions(&fx, &fy, block);
+        }
+    }
+
+    /// The pattern at the texel coordinates of a block (up to [`BLOCK_PX`] pixels): lane by
+    /// lane when all of them lie inside the texture, else one by one (the background outside).
+    #[inline(always)]
+    fn sample_positions(&self, fx: &[f64; BLOCK_PX], fy: &[f64; BLOCK_PX], block: &mut [f32]) {
+        let inside = |k: usize| {
+            fx[k] >= 1.0 && fy[k] >= 1.0 && fx[k] < self.end_texel[0] && fy[k] < self.end_texel[1]
+        };
+        if block.len() == BLOCK_PX && (0..BLOCK_PX).all(inside) {
+            self.sample_block(fx, fy, block);
+        } else {
+            for (k, value) in block.iter_mut().enumerate() {
+                *value = self.sample_texels(fx[k], fy[k]);
             }
         }
     }
@@ -358,8 +395,8 @@ impl FastRenderer {
     }
 }
 
-/// Pixels per block of the affine row loop.
-const BLOCK_PX: usize = 8;
+/// Pixels per block of the row loops (the finite-element path's span between exact points).
+const BLOCK_PX: usize = BLOCK_SPAN_PX;
 
 /// The Catmull-Rom weights of a block of `t`: `w[k][lane]` (Horner, lane by lane).
 #[inline(always)]

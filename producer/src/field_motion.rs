@@ -1,0 +1,584 @@
+//! The camera's view of a finite-element displacement field: the specimen as a structure
+//! (crate `membrane`), its nodal displacements interpolated by the mesh's own quadratic shape
+//! functions, seen through a camera of a given scale.
+//!
+//! Coordinates: reference image px X ↔ specimen mm by [`View`] (rig X is the image column,
+//! rig Y the image row, as for the homogeneous camera of `rig_follow`). The field is exact
+//! everywhere in the mesh, not only at its nodes: x = φ(X) = X + Σ Nᵢ(ξ, η) uᵢ in the element
+//! holding X.
+//!
+//! The inverse X = φ⁻¹(x), what every renderer needs per pixel, is exact and needs no
+//! iteration on the field: the deformed mesh (nodes at Xᵢ + uᵢ, same elements) is the image of
+//! the reference one under φ with the same shape functions, so locating x in the deformed mesh
+//! gives (element, ξ, η) and X = Σ Nᵢ(ξ, η) Xᵢ. A point of the image outside the deformed mesh
+//! is not material (the room behind the specimen, between the arms of a cruciform): `None`,
+//! which the renderers show as [`BACKDROP`].
+//!
+//! Along a row of pixels, each pixel starts from its neighbour's element and natural
+//! coordinates (one or two Newton steps of the quadratic map), and falls back to the element
+//! grid when it crosses into another element.
+
+use std::sync::Arc;
+
+use membrane::{point_at, sample_at, t6, ElementGrid, Location, Mesh};
+
+use crate::error::ProducerError;
+use crate::motion::{inverse, mul_mat, Mat2, Vec2};
+
+/// How far apart along a row the fast renderer finds exact points of the inverse map (the
+/// pixels between are interpolated, [`hermite_along_row`]).
+pub const BLOCK_SPAN_PX: usize = 8;
+
+/// The pattern value where the camera sees no material (behind the specimen): black.
+pub const BACKDROP: f32 = 0.0;
+
+/// How the camera sees the specimen: the reference point `centre_mm` at the image point
+/// `centre_px`, `mm_per_px` on both axes, no rotation (a rotated specimen is a boundary
+/// condition of the mechanics, not of the camera).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    pub mm_per_px: f64,
+    pub centre_px: Vec2,
+    pub centre_mm: Vec2,
+}
+
+impl View {
+    /// Specimen mm of image px.
+    pub fn to_mm(&self, p_px: Vec2) -> [f64; 2] {
+        [
+            self.centre_mm[0] + (p_px[0] - self.centre_px[0]) * self.mm_per_px,
+            self.centre_mm[1] + (p_px[1] - self.centre_px[1]) * self.mm_per_px,
+        ]
+    }
+
+    /// Image px of specimen mm.
+    pub fn to_px(&self, x_mm: [f64; 2]) -> Vec2 {
+        [
+            self.centre_px[0] + (x_mm[0] - self.centre_mm[0]) / self.mm_per_px,
+            self.centre_px[1] + (x_mm[1] - self.centre_mm[1]) / self.mm_per_px,
+        ]
+    }
+}
+
+/// The reference mesh and its element grid, built once per specimen and shared by every state.
+#[derive(Debug)]
+pub struct ReferenceMesh {
+    pub mesh: Mesh,
+    grid: ElementGrid,
+}
+
+impl ReferenceMesh {
+    pub fn new(mesh: Mesh) -> Arc<ReferenceMesh> {
+        let grid = ElementGrid::new(&mesh);
+        Arc::new(ReferenceMesh { mesh, grid })
+    }
+}
+
+/// A solved state of the specimen as the camera sees it.
+#[derive(Clone, Debug)]
+pub struct FieldMotion {
+    reference: Arc<ReferenceMesh>,
+    /// The deformed mesh: nodes at Xᵢ + uᵢ.
+    current: Mesh,
+    current_grid: ElementGrid,
+    /// Nodal displacements, two per node, mm.
+    u_mm: Vec<f64>,
+    view: View,
+}
+
+/// Where a pixel of a row was found, to start the next pixel from.
+pub type RowHint = Option<Location>;
+
+impl FieldMotion {
+    /// The state of nodal displacements `u_mm` (two per node, mm) of `reference`, seen
+    /// through `view`. Refused: a length that is not two per node, a value that is not finite,
+    /// a scale that is not positive, an element the displacement turns inside out.
+    pub fn new(
+        reference: Arc<ReferenceMesh>,
+        u_mm: Vec<f64>,
+        view: View,
+    ) -> Result<FieldMotion, ProducerError> {
+        let invalid = |name: &str, value: String, expected: &str| ProducerError::InvalidParameter {
+            name: name.to_owned(),
+            value,
+            expected: expected.to_owned(),
+        };
+        let nodes = reference.mesh.nodes_mm.len();
+        if u_mm.len() != 2 * nodes {
+            return Err(invalid(
+                "specimen displacements",
+                format!("{} values", u_mm.len()),
+                &format!("two per node of the mesh ({} values)", 2 * nodes),
+            ));
+        }
+        if let Some(i) = u_mm.iter().position(|u| !u.is_finite()) {
+            return Err(invalid(
+                "specimen displacement",
+                format!("{} at node {}", u_mm[i], i / 2),
+                "a finite number of mm",
+            ));
+        }
+        let finite = |v: Vec2| v[0].is_finite() && v[1].is_finite();
+        if !(view.mm_per_px.is_finite()
+            && view.mm_per_px > 0.0
+            && finite(view.centre_px)
+            && finite(view.centre_mm))
+        {
+            return Err(invalid(
+                "camera view",
+                format!("{view:?}"),
+                "a positive finite mm per px and finite centres",
+            ));
+        }
+        let current = Mesh {
+            nodes_mm: reference
+                .mesh
+                .nodes_mm
+                .iter()
+                .enumerate()
+                .map(|(n, x)| [x[0] + u_mm[2 * n], x[1] + u_mm[2 * n + 1]])
+                .collect(),
+            elements: reference.mesh.elements.clone(),
+        };
+        if let Err(membrane::GeometryError::InvertedElement { element, .. }) =
+            current.gauss_points()
+        {
+            return Err(invalid(
+                "specimen displacements",
+                format!("element {element} turned inside out"),
+                "a state of positive Jacobian everywhere (a converged solution)",
+            ));
+        }
+        let current_grid = ElementGrid::new(&current);
+        Ok(FieldMotion {
+            reference,
+            current,
+            current_grid,
+            u_mm,
+            view,
+        })
+    }
+
+    pub fn view(&self) -> &View {
+        &self.view
+    }
+
+    /// Displacement u(X) = φ(X) − X at the reference image point `p_px`, px; None off the
+    /// specimen. The frame's ground truth.
+    pub fn displacement_px(&self, p_px: Vec2) -> Option<Vec2> {
+        let location = self
+            .reference
+            .grid
+            .locate(&self.reference.mesh, self.view.to_mm(p_px))?;
+        let s = sample_at(&self.reference.mesh, &self.u_mm, location)?;
+        Some([
+            s.displacement_mm[0] / self.view.mm_per_px,
+            s.displacement_mm[1] / self.view.mm_per_px,
+        ])
+    }
+
+    /// x = φ(X), px; None off the specimen.
+    pub fn forward(&self, p_px: Vec2) -> Option<Vec2> {
+        let u = self.displacement_px(p_px)?;
+        Some([p_px[0] + u[0], p_px[1] + u[1]])
+    }
+
+    /// F(X) = ∂φ/∂X at the reference image point `p_px` (the same in px as in mm); None off the
+    /// specimen.
+    pub fn gradient(&self, p_px: Vec2) -> Option<Mat2> {
+        let location = self
+            .reference
+            .grid
+            .locate(&self.reference.mesh, self.view.to_mm(p_px))?;
+        Some(sample_at(&self.reference.mesh, &self.u_mm, location)?.f)
+    }
+
+    /// X = φ⁻¹(x), px; None where the image point `x_px` shows no material.
+    pub fn inverse(&self, x_px: Vec2) -> Option<Vec2> {
+        let location = self
+            .current_grid
+            .locate(&self.current, self.view.to_mm(x_px))?;
+        Some(self.view.to_px(point_at(&self.reference.mesh, location)))
+    }
+
+    /// [`Self::inverse`] starting from `hint`, where the previous pixel of the row was found;
+    /// updates `hint` (None off the specimen).
+    #[inline]
+    pub fn inverse_along_row(&self, x_px: Vec2, hint: &mut RowHint) -> Option<Vec2> {
+        let location = self.locate_current(x_px, hint)?;
+        Some(self.view.to_px(point_at(&self.reference.mesh, location)))
+    }
+
+    /// X = φ⁻¹(x) with its gradient ∂X/∂x = F⁻¹ there (what a renderer interpolates between
+    /// two exact points of a row), from `hint` like [`Self::inverse_along_row`].
+    pub fn inverse_point(&self, x_px: Vec2, hint: &mut RowHint) -> Option<InversePoint> {
+        let location = self.locate_current(x_px, hint)?;
+        let element = &self.reference.mesh.elements[location.element];
+        let shape = t6::shape(location.xi, location.eta);
+        let dn = t6::shape_gradients(location.xi, location.eta);
+        // J = ∂(position)/∂(ξ, η) in both configurations; ∂X/∂x = J_reference J_current⁻¹.
+        let (mut x_mm, mut j_ref, mut j_cur) = ([0.0; 2], [[0.0; 2]; 2], [[0.0; 2]; 2]);
+        for (k, &node) in element.iter().enumerate() {
+            let (p, q) = (
+                self.reference.mesh.nodes_mm[node],
+                self.current.nodes_mm[node],
+            );
+            for i in 0..2 {
+                x_mm[i] += shape[k] * p[i];
+                for a in 0..2 {
+                    j_ref[i][a] += dn[k][a] * p[i];
+                    j_cur[i][a] += dn[k][a] * q[i];
+                }
+            }
+        }
+        let j_cur_inverse = inverse(&j_cur);
+        // The next call is most likely `span` px further along the row: start its Newton from
+        // the first-order prediction of its natural coordinates, not from this point's.
+        Some(InversePoint {
+            reference_px: self.view.to_px(x_mm),
+            gradient: mul_mat(&j_ref, &j_cur_inverse),
+            location,
+            natural_per_px: [
+                j_cur_inverse[0][0] * self.view.mm_per_px,
+                j_cur_inverse[1][0] * self.view.mm_per_px,
+            ],
+        })
+    }
+
+    /// Where `x_px` is in the deformed mesh, from `hint`; updates `hint`.
+    #[inline]
+    fn locate_current(&self, x_px: Vec2, hint: &mut RowHint) -> Option<Location> {
+        let x_mm = self.view.to_mm(x_px);
+        let location = match *hint {
+            Some(near) => self.current_grid.locate_near(&self.current, x_mm, near),
+            None => self.current_grid.locate(&self.current, x_mm),
+        };
+        *hint = location;
+        location
+    }
+}
+
+/// X at `t` ∈ [0, 1] of the way from `a` to `b`, two points `span_px` apart along a row: the
+/// cubic Hermite interpolation of X from X and ∂X/∂x at both ends (within 1e-3 px inside one
+/// element at the span the renderer uses, 3e-4 px on a cruciform stretched 1.5: see the tests).
+#[inline(always)]
+pub fn hermite_along_row(a: &InversePoint, b: &InversePoint, span_px: f64, t: f64) -> Vec2 {
+    let (t2, t3) = (t * t, t * t * t);
+    let (h00, h10) = (2.0 * t3 - 3.0 * t2 + 1.0, t3 - 2.0 * t2 + t);
+    let (h01, h11) = (-2.0 * t3 + 3.0 * t2, t3 - t2);
+    let at = |i: usize| {
+        h00 * a.reference_px[i]
+            + h10 * span_px * a.gradient[i][0]
+            + h01 * b.reference_px[i]
+            + h11 * span_px * b.gradient[i][0]
+    };
+    [at(0), at(1)]
+}
+
+/// Walks a row of pixels in blocks of [`BLOCK_SPAN_PX`], giving each pixel's X = φ⁻¹(x)
+/// (None: no material there). X is found exactly at both ends of a block; when both lie in the
+/// same element the pixels between take [`hermite_along_row`], else the block is halved at an
+/// exact point, down to single pixels (a block crossing an element edge or the specimen's edge
+/// costs a few more exact points, never an interpolation across the edge).
+pub struct RowWalker<'f> {
+    field: &'f FieldMotion,
+    y_px: f64,
+    /// The exact point at the start of the next block.
+    left: Option<InversePoint>,
+    hint: RowHint,
+}
+
+impl<'f> RowWalker<'f> {
+    /// The walk of row `y_px` from column 0.
+    pub fn new(field: &'f FieldMotion, y_px: f64) -> Self {
+        let mut hint = None;
+        let left = field.inverse_point([0.0, y_px], &mut hint);
+        RowWalker {
+            field,
+            y_px,
+            left,
+            hint,
+        }
+    }
+
+    /// X of the columns `first_col`.. `first_col + BLOCK_SPAN_PX` (the block after the previous
+    /// one) into `out`.
+    pub fn block(&mut self, first_col: usize, out: &mut [Option<Vec2>; BLOCK_SPAN_PX]) {
+        let left = self.left;
+        let right = self.point(first_col + BLOCK_SPAN_PX, &left, BLOCK_SPAN_PX as f64);
+        self.fill(first_col, (0, &left), (BLOCK_SPAN_PX, &right), out);
+        self.left = right;
+    }
+
+    /// The exact point of column `col`, Newton started `ahead_px` ahead of `from` when there is
+    /// one.
+    fn point(
+        &mut self,
+        col: usize,
+        from: &Option<InversePoint>,
+        ahead_px: f64,
+    ) -> Option<InversePoint> {
+        if let Some(p) = from {
+            self.hint = p.hint_ahead(ahead_px);
+        }
+        self.field
+            .inverse_point([col as f64, self.y_px], &mut self.hint)
+    }
+
+    /// Pixels k0..k1 of the block from the exact points at k0 and k1.
+    fn fill(
+        &mut self,
+        first_col: usize,
+        (k0, a): (usize, &Option<InversePoint>),
+        (k1, c): (usize, &Option<InversePoint>),
+        out: &mut [Option<Vec2>; BLOCK_SPAN_PX],
+    ) {
+        match (a, c) {
+            (Some(pa), Some(pc)) if pa.location.element == pc.location.element => {
+                let span = (k1 - k0) as f64;
+                for (k, x) in out.iter_mut().enumerate().take(k1).skip(k0) {
+                    *x = Some(hermite_along_row(pa, pc, span, (k - k0) as f64 / span));
+                }
+            }
+            _ if k1 - k0 == 1 => out[k0] = a.map(|p| p.reference_px),
+            _ => {
+                let mid = (k0 + k1) / 2;
+                let m = self.point(first_col + mid, a, (mid - k0) as f64);
+                self.fill(first_col, (k0, a), (mid, &m), out);
+                self.fill(first_col, (mid, &m), (k1, c), out);
+            }
+        }
+    }
+}
+
+/// An image point's reference point and the inverse map's gradient there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InversePoint {
+    /// X = φ⁻¹(x), px.
+    pub reference_px: Vec2,
+    /// ∂X/∂x = F⁻¹, row-major.
+    pub gradient: Mat2,
+    /// Where x lies in the deformed mesh (the same element and (ξ, η) as X in the reference).
+    pub location: Location,
+    /// ∂(ξ, η)/∂x along the row, per px: where to start looking for a point further along.
+    pub natural_per_px: [f64; 2],
+}
+
+impl InversePoint {
+    /// The hint for the point `step_px` further along the row: this element, at the natural
+    /// coordinates predicted to first order.
+    pub fn hint_ahead(&self, step_px: f64) -> RowHint {
+        Some(Location {
+            element: self.location.element,
+            xi: self.location.xi + step_px * self.natural_per_px[0],
+            eta: self.location.eta + step_px * self.natural_per_px[1],
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use membrane::specimens::cruciform::CruciformGeometry;
+
+    /// The default cruciform (100 mm arms, 20 mm fillets) seen at 0.2 mm/px, its centre at the
+    /// image point (100, 80).
+    fn cruciform() -> Arc<ReferenceMesh> {
+        ReferenceMesh::new(CruciformGeometry::default().mesh().unwrap().mesh)
+    }
+
+    fn view() -> View {
+        View {
+            mm_per_px: 0.2,
+            centre_px: [100.0, 80.0],
+            centre_mm: [0.0, 0.0],
+        }
+    }
+
+    /// A smooth heterogeneous field: u = (0.08 X + 4e-4 X Y + 2e-5 Y³, -0.03 Y + 3e-4 X²) mm.
+    fn smooth(x: [f64; 2]) -> [f64; 2] {
+        [
+            0.08 * x[0] + 4e-4 * x[0] * x[1] + 2e-5 * x[1].powi(3),
+            -0.03 * x[1] + 3e-4 * x[0] * x[0],
+        ]
+    }
+
+    fn field(reference: &Arc<ReferenceMesh>, f: impl Fn([f64; 2]) -> [f64; 2]) -> FieldMotion {
+        let u = reference.mesh.nodes_mm.iter().flat_map(|&x| f(x)).collect();
+        FieldMotion::new(reference.clone(), u, view()).unwrap()
+    }
+
+    #[test]
+    fn the_inverse_of_the_forward_map_is_exact_and_off_the_specimen_is_nothing() {
+        let reference = cruciform();
+        let motion = field(&reference, smooth);
+        let mut checked = 0;
+        for y in (0..160).step_by(3) {
+            for x in (0..200).step_by(3) {
+                let p = [x as f64 + 0.3, y as f64 - 0.2];
+                let Some(x_px) = motion.forward(p) else {
+                    continue;
+                };
+                let back = motion
+                    .inverse(x_px)
+                    .expect("a material point's image is material");
+                assert!(
+                    (back[0] - p[0]).abs() < 1e-8 && (back[1] - p[1]).abs() < 1e-8,
+                    "{p:?} → {x_px:?} → {back:?}"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 2000, "{checked}");
+        // The corner between the +x and +y arms, far from both, is no material before or after.
+        let corner_px = view().to_px([95.0, 95.0]);
+        assert!(motion.displacement_px(corner_px).is_none());
+        assert!(motion.inverse(corner_px).is_none());
+    }
+
+    #[test]
+    fn a_homogeneous_field_is_its_affine_map_anywhere() {
+        let reference = cruciform();
+        let f = [[1.25, 0.05], [-0.02, 0.9]];
+        let motion = field(&reference, |x| {
+            [
+                (f[0][0] - 1.0) * x[0] + f[0][1] * x[1] + 0.3,
+                f[1][0] * x[0] + (f[1][1] - 1.0) * x[1] - 0.1,
+            ]
+        });
+        for p in [[100.0, 80.0], [37.5, 121.25], [180.0, 90.0], [100.0, 20.0]] {
+            let x_mm = view().to_mm(p);
+            let want = [
+                (f[0][0] - 1.0) * x_mm[0] + f[0][1] * x_mm[1] + 0.3,
+                f[1][0] * x_mm[0] + (f[1][1] - 1.0) * x_mm[1] - 0.1,
+            ];
+            let u = motion.displacement_px(p).unwrap();
+            for i in 0..2 {
+                assert!((u[i] - want[i] / 0.2).abs() < 1e-9, "{p:?}: {u:?}");
+            }
+            let g = motion.gradient(p).unwrap();
+            for i in 0..2 {
+                for j in 0..2 {
+                    assert!((g[i][j] - f[i][j]).abs() < 1e-9, "{p:?}: {g:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_row_walked_with_hints_is_the_inverse_located_from_scratch() {
+        let reference = cruciform();
+        let motion = field(&reference, smooth);
+        for y in (0..160).step_by(11) {
+            let mut hint = None;
+            for x in 0..200 {
+                let x_px = [x as f64, y as f64];
+                let walked = motion.inverse_along_row(x_px, &mut hint);
+                let direct = motion.inverse(x_px);
+                match (walked, direct) {
+                    (Some(a), Some(b)) => assert!(
+                        (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9,
+                        "{x_px:?}: {a:?} against {b:?}"
+                    ),
+                    (None, None) => {}
+                    other => panic!("{x_px:?}: {other:?}"),
+                }
+            }
+        }
+    }
+
+    /// ∂X/∂x at an image point is the inverse of F at its reference point.
+    #[test]
+    fn the_inverse_gradient_is_the_inverse_of_f() {
+        let reference = cruciform();
+        let motion = field(&reference, smooth);
+        for x_px in [[100.0, 80.0], [150.3, 77.7], [60.0, 120.5], [20.0, 80.0]] {
+            let point = motion.inverse_point(x_px, &mut None).unwrap();
+            let f = motion.gradient(point.reference_px).unwrap();
+            let product = mul_mat(&f, &point.gradient);
+            for (i, row) in product.iter().enumerate() {
+                for (j, v) in row.iter().enumerate() {
+                    let want = if i == j { 1.0 } else { 0.0 };
+                    assert!((v - want).abs() < 1e-9, "{x_px:?}: {product:?}");
+                }
+            }
+        }
+    }
+
+    /// How far the Hermite interpolation between exact points `span` px apart in one element is
+    /// from the exact inverse, on a solved cruciform (equibiaxial grip stretch 1.5, the fillets'
+    /// strain concentrations in view at 0.16 mm/px, as the default camera sees it).
+    #[test]
+    fn hermite_between_exact_points_of_one_element_is_within_1e_3_px() {
+        let specimen = CruciformGeometry::default().mesh().unwrap();
+        let law = material::InvariantLaw::smactane();
+        let sheet = membrane::Membrane::new(
+            &specimen.mesh,
+            specimen.thickness_mm,
+            &law,
+            membrane::Wrinkling::default(),
+        )
+        .unwrap();
+        let clamps = specimen.clamps_at(membrane::GripStretch { x: 1.5, y: 1.5 });
+        let solved = membrane::solve(&sheet, &clamps, membrane::NewtonSettings::default()).unwrap();
+        let reference = ReferenceMesh::new(specimen.mesh);
+        let view = View {
+            mm_per_px: 0.16,
+            centre_px: [511.5, 511.5],
+            centre_mm: [0.0, 0.0],
+        };
+        let motion = FieldMotion::new(reference, solved.displacement_mm, view).unwrap();
+        for span in [8usize, 16] {
+            let mut worst = 0.0f64;
+            for y in (0..1024).step_by(37) {
+                let y = y as f64;
+                for start in (0..1024 - span).step_by(span) {
+                    let a = motion.inverse_point([start as f64, y], &mut None);
+                    let b = motion.inverse_point([(start + span) as f64, y], &mut None);
+                    let (Some(a), Some(b)) = (a, b) else { continue };
+                    if a.location.element != b.location.element {
+                        continue;
+                    }
+                    for k in 1..span {
+                        let got = hermite_along_row(&a, &b, span as f64, k as f64 / span as f64);
+                        let want = motion.inverse([(start + k) as f64, y]).unwrap();
+                        worst = worst
+                            .max((got[0] - want[0]).abs())
+                            .max((got[1] - want[1]).abs());
+                    }
+                }
+            }
+            eprintln!("Hermite over {span} px: worst {worst:.2e} px");
+            // Half the fast renderer's own bound against the exact one (2 millipixels).
+            if span == BLOCK_SPAN_PX {
+                assert!(worst < 1e-3, "{worst} px");
+            }
+        }
+    }
+
+    #[test]
+    fn bad_states_are_refused_with_the_reason() {
+        let reference = cruciform();
+        let n = reference.mesh.nodes_mm.len();
+        let short = FieldMotion::new(reference.clone(), vec![0.0; 2 * n - 1], view());
+        assert!(short.unwrap_err().to_string().contains("two per node"));
+        let mut nan = vec![0.0; 2 * n];
+        nan[7] = f64::NAN;
+        let err = FieldMotion::new(reference.clone(), nan, view()).unwrap_err();
+        assert!(err.to_string().contains("node 3"), "{err}");
+        // Folding the sheet over itself along x: x ↦ −x turns every element inside out.
+        let folded: Vec<f64> = reference
+            .mesh
+            .nodes_mm
+            .iter()
+            .flat_map(|x| [-2.0 * x[0], 0.0])
+            .collect();
+        let err = FieldMotion::new(reference.clone(), folded, view()).unwrap_err();
+        assert!(err.to_string().contains("inside out"), "{err}");
+        let bad_view = View {
+            mm_per_px: 0.0,
+            ..view()
+        };
+        assert!(FieldMotion::new(reference, vec![0.0; 2 * n], bad_view).is_err());
+    }
+}
