@@ -1,0 +1,212 @@
+//! The correlator on the specimen as a structure: the default cruciform (100 mm arms, 20 mm
+//! fillets, Smactane™) solved by finite elements at equibiaxial grip stretches up to 1.3, filmed
+//! at 0.3 mm/px (the central square, the fillets and the roots of the four arms in a 512² frame),
+//! compared node by node with the finite-element truth, and with the same camera on the
+//! homogeneous equibiaxial stretch of the same mean.
+
+use correlator::{Correlator, CorrelatorSettings, NodeStatus, ReferenceMode};
+use membrane::specimens::cruciform::CruciformGeometry;
+use producer::motion::Affine;
+use producer::{
+    CameraModel, FastRenderer, FieldMotion, Motion, ReferenceMesh, Speckle, SpeckleParams, View,
+};
+
+/// A point or a displacement, px.
+type Point = [f64; 2];
+/// A frame's true displacement at a reference point (None off the specimen).
+type Truth = Box<dyn Fn(Point) -> Option<Point>>;
+
+const SIZE: usize = 512;
+const MM_PER_PX: f64 = 0.3;
+const STATES: usize = 6;
+const GRIP_STRETCH: f64 = 1.3;
+
+/// Error statistics of the `ok` nodes whose reference point is on the specimen, px.
+#[derive(Debug, Default)]
+struct Errors {
+    /// Nodes whose whole reference ZOI is on the specimen.
+    all: Vec<f64>,
+    /// Nodes on the specimen whose reference ZOI reaches beyond its edge.
+    edge: Vec<f64>,
+    /// `ok` nodes whose reference point is off the specimen (no truth there).
+    ok_off_specimen: usize,
+}
+
+impl Errors {
+    fn mean(&self) -> f64 {
+        self.all.iter().sum::<f64>() / self.all.len() as f64
+    }
+    fn p99(&self) -> f64 {
+        let mut v = self.all.clone();
+        v.sort_by(f64::total_cmp);
+        v[(v.len() * 99) / 100]
+    }
+}
+
+/// Whether the reference ZOI of the node at `(x, y)` lies on the specimen: its corners and edge
+/// midpoints all have a truth.
+fn zoi_on_specimen(truth: &dyn Fn(Point) -> Option<Point>, x: f64, y: f64) -> bool {
+    let half = CorrelatorSettings::default().zoi_px as f64 / 2.0;
+    [-half, 0.0, half].iter().all(|&dx| {
+        [-half, 0.0, half]
+            .iter()
+            .all(|&dy| truth([x + dx, y + dy]).is_some())
+    })
+}
+
+fn view() -> View {
+    let c = (SIZE as f64 - 1.0) / 2.0;
+    View {
+        mm_per_px: MM_PER_PX,
+        centre_px: [c, c],
+        centre_mm: [0.0, 0.0],
+    }
+}
+
+/// Correlates `frames` (the first the reference) with the automatic reference and compares each
+/// `ok` node with `truth` (None off the specimen).
+fn measure(frames: &[Vec<u16>], truth: &[Truth]) -> Errors {
+    let settings = CorrelatorSettings {
+        reference: ReferenceMode::AUTO_DEFAULT,
+        ..CorrelatorSettings::default()
+    };
+    let mut correlator = Correlator::new(settings, SIZE, SIZE).unwrap();
+    correlator.set_reference(&frames[0]).unwrap();
+    let mut errors = Errors::default();
+    for (pixels, truth) in frames[1..].iter().zip(&truth[1..]) {
+        let field = correlator.correlate(pixels).unwrap();
+        for node in field.nodes.iter().filter(|n| n.status == NodeStatus::Ok) {
+            match truth([node.x_px, node.y_px]) {
+                Some(u) => {
+                    let e = (node.u_px - u[0]).hypot(node.v_px - u[1]);
+                    if zoi_on_specimen(truth, node.x_px, node.y_px) {
+                        errors.all.push(e);
+                    } else {
+                        errors.edge.push(e);
+                    }
+                }
+                None => errors.ok_off_specimen += 1,
+            }
+        }
+    }
+    errors
+}
+
+#[test]
+fn the_correlator_measures_a_finite_element_cruciform_node_by_node() {
+    let specimen = CruciformGeometry::default().mesh().unwrap();
+    let law = material::InvariantLaw::smactane();
+    let sheet = membrane::Membrane::new(
+        &specimen.mesh,
+        specimen.thickness_mm,
+        &law,
+        membrane::Wrinkling::default(),
+    )
+    .unwrap();
+    let reference = ReferenceMesh::new(specimen.mesh.clone());
+    let mut states = vec![FieldMotion::new(
+        reference.clone(),
+        vec![0.0; specimen.mesh.dof_count()],
+        view(),
+    )
+    .unwrap()];
+    for k in 1..=STATES {
+        let stretch = 1.0 + (GRIP_STRETCH - 1.0) * k as f64 / STATES as f64;
+        let clamps = specimen.clamps_at(membrane::GripStretch {
+            x: stretch,
+            y: stretch,
+        });
+        let solved = membrane::solve(&sheet, &clamps, membrane::NewtonSettings::default()).unwrap();
+        states.push(FieldMotion::new(reference.clone(), solved.displacement_mm, view()).unwrap());
+    }
+    // The homogeneous comparison: each state's mean stretch of the central square (its edge
+    // midpoints), about the image centre.
+    let c = (SIZE as f64 - 1.0) / 2.0;
+    let half_px = 50.0 / MM_PER_PX;
+    let mean_stretches: Vec<f64> = states
+        .iter()
+        .map(|s| {
+            let right = s.displacement_px([c + half_px, c]).unwrap()[0];
+            let left = s.displacement_px([c - half_px, c]).unwrap()[0];
+            1.0 + (right - left) / (2.0 * half_px)
+        })
+        .collect();
+    let extent = [-0.6 * SIZE as f64, 1.6 * SIZE as f64];
+    let speckle = Speckle::new(SpeckleParams::default(), extent, extent);
+    let renderer = FastRenderer::new(&speckle, extent, extent, 4, 2);
+    let expose = |k: usize, pattern: &[f32]| {
+        CameraModel::read_noise_only_16bit(0.005, k as u64 + 1).exposed(k as u64, pattern, SIZE, 2)
+    };
+    let mut pattern = vec![0f32; SIZE * SIZE];
+    let mut structure_frames = vec![];
+    let mut homogeneous_frames = vec![];
+    let mut homogeneous_truth: Vec<Truth> = vec![];
+    for (k, (state, &stretch)) in states.iter().zip(&mean_stretches).enumerate() {
+        renderer.render_field(state, SIZE, &mut pattern);
+        structure_frames.push(expose(k, &pattern));
+        let motion = Motion::Affine(Affine {
+            f: [[stretch, 0.0], [0.0, stretch]],
+            translation_px: [0.0, 0.0],
+            centre_px: [c, c],
+        });
+        renderer.render(&motion, SIZE, &mut pattern);
+        homogeneous_frames.push(expose(k, &pattern));
+        homogeneous_truth.push(Box::new(move |p| Some(motion.displacement(p))));
+    }
+    let structure_truth: Vec<Truth> = states
+        .iter()
+        .map(|s| {
+            let s = s.clone();
+            Box::new(move |p: [f64; 2]| s.displacement_px(p)) as Box<dyn Fn(_) -> _>
+        })
+        .collect();
+    let structure = measure(&structure_frames, &structure_truth);
+    let homogeneous = measure(&homogeneous_frames, &homogeneous_truth);
+    // The field is not homogeneous: the truth's stretch along x over the central row of nodes
+    // varies (arm roots against the centre).
+    let last = states.last().unwrap();
+    let stretch_at = |x: f64| {
+        let g = last.gradient([x, c]).unwrap();
+        g[0][0]
+    };
+    let (centre, root) = (stretch_at(c), stretch_at(c + 0.95 * half_px));
+    println!(
+        "grip stretch {GRIP_STRETCH}: mean stretch of the central square {:.4}, F11 at the centre {centre:.4}, near the arm root {root:.4}",
+        mean_stretches.last().unwrap()
+    );
+    for (name, e) in [("structure", &structure), ("homogeneous", &homogeneous)] {
+        println!(
+            "{name}: {} ok nodes with their ZOI on the specimen, error mean {:.4} px p99 {:.4} px worst {:.4} px; {} ok nodes whose ZOI crosses the specimen's edge, worst {:.4} px; {} ok nodes off the specimen",
+            e.all.len(),
+            e.mean(),
+            e.p99(),
+            e.all.iter().cloned().fold(0.0, f64::max),
+            e.edge.len(),
+            e.edge.iter().cloned().fold(0.0, f64::max),
+            e.ok_off_specimen
+        );
+    }
+    assert!(
+        (centre - root).abs() > 0.01,
+        "{centre} {root}: homogeneous?"
+    );
+    assert!(structure.all.len() > 400, "{}", structure.all.len());
+    // The mean within 2× the homogeneous run's (issue 24's target for a run on the
+    // cruciform): 1.45× when written (0.0184 against 0.0127 px).
+    assert!(
+        structure.mean() <= 2.0 * homogeneous.mean(),
+        "mean {} against {}",
+        structure.mean(),
+        homogeneous.mean()
+    );
+    // The p99 misses that target: 2.6× when written (0.118 against 0.046 px), the worst nodes
+    // at the arm roots and along the fillets, where the strain changes by 0.1 over a ZOI
+    // (first-order ZOIs on a steep field, issue 26's "steep fields") and near the edge. A guard
+    // against it getting worse until then, not the target.
+    assert!(
+        structure.p99() <= 3.0 * homogeneous.p99(),
+        "p99 {} against {}",
+        structure.p99(),
+        homogeneous.p99()
+    );
+}
