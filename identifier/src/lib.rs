@@ -42,4 +42,5 @@ pub mod route;
 pub mod section_cut;
 pub mod stability;
 pub mod subsample;
+pub mod tapered_ramp;
 pub mod vfm;

@@ -1,4 +1,5 @@
-//! The virtual fields method over section cuts: every cut of every frame is one equation,
+//! The virtual fields method over section cuts and tapered ramps (`tapered_ramp`, which reach
+//! the centre of a cruciform): every virtual field of every frame is one equation,
 //! the force its band carries under the law (`section_cut`) against the arm's measured grip
 //! force. All frames of a test are fitted together: by linear least squares when the model's
 //! stress is linear in all its parameters (a cut's force is then the same combination of the
@@ -9,16 +10,43 @@
 use crate::lsq::{inverse_normal_matrix, levenberg_marquardt, linear_least_squares, LsqError};
 use crate::models::Model;
 use crate::section_cut::{cut_force, CutError, FieldGrid, SectionCut};
+use crate::tapered_ramp::{RampError, RampQuadrature};
 use nalgebra::{DMatrix, DVector};
 
 /// Condition number of the scaled Jacobian beyond which the parameters are not told apart.
 pub const MAX_CONDITION: f64 = 1e8;
 
-/// One equation: a frame's field, a cut across one arm, and that arm's measured force.
+/// A virtual field whose work balances one arm's grip force.
+#[derive(Clone, Copy, Debug)]
+pub enum VirtualField<'a> {
+    /// The paper's section cut across the arm.
+    Cut(SectionCut),
+    /// A ramp tapered across, which may reach the centre, by its quadrature over the frame.
+    Ramp(&'a RampQuadrature),
+}
+
+impl VirtualField<'_> {
+    /// The force the field's internal virtual work balances, N.
+    pub fn force_n(
+        &self,
+        grid: &FieldGrid,
+        model: &Model,
+        p: &[f64],
+        thickness_mm: f64,
+    ) -> Result<f64, VfmError> {
+        Ok(match self {
+            VirtualField::Cut(cut) => cut_force(grid, cut, model, p, thickness_mm)?.force_n,
+            VirtualField::Ramp(quadrature) => quadrature.force_n(grid, model, p, thickness_mm)?,
+        })
+    }
+}
+
+/// One equation: a frame's field, a virtual field, and the measured force of the arm it
+/// balances.
 #[derive(Clone, Copy, Debug)]
 pub struct CutObservation<'a> {
     pub grid: &'a FieldGrid,
-    pub cut: SectionCut,
+    pub cut: VirtualField<'a>,
     /// Reference thickness of the sheet, mm.
     pub thickness_mm: f64,
     /// The arm's grip force at the frame, N.
@@ -46,6 +74,8 @@ pub enum VfmError {
     #[error(transparent)]
     Cut(#[from] CutError),
     #[error(transparent)]
+    Ramp(#[from] RampError),
+    #[error(transparent)]
     Lsq(#[from] LsqError),
     #[error(
         "the states the field reached do not separate the {params} parameters of {model}: \
@@ -61,9 +91,9 @@ pub enum VfmError {
 }
 
 /// Computed forces of every observation at `p` (N), `None` where the law is undefined.
-fn computed(model: &Model, obs: &[CutObservation], p: &[f64]) -> Result<Vec<f64>, CutError> {
+fn computed(model: &Model, obs: &[CutObservation], p: &[f64]) -> Result<Vec<f64>, VfmError> {
     obs.iter()
-        .map(|o| cut_force(o.grid, &o.cut, model, p, o.thickness_mm).map(|c| c.force_n))
+        .map(|o| o.cut.force_n(o.grid, model, p, o.thickness_mm))
         .collect()
 }
 
@@ -88,7 +118,7 @@ fn condition(j: &DMatrix<f64>) -> f64 {
 }
 
 /// Jacobian of the computed forces by central differences (relative step).
-fn jacobian(model: &Model, obs: &[CutObservation], p: &[f64]) -> Result<DMatrix<f64>, CutError> {
+fn jacobian(model: &Model, obs: &[CutObservation], p: &[f64]) -> Result<DMatrix<f64>, VfmError> {
     let mut j = DMatrix::zeros(obs.len(), p.len());
     for k in 0..p.len() {
         let h = 1e-6 * p[k].abs().max(1e-3);
@@ -215,7 +245,7 @@ mod tests {
             .iter()
             .map(|grid| CutObservation {
                 grid,
-                cut: CUT,
+                cut: VirtualField::Cut(CUT),
                 thickness_mm: 2.0,
                 force_n: cut_force(grid, &CUT, model, truth, 2.0).unwrap().force_n,
             })
