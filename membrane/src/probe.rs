@@ -105,39 +105,70 @@ impl ElementGrid {
         )
     }
 
-    /// The element of `mesh` (the one the grid was built from) holding `x_mm` and where in
-    /// it; None outside the mesh.
-    pub fn locate(&self, mesh: &Mesh, x_mm: [f64; 2]) -> Option<Location> {
+    /// The elements whose bounding box holds `x_mm` (candidates for holding it); none outside
+    /// the grid.
+    pub fn candidates(&self, x_mm: [f64; 2]) -> impl Iterator<Item = usize> + '_ {
         let outside = |v: f64, low: f64, count: usize| {
             v < low - self.bucket_mm * 1e-9
                 || v > low + self.bucket_mm * count as f64 + self.bucket_mm * 1e-9
         };
-        if outside(x_mm[0], self.origin_mm[0], self.columns)
+        let beyond = outside(x_mm[0], self.origin_mm[0], self.columns)
             || outside(x_mm[1], self.origin_mm[1], self.rows)
-        {
-            return None;
-        }
-        let (c, r) = self.cell(x_mm);
+            || !(x_mm[0].is_finite() && x_mm[1].is_finite());
+        let bucket: &[usize] = if beyond {
+            &[]
+        } else {
+            let (c, r) = self.cell(x_mm);
+            &self.buckets[r * self.columns + c]
+        };
         let slack = self.bucket_mm * 1e-9;
-        let in_box = |e: usize| {
+        bucket.iter().copied().filter(move |&e| {
             let [low, high] = self.boxes[e];
             x_mm[0] >= low[0] - slack
                 && x_mm[0] <= high[0] + slack
                 && x_mm[1] >= low[1] - slack
                 && x_mm[1] <= high[1] + slack
-        };
-        self.buckets[r * self.columns + c]
-            .iter()
-            .filter(|&&e| in_box(e))
-            .find_map(|&e| {
-                natural_coordinates(&mesh.element_nodes_mm(e), x_mm, CENTROID).map(|(xi, eta)| {
-                    Location {
-                        element: e,
-                        xi,
-                        eta,
-                    }
+        })
+    }
+
+    /// Whether any element's bounding box meets the rectangle [low, high] (mm): when none
+    /// does, no point of it is in the mesh.
+    pub fn any_element_meets(&self, low: [f64; 2], high: [f64; 2]) -> bool {
+        let grid_high = [
+            self.origin_mm[0] + self.bucket_mm * self.columns as f64,
+            self.origin_mm[1] + self.bucket_mm * self.rows as f64,
+        ];
+        if high[0] < self.origin_mm[0]
+            || high[1] < self.origin_mm[1]
+            || low[0] > grid_high[0]
+            || low[1] > grid_high[1]
+        {
+            return false;
+        }
+        let (c0, r0) = self.cell(low);
+        let (c1, r1) = self.cell(high);
+        (r0..=r1).any(|r| {
+            (c0..=c1).any(|c| {
+                self.buckets[r * self.columns + c].iter().any(|&e| {
+                    let [lo, hi] = self.boxes[e];
+                    lo[0] <= high[0] && hi[0] >= low[0] && lo[1] <= high[1] && hi[1] >= low[1]
                 })
             })
+        })
+    }
+
+    /// The element of `mesh` (the one the grid was built from) holding `x_mm` and where in
+    /// it; None outside the mesh.
+    pub fn locate(&self, mesh: &Mesh, x_mm: [f64; 2]) -> Option<Location> {
+        self.candidates(x_mm).find_map(|e| {
+            natural_coordinates(&mesh.element_nodes_mm(e), x_mm, CENTROID).map(|(xi, eta)| {
+                Location {
+                    element: e,
+                    xi,
+                    eta,
+                }
+            })
+        })
     }
 
     /// [`Self::locate`], trying first the element of `near` from its natural coordinates

@@ -89,8 +89,7 @@ fn element_maps(mesh: &Mesh) -> Vec<QuadraticMap> {
 #[derive(Clone, Debug)]
 pub struct FieldMotion {
     reference: Arc<ReferenceMesh>,
-    /// The deformed mesh: nodes at Xᵢ + uᵢ.
-    current: Mesh,
+    /// The element grid and maps of the deformed mesh (nodes at Xᵢ + uᵢ).
     current_grid: ElementGrid,
     current_maps: Vec<QuadraticMap>,
     /// Nodal displacements, two per node, mm.
@@ -165,7 +164,6 @@ impl FieldMotion {
         let current_maps = element_maps(&current);
         Ok(FieldMotion {
             reference,
-            current,
             current_grid,
             current_maps,
             u_mm,
@@ -241,6 +239,17 @@ impl FieldMotion {
         })
     }
 
+    /// Whether any element of the deformed mesh comes near the pixels `from_col..=to_col` of
+    /// row `y_px` (when not, they all show the backdrop).
+    fn material_near(&self, from_col: usize, to_col: usize, y_px: f64) -> bool {
+        let a = self.view.to_mm([from_col as f64, y_px]);
+        let b = self.view.to_mm([to_col as f64, y_px]);
+        self.current_grid.any_element_meets(
+            [a[0].min(b[0]), a[1].min(b[1])],
+            [a[0].max(b[0]), a[1].max(b[1])],
+        )
+    }
+
     /// Where `x_px` is in the deformed mesh: Newton in the element of `hint` from its natural
     /// coordinates, else through the element grid; updates `hint`.
     #[inline]
@@ -255,10 +264,54 @@ impl FieldMotion {
                     eta,
                 })
         });
-        let location = near.or_else(|| self.current_grid.locate(&self.current, x_mm));
+        let location = near.or_else(|| {
+            self.current_grid.candidates(x_mm).find_map(|e| {
+                self.current_maps[e]
+                    .natural(x_mm, (1.0 / 3.0, 1.0 / 3.0))
+                    .map(|(xi, eta)| Location {
+                        element: e,
+                        xi,
+                        eta,
+                    })
+            })
+        });
         *hint = location;
         location
     }
+}
+
+/// The cubic Hermite basis (h00, h10, h01, h11) at `t`.
+const fn hermite_basis(t: f64) -> [f64; 4] {
+    let (t2, t3) = (t * t, t * t * t);
+    [
+        2.0 * t3 - 3.0 * t2 + 1.0,
+        t3 - 2.0 * t2 + t,
+        -2.0 * t3 + 3.0 * t2,
+        t3 - t2,
+    ]
+}
+
+/// [`hermite_basis`] at the pixels of a whole block, k / [`BLOCK_SPAN_PX`].
+const BLOCK_BASIS: [[f64; 4]; BLOCK_SPAN_PX] = {
+    let mut table = [[0.0; 4]; BLOCK_SPAN_PX];
+    let mut k = 0;
+    while k < BLOCK_SPAN_PX {
+        table[k] = hermite_basis(k as f64 / BLOCK_SPAN_PX as f64);
+        k += 1;
+    }
+    table
+};
+
+/// X from the Hermite basis `h` between `a` and `b`, `span_px` apart.
+#[inline(always)]
+fn hermite_with(a: &InversePoint, b: &InversePoint, span_px: f64, h: &[f64; 4]) -> Vec2 {
+    let at = |i: usize| {
+        h[0] * a.reference_px[i]
+            + h[1] * span_px * a.gradient[i][0]
+            + h[2] * b.reference_px[i]
+            + h[3] * span_px * b.gradient[i][0]
+    };
+    [at(0), at(1)]
 }
 
 /// X at `t` ∈ [0, 1] of the way from `a` to `b`, two points `span_px` apart along a row: the
@@ -267,16 +320,7 @@ impl FieldMotion {
 /// never across an element's edge, where F jumps: 0.13 px there at worst on that cruciform).
 #[inline(always)]
 pub fn hermite_along_row(a: &InversePoint, b: &InversePoint, span_px: f64, t: f64) -> Vec2 {
-    let (t2, t3) = (t * t, t * t * t);
-    let (h00, h10) = (2.0 * t3 - 3.0 * t2 + 1.0, t3 - 2.0 * t2 + t);
-    let (h01, h11) = (-2.0 * t3 + 3.0 * t2, t3 - t2);
-    let at = |i: usize| {
-        h00 * a.reference_px[i]
-            + h10 * span_px * a.gradient[i][0]
-            + h01 * b.reference_px[i]
-            + h11 * span_px * b.gradient[i][0]
-    };
-    [at(0), at(1)]
+    hermite_with(a, b, span_px, &hermite_basis(t))
 }
 
 /// Walks a row of pixels in blocks of [`BLOCK_SPAN_PX`], giving each pixel's X = φ⁻¹(x)
@@ -339,12 +383,27 @@ impl<'f> RowWalker<'f> {
     ) {
         match (a, c) {
             (Some(pa), Some(pc)) if pa.location.element == pc.location.element => {
-                let span = (k1 - k0) as f64;
-                for (k, x) in out.iter_mut().enumerate().take(k1).skip(k0) {
-                    *x = Some(hermite_along_row(pa, pc, span, (k - k0) as f64 / span));
+                if k1 - k0 == BLOCK_SPAN_PX {
+                    for (x, h) in out.iter_mut().zip(&BLOCK_BASIS) {
+                        *x = Some(hermite_with(pa, pc, BLOCK_SPAN_PX as f64, h));
+                    }
+                } else {
+                    let span = (k1 - k0) as f64;
+                    for (k, x) in out.iter_mut().enumerate().take(k1).skip(k0) {
+                        *x = Some(hermite_along_row(pa, pc, span, (k - k0) as f64 / span));
+                    }
                 }
             }
             _ if k1 - k0 == 1 => out[k0] = a.map(|p| p.reference_px),
+            // Both ends off the specimen and no element near the segment between them: all
+            // of it shows the backdrop.
+            (None, None)
+                if !self
+                    .field
+                    .material_near(first_col + k0, first_col + k1, self.y_px) =>
+            {
+                out[k0..k1].fill(None);
+            }
             _ => {
                 let mid = (k0 + k1) / 2;
                 let m = self.point(first_col + mid, a, (mid - k0) as f64);
