@@ -170,6 +170,19 @@ mod tests {
         assert!((last - 2.0).abs() < 1e-12);
     }
 
+    /// A bare word as a value is named with what to write instead.
+    #[test]
+    fn a_bare_word_in_a_program_is_named_with_the_fix() {
+        let err = Program::from_toml(
+            "[[channel]]\ntarget = x+\nsegments = []",
+            std::path::Path::new("."),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.starts_with("program TOML: "), "{err}");
+        assert!(err.contains("`x+` is not a TOML value"), "{err}");
+    }
+
     #[test]
     fn bad_programs_are_rejected_with_a_reason() {
         let err = Program::from_toml(

@@ -36,6 +36,7 @@ pub mod shm;
 pub mod signals;
 pub mod stats;
 pub mod text;
+pub mod toml_hint;
 
 pub use clock::monotonic_ns;
 pub use field::{FieldHeader, FieldNode, GaugeStrain, GradientSource, NodeStatus, StrainMeasure};

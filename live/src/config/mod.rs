@@ -364,8 +364,17 @@ impl Default for IdentifierSection {
 impl RunConfig {
     /// Parses a TOML file's text; errors name the file and the offending key or line.
     pub fn from_toml(text: &str, source: &str) -> anyhow::Result<RunConfig> {
-        use anyhow::Context as _;
-        toml::from_str(text).with_context(|| source.to_string())
+        toml::from_str(text).map_err(|error| {
+            let hint = error
+                .span()
+                .and_then(|span| wire::toml_hint::bare_word_hint(text, span.start));
+            match hint {
+                Some(hint) => {
+                    anyhow::anyhow!("{source}: {}\n{hint}", error.to_string().trim_end())
+                }
+                None => anyhow::Error::new(error).context(source.to_string()),
+            }
+        })
     }
 
     /// The configuration of `--config FILE`, or the defaults without one.

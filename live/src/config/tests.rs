@@ -189,3 +189,22 @@ fn bad_configurations_are_refused_with_the_key_named() {
     let round = RunConfig::from_toml(&ok.to_toml(), "round").unwrap();
     assert_eq!(round, ok);
 }
+
+/// A bare word as a value (the commonest slip in a hand-edited file) is named with what to
+/// write instead, not only as the parser's "invalid boolean".
+#[test]
+fn a_bare_word_value_is_named_with_the_fix() {
+    let error = RunConfig::from_toml("[camera]\nfps = ten\n", "run.toml").unwrap_err();
+    let text = format!("{error:#}");
+    assert!(text.starts_with("run.toml: "), "{text}");
+    assert!(text.contains("line 2"), "{text}");
+    assert!(
+        text.contains("`ten` is not a TOML value: numbers are written in digits"),
+        "{text}"
+    );
+    // Other errors keep the parser's own words.
+    let error = RunConfig::from_toml("[camera]\nfps = \"ten\"\n", "run.toml").unwrap_err();
+    let text = format!("{error:#}");
+    assert!(!text.contains("not a TOML value"), "{text}");
+    assert!(text.contains("run.toml"), "{text}");
+}

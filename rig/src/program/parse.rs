@@ -13,8 +13,12 @@ use std::path::{Path, PathBuf};
 /// Why a program was refused.
 #[derive(Debug, thiserror::Error)]
 pub enum ProgramError {
-    #[error("program TOML: {0}")]
-    Toml(toml::de::Error),
+    #[error("program TOML: {error}{}", hint.as_deref().map(|h| format!("\n{h}")).unwrap_or_default())]
+    Toml {
+        error: Box<toml::de::Error>,
+        /// What to write instead of a bare word (`wire::toml_hint`).
+        hint: Option<Box<str>>,
+    },
     #[error("setup axis {axis:?}: expected x, y or z")]
     SetupAxis { axis: String },
     #[error(
@@ -135,7 +139,13 @@ fn default_stop_rate() -> f64 {
 impl Program {
     /// Parse a TOML program; CSV paths are relative to `base_dir`.
     pub fn from_toml(text: &str, base_dir: &Path) -> Result<Program, ProgramError> {
-        let file: ProgramFile = toml::from_str(text).map_err(ProgramError::Toml)?;
+        let file: ProgramFile = toml::from_str(text).map_err(|error| ProgramError::Toml {
+            hint: error
+                .span()
+                .and_then(|span| wire::toml_hint::bare_word_hint(text, span.start))
+                .map(String::into_boxed_str),
+            error: Box::new(error),
+        })?;
         Program::from_file(file, base_dir)
     }
 
