@@ -128,18 +128,6 @@ impl CorrelateBench {
         self.images.height_px
     }
 
-    /// The standard case of the speed target: rendered 1024², CORRELI-GD, ZOI 32, step 16.
-    pub fn standard(&self) -> bool {
-        self.rendered
-            && self.args.method == Method::Correli
-            && (
-                self.width_px(),
-                self.height_px(),
-                self.args.zoi,
-                self.args.step,
-            ) == (1024, 1024, 32, 16)
-    }
-
     /// The settings of the benchmarked method on `threads` threads.
     fn settings(&self, threads: usize) -> CorrelatorSettings {
         self.settings_with(self.args.method, self.args.zoi, threads)
