@@ -15,7 +15,7 @@ use crate::assembly::Membrane;
 use crate::boundary::Clamp;
 use crate::error::SolveError;
 use crate::law::SheetLaw;
-use crate::solver::{factorise, Equilibrium, FreeDofs};
+use crate::solver::{factorise, Analysis, Equilibrium, FreeDofs};
 use crate::specimens::Grip;
 use faer::linalg::solvers::Solve;
 use faer::sparse::Triplet;
@@ -33,12 +33,14 @@ pub struct Condensed {
 
 /// Condenses the tangent at `equilibrium` (a converged solve of `clamps`) on the axial
 /// translations of `grips` (whose nodes `clamps` hold). The tangent must be positive definite
-/// there: an unstable state is a [`SolveError::Unstable`] at load factor 1.
+/// there: an unstable state is a [`SolveError::Unstable`] at load factor 1. `analysis`: the
+/// symbolic factorisation of the solves of the same clamped nodes, reused or made and kept.
 pub fn condense<L: SheetLaw + ?Sized>(
     membrane: &Membrane<'_, L>,
     clamps: &[Clamp],
     equilibrium: &Equilibrium,
     grips: &[Grip],
+    analysis: &mut Analysis,
 ) -> Result<Condensed, SolveError> {
     let dofs = FreeDofs::of(membrane, clamps)?;
     let u = &equilibrium.displacement_mm;
@@ -71,7 +73,10 @@ pub fn condense<L: SheetLaw + ?Sized>(
             }
         }
     }
-    let llt = factorise(dofs.count, &triplets, &mut None).map_err(at_end)?;
+    let mut symbolic = analysis.take_for(&dofs.free);
+    let llt = factorise(dofs.count, &triplets, &mut symbolic);
+    analysis.keep(&dofs.free, symbolic);
+    let llt = llt.map_err(at_end)?;
     // K d over every DOF, element by element.
     let product = |d: &[f64]| -> Vec<f64> {
         let mut y = vec![0.0; d.len()];

@@ -45,6 +45,7 @@ pub use principal::PrincipalStresses;
 pub use probe::{Location, PointSample, Probe};
 pub use region::Region;
 pub use solver::{
-    solve, solve_from, solve_until_stopped, Equilibrium, NewtonSettings, Outcome, StepRecord,
+    solve, solve_from, solve_until_stopped, Analysis, Equilibrium, NewtonSettings, Outcome,
+    StepRecord,
 };
 pub use specimens::{GripStretch, Specimen, SpecimenChoice, SpecimenShape};

@@ -193,17 +193,47 @@ pub fn solve_until_stopped<L: SheetLaw + ?Sized>(
     Solver::new(membrane, clamps, settings, free, None).map(|mut solver| solver.run())
 }
 
+/// The sparse Cholesky's symbolic analysis (fill-reducing ordering, supernodes) of a mesh with
+/// a set of clamped DOFs, kept between the solves of a moving grip: it depends on the pattern
+/// only, and is made again when the clamped DOFs differ from those it was made for.
+#[derive(Clone, Debug, Default)]
+pub struct Analysis {
+    free: Vec<Option<usize>>,
+    symbolic: Option<SymbolicLlt<usize>>,
+}
+
+impl Analysis {
+    /// The symbolic analysis for `free`, if this one was made for it.
+    pub(crate) fn take_for(&mut self, free: &[Option<usize>]) -> Option<SymbolicLlt<usize>> {
+        if self.free == free {
+            self.symbolic.take()
+        } else {
+            None
+        }
+    }
+
+    pub(crate) fn keep(&mut self, free: &[Option<usize>], symbolic: Option<SymbolicLlt<usize>>) {
+        if symbolic.is_some() {
+            self.free = free.to_vec();
+            self.symbolic = symbolic;
+        }
+    }
+}
+
 /// [`solve_until_stopped`] warm-started from the displacement `start_mm` (a converged
 /// equilibrium of the same clamped nodes, e.g. the previous solve of a moving grip): load
 /// factor 0 is `start_mm`, load factor 1 the clamps' motion at full load, the clamped DOFs in
 /// between on the straight line from one to the other. The load is first taken in
 /// `settings.load_steps` increments (1: a single Newton solve from the start), cut in halves
 /// when an increment fails (load sub-stepping).
+/// `analysis` is the symbolic factorisation of earlier solves of the same clamped nodes (an
+/// empty one the first time): reused, or made and kept.
 pub fn solve_from<L: SheetLaw + ?Sized>(
     membrane: &Membrane<'_, L>,
     clamps: &[Clamp],
     start_mm: &[f64],
     settings: NewtonSettings,
+    analysis: &mut Analysis,
 ) -> Result<Outcome, SolveError> {
     let free = FreeDofs::of(membrane, clamps)?;
     if start_mm.len() != free.free.len() {
@@ -220,7 +250,12 @@ pub fn solve_from<L: SheetLaw + ?Sized>(
             .flat_map(|c| c.prescribed(nodes, 1.0))
             .collect(),
     };
-    Solver::new(membrane, clamps, settings, free, Some(warm)).map(|mut solver| solver.run())
+    let symbolic = analysis.take_for(&free.free);
+    let mut solver = Solver::new(membrane, clamps, settings, free, Some(warm))?;
+    solver.symbolic = symbolic;
+    let outcome = solver.run();
+    analysis.keep(&solver.free, solver.symbolic.take());
+    Ok(outcome)
 }
 
 /// Which DOFs the clamps hold, and the index of each free one in the linear systems.

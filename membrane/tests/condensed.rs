@@ -62,7 +62,15 @@ fn the_condensed_tangent_is_the_derivative_of_the_solved_grip_forces() {
     // A biaxial state (x further than y): not symmetric between the axes.
     let base = clamps(&specimen, 1.4, 0, 0.0);
     let equilibrium = solve(&membrane, &base, settings).unwrap();
-    let condensed = condense(&membrane, &base, &equilibrium, &specimen.grips).unwrap();
+    let mut analysis = membrane::Analysis::default();
+    let condensed = condense(
+        &membrane,
+        &base,
+        &equilibrium,
+        &specimen.grips,
+        &mut analysis,
+    )
+    .unwrap();
     let k = &condensed.stiffness_n_per_mm;
     let scale = k.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
     let h_mm = 1e-2;
@@ -71,9 +79,16 @@ fn the_condensed_tangent_is_the_derivative_of_the_solved_grip_forces() {
         ..settings
     };
     for b in 0..specimen.grips.len() {
-        let solved = |extra_mm: f64| {
+        let mut solved = |extra_mm: f64| {
             let c = clamps(&specimen, 1.4, b, extra_mm);
-            let e = solve_from(&membrane, &c, &equilibrium.displacement_mm, warm).unwrap();
+            let e = solve_from(
+                &membrane,
+                &c,
+                &equilibrium.displacement_mm,
+                warm,
+                &mut analysis,
+            )
+            .unwrap();
             assert!(e.stopped.is_none());
             axial_forces(&specimen, &e.reached)
         };
@@ -121,6 +136,7 @@ fn a_warm_start_reaches_the_equilibrium_of_a_solve_from_rest() {
             load_steps: 1,
             ..settings
         },
+        &mut membrane::Analysis::default(),
     )
     .unwrap();
     assert!(warm.stopped.is_none());
@@ -135,5 +151,12 @@ fn a_warm_start_reaches_the_equilibrium_of_a_solve_from_rest() {
     }
     assert!(iterations < cold.steps.iter().map(|s| s.residuals_n.len()).sum());
     // A start of the wrong length is refused.
-    assert!(solve_from(&membrane, &target, &[0.0; 3], settings).is_err());
+    assert!(solve_from(
+        &membrane,
+        &target,
+        &[0.0; 3],
+        settings,
+        &mut membrane::Analysis::default()
+    )
+    .is_err());
 }
