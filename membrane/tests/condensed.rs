@@ -1,6 +1,9 @@
 //! The grips' condensed tangent against finite differences of solved grip forces, and a
 //! warm-started solve against one from rest.
 
+// The stiffness matrix indexed by grip, as K[a][b] reads.
+#![allow(clippy::needless_range_loop)]
+
 use material::InvariantLaw;
 use membrane::specimens::cruciform::CruciformGeometry;
 use membrane::specimens::Specimen;

@@ -8,6 +8,9 @@
 //! displacement gradient H and mean displacement follow the same way, from the grips'
 //! displacement modes. No allocation: fixed arrays of [`MAX_GRIPS`].
 
+// Small matrices indexed by grip and component read as the formulas do.
+#![allow(clippy::needless_range_loop)]
+
 /// The cruciform's four grips at most.
 pub const MAX_GRIPS: usize = 4;
 
