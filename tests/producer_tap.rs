@@ -241,6 +241,9 @@ fn follow_rig_renders_each_frame_from_a_real_rig_sample_with_exact_truth() {
             &instance,
             "--test",
             "uniaxial",
+            // The analytic sheet: its frames' truth is uniaxial exactly (F22 = F11^-1/2).
+            "--specimen",
+            "homogeneous",
             "--speed",
             "20",
             "--publish-hz",
@@ -395,6 +398,9 @@ fn follow_rig_skips_and_counts_states_beyond_the_envelope_with_one_warning() {
             &instance,
             "--test",
             "uniaxial",
+            // The analytic sheet: stretch_x leaves the envelope first.
+            "--specimen",
+            "homogeneous",
             "--rate",
             "0.05",
             "--stretch",

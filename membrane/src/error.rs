@@ -23,6 +23,8 @@ pub enum GeometryError {
     TooManyElements { elements: usize, limit: usize },
     #[error("element {element} is inverted in the reference mesh (Jacobian {jacobian_mm2} mm²)")]
     InvertedElement { element: usize, jacobian_mm2: f64 },
+    #[error("the region holds no element of the mesh")]
+    EmptyRegion,
 }
 
 /// Where the solution of a load stopped, and why.
@@ -62,6 +64,8 @@ pub enum SolveError {
     UnknownNode { node: usize, nodes: usize },
     #[error("nothing is clamped: the sheet is free to move as a rigid body")]
     NoClamp,
+    #[error("a warm start of {values} displacements for a mesh of {dofs} degrees of freedom")]
+    StartLength { values: usize, dofs: usize },
     #[error("the sparse factorisation could not be made: {cause}")]
     Factorisation { cause: faer::sparse::CreationError },
 }

@@ -7,7 +7,8 @@
 //! [`InvariantDerivatives`]) or a law by its principal stresses ([`PrincipalStresses`]: Ogden). A sheet carries no compression: tension-field relaxation
 //! ([`Wrinkling`]). The specimens of the paper are meshed in code ([`specimens`]), clamped by
 //! grips moving as rigid bodies ([`Clamp`]), and solved by Newton with line search and load
-//! stepping ([`solve`]); a failure names its state and reason ([`SolveError`]). A path of grip
+//! stepping ([`solve`], warm-started from an earlier equilibrium: [`solve_from`]), its tangent
+//! condensed on the grips ([`condense`]); a failure names its state and reason ([`SolveError`]). A path of grip
 //! stretches ([`solve_path`]) gives nodal fields ([`nodal`]) written as VTK and CSV ([`output`]).
 //! Units: mm, N, MPa.
 
@@ -15,6 +16,7 @@
 
 pub mod assembly;
 pub mod boundary;
+pub mod condensed;
 pub mod constitutive;
 pub mod error;
 pub mod law;
@@ -24,6 +26,7 @@ pub mod output;
 pub mod path;
 pub mod principal;
 pub mod probe;
+pub mod region;
 pub mod solver;
 pub mod specimens;
 pub mod t6;
@@ -31,6 +34,7 @@ mod wrinkling;
 
 pub use assembly::{Membrane, PointField};
 pub use boundary::{Clamp, Held, RigidMotion};
+pub use condensed::{condense, Condensed};
 pub use constitutive::{MembraneState, Wrinkling};
 pub use error::{GeometryError, SolveError};
 pub use law::{InvariantDerivatives, MembraneLaw, SheetLaw};
@@ -39,5 +43,9 @@ pub use nodal::{NodalField, NodeFailure};
 pub use path::{solve_path, Path, PathReport, PathState, PathStop, StateFigures};
 pub use principal::PrincipalStresses;
 pub use probe::{point_at, sample_at, ElementGrid, Location, PointSample, Probe};
-pub use solver::{solve, solve_until_stopped, Equilibrium, NewtonSettings, Outcome, StepRecord};
+pub use region::Region;
+pub use solver::{
+    solve, solve_from, solve_until_stopped, Analysis, Equilibrium, NewtonSettings, Outcome,
+    StepRecord,
+};
 pub use specimens::{GripStretch, Specimen, SpecimenChoice, SpecimenShape};

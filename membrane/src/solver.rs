@@ -83,7 +83,7 @@ impl Equilibrium {
 }
 
 /// Where a failed increment stopped (the load factor is filled in by the caller).
-enum Failure {
+pub(crate) enum Failure {
     Point(FailureAt),
     NotConverged {
         iterations: usize,
@@ -96,132 +96,9 @@ enum Failure {
     Factorisation(CreationError),
 }
 
-struct Solver<'m, 'a, L: SheetLaw + ?Sized> {
-    membrane: &'m Membrane<'a, L>,
-    clamps: &'m [Clamp],
-    settings: NewtonSettings,
-    /// Free index of each DOF, `None` if prescribed.
-    free: Vec<Option<usize>>,
-    free_count: usize,
-    symbolic: Option<SymbolicLlt<usize>>,
-}
-
-/// Solves the clamped sheet up to load factor 1: its equilibrium there, or why it stopped.
-pub fn solve<L: SheetLaw + ?Sized>(
-    membrane: &Membrane<'_, L>,
-    clamps: &[Clamp],
-    settings: NewtonSettings,
-) -> Result<Equilibrium, SolveError> {
-    let outcome = solve_until_stopped(membrane, clamps, settings)?;
-    match outcome.stopped {
-        Some(error) => Err(error),
-        None => Ok(outcome.reached),
-    }
-}
-
-/// How far a load went: the last converged equilibrium (at load factor 1 if it went through,
-/// else where it stopped, with its forces) and, if it stopped, why.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Outcome {
-    pub reached: Equilibrium,
-    pub stopped: Option<SolveError>,
-}
-
-/// [`solve`], keeping the last converged equilibrium when the load stops on the way; an error
-/// only for clamps that cannot be applied.
-pub fn solve_until_stopped<L: SheetLaw + ?Sized>(
-    membrane: &Membrane<'_, L>,
-    clamps: &[Clamp],
-    settings: NewtonSettings,
-) -> Result<Outcome, SolveError> {
-    let nodes = membrane.mesh.nodes_mm.len();
-    if clamps.iter().all(|c| c.nodes.is_empty()) {
-        return Err(SolveError::NoClamp);
-    }
-    let mut free = vec![Some(0); 2 * nodes];
-    for clamp in clamps {
-        if let Some(&node) = clamp.nodes.iter().find(|&&n| n >= nodes) {
-            return Err(SolveError::UnknownNode { node, nodes });
-        }
-        for (dof, _) in clamp.prescribed(&membrane.mesh.nodes_mm, 0.0) {
-            free[dof] = None;
-        }
-    }
-    let mut free_count = 0;
-    for slot in free.iter_mut().flatten() {
-        *slot = free_count;
-        free_count += 1;
-    }
-    let mut solver = Solver {
-        membrane,
-        clamps,
-        settings,
-        free,
-        free_count,
-        symbolic: None,
-    };
-    Ok(solver.run())
-}
-
-fn norm(v: impl Iterator<Item = f64>) -> f64 {
-    v.map(|x| x * x).sum::<f64>().sqrt()
-}
-
-impl<L: SheetLaw + ?Sized> Solver<'_, '_, L> {
-    fn run(&mut self) -> Outcome {
-        let mut u = vec![0.0; self.free.len()];
-        let mut converged = 0.0;
-        let initial = 1.0 / self.settings.load_steps.max(1) as f64;
-        // The smallest step: a failure there stops the load (no creeping towards a limit).
-        let smallest = initial / 2f64.powi(self.settings.max_step_cuts.min(60) as i32);
-        let mut increment = initial;
-        let mut successes = 0;
-        let mut steps = Vec::new();
-        let mut forces = vec![0.0; self.free.len()];
-        let mut stopped = None;
-        while converged < 1.0 {
-            let target = if converged + increment > 1.0 - 1e-12 {
-                1.0
-            } else {
-                converged + increment
-            };
-            match self.increment(&u, target) {
-                Ok((u_new, evaluation, record)) => {
-                    u = u_new;
-                    forces = evaluation.forces_n;
-                    converged = target;
-                    steps.push(record);
-                    // Two good steps in a row after a cut: the step grows back.
-                    successes += 1;
-                    if successes >= 2 && increment < initial {
-                        increment = (2.0 * increment).min(initial);
-                        successes = 0;
-                    }
-                }
-                Err(failure) if increment <= smallest * (1.0 + 1e-9) => {
-                    stopped = Some(self.error(failure, target, converged));
-                    break;
-                }
-                Err(_) => {
-                    increment *= 0.5;
-                    successes = 0;
-                }
-            }
-        }
-        Outcome {
-            reached: Equilibrium {
-                load_factor: converged,
-                displacement_mm: u,
-                nodal_forces_n: forces,
-                steps,
-                free_dofs: self.free_count,
-            },
-            stopped,
-        }
-    }
-
-    fn error(&self, failure: Failure, load_factor: f64, converged_load_factor: f64) -> SolveError {
-        match failure {
+impl Failure {
+    pub(crate) fn into_error(self, load_factor: f64, converged_load_factor: f64) -> SolveError {
+        match self {
             Failure::Point(FailureAt {
                 element,
                 point,
@@ -263,9 +140,249 @@ impl<L: SheetLaw + ?Sized> Solver<'_, '_, L> {
             Failure::Factorisation(cause) => SolveError::Factorisation { cause },
         }
     }
+}
+
+struct Solver<'m, 'a, L: SheetLaw + ?Sized> {
+    membrane: &'m Membrane<'a, L>,
+    clamps: &'m [Clamp],
+    settings: NewtonSettings,
+    /// Free index of each DOF, `None` if prescribed.
+    free: Vec<Option<usize>>,
+    free_count: usize,
+    symbolic: Option<SymbolicLlt<usize>>,
+    /// A warm start: the displacement the load starts from, and the clamps' prescribed values
+    /// at its end (the prescribed DOFs go linearly from one to the other with the load factor).
+    /// None: from the reference, the clamps' own motion scaled by the load factor.
+    warm: Option<WarmStart>,
+}
+
+struct WarmStart {
+    start_mm: Vec<f64>,
+    end_mm: Vec<(usize, f64)>,
+}
+
+/// Solves the clamped sheet up to load factor 1: its equilibrium there, or why it stopped.
+pub fn solve<L: SheetLaw + ?Sized>(
+    membrane: &Membrane<'_, L>,
+    clamps: &[Clamp],
+    settings: NewtonSettings,
+) -> Result<Equilibrium, SolveError> {
+    let outcome = solve_until_stopped(membrane, clamps, settings)?;
+    match outcome.stopped {
+        Some(error) => Err(error),
+        None => Ok(outcome.reached),
+    }
+}
+
+/// How far a load went: the last converged equilibrium (at load factor 1 if it went through,
+/// else where it stopped, with its forces) and, if it stopped, why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outcome {
+    pub reached: Equilibrium,
+    pub stopped: Option<SolveError>,
+}
+
+/// [`solve`], keeping the last converged equilibrium when the load stops on the way; an error
+/// only for clamps that cannot be applied.
+pub fn solve_until_stopped<L: SheetLaw + ?Sized>(
+    membrane: &Membrane<'_, L>,
+    clamps: &[Clamp],
+    settings: NewtonSettings,
+) -> Result<Outcome, SolveError> {
+    let free = FreeDofs::of(membrane, clamps)?;
+    Solver::new(membrane, clamps, settings, free, None).map(|mut solver| solver.run())
+}
+
+/// The sparse Cholesky's symbolic analysis (fill-reducing ordering, supernodes) of a mesh with
+/// a set of clamped DOFs, kept between the solves of a moving grip: it depends on the pattern
+/// only, and is made again when the clamped DOFs differ from those it was made for.
+#[derive(Clone, Debug, Default)]
+pub struct Analysis {
+    free: Vec<Option<usize>>,
+    symbolic: Option<SymbolicLlt<usize>>,
+}
+
+impl Analysis {
+    /// The symbolic analysis for `free`, if this one was made for it.
+    pub(crate) fn take_for(&mut self, free: &[Option<usize>]) -> Option<SymbolicLlt<usize>> {
+        if self.free == free {
+            self.symbolic.take()
+        } else {
+            None
+        }
+    }
+
+    pub(crate) fn keep(&mut self, free: &[Option<usize>], symbolic: Option<SymbolicLlt<usize>>) {
+        if symbolic.is_some() {
+            self.free = free.to_vec();
+            self.symbolic = symbolic;
+        }
+    }
+}
+
+/// [`solve_until_stopped`] warm-started from the displacement `start_mm` (a converged
+/// equilibrium of the same clamped nodes, e.g. the previous solve of a moving grip): load
+/// factor 0 is `start_mm`, load factor 1 the clamps' motion at full load, the clamped DOFs in
+/// between on the straight line from one to the other. The load is first taken in
+/// `settings.load_steps` increments (1: a single Newton solve from the start), cut in halves
+/// when an increment fails (load sub-stepping).
+/// `analysis` is the symbolic factorisation of earlier solves of the same clamped nodes (an
+/// empty one the first time): reused, or made and kept.
+pub fn solve_from<L: SheetLaw + ?Sized>(
+    membrane: &Membrane<'_, L>,
+    clamps: &[Clamp],
+    start_mm: &[f64],
+    settings: NewtonSettings,
+    analysis: &mut Analysis,
+) -> Result<Outcome, SolveError> {
+    let free = FreeDofs::of(membrane, clamps)?;
+    if start_mm.len() != free.free.len() {
+        return Err(SolveError::StartLength {
+            values: start_mm.len(),
+            dofs: free.free.len(),
+        });
+    }
+    let nodes = &membrane.mesh.nodes_mm;
+    let warm = WarmStart {
+        start_mm: start_mm.to_vec(),
+        end_mm: clamps
+            .iter()
+            .flat_map(|c| c.prescribed(nodes, 1.0))
+            .collect(),
+    };
+    let symbolic = analysis.take_for(&free.free);
+    let mut solver = Solver::new(membrane, clamps, settings, free, Some(warm))?;
+    solver.symbolic = symbolic;
+    let outcome = solver.run();
+    analysis.keep(&solver.free, solver.symbolic.take());
+    Ok(outcome)
+}
+
+/// Which DOFs the clamps hold, and the index of each free one in the linear systems.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct FreeDofs {
+    /// Free index of each DOF, `None` if prescribed.
+    pub free: Vec<Option<usize>>,
+    pub count: usize,
+}
+
+impl FreeDofs {
+    pub(crate) fn of<L: SheetLaw + ?Sized>(
+        membrane: &Membrane<'_, L>,
+        clamps: &[Clamp],
+    ) -> Result<FreeDofs, SolveError> {
+        let nodes = membrane.mesh.nodes_mm.len();
+        if clamps.iter().all(|c| c.nodes.is_empty()) {
+            return Err(SolveError::NoClamp);
+        }
+        let mut free = vec![Some(0); 2 * nodes];
+        for clamp in clamps {
+            if let Some(&node) = clamp.nodes.iter().find(|&&n| n >= nodes) {
+                return Err(SolveError::UnknownNode { node, nodes });
+            }
+            for (dof, _) in clamp.prescribed(&membrane.mesh.nodes_mm, 0.0) {
+                free[dof] = None;
+            }
+        }
+        let mut count = 0;
+        for slot in free.iter_mut().flatten() {
+            *slot = count;
+            count += 1;
+        }
+        Ok(FreeDofs { free, count })
+    }
+}
+
+fn norm(v: impl Iterator<Item = f64>) -> f64 {
+    v.map(|x| x * x).sum::<f64>().sqrt()
+}
+
+impl<'m, 'a, L: SheetLaw + ?Sized> Solver<'m, 'a, L> {
+    fn new(
+        membrane: &'m Membrane<'a, L>,
+        clamps: &'m [Clamp],
+        settings: NewtonSettings,
+        free: FreeDofs,
+        warm: Option<WarmStart>,
+    ) -> Result<Self, SolveError> {
+        Ok(Solver {
+            membrane,
+            clamps,
+            settings,
+            free: free.free,
+            free_count: free.count,
+            symbolic: None,
+            warm,
+        })
+    }
+
+    fn run(&mut self) -> Outcome {
+        let mut u = match &self.warm {
+            Some(warm) => warm.start_mm.clone(),
+            None => vec![0.0; self.free.len()],
+        };
+        let mut converged = 0.0;
+        let initial = 1.0 / self.settings.load_steps.max(1) as f64;
+        // The smallest step: a failure there stops the load (no creeping towards a limit).
+        let smallest = initial / 2f64.powi(self.settings.max_step_cuts.min(60) as i32);
+        let mut increment = initial;
+        let mut successes = 0;
+        let mut steps = Vec::new();
+        let mut forces = vec![0.0; self.free.len()];
+        let mut stopped = None;
+        while converged < 1.0 {
+            let target = if converged + increment > 1.0 - 1e-12 {
+                1.0
+            } else {
+                converged + increment
+            };
+            match self.increment(&u, target) {
+                Ok((u_new, evaluation, record)) => {
+                    u = u_new;
+                    forces = evaluation.forces_n;
+                    converged = target;
+                    steps.push(record);
+                    // Two good steps in a row after a cut: the step grows back.
+                    successes += 1;
+                    if successes >= 2 && increment < initial {
+                        increment = (2.0 * increment).min(initial);
+                        successes = 0;
+                    }
+                }
+                Err(failure) if increment <= smallest * (1.0 + 1e-9) => {
+                    stopped = Some(failure.into_error(target, converged));
+                    break;
+                }
+                Err(_) => {
+                    increment *= 0.5;
+                    successes = 0;
+                }
+            }
+        }
+        Outcome {
+            reached: Equilibrium {
+                load_factor: converged,
+                displacement_mm: u,
+                nodal_forces_n: forces,
+                steps,
+                free_dofs: self.free_count,
+            },
+            stopped,
+        }
+    }
 
     /// Prescribed displacements at `factor`.
     fn prescribed(&self, factor: f64) -> Vec<(usize, f64)> {
+        if let Some(warm) = &self.warm {
+            return warm
+                .end_mm
+                .iter()
+                .map(|&(dof, end)| {
+                    let start = warm.start_mm[dof];
+                    (dof, start + factor * (end - start))
+                })
+                .collect();
+        }
         let nodes = &self.membrane.mesh.nodes_mm;
         self.clamps
             .iter()
@@ -418,27 +535,37 @@ impl<L: SheetLaw + ?Sized> Solver<'_, '_, L> {
             }
         }
         let n = self.free_count;
-        let matrix = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets)
-            .map_err(Failure::Factorisation)?;
-        let symbolic = match &self.symbolic {
-            Some(s) => s.clone(),
-            None => {
-                let s = SymbolicLlt::try_new(matrix.symbolic(), Side::Lower)
-                    .map_err(|e| Failure::Factorisation(e.into()))?;
-                self.symbolic = Some(s.clone());
-                s
-            }
-        };
-        let llt = Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), Side::Lower).map_err(
-            |e| match e {
-                faer::sparse::linalg::LltError::Numeric(
-                    faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index },
-                ) => Failure::Unstable { pivot: index },
-                faer::sparse::linalg::LltError::Generic(e) => Failure::Factorisation(e.into()),
-            },
-        )?;
+        let llt = factorise(n, &triplets, &mut self.symbolic)?;
         let mut x = Mat::from_fn(n, 1, |i, _| rhs[i]);
         llt.solve_in_place(x.as_mut());
         Ok((0..n).map(|i| x[(i, 0)]).collect())
     }
+}
+
+/// The sparse Cholesky factorisation of the free-free tangent given by its lower triplets
+/// (`symbolic`: the analysis of an earlier matrix of the same pattern, made on first use).
+/// faer runs sequentially here (built without its `rayon` feature): the same matrix gives the
+/// same bits on any machine load, which the rig's journal replay relies on.
+pub(crate) fn factorise(
+    n: usize,
+    triplets: &[Triplet<usize, usize, f64>],
+    symbolic: &mut Option<SymbolicLlt<usize>>,
+) -> Result<Llt<usize, f64>, Failure> {
+    let matrix = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, triplets)
+        .map_err(Failure::Factorisation)?;
+    let symbolic = match symbolic {
+        Some(s) => s.clone(),
+        None => {
+            let s = SymbolicLlt::try_new(matrix.symbolic(), Side::Lower)
+                .map_err(|e| Failure::Factorisation(e.into()))?;
+            *symbolic = Some(s.clone());
+            s
+        }
+    };
+    Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), Side::Lower).map_err(|e| match e {
+        faer::sparse::linalg::LltError::Numeric(
+            faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index },
+        ) => Failure::Unstable { pivot: index },
+        faer::sparse::linalg::LltError::Generic(e) => Failure::Factorisation(e.into()),
+    })
 }

@@ -4,7 +4,7 @@
 use crate::control::{AxisControl, ControlMode};
 use crate::ids::{Axis, Channel};
 use crate::program::{Program, ProgramError, Step, StopTransition};
-use crate::specimen::{Loading, SpecimenConfig, SpecimenGeometry};
+use crate::specimen::{Loading, SpecimenConfig, SpecimenSettings};
 
 /// Why a built-in test's program was refused: its rate or stretch as the command line gives
 /// them, or the program they make.
@@ -42,45 +42,48 @@ impl BuiltinTest {
         }
     }
 
-    /// The specimen of the test: a 100 × 20 × 2 mm strip in uniaxial tension along X, the
-    /// default 100 × 100 × 2 mm cruciform centre in equibiaxial tension.
-    pub fn specimen(self) -> SpecimenConfig {
+    /// The loading of the test: uniaxial along X, or equibiaxial.
+    pub fn loading(self) -> Loading {
         match self {
-            BuiltinTest::Uniaxial => SpecimenConfig {
-                geometry: SpecimenGeometry {
-                    gauge_length_mm: 100.0,
-                    width_mm: 20.0,
-                    thickness_mm: 2.0,
-                },
-                loading: Loading::Uniaxial(Axis::X),
-                ..SpecimenConfig::default()
-            },
-            BuiltinTest::Equibiaxial => SpecimenConfig::default(),
+            BuiltinTest::Uniaxial => Loading::Uniaxial(Axis::X),
+            BuiltinTest::Equibiaxial => Loading::Equibiaxial,
         }
     }
 
+    /// The specimen of the test, as `settings` make it: the uniaxial strip in uniaxial tension
+    /// along X, the cruciform in equibiaxial tension (by default a 100 × 20 × 2 mm strip and a
+    /// cruciform whose centre is 100 × 100 × 2 mm).
+    pub fn specimen(self, settings: &SpecimenSettings) -> SpecimenConfig {
+        SpecimenConfig::of(self.loading(), settings)
+    }
+
     /// Hold 1 s, then ramp the elongation(s) to `stretch` at `rate_per_s` (stretch per second),
-    /// then hold 1 s. Stop transition: ramp to zero at 10× the loading rate.
-    pub fn program(self, rate_per_s: f64, stretch: f64) -> Result<Program, TestError> {
+    /// then hold 1 s. Stop transition: ramp to zero at 10× the loading rate. The stretch is
+    /// nominal: the elongation over the specimen's gauge length ([`SpecimenConfig::gauge_mm`]:
+    /// the homogeneous sheet's stretch; the structure's gauge zone reaches less, its arms take
+    /// the rest).
+    pub fn program(
+        self,
+        specimen: &SpecimenConfig,
+        rate_per_s: f64,
+        stretch: f64,
+    ) -> Result<Program, TestError> {
         if !(rate_per_s.is_finite() && rate_per_s > 0.0) {
             return Err(TestError::Rate { rate_per_s });
         }
         if !(stretch.is_finite() && stretch > 1.0 && stretch <= 8.0) {
             return Err(TestError::Stretch { stretch });
         }
-        let geometry = self.specimen().geometry;
+        let gauge_mm = specimen.gauge_mm();
         let axes: &[(Axis, f64)] = match self {
-            BuiltinTest::Uniaxial => &[(Axis::X, geometry.gauge_length_mm)],
-            BuiltinTest::Equibiaxial => &[
-                (Axis::X, geometry.gauge_length_mm),
-                (Axis::Y, geometry.width_mm),
-            ],
+            BuiltinTest::Uniaxial => &[(Axis::X, gauge_mm[0])],
+            BuiltinTest::Equibiaxial => &[(Axis::X, gauge_mm[0]), (Axis::Y, gauge_mm[1])],
         };
         let centroid = AxisControl::Centroid(ControlMode::Displacement);
         let program = Program {
             name: format!("{} to λ {stretch} at {rate_per_s} /s", self.name()),
             stop: StopTransition::RampToZero,
-            stop_rate_per_s: 10.0 * rate_per_s * geometry.gauge_length_mm,
+            stop_rate_per_s: 10.0 * rate_per_s * gauge_mm[0],
             setup: axes.iter().map(|&(axis, _)| (axis, centroid)).collect(),
             channels: axes
                 .iter()

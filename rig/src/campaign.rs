@@ -10,7 +10,7 @@ use crate::program::{Program, Step};
 use crate::refusal::Refusal;
 use crate::rig::{Rig, RigCommand};
 use crate::snapshot::ProgramStatus;
-use crate::specimen::SpecimenConfig;
+use crate::specimen::{SpecimenConfig, SpecimenSettings};
 use material::InvariantLaw;
 
 /// One test of a campaign: a built-in test to a stretch at a stretch rate.
@@ -78,15 +78,15 @@ pub const UNLOAD_RATE_FACTOR: f64 = 5.0;
 pub const UNLOADED_HOLD_S: f64 = 0.5;
 
 impl CampaignTest {
-    /// The test's program: hold, ramp to the stretch, hold, ramp back to zero elongation at
-    /// [`UNLOAD_RATE_FACTOR`] times the rate, hold.
-    pub fn program(&self) -> Result<Program, TestError> {
-        let mut program = self.test.program(self.rate_per_s, self.stretch)?;
-        let geometry = self.test.specimen().geometry;
+    /// The test's program on `specimen`: hold, ramp to the stretch, hold, ramp back to zero
+    /// elongation at [`UNLOAD_RATE_FACTOR`] times the rate, hold.
+    pub fn program(&self, specimen: &SpecimenConfig) -> Result<Program, TestError> {
+        let mut program = self.test.program(specimen, self.rate_per_s, self.stretch)?;
+        let gauge_mm = specimen.gauge_mm()[0];
         for (_, steps) in &mut program.channels {
             steps.push(Step::Ramp {
                 to: 0.0,
-                rate_per_s: UNLOAD_RATE_FACTOR * self.rate_per_s * geometry.gauge_length_mm,
+                rate_per_s: UNLOAD_RATE_FACTOR * self.rate_per_s * gauge_mm,
                 relative: false,
             });
             steps.push(Step::Hold {
@@ -124,10 +124,12 @@ impl CampaignTest {
             stretch: number("stretch", stretch)?,
             rate_per_s: number("rate", rate)?,
         };
-        test.program().map_err(|reason| CampaignError::Test {
-            text: text.to_string(),
-            reason,
-        })?;
+        let specimen = test.test.specimen(&SpecimenSettings::default());
+        test.program(&specimen)
+            .map_err(|reason| CampaignError::Test {
+                text: text.to_string(),
+                reason,
+            })?;
         Ok(test)
     }
 }
@@ -150,6 +152,8 @@ pub struct Campaign {
     next: usize,
     /// The material of every specimen; None: each built-in specimen's own (Smactane).
     law: Option<InvariantLaw>,
+    /// The model and geometries of the specimens.
+    specimen: SpecimenSettings,
 }
 
 impl Campaign {
@@ -176,13 +180,15 @@ impl Campaign {
         if tests.is_empty() {
             return Err(CampaignError::Empty);
         }
+        let specimen = SpecimenSettings::default();
         for test in &tests {
-            test.program()?;
+            test.program(&test.test.specimen(&specimen))?;
         }
         Ok(Campaign {
             tests,
             next: 0,
             law: None,
+            specimen,
         })
     }
 
@@ -192,9 +198,15 @@ impl Campaign {
         self
     }
 
+    /// Every specimen of the campaign of the model and geometries of `specimen`.
+    pub fn with_specimen(mut self, specimen: SpecimenSettings) -> Campaign {
+        self.specimen = specimen;
+        self
+    }
+
     /// The specimen test `test` mounts.
     pub fn specimen_of(&self, test: &CampaignTest) -> SpecimenConfig {
-        let mut specimen = test.test.specimen();
+        let mut specimen = test.test.specimen(&self.specimen);
         if let Some(law) = &self.law {
             specimen.law = law.clone();
         }
@@ -235,12 +247,13 @@ impl Campaign {
                 number: k + 1,
                 test: *test,
             };
+            let specimen = self.specimen_of(test);
             let mut scratch_config = config.clone();
-            scratch_config.specimen = Some(self.specimen_of(test));
+            scratch_config.specimen = Some(specimen.clone());
             let mut rig = Rig::new(scratch_config, 0)
                 .map_err(|reason| CampaignError::Machine { at, reason })?;
             let program = test
-                .program()
+                .program(&specimen)
                 .map_err(|reason| CampaignError::TestProgram { at, reason })?;
             rig.command(RigCommand::StartProgram(Box::new(program)))
                 .map_err(|reason| CampaignError::RefusedByRig { at, reason })?;
@@ -264,10 +277,9 @@ impl Campaign {
         let Some(&test) = self.tests.get(self.next) else {
             return Ok(CampaignEvent::Done);
         };
-        let program = test.program().map_err(Refusal::invalid)?;
-        rig.command(RigCommand::MountSpecimen(Some(Box::new(
-            self.specimen_of(&test),
-        ))))?;
+        let specimen = self.specimen_of(&test);
+        let program = test.program(&specimen).map_err(Refusal::invalid)?;
+        rig.command(RigCommand::MountSpecimen(Some(Box::new(specimen))))?;
         rig.command(RigCommand::StartProgram(Box::new(program)))?;
         let index = self.next;
         self.next += 1;

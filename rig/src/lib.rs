@@ -41,5 +41,5 @@ pub use refusal::Refusal;
 pub use rig::{Rig, RigCommand};
 pub use snapshot::{ProgramStatus, RigSnapshot, SpecimenKinematics};
 pub use specimen::{
-    GaugeFraction, GripEffects, Loading, Misalignment, SpecimenConfig, SpecimenGeometry,
+    Loading, Misalignment, SolveSchedule, SpecimenConfig, SpecimenModel, SpecimenSettings,
 };

@@ -90,6 +90,8 @@ pub struct Rig {
     tripped: u32,
     /// 20 ms running mean of each pair force, for the break detector.
     pair_force_mean_kn: [f64; 3],
+    /// The specimen's solve failed on this step (a break: its reason is the specimen's fault).
+    specimen_failed: bool,
     snapshot: RigSnapshot,
 }
 
@@ -127,6 +129,7 @@ impl Rig {
             program: ProgramStatus::Idle,
             tripped: 0,
             pair_force_mean_kn: [0.0; 3],
+            specimen_failed: false,
             snapshot: RigSnapshot::default(),
         };
         rig.load_specimen();
@@ -555,7 +558,9 @@ impl Rig {
             self.kinematics = SpecimenKinematics::default();
             return;
         };
-        let response = specimen.respond(&positions);
+        let t_s = self.snapshot.step as f64 * self.dt_s;
+        let response = specimen.respond(t_s, &positions);
+        self.specimen_failed |= response.failed_now;
         self.external_force_n = response.grip_force_n;
         self.kinematics = response.kinematics;
     }
@@ -589,6 +594,10 @@ impl Rig {
     fn detect(&mut self) {
         let now = self.violations_now();
         let mut rising = now & !self.tripped;
+        // A specimen that cannot be solved any more is unloaded as a torn one.
+        if std::mem::take(&mut self.specimen_failed) {
+            rising |= SPECIMEN_BREAK_BIT;
+        }
         // Break detector on the X and Y pairs.
         let alpha = self.dt_s / 0.020;
         for axis in [Axis::X, Axis::Y] {

@@ -5,6 +5,7 @@
 use crate::builtin::BuiltinTest;
 use crate::campaign::{Campaign, CampaignError, CampaignTest};
 use crate::program::{Program, ProgramError};
+use crate::specimen::{SpecimenConfig, SpecimenSettings};
 use crate::strain::test::{StrainTest, StrainTestError};
 use material::{InvariantLaw, LawError};
 use std::path::PathBuf;
@@ -122,6 +123,9 @@ pub struct RigSettings {
     pub exit_when_done: bool,
     /// Folder of the resume journal (see `process`).
     pub state_dir: Option<PathBuf>,
+    /// The specimens' model (homogeneous or the finite-element structure) and geometries.
+    #[serde(default)]
+    pub specimen: SpecimenSettings,
 }
 
 impl Default for RigSettings {
@@ -140,6 +144,7 @@ impl Default for RigSettings {
             duration_s: None,
             exit_when_done: false,
             state_dir: None,
+            specimen: SpecimenSettings::default(),
         }
     }
 }
@@ -168,10 +173,9 @@ pub enum SettingsError {
 
 impl RigSettings {
     /// The program of the start (a file read, or a built-in test's), and the specimen it
-    /// mounts (a built-in test's).
-    pub fn program(
-        &self,
-    ) -> Result<(Option<Program>, Option<crate::specimen::SpecimenConfig>), SettingsError> {
+    /// mounts (a built-in test's; else the cruciform of the settings' model).
+    pub fn program(&self) -> Result<(Option<Program>, SpecimenConfig), SettingsError> {
+        let cruciform = BuiltinTest::Equibiaxial.specimen(&self.specimen);
         Ok(match &self.start {
             RigStart::Program { file } => {
                 let text =
@@ -185,13 +189,18 @@ impl RigSettings {
                         file: file.clone(),
                         reason,
                     })?;
-                (Some(program), None)
+                (Some(program), cruciform)
             }
-            RigStart::Builtin { test } => (
-                Some(test.test.program(test.rate_per_s, test.stretch)?),
-                Some(test.test.specimen()),
-            ),
-            RigStart::Idle | RigStart::Campaign { .. } | RigStart::Strain { .. } => (None, None),
+            RigStart::Builtin { test } => {
+                let specimen = test.test.specimen(&self.specimen);
+                let program = test
+                    .test
+                    .program(&specimen, test.rate_per_s, test.stretch)?;
+                (Some(program), specimen)
+            }
+            RigStart::Idle | RigStart::Campaign { .. } | RigStart::Strain { .. } => {
+                (None, cruciform)
+            }
         })
     }
 
@@ -200,7 +209,7 @@ impl RigSettings {
         let RigStart::Campaign { tests } = &self.start else {
             return Ok(None);
         };
-        let campaign = Campaign::new(tests.clone())?;
+        let campaign = Campaign::new(tests.clone())?.with_specimen(self.specimen.clone());
         Ok(Some(match &self.law {
             Some(law) => campaign.with_law(law.law()?),
             None => campaign,
@@ -209,14 +218,12 @@ impl RigSettings {
 
     /// The strain-controlled test of the start, checked, and the cruciform it mounts (of the
     /// law if given).
-    pub fn strain(
-        &self,
-    ) -> Result<Option<(StrainTest, crate::specimen::SpecimenConfig)>, SettingsError> {
+    pub fn strain(&self) -> Result<Option<(StrainTest, SpecimenConfig)>, SettingsError> {
         let RigStart::Strain { test } = &self.start else {
             return Ok(None);
         };
         test.check()?;
-        let mut specimen = BuiltinTest::Equibiaxial.specimen();
+        let mut specimen = BuiltinTest::Equibiaxial.specimen(&self.specimen);
         if let Some(law) = &self.law {
             specimen.law = law.law()?;
         }

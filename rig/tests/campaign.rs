@@ -43,18 +43,15 @@ fn paper_campaign_runs_both_tests_in_order() {
         max_stretch[k][1] = max_stretch[k][1].max(kin.stretch_y);
         if step % 500 == 0 && kin.stretch_x > 1.2 && s.program == ProgramStatus::Running {
             let specimen = rig.specimen().unwrap();
-            let geometry = specimen.config().geometry;
+            let section0 = specimen.config().reference_sections_mm2()[0];
             let loading = specimen.config().loading;
             let (lambda, expected_kn) = match loading {
                 Loading::Uniaxial(_) => {
                     let l = kin.stretch_x;
-                    let section0 = geometry.width_mm * geometry.thickness_mm;
                     (l, law.uniaxial_nominal_stress_mpa(l) * section0 * 1e-3)
                 }
                 Loading::Equibiaxial => {
-                    // The grip effects make the gauge zone's state biaxial, not equibiaxial.
                     let l = kin.stretch_x;
-                    let section0 = geometry.width_mm * geometry.thickness_mm;
                     let stress = law.in_plane_stress(l, kin.stretch_y);
                     (l, stress.nominal_stress_mpa[0] * section0 * 1e-3)
                 }
@@ -73,29 +70,22 @@ fn paper_campaign_runs_both_tests_in_order() {
     assert_eq!(started.len(), 2);
     assert_eq!(started[0].1, rig::builtin::BuiltinTest::Uniaxial);
     assert_eq!(started[1].1, rig::builtin::BuiltinTest::Equibiaxial);
-    // Uniaxial: the grips to λ 3; the gauge zone takes ln λ = (0.92 − 0.05 ln 3) ln 3 of it
-    // (λ ≈ 2.59, a little less for the grips' give); the free lateral stretch contracts.
-    let gauge_uniaxial = ((0.92 - 0.05 * 3f64.ln()) * 3f64.ln()).exp();
+    // The homogeneous sheet (the default model) stretches as the grips, less the grips' give
+    // (1 mm/kN each: 0.15 mm in uniaxial, 2.3 mm at the equibiaxial 1.15 kN). Uniaxial: to λ 3, the free lateral stretch
+    // contracts; equibiaxial: to λ 2 on both axes, on the equibiaxial path.
     assert!(
-        max_stretch[0][0] < gauge_uniaxial && max_stretch[0][0] > gauge_uniaxial - 0.02,
+        max_stretch[0][0] <= 3.0 && max_stretch[0][0] > 2.99,
         "{max_stretch:?}"
     );
     assert!(max_stretch[0][1] <= 1.0 + 1e-3, "{max_stretch:?}");
-    // Equibiaxial: the grips to λ 2 on both axes; the gauge zone stretches less, and less
-    // along y than along x (displacement control misses the equibiaxial path).
-    let ln2 = 2f64.ln();
-    let gauge_x = ((0.92 - 0.05 * ln2) * ln2 - 0.04 * ln2).exp();
-    let gauge_y = ((0.85 - 0.04 * ln2) * ln2 - 0.04 * ln2).exp();
-    assert!(
-        max_stretch[1][0] < gauge_x && max_stretch[1][0] > gauge_x - 0.02,
-        "{max_stretch:?} vs {gauge_x}"
-    );
-    assert!(
-        max_stretch[1][1] < gauge_y && max_stretch[1][1] > gauge_y - 0.02,
-        "{max_stretch:?} vs {gauge_y}"
-    );
+    for axis in 0..2 {
+        assert!(
+            max_stretch[1][axis] <= 2.0 && max_stretch[1][axis] > 1.97,
+            "{max_stretch:?}"
+        );
+    }
     let rho = max_stretch[1][1].ln() / max_stretch[1][0].ln();
-    assert!((rho - 1.0).abs() > 0.05, "ρ {rho}");
+    assert!((rho - 1.0).abs() < 1e-3, "ρ {rho}");
     for rel in worst_force_rel {
         assert!(
             rel < 0.01,

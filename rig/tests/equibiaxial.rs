@@ -3,7 +3,7 @@
 //! grip forces against eq. (19) evaluated directly with the law (`material`).
 
 use material::InvariantLaw;
-use rig::{Axis, GripEffects, Program, ProgramStatus, Rig, RigCommand, RigConfig};
+use rig::{Axis, Program, ProgramStatus, Rig, RigCommand, RigConfig};
 
 const PROGRAM: &str = r#"
 name = "equibiaxial to 2 at 1e-3 /s"
@@ -23,17 +23,16 @@ segments = [{ kind = "hold", duration_s = 1.0 }, { kind = "ramp", to = 100.0, ra
 
 #[test]
 fn equibiaxial_ramp_to_stretch_two() {
-    // The homogeneous sheet: this test checks the grips against eq. (19); the grip effects
-    // have their own tests (tests/strain_control.rs, rig/tests/campaign.rs).
+    // The homogeneous sheet with rigid grips: this test checks the grips against eq. (19);
+    // the structure's grip effects have their own tests (tests/strain_control.rs,
+    // rig/tests/structure.rs).
     let mut config = RigConfig::default();
-    config.specimen.as_mut().unwrap().grip = GripEffects::none();
+    config.specimen.as_mut().unwrap().grip_compliance_mm_per_kn = 0.0;
     let specimen = config.specimen.clone().unwrap();
-    let gauge_mm = specimen.geometry.gauge_length_mm;
-    let section_mm2 = specimen.geometry.width_mm * specimen.geometry.thickness_mm;
-    assert_eq!(
-        gauge_mm, specimen.geometry.width_mm,
-        "square cruciform centre"
-    );
+    assert_eq!(specimen.model, rig::SpecimenModel::Homogeneous);
+    let [gauge_mm, gauge_y_mm] = specimen.gauge_mm();
+    let section_mm2 = specimen.reference_sections_mm2()[0];
+    assert_eq!(gauge_mm, gauge_y_mm, "square cruciform centre");
     let noise_kn = config.load_cell_noise_kn;
     let mut rig = Rig::new(config, 11).unwrap();
     rig.advance_to(0.5);

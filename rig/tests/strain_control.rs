@@ -1,5 +1,6 @@
 //! Strain control closed on a simulated plant, without processes: the rig (hydraulics,
-//! centroid displacement loops, the default specimen with its grip effects) and a delayed
+//! centroid displacement loops, a short-armed finite-element cruciform whose arms and corners
+//! take part of the grips' stretch) and a delayed
 //! "measurement" that is the gauge zone's truth plus noise, captured at a frame rate of 10 to
 //! 25 Hz and delivered a latency later, as the live correlator's fields are (issue 16).
 
@@ -14,7 +15,10 @@ use rig::strain::{
     GaugeMeasurement, HoldReason, InterlockLimits, OuterLoopConfig, StrainControl, StrainEvent,
     StrainMode, StrainPath, StrainSegment,
 };
-use rig::{Axis, AxisControl, ControlMode, Program, Rig, RigCommand, RigConfig};
+use rig::{
+    Axis, AxisControl, ControlMode, Loading, Program, Rig, RigCommand, RigConfig, SpecimenConfig,
+    SpecimenModel, SpecimenSettings,
+};
 use std::collections::VecDeque;
 
 /// The camera + correlator: captures the gauge truth at `fps`, delivers it `latency_s` later.
@@ -88,7 +92,24 @@ fn truth(rig: &Rig) -> [f64; 2] {
     [k.stretch_x.ln(), k.stretch_y.ln()]
 }
 
-/// A rig at rest with the default specimen, strain control idle, fields flowing for 0.5 s.
+/// The rig of these tests: the structure cruciform with 20 mm arms and 10 mm fillets (its
+/// central square takes about half of the grips' log stretch, so that λ 1.6 is within the
+/// stroke; the default 80 mm arms leave it a fifth).
+fn structure_rig(seed: u64) -> Rig {
+    let mut settings = SpecimenSettings {
+        model: SpecimenModel::Structure,
+        ..SpecimenSettings::default()
+    };
+    settings.geometry.cruciform.arm_length_mm = 20.0;
+    settings.geometry.cruciform.fillet_radius_mm = 10.0;
+    let config = RigConfig {
+        specimen: Some(SpecimenConfig::of(Loading::Equibiaxial, &settings)),
+        ..RigConfig::default()
+    };
+    Rig::new(config, seed).unwrap()
+}
+
+/// A rig at rest with the structure cruciform, strain control idle, fields flowing for 0.5 s.
 fn bench(fps: f64, latency_s: f64, seed: u64) -> (Rig, StrainControl, DelayedMeasurement) {
     bench_with(fps, latency_s, seed, OnRestore::Resume)
 }
@@ -99,10 +120,10 @@ fn bench_with(
     seed: u64,
     on_restore: OnRestore,
 ) -> (Rig, StrainControl, DelayedMeasurement) {
-    let mut rig = Rig::new(RigConfig::default(), seed).unwrap();
+    let mut rig = structure_rig(seed);
     let mut control = StrainControl::new(
         &rig,
-        OuterLoopConfig::default(),
+        OuterLoopConfig::for_specimen(rig.specimen().unwrap()),
         InterlockLimits::default(),
         on_restore,
     )
@@ -152,11 +173,14 @@ fn worst_ratio_error(trace: &[([f64; 2], [f64; 2])], ratio: f64) -> f64 {
 
 const RATE_LOG_PER_S: f64 = 0.02;
 
+/// The larger measured stretch the ratio paths go to.
+const TARGET_STRETCH: f64 = 1.6;
+
 #[test]
-fn equibiaxial_in_strain_control_holds_the_ratio_where_displacement_control_misses_it() {
+fn equibiaxial_in_strain_control_holds_the_ratio() {
     for (fps, latency_s, seed) in [(10.0, 0.15, 1), (25.0, 0.06, 2)] {
         let (mut rig, mut control, mut camera) = bench(fps, latency_s, seed);
-        let path = StrainPath::ratio_path(1.0, 1.8, RATE_LOG_PER_S).unwrap();
+        let path = StrainPath::ratio_path(1.0, TARGET_STRETCH, RATE_LOG_PER_S).unwrap();
         let trace = run_path(&mut rig, &mut control, &mut camera, path);
         let worst = worst_ratio_error(&trace, 1.0);
         let end = truth(&rig);
@@ -167,7 +191,7 @@ fn equibiaxial_in_strain_control_holds_the_ratio_where_displacement_control_miss
         );
         assert!(worst <= 0.01, "|ρ − 1| {worst}");
         // Reaches the target, with no overshoot or oscillation above 1 % of it.
-        let target = 1.8f64.ln();
+        let target = TARGET_STRETCH.ln();
         for (_, y) in &trace {
             assert!(y[0] <= 1.01 * target && y[1] <= 1.01 * target, "{y:?}");
         }
@@ -175,49 +199,13 @@ fn equibiaxial_in_strain_control_holds_the_ratio_where_displacement_control_miss
         assert!((end[1] - target).abs() < 0.01 * target, "{end:?}");
         assert_eq!(control.mode(), &StrainMode::Done);
     }
-    // Displacement control of the same test: both grips to the elongation that gives λ 1.8
-    // along x; the gauge zone's ρ is off by more than 0.05.
-    let mut rig = Rig::new(RigConfig::default(), 3).unwrap();
-    let program = Program::from_toml(
-        r#"
-name = "equibiaxial in displacement"
-[[setup]]
-axis = "x"
-control = "centroid_displacement"
-[[setup]]
-axis = "y"
-control = "centroid_displacement"
-[[channel]]
-target = "x.elongation"
-segments = [{ kind = "ramp", to = 110.0, rate_per_s = 20.0 }]
-[[channel]]
-target = "y.elongation"
-segments = [{ kind = "ramp", to = 110.0, rate_per_s = 20.0 }]
-"#,
-        std::path::Path::new("."),
-    )
-    .unwrap();
-    rig.command(RigCommand::StartProgram(Box::new(program)))
-        .unwrap();
-    let mut worst = 0.0f64;
-    let mut best = f64::INFINITY;
-    for _ in 0..(6.0 * rig.config().control_hz) as usize {
-        rig.step();
-        let y = truth(&rig);
-        if y[0].max(y[1]) >= 1.05f64.ln() {
-            let e = (y[1] / y[0] - 1.0).abs();
-            worst = worst.max(e);
-            best = best.min(e);
-        }
-    }
-    println!("displacement control: |ρ−1| from {best:.4} to {worst:.4}");
-    assert!(best > 0.05, "displacement control |ρ − 1| only {best}");
 }
 
 #[test]
-fn pure_shear_and_ratio_one_half_paths() {
+fn pure_shear_in_displacement_control_misses_the_path_strain_control_holds() {
+    // Strain control of pure shear (ρ = 0): the gauge zone's ln λy held at 0.
     let (mut rig, mut control, mut camera) = bench(15.0, 0.1, 4);
-    let path = StrainPath::ratio_path(0.0, 1.8, RATE_LOG_PER_S).unwrap();
+    let path = StrainPath::ratio_path(0.0, TARGET_STRETCH, RATE_LOG_PER_S).unwrap();
     let trace = run_path(&mut rig, &mut control, &mut camera, path);
     let worst_y = trace.iter().map(|(_, y)| y[1].abs()).fold(0.0, f64::max);
     let at = trace
@@ -230,10 +218,50 @@ fn pure_shear_and_ratio_one_half_paths() {
         trace[at].1[0]
     );
     assert!(worst_y <= 0.002, "|ln λy| {worst_y}");
-    assert!((truth(&rig)[0] - 1.8f64.ln()).abs() < 0.01);
+    assert!((truth(&rig)[0] - TARGET_STRETCH.ln()).abs() < 0.01);
+    // Displacement control of pure shear by the grips (y grips held where they were mounted,
+    // x pulled): the arms along y let the centre contract, ρ is off by more than 0.05.
+    let mut rig = structure_rig(3);
+    let program = Program::from_toml(
+        r#"
+name = "pure shear in displacement"
+[[setup]]
+axis = "x"
+control = "centroid_displacement"
+[[setup]]
+axis = "y"
+control = "centroid_displacement"
+[[channel]]
+target = "x.elongation"
+segments = [{ kind = "ramp", to = 110.0, rate_per_s = 20.0 }]
+[[channel]]
+target = "y.elongation"
+segments = [{ kind = "hold", duration_s = 6.0 }]
+"#,
+        std::path::Path::new("."),
+    )
+    .unwrap();
+    rig.command(RigCommand::StartProgram(Box::new(program)))
+        .unwrap();
+    let mut worst = 0.0f64;
+    let mut best = f64::INFINITY;
+    for _ in 0..(6.0 * rig.config().control_hz) as usize {
+        rig.step();
+        let y = truth(&rig);
+        if y[0].max(y[1]) >= 1.05f64.ln() {
+            let e = (y[1] / y[0]).abs();
+            worst = worst.max(e);
+            best = best.min(e);
+        }
+    }
+    println!("displacement control of pure shear: |ρ| from {best:.4} to {worst:.4}");
+    assert!(best > 0.05, "displacement control |ρ| only {best}");
+}
 
+#[test]
+fn ratio_one_half_path() {
     let (mut rig, mut control, mut camera) = bench(15.0, 0.1, 5);
-    let path = StrainPath::ratio_path(0.5, 1.8, RATE_LOG_PER_S).unwrap();
+    let path = StrainPath::ratio_path(0.5, TARGET_STRETCH, RATE_LOG_PER_S).unwrap();
     let trace = run_path(&mut rig, &mut control, &mut camera, path);
     let worst = worst_ratio_error(&trace, 0.5);
     println!("ρ = 0.5: worst |ρ−0.5| {worst:.5}");

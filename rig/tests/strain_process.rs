@@ -38,7 +38,7 @@ fn a_strain_controlled_rig_follows_fields_holds_while_they_stop_and_resumes() {
         state_dir: Some(dir.clone()),
         strain: Some(StrainOptions {
             test,
-            specimen: rig::builtin::BuiltinTest::Equibiaxial.specimen(),
+            specimen: rig::builtin::BuiltinTest::Equibiaxial.specimen(&Default::default()),
         }),
         ..common::rig_options(&name)
     };

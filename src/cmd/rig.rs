@@ -81,6 +81,11 @@ pub struct RigArgs {
     /// Seed of the simulation (valve offsets, load-cell noise).
     #[arg(long, default_value_t = RigSettings::default().seed)]
     pub seed: u64,
+    /// The specimen's model: structure (the finite-element cruciform and strip of the default
+    /// `[specimen.geometry]`, grip and edge effects from the mechanics) or homogeneous (the
+    /// analytic sheet, λ = the grips' nominal stretch).
+    #[arg(long, default_value_t = rig::SpecimenModel::Structure)]
+    pub specimen: rig::SpecimenModel,
     /// Stop after this much simulated time (s).
     #[arg(long)]
     pub duration_s: Option<f64>,
@@ -135,6 +140,10 @@ fn settings_of(args: RigArgs) -> anyhow::Result<RigSettings> {
         duration_s: args.duration_s,
         exit_when_done: args.exit_when_done,
         state_dir: args.state_dir,
+        specimen: rig::SpecimenSettings {
+            model: args.specimen,
+            ..rig::SpecimenSettings::default()
+        },
     })
 }
 

@@ -246,6 +246,10 @@ pub struct SpecimenSection {
     pub law_f: Vec<f64>,
     /// ln g(I2) = Σ b_i (I2 − 3)^i (eq. 25), g in MPa.
     pub law_g: Vec<f64>,
+    /// The rig's specimen: `homogeneous` (the analytic sheet, the default: the run's
+    /// acceptance divides forces by sections, right only for a homogeneous field) or
+    /// `structure` (the finite-element cruciform and strip of `[specimen.geometry]`).
+    pub model: rig::SpecimenModel,
     /// The specimen as a structure (`[specimen.geometry]`): its shape and the geometry of each
     /// shape, meshed by `membrane` (`dicstream specimen` solves it).
     pub geometry: membrane::SpecimenChoice,
@@ -346,6 +350,7 @@ impl Default for SpecimenSection {
         SpecimenSection {
             law_f: law.f.coefficients().to_vec(),
             law_g: law.g.coefficients().to_vec(),
+            model: rig::SpecimenModel::default(),
             geometry: membrane::SpecimenChoice::default(),
         }
     }

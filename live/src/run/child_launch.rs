@@ -119,6 +119,10 @@ pub fn rig_settings(
         seed: g.seed,
         state_dir: Some(results.rig_state()),
         exit_when_done: true,
+        specimen: rig::SpecimenSettings {
+            model: config.specimen.model,
+            geometry: config.specimen.geometry.clone(),
+        },
         ..RigSettings::default()
     })
 }

@@ -19,13 +19,13 @@ pub struct StripGeometry {
 }
 
 impl StripGeometry {
-    /// A uniaxial strip 100 × 10 × 2 mm, 1.25 mm elements.
+    /// A uniaxial strip 100 × 20 × 2 mm (the rig's uniaxial specimen), 2.5 mm elements.
     pub fn uniaxial() -> Self {
         StripGeometry {
             length_mm: 100.0,
-            width_mm: 10.0,
+            width_mm: 20.0,
             thickness_mm: 2.0,
-            element_size_mm: 1.25,
+            element_size_mm: 2.5,
         }
     }
 

@@ -103,14 +103,16 @@ fn program(
             value: request.value,
         });
     };
-    let mounted = rig.specimen().map(|s| s.config().loading);
-    if mounted != Some(test.specimen().loading) {
-        return Err(CommandRefused::NeedsSpecimen {
+    let mounted = rig.specimen().map(|s| s.config());
+    match mounted {
+        Some(specimen) if specimen.loading == test.loading() => {
+            Ok(test.program(specimen, options.test_rate_per_s, options.test_stretch)?)
+        }
+        _ => Err(CommandRefused::NeedsSpecimen {
             test: test.name(),
-            mounted: mounted.map(|loading| loading.name()),
-        });
+            mounted: mounted.map(|s| s.loading.name()),
+        }),
     }
-    Ok(test.program(options.test_rate_per_s, options.test_stretch)?)
 }
 
 /// An actuator's or an axis's control mode from the request's mode code.

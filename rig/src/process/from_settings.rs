@@ -21,10 +21,10 @@ impl ProcessOptions {
     pub fn from_settings(settings: &RigSettings) -> Result<ProcessOptions, SettingsError> {
         settings.check_law()?;
         let (program, specimen) = settings.program()?;
-        let mut config = RigConfig::default();
-        if specimen.is_some() {
-            config.specimen = specimen;
-        }
+        let config = RigConfig {
+            specimen: Some(specimen),
+            ..RigConfig::default()
+        };
         Ok(ProcessOptions {
             instance: settings.instance.clone(),
             config,

@@ -50,6 +50,8 @@ pub(super) struct RigShell {
     summary: ProcessSummary,
     pacing: Pacing,
     last_flush: Instant,
+    /// The mounted specimen's failed solve was said (once per specimen).
+    fault_said: bool,
 }
 
 impl RigShell {
@@ -115,6 +117,7 @@ impl RigShell {
                 was_max: false,
             },
             last_flush: started,
+            fault_said: false,
         })
     }
 
@@ -190,6 +193,13 @@ impl RigShell {
         for (t_s, event) in self.session.strain_events.drain(..) {
             eprintln!("rig: t = {t_s:.3} s: {}", strain_message(&event));
         }
+        let fault = self.session.rig.specimen().and_then(|s| s.fault());
+        if let (Some(fault), false) = (fault, self.fault_said) {
+            eprintln!(
+                "rig: {fault}; the specimen carries no force from now on (break, grips held)"
+            );
+        }
+        self.fault_said = fault.is_some();
         if let PeriodEvent::TestStarted(CampaignEvent::Started { index, test }) = event {
             eprintln!(
                 "rig: campaign test {}/{}: {} to λ {} at {} /s, started at t = {:.1} s",

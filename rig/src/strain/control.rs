@@ -124,7 +124,7 @@ impl StrainControl {
         if specimen.config().loading != crate::specimen::Loading::Equibiaxial {
             return Err(StrainStartError::NotCruciform);
         }
-        let g = specimen.config().geometry;
+        let gauge_mm = specimen.config().gauge_mm();
         let channels = &rig.config().limits.channels;
         let dt = rig.dt_s();
         let max_step_mm = [Axis::X, Axis::Y].map(|a| {
@@ -134,7 +134,7 @@ impl StrainControl {
                     .min(channels[a.minus().index()].rate_max_mm_s);
             machine_mm_s.min(config.max_elongation_rate_mm_s) * dt
         });
-        let mut outer = OuterLoop::new(config, [g.gauge_length_mm, g.width_mm]);
+        let mut outer = OuterLoop::new(config, gauge_mm);
         outer.record(rig.state().t_s, elongations(rig));
         Ok(StrainControl {
             outer,

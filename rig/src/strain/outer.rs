@@ -2,8 +2,10 @@
 //!
 //! The rig knows its own grips-to-gauge map only approximately: gauge log strain ≈ k̂ × nominal
 //! log strain of the axis + ĉ × that of the other axis (k̂ = [`OuterLoopConfig::model_fraction`],
-//! 0.85 by default, ĉ = [`OuterLoopConfig::model_cross`], −0.03, against a true map that
-//! depends on the stretch and on the grips' give). Per axis the loop keeps an on-line model
+//! ĉ = [`OuterLoopConfig::model_cross`]: the mounted specimen's small-strain map,
+//! [`OuterLoopConfig::for_specimen`] — 1 and 0 on the homogeneous sheet, the finite-element
+//! structure's from its tangent at rest — against a true map that depends on the stretch and
+//! on the grips' give). Per axis the loop keeps an on-line model
 //! y_i ≈ g_i k̂_i u_i + ĉ u_j + b_i (u = ln(1 + elongation / gauge length), the nominal log
 //! strain the rig measures with its own position sensors) and:
 //!
@@ -55,13 +57,25 @@ pub struct OuterLoopConfig {
 impl Default for OuterLoopConfig {
     fn default() -> Self {
         OuterLoopConfig {
-            model_fraction: [0.85, 0.85],
-            model_cross: -0.03,
+            model_fraction: [1.0, 1.0],
+            model_cross: 0.0,
             max_elongation_rate_mm_s: 25.0,
             adaptation_gain: 0.6,
             offset_scale: 0.005,
             gain_range: [0.5, 2.0],
             history_s: 5.0,
+        }
+    }
+}
+
+impl OuterLoopConfig {
+    /// The default loop on the grips-to-gauge map of `specimen` at small strain.
+    pub fn for_specimen(specimen: &crate::specimen::Specimen) -> OuterLoopConfig {
+        let (model_fraction, model_cross) = specimen.gauge_map();
+        OuterLoopConfig {
+            model_fraction,
+            model_cross,
+            ..OuterLoopConfig::default()
         }
     }
 }
@@ -213,19 +227,22 @@ impl OuterLoop {
         if !c
             .model_fraction
             .iter()
-            .all(|k| k.is_finite() && *k >= 0.2 && *k <= 1.5)
+            .all(|k| k.is_finite() && *k >= 0.05 && *k <= 1.5)
         {
             return Err(BadSetting::new(
                 "model_fraction",
                 c.model_fraction,
-                "values in [0.2, 1.5]",
+                "values in [0.05, 1.5]",
             ));
         }
-        if !(c.model_cross.is_finite() && c.model_cross.abs() <= 0.1) {
+        if !(c.model_cross.is_finite()
+            && c.model_cross.abs() <= 0.5
+            && c.model_cross.abs() < c.model_fraction[0].min(c.model_fraction[1]))
+        {
             return Err(BadSetting::new(
                 "model_cross",
                 c.model_cross,
-                "a value in [−0.1, 0.1]",
+                "a value in [−0.5, 0.5], smaller than the fractions",
             ));
         }
         if !(c.adaptation_gain > 0.0 && c.adaptation_gain <= 1.0) {
@@ -288,8 +305,13 @@ mod tests {
     #[test]
     fn identifies_a_linear_map_and_inverts_it() {
         // True map: y = 0.9 ux − 0.03 uy + 0.01 on x, 0.8 uy − 0.03 ux − 0.005 on y: gains and
-        // offsets off the model's, its cross term (the closed-loop tests have it off too).
-        let mut o = OuterLoop::new(OuterLoopConfig::default(), [100.0; 2]);
+        // offsets off the model's (k̂ 0.85, ĉ −0.03), its cross term right.
+        let config = OuterLoopConfig {
+            model_fraction: [0.85, 0.85],
+            model_cross: -0.03,
+            ..OuterLoopConfig::default()
+        };
+        let mut o = OuterLoop::new(config, [100.0; 2]);
         let truth = |u: [f64; 2]| {
             [
                 0.9 * u[0] - 0.03 * u[1] + 0.01,

@@ -97,12 +97,10 @@ impl StrainRun {
     ) -> Result<StrainRun, StrainRunError> {
         rig.command(RigCommand::MountSpecimen(Some(Box::new(specimen))))
             .map_err(StrainRunError::Mount)?;
-        let control = StrainControl::new(
-            rig,
-            OuterLoopConfig::default(),
-            test.limits,
-            test.on_interlock,
-        )?;
+        let loop_config = OuterLoopConfig::for_specimen(
+            rig.specimen().expect("the specimen was mounted just now"),
+        );
+        let control = StrainControl::new(rig, loop_config, test.limits, test.on_interlock)?;
         Ok(StrainRun {
             test,
             control,
@@ -245,11 +243,11 @@ impl StrainRun {
 
     /// Both elongations back to 0 at the campaign's unloading rate, then a short hold.
     fn unload(&self, rig: &Rig) -> Program {
-        let geometry = rig
+        let gauge_mm = rig
             .specimen()
-            .map(|s| s.config().geometry)
+            .map(|s| s.config().gauge_mm()[0])
             .expect("a strain run has its specimen");
-        let rate_mm_s = UNLOAD_RATE_FACTOR * self.test.rate_log_per_s * geometry.gauge_length_mm;
+        let rate_mm_s = UNLOAD_RATE_FACTOR * self.test.rate_log_per_s * gauge_mm;
         let centroid = AxisControl::Centroid(ControlMode::Displacement);
         Program {
             name: format!("unload after strain-controlled {}", self.test.kind.name()),
@@ -294,8 +292,12 @@ mod tests {
         budget_s: f64,
     ) -> (Rig, StrainRun, Vec<StrainRunEvent>, Vec<RigControl>) {
         let mut rig = Rig::new(RigConfig::default(), 1).unwrap();
-        let mut strain =
-            StrainRun::new(&mut rig, test, BuiltinTest::Equibiaxial.specimen()).unwrap();
+        let mut strain = StrainRun::new(
+            &mut rig,
+            test,
+            BuiltinTest::Equibiaxial.specimen(&Default::default()),
+        )
+        .unwrap();
         let mut in_flight: Vec<GaugeMeasurement> = Vec::new();
         let mut newest: Option<GaugeMeasurement> = None;
         let mut next_capture_s = 0.0;
