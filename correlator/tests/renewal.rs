@@ -36,7 +36,7 @@ fn a_rigid_motion_keeps_the_reference() {
         .set_reference(&render(SIZE, SIZE, 40.0, translation(0.0, 0.0), 0.01, 1))
         .unwrap();
     for k in 1..=10u64 {
-        let (u, v) = (3.0 * k as f64, -1.0 * k as f64);
+        let (u, v) = (3.0 * k as f64, -(k as f64));
         let frame = render(SIZE, SIZE, 40.0, translation(u, v), 0.01, 1 + k);
         let field = correlator.correlate(&frame).unwrap();
         assert!(!field.reference_updated, "renewed at frame {k} ({u} px)");
