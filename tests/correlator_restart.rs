@@ -1,10 +1,11 @@
 //! Restart: a correlator with --state-dir killed by SIGKILL and started again resumes against
 //! the same reference and keeps measuring the same total displacement; it loses only the frames
-//! it missed. Compared with an uninterrupted correlator fed the same frames (another instance).
+//! it missed, also with its state saved off the frame path. Compared with an uninterrupted correlator fed the same frames (another instance).
 
 mod common;
 
 use common::camera::{final_line, render, translation, Bench, FieldCopy};
+use common::HANG_GUARD;
 use wire::NodeStatus;
 
 const W: usize = 256;
@@ -79,14 +80,22 @@ fn restart_resumes(mode: &str, test: &str) {
         let field = bench.next_field();
         assert_eq!(field.header.frame_id, k);
     }
+    // The state is saved off the frame path (a writer thread): the reference field 3 left
+    // behind reaches the folder soon after the field, an earlier one of the same origin until
+    // then (the first frame's, the origin, before its field).
     assert!(state_dir.join("reference.state").is_file());
-    let summary = std::fs::read_to_string(state_dir.join("state.json")).unwrap();
-    eprintln!("state.json after frame 3:\n{summary}");
     let expected_reference = if mode == "fixed" { 0 } else { 3 };
-    assert!(
-        summary.contains(&format!("\"reference_frame_id\": {expected_reference},")),
-        "{summary}"
-    );
+    let wanted = format!("\"reference_frame_id\": {expected_reference},");
+    let started = std::time::Instant::now();
+    let summary = loop {
+        let summary = std::fs::read_to_string(state_dir.join("state.json")).unwrap();
+        if summary.contains(&wanted) {
+            break summary;
+        }
+        assert!(started.elapsed() < HANG_GUARD, "{summary}");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    };
+    eprintln!("state.json after frame 3:\n{summary}");
     bench.proc(first).signal(libc::SIGKILL);
     let status = bench.proc(first).wait_exit();
     assert!(!status.success(), "SIGKILL: {status:?}");

@@ -1,7 +1,8 @@
 //! The correlator: mesh, reference cache, worker pool, the assembly of a field (final
 //! corrections, consistency, strains). The first pass's guesses are in `guess.rs`, the rescue
 //! of failed nodes in `growth.rs`, IC-GN in `icgn_stage.rs`, the followed mesh at a reference
-//! update in `followed.rs`, measurements against the origin in `reanchor.rs`.
+//! update in `followed.rs`, when the automatic reference is renewed in `renewal.rs`,
+//! measurements against the origin in `reanchor.rs`.
 
 mod assemble;
 mod followed;
@@ -10,6 +11,7 @@ mod guess;
 mod icgn_stage;
 mod parts;
 mod reanchor;
+mod renewal;
 
 use crate::field::{Field, Node, NodeStatus};
 use crate::global::GlobalCorrelator;
@@ -187,6 +189,8 @@ pub struct Correlator {
     /// changes).
     origin_generation: u64,
     history: History,
+    /// Camera frames since the last frame correlated (see [`Correlator::correlate_after`]).
+    frame_step: u64,
     frame: FrameResults,
     scratch: Scratch,
     field: Field,
@@ -259,11 +263,13 @@ impl Correlator {
                 keypoints: None,
                 global_stale: true,
                 frames_since: 0,
+                refused_first: None,
                 is_origin: true,
             },
             origin: None,
             origin_generation: 0,
             history: History::new(nodes),
+            frame_step: 1,
             frame: FrameResults::new(nodes),
             scratch: Scratch::new(nodes),
             field,
@@ -513,10 +519,26 @@ impl Correlator {
             self.keep_reference_coefficients();
         }
         self.reference.frames_since = 0;
+        self.reference.refused_first = None;
     }
 
     /// Correlates one deformed image against the current reference and returns the field.
+    /// The image is the camera's next frame after the last one correlated (see
+    /// [`Correlator::correlate_after`] when frames were dropped).
     pub fn correlate(&mut self, pixels: &[u16]) -> Result<&Field, SettingsError> {
+        self.correlate_after(pixels, 1)
+    }
+
+    /// [`Correlator::correlate`] of the camera frame `frame_step` frames after the last one
+    /// correlated (a live correlator that dropped frames while busy): the predictions extrapolate
+    /// each node's velocity over that many frames, so they still place the ZOIs within a pixel
+    /// and the integer search is still skipped.
+    pub fn correlate_after(
+        &mut self,
+        pixels: &[u16],
+        frame_step: u64,
+    ) -> Result<&Field, SettingsError> {
+        self.frame_step = frame_step.max(1);
         self.check_size("deformed", pixels)?;
         if self.reference.pixels.is_none() {
             return Err(SettingsError::NoReference);
@@ -567,6 +589,14 @@ impl Correlator {
             total.add(&self.pool.engine(i).split);
         }
         total
+    }
+
+    /// Integer FFT searches run by this correlator so far (every ZOI correlation that did not
+    /// take a confirmed prediction's shortcut, the measurements against the origin included).
+    pub fn fft_searches(&self) -> u64 {
+        (0..self.pool.threads())
+            .map(|i| self.pool.engine(i).searches)
+            .sum()
     }
 
     /// Switches the per-engine time split on or off and resets it (benchmark only: reads the clock in the hot loop).

@@ -9,7 +9,15 @@
 //!   released at once and counted as skipped; gaps in frame ids (the camera's safe overflow
 //!   dropped them before they reached us) are counted as lost. Dropped = skipped + lost.
 //! - A frame is correlated straight from shared memory (no copy) and its sample is released as
-//!   soon as `correlate` returns (the correlator copies a new reference itself).
+//!   soon as `correlate` returns (the correlator copies a new reference itself). The frames
+//!   dropped since the last one correlated are told to the correlator, whose predictions then
+//!   extrapolate over them (`Correlator::correlate_after`).
+//! - Lost frames: `frames` keeps two samples per subscriber (`wire::services::FRAMES`); while a
+//!   frame takes longer than two frame periods, the camera's safe overflow replaces the oldest
+//!   waiting one, and its id never arrives. Skipped frames did arrive but were older than the
+//!   newest when the correlator was free again.
+//! - A new reference is handed to the state folder's writer thread (`state/writer.rs`), which
+//!   saves it off the frame path.
 //! - A field is written in place into a loaned `[FieldNode]` slice and sent.
 //! - A bad frame (header inconsistent with its payload, unknown bit depth, another size than the
 //!   reference) is a logged error for that frame (rate-limited); the process goes on.
@@ -19,6 +27,7 @@
 //!   per loaned sample; see `tests/process_allocations.rs`.
 
 use crate::settings::{CorrelatorSettings, Method};
+use crate::state::writer::StateWriter;
 use crate::state::{ReferenceIds, SavedReference, StateDir, REFERENCE_FROM_FILE};
 use crate::{Correlator, Field};
 use iceoryx2::prelude::*;
@@ -213,6 +222,7 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
     let mut live = Live::new(&config);
     let starting_reference = start(&mut live, &node, saved, state.as_mut(), &config)?;
     print_ready(&config, &instance, &starting_reference);
+    let mut writer = state.map(StateWriter::spawn);
 
     let started = Instant::now();
     let mut last_activity = started;
@@ -248,7 +258,7 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
         }
         if let Some((sample, t_received_ns)) = newest {
             last_activity = Instant::now();
-            live.handle(&node, sample, t_received_ns, state.as_mut())?;
+            live.handle(&node, sample, t_received_ns, writer.as_mut())?;
         }
         if status.due(config.status_interval) {
             status.print(&mut live);
@@ -271,7 +281,10 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
     let mut summary = live.summary.clone();
     summary.correlate_p50_ms = live.run_hist.median_ms();
     summary.correlate_p99_ms = live.run_hist.quantile_ms(0.99);
-    summary.state_saves = state.as_ref().map_or(0, |s| s.saves);
+    summary.state_saves = match writer {
+        Some(writer) => writer.finish()?,
+        None => 0,
+    };
     Ok(summary)
 }
 
@@ -352,6 +365,8 @@ struct Live {
     sequence_id: Option<u32>,
     /// Frame ids received: gaps are lost frames.
     frame_ids: IdGaps,
+    /// Sequence and id of the last frame correlated.
+    last_correlated: Option<(u32, u64)>,
     summary: ProcessSummary,
     /// Correlation time per frame (ns): whole run, and since the last status line.
     run_hist: Durations,
@@ -371,6 +386,7 @@ impl Live {
             origin_frame_id: 0,
             sequence_id: None,
             frame_ids: IdGaps::default(),
+            last_correlated: None,
             summary: ProcessSummary::default(),
             run_hist: Durations::new(),
             window_hist: Durations::new(),
@@ -469,7 +485,7 @@ impl Live {
         node: &Node<ipc::Service>,
         sample: iceoryx2::sample::Sample<ipc::Service, [u16], FrameHeader>,
         t_received_ns: u64,
-        state: Option<&mut StateDir>,
+        state: Option<&mut StateWriter>,
     ) -> Result<(), ProcessError> {
         let header = *sample.user_header();
         let pixels: &[u16] = sample.payload();
@@ -478,13 +494,22 @@ impl Live {
             return Ok(());
         }
         self.check_sequence(&header);
-        let Some(mut new_reference) = self.ready_reference(node, &header, pixels)? else {
+        let Some(new_origin) = self.ready_reference(node, &header, pixels)? else {
             return Ok(());
         };
         let correlator = self.correlator.as_mut().expect("made above");
         let reference_frame_id = self.reference_frame_id.expect("set with the correlator");
+        // Camera frames since the last one correlated (dropped ones in between), 1 after a
+        // new reference or sequence.
+        let frame_step = match self.last_correlated {
+            Some((sequence, id)) if sequence == header.sequence_id && header.frame_id > id => {
+                header.frame_id - id
+            }
+            _ => 1,
+        };
         let t = Instant::now();
-        correlator.correlate(pixels)?;
+        correlator.correlate_after(pixels, frame_step)?;
+        self.last_correlated = Some((header.sequence_id, header.frame_id));
         let correlate_ns = t.elapsed().as_nanos() as u64;
         self.warn_few_valid(header.frame_id);
         // The frame is no longer needed: the correlator copied it if it became the reference.
@@ -492,15 +517,23 @@ impl Live {
         self.run_hist.record_ns(correlate_ns);
         self.window_hist.record_ns(correlate_ns);
         self.summary.frames_correlated += 1;
-        if self.field().reference_updated {
+        let renewed = self.field().reference_updated;
+        if renewed {
             self.reference_frame_id = Some(header.frame_id);
-            new_reference = true;
         }
         self.summary.reference_frame_id = self.reference_frame_id;
-        // Saved before the field goes out: whoever sees field k may rely on the state folder
-        // holding the reference that field k left behind.
-        if let (true, Some(state)) = (new_reference, state) {
-            self.save_reference(state)?;
+        // Handed to the writer before the field goes out: the state folder holds the reference
+        // field k left behind once the writer is done, an earlier one of the same origin
+        // until then (`state/writer.rs`). A new origin (the first frame, a new sequence) is
+        // written before its first field goes out: a restart must never resume on the
+        // previous origin's reference once a field of the new one was seen.
+        if let Some(state) = state {
+            if new_origin || renewed {
+                self.save_reference(state)?;
+            }
+            if new_origin {
+                state.flush()?;
+            }
         }
         let times = FieldTimes {
             reference_frame_id,
@@ -621,14 +654,14 @@ impl Live {
         }
     }
 
-    /// The reference the last field left behind, into the state folder.
-    fn save_reference(&self, state: &mut StateDir) -> Result<(), ProcessError> {
+    /// The reference the last field left behind, to the state folder's writer.
+    fn save_reference(&self, state: &mut StateWriter) -> Result<(), ProcessError> {
         let ids = ReferenceIds {
             reference_frame_id: self.reference_frame_id.expect("set"),
             origin_frame_id: self.origin_frame_id,
             sequence_id: self.sequence_id.unwrap_or(0),
         };
-        state.save(self.correlator.as_ref().expect("made above"), ids)?;
+        state.submit(self.correlator.as_ref().expect("made above"), ids)?;
         Ok(())
     }
 

@@ -35,27 +35,47 @@ pub enum ReferenceMode {
     Fixed,
     /// Each frame is correlated with the previous one; displacements accumulate on the followed mesh.
     Incremental,
-    /// The reference is replaced by the current frame (mesh followed) when the displacement since
-    /// the reference exceeds `max_displacement_zoi_fraction` of the ZOI size or the mean score drops
-    /// below `min_mean_score`.
+    /// The reference is replaced by the current frame (mesh followed) when the correlation
+    /// against it degrades: the ZOIs deformed since the reference by more than
+    /// `max_deformation_px` (how far the deformation since the reference moves a ZOI's corner
+    /// relative to its centre, 90th percentile of the valid nodes), the mean score below
+    /// `min_mean_score`, or more nodes refused than in the first frame against it (5 % of the
+    /// nodes). A rigid motion, however large, does not call for a new reference: the
+    /// predictions place every ZOI (see `correlator/renewal.rs`).
     Auto {
-        max_displacement_zoi_fraction: f64,
+        max_deformation_px: f64,
         min_mean_score: f64,
     },
 }
 
 impl ReferenceMode {
-    /// Auto update with the defaults: a quarter of the ZOI, mean score 0.5.
+    /// Auto update with `correli`'s defaults: a ZOI's corner moved 0.5 px relative to its
+    /// centre by the deformation since the reference (a strain of 3 % on a 32 px ZOI), mean
+    /// score 0.5. The rigid ZOI's error grows with that deformation (on a uniaxial ramp to λ 2,
+    /// 1024², 120 frames: mean node error 0.0130 px at 0.5 px, 0.0147 px at 1 px, 0.0232 px at
+    /// 2 px; the displacement rule it replaces renewed at about 0.4 px and gave 0.0126 px, with
+    /// 36 renewals against 22; `examples/renewal_cost.rs`).
     pub const AUTO_DEFAULT: ReferenceMode = ReferenceMode::Auto {
-        max_displacement_zoi_fraction: 0.25,
+        max_deformation_px: 0.5,
         min_mean_score: 0.5,
     };
 
-    /// The mode of a kind (`auto` with the default thresholds).
-    pub fn of_kind(kind: ReferenceKind) -> ReferenceMode {
+    /// Auto update with the IC-GN methods' defaults: their shape function follows the
+    /// deformation since the reference, so it may grow to 2 px at a corner (12.5 % strain on a
+    /// 33 px subset; on the same ramp `icgn1`'s mean node error is 0.0084 px with 6 renewals,
+    /// 0.0086 px with the 34 of the displacement rule it replaces; at 4 px the 30 % stretch of
+    /// `tests/icgn.rs` loses 4 % of its accuracy).
+    pub const AUTO_DEFAULT_ICGN: ReferenceMode = ReferenceMode::Auto {
+        max_deformation_px: 2.0,
+        min_mean_score: 0.5,
+    };
+
+    /// The mode of a kind for a method (`auto` with the method's default thresholds).
+    pub fn of_kind(kind: ReferenceKind, method: Method) -> ReferenceMode {
         match kind {
             ReferenceKind::Fixed => ReferenceMode::Fixed,
             ReferenceKind::Incremental => ReferenceMode::Incremental,
+            ReferenceKind::Auto if method.is_icgn() => ReferenceMode::AUTO_DEFAULT_ICGN,
             ReferenceKind::Auto => ReferenceMode::AUTO_DEFAULT,
         }
     }
@@ -247,7 +267,9 @@ pub enum SettingsError {
     BaseLength { got: usize, expected: usize },
     #[error("saved reference displacement of node {node} is not finite")]
     BaseNotFinite { node: usize },
-    #[error("auto reference thresholds invalid: expected 0 < displacement fraction <= 0.5 and 0 <= score < 1")]
+    #[error(
+        "auto reference thresholds invalid: expected 0 < deformation <= 8 px and 0 <= score < 1"
+    )]
     AutoThresholds,
 }
 
@@ -315,14 +337,13 @@ impl CorrelatorSettings {
             });
         }
         if let ReferenceMode::Auto {
-            max_displacement_zoi_fraction,
+            max_deformation_px,
             min_mean_score,
         } = self.reference
         {
-            let fraction_ok =
-                max_displacement_zoi_fraction > 0.0 && max_displacement_zoi_fraction <= 0.5;
+            let deformation_ok = max_deformation_px > 0.0 && max_deformation_px <= 8.0;
             let score_ok = (0.0..1.0).contains(&min_mean_score);
-            if !fraction_ok || !score_ok {
+            if !deformation_ok || !score_ok {
                 return Err(SettingsError::AutoThresholds);
             }
         }

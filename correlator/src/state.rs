@@ -1,6 +1,7 @@
 //! What a live correlator saves so that a restarted one resumes against the same reference:
 //! one binary file, `reference.state`, written atomically (temporary sibling, then rename)
-//! whenever the reference changes, and a human-readable `state.json` beside it.
+//! whenever the reference changes, and a human-readable `state.json` beside it. The live
+//! process writes them off the frame path, on the thread of [`writer::StateWriter`].
 //!
 //! `reference.state`, all little-endian:
 //!
@@ -13,7 +14,7 @@
 //! | 28 | 16 | ROI x, y, width, height (px, u32 each) |
 //! | 44 | 8 | mesh nx, ny (u32 each) |
 //! | 52 | 20 | reference mode, guess, strain measure, max iterations, strain window (u32 each) |
-//! | 72 | 16 | auto thresholds: displacement fraction, mean score (f64 each; 0 unless auto) |
+//! | 72 | 16 | auto thresholds: deformation (px), mean score (f64 each; 0 unless auto) |
 //! | 88 | 8 | reference frame id (u64; `u64::MAX` for an image file) |
 //! | 96 | 8 | origin frame id: the frame the mesh is defined in (u64; `u64::MAX`: an image file) |
 //! | 104 | 8 | sequence id (u32), then the sub-pixel method (u32: 0 correli, 1 icgn1, 2 icgn2) |
@@ -25,11 +26,12 @@
 //! [`origin`]).
 //!
 //! Encoding reuses one buffer, and opening, writing and renaming short paths does not allocate,
-//! so saving on every frame (incremental mode) keeps the live loop allocation-free. Written
+//! so saving on every frame (incremental mode) allocates nothing. Written
 //! files survive a killed process (the rename is atomic); they are not fsynced, so a power cut
 //! may lose the last reference change.
 
 mod origin;
+pub mod writer;
 
 pub use origin::ORIGIN_FILE;
 
@@ -128,9 +130,9 @@ impl Layout {
             ReferenceMode::Fixed => (0, [0.0, 0.0]),
             ReferenceMode::Incremental => (1, [0.0, 0.0]),
             ReferenceMode::Auto {
-                max_displacement_zoi_fraction,
+                max_deformation_px,
                 min_mean_score,
-            } => (2, [max_displacement_zoi_fraction, min_mean_score]),
+            } => (2, [max_deformation_px, min_mean_score]),
         };
         Layout {
             width_px: w as u32,
@@ -239,7 +241,7 @@ fn mode_name(code: u32, auto: [f64; 2]) -> String {
     match code {
         0 => "fixed".into(),
         1 => "incremental".into(),
-        2 => format!("auto ({} of the ZOI, score {})", auto[0], auto[1]),
+        2 => format!("auto (deformation {} px, score {})", auto[0], auto[1]),
         other => format!("code {other}"),
     }
 }
@@ -413,17 +415,32 @@ impl StateDir {
     /// Writes the correlator's current reference with its frame id, atomically, then the
     /// human-readable summary. No allocation after the first call.
     pub fn save(&mut self, correlator: &Correlator, ids: ReferenceIds) -> Result<(), StateError> {
-        let reference_frame_id = ids.reference_frame_id;
-        let layout = Layout::of(correlator);
         let pixels = correlator
             .reference_pixels()
             .expect("save is called once a reference is set");
+        let origin = correlator
+            .origin_pixels()
+            .map(|origin| (origin, correlator.origin_generation()));
+        let layout = Layout::of(correlator);
+        self.save_parts(&layout, ids, pixels, correlator.reference_base_px(), origin)
+    }
+
+    /// [`StateDir::save`] from the parts of a correlator's reference: its layout, pixels, bases
+    /// and origin with its generation (what [`writer::StateWriter`] copies off the frame path).
+    fn save_parts(
+        &mut self,
+        layout: &Layout,
+        ids: ReferenceIds,
+        pixels: &[u16],
+        base_px: impl ExactSizeIterator<Item = (f64, f64)>,
+        origin: Option<(&[u16], u64)>,
+    ) -> Result<(), StateError> {
+        let reference_frame_id = ids.reference_frame_id;
         // The origin first: a reference state on disk never names an origin that is not.
-        if let Some(origin) = correlator.origin_pixels() {
-            let generation = correlator.origin_generation();
+        if let Some((origin, generation)) = origin {
             if self.saved_origin != Some(generation) {
                 origin::encode(
-                    correlator.image_size(),
+                    (layout.width_px as usize, layout.height_px as usize),
                     ids.origin_frame_id,
                     origin,
                     &mut self.origin_bytes,
@@ -434,17 +451,11 @@ impl StateDir {
                 self.saved_origin = Some(generation);
             }
         }
-        encode(
-            &layout,
-            ids,
-            pixels,
-            correlator.reference_base_px(),
-            &mut self.bytes,
-        );
+        encode(layout, ids, pixels, base_px, &mut self.bytes);
         self.file.write(&self.bytes).map_err(StateError::Write)?;
         self.summary.clear();
         summary_json(
-            &layout,
+            layout,
             reference_frame_id,
             self.saves + 1,
             &mut self.summary,
@@ -633,7 +644,7 @@ fn summary_json(layout: &Layout, reference_frame_id: u64, saves: u64, out: &mut 
     };
     let _ = write!(
         out,
-        "  \"saves_by_this_process\": {saves},\n  \"image\": [{}, {}],\n  \"zoi\": {},\n  \"step\": {},\n  \"roi\": [{}, {}, {}, {}],\n  \"mesh\": [{}, {}],\n  \"reference_mode\": \"{mode}\",\n  \"auto_displacement_zoi_fraction\": {},\n  \"auto_min_mean_score\": {},\n  \"method\": \"{}\",\n  \"guess\": \"{}\",\n  \"strain\": \"{}\",\n  \"max_iterations\": {},\n  \"strain_window_nodes\": {}\n}}\n",
+        "  \"saves_by_this_process\": {saves},\n  \"image\": [{}, {}],\n  \"zoi\": {},\n  \"step\": {},\n  \"roi\": [{}, {}, {}, {}],\n  \"mesh\": [{}, {}],\n  \"reference_mode\": \"{mode}\",\n  \"auto_max_deformation_px\": {},\n  \"auto_min_mean_score\": {},\n  \"method\": \"{}\",\n  \"guess\": \"{}\",\n  \"strain\": \"{}\",\n  \"max_iterations\": {},\n  \"strain_window_nodes\": {}\n}}\n",
         layout.width_px,
         layout.height_px,
         layout.zoi_px,

@@ -271,6 +271,9 @@ pub struct ZoiEngine {
     uncached_windowed: Vec<f32>,
     pub profile: bool,
     pub split: TimeSplit,
+    /// Integer FFT searches this engine ran (a confirmed prediction runs none): a count, not
+    /// a time, so tests can tell a shortcut taken from one missed.
+    pub searches: u64,
     /// IC-GN: room for one reference subset prepared on the fly (a node's subset in the
     /// origin frame), empty for CORRELI-GD.
     pub subset_scratch: Vec<f32>,
@@ -318,6 +321,7 @@ impl ZoiEngine {
             uncached_windowed: vec![0.0; n * n],
             profile: false,
             split: TimeSplit::default(),
+            searches: 0,
             subset_scratch: Vec::new(),
         }
     }
@@ -592,6 +596,7 @@ impl ZoiEngine {
                 return result;
             }
         }
+        self.searches += 1;
         let origin = match self.integer_step(reference.plain, deformed, &search, a, &mut timer) {
             Ok(origin) => origin,
             Err(status) => return ZoiResult::with_status(status, 0),

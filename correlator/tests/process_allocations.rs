@@ -167,7 +167,15 @@ fn steady_state_allocations(
     let summary = shell.join().unwrap().unwrap();
     assert_eq!(summary.frames_correlated, FRAMES);
     if with_state {
-        assert!(summary.state_saves >= FRAMES - 1, "{summary:?}");
+        // Saved off the frame path: references handed over while the writer was busy
+        // replace each other, and the last one is written before the process ends.
+        assert!(summary.state_saves >= 1, "{summary:?}");
+        let saved = correlator::state::StateDir::open(&cleanup.state_dir)
+            .unwrap()
+            .load()
+            .unwrap()
+            .unwrap();
+        assert_eq!(saved.reference_frame_id, FRAMES - 1, "{summary:?}");
     }
     drop(cleanup);
     let left = instance.leftover_files();

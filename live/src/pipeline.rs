@@ -2,8 +2,13 @@
 //! correlator and identifier run as processes sharing the machine's cores, the camera
 //! following a uniaxial test that lasts the requested time; the figures are the per-frame
 //! latency from capture to field published and to identification published, the sustained
-//! rate, the frames the correlator never measured, and the CPU each process used. With
+//! rate, the frames the correlator never measured (`pipeline/gaps.rs`: where and why), and the
+//! CPU each process used. With
 //! `--fps max` trials at increasing rates find the highest rate without a dropped frame.
+
+mod gaps;
+
+pub use gaps::FrameGaps;
 
 use crate::config::{RunConfig, TestSection};
 use crate::latency::{FieldLatencyPartsMs, Percentiles};
@@ -17,6 +22,7 @@ use std::path::{Path, PathBuf};
 pub struct PipelineSettings {
     pub width_px: u32,
     pub height_px: u32,
+    pub method: correlator::settings::Method,
     pub zoi_px: usize,
     pub step_px: usize,
     pub correlator_threads: usize,
@@ -41,6 +47,8 @@ pub struct PipelineResult {
     /// included), correlating, delivering to the run's monitor.
     pub latency_field_parts_ms: FieldLatencyPartsMs,
     pub cpu_cores: BTreeMap<String, f64>,
+    /// The frames not correlated: where the ids go missing and why.
+    pub frame_gaps: FrameGaps,
     pub results: PathBuf,
 }
 
@@ -67,6 +75,7 @@ pub fn trial_config(settings: &PipelineSettings, fps: f64, results_dir: &Path) -
     config.camera.width_px = settings.width_px;
     config.camera.height_px = settings.height_px;
     config.camera.fps = fps;
+    config.correlator.method = settings.method;
     config.correlator.zoi_px = settings.zoi_px;
     config.correlator.step_px = settings.step_px;
     config.correlator.threads = settings.correlator_threads;
@@ -117,6 +126,7 @@ fn result_of(report: &RunReport, fps: f64) -> PipelineResult {
         latency_ms,
         latency_field_parts_ms: report.latency_field_parts_ms,
         cpu_cores: report.cpu_cores.clone(),
+        frame_gaps: FrameGaps::of_results(&report.results),
         results: report.results.clone(),
     }
 }

@@ -1,7 +1,9 @@
 //! `dicstream bench pipeline`: the live bench's per-frame latency, sustained rate, drops and
 //! CPU per process on this machine (see `live::pipeline`).
 
+use super::named_arg::named;
 use anyhow::Result;
+use correlator::settings::Method;
 use live::pipeline::{measure, PipelineResult, PipelineSettings};
 use std::path::PathBuf;
 
@@ -12,6 +14,9 @@ pub struct PipelineBenchArgs {
     pub width: u32,
     #[arg(long, default_value_t = 1024)]
     pub height: u32,
+    /// Sub-pixel method (with --zoi 33 for icgn1 or icgn2).
+    #[arg(long, value_parser = named::<Method>(), default_value_t = Method::default())]
+    pub method: Method,
     /// ZOI side and step, px.
     #[arg(long, default_value_t = 32)]
     pub zoi: usize,
@@ -32,7 +37,8 @@ pub struct PipelineBenchArgs {
     pub out: PathBuf,
     /// Print one JSON object (keys fps_sustained, frames, dropped, latency_ms{field,
     /// identification}{p50,p90,p99,p999,max}, latency_field_parts_ms{waiting, correlating,
-    /// delivering}, cpu_cores) instead of text.
+    /// delivering}, cpu_cores, frame_gaps{missing, gaps, longest, after_renewal, skipped,
+    /// lost}) instead of text.
     #[arg(long)]
     pub json: bool,
 }
@@ -55,10 +61,21 @@ fn describe(r: &PipelineResult) -> String {
     let part = |name: &str, p: &live::latency::Percentiles| {
         format!("{name} p50 {:.1} p99 {:.1}", p.p50, p.p99)
     };
+    let g = &r.frame_gaps;
+    let split = |n: Option<u64>| n.map_or("?".to_string(), |n| n.to_string());
+    let gaps = format!(
+        "not correlated: {} frame(s) in {} gap(s) of frame ids (longest {}), {} right after a reference renewal; the correlator skipped {} (superseded by a newer frame while busy) and lost {} (overwritten in its 2-frame queue)",
+        g.missing,
+        g.gaps,
+        g.longest,
+        g.after_renewal,
+        split(g.skipped),
+        split(g.lost)
+    );
     let budget = r.field_p99_budget_ms();
     let field_p99 = r.latency_ms.get("field").map_or(f64::NAN, |p| p.p99);
     format!(
-        "{:.1} frames/s asked, {:.2} sustained; {} frames, {} dropped\n  latency from capture to {}\n    of which {}, {}, {} ms\n    field p99 {field_p99:.1} ms against the work's {budget:.1} ms (correlating p99 + one period): {}\n  latency from capture to {}\n  CPU (100 % = one core): {}\n  results: {}",
+        "{:.1} frames/s asked, {:.2} sustained; {} frames, {} dropped\n  latency from capture to {}\n    of which {}, {}, {} ms\n    field p99 {field_p99:.1} ms against the work's {budget:.1} ms (correlating p99 + one period): {}\n  latency from capture to {}\n  {gaps}\n  CPU (100 % = one core): {}\n  results: {}",
         r.fps_requested,
         r.fps_sustained,
         r.frames,
@@ -88,6 +105,7 @@ pub fn run(args: PipelineBenchArgs) -> Result<()> {
     let settings = PipelineSettings {
         width_px: args.width,
         height_px: args.height,
+        method: args.method,
         zoi_px: args.zoi,
         step_px: args.step,
         correlator_threads: args.threads,
@@ -111,9 +129,10 @@ pub fn run(args: PipelineBenchArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&result)?);
     } else {
         println!(
-            "bench pipeline, {}x{} px, ZOI {} px, step {} px, {} correlator thread(s):\n  {}",
+            "bench pipeline, {}x{} px, {} ZOI {} px, step {} px, {} correlator thread(s):\n  {}",
             args.width,
             args.height,
+            args.method,
             args.zoi,
             args.step,
             args.threads,

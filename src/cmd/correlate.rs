@@ -77,7 +77,7 @@ impl CorrelationArgs {
             step_px: self.step,
             roi: self.roi,
             strain: self.strain,
-            reference: ReferenceMode::of_kind(reference),
+            reference: ReferenceMode::of_kind(reference, self.method),
             guess: self.guess,
             min_zncc: self.min_zncc,
             gradient_correction: self.gradient_correction,

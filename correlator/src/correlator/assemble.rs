@@ -201,6 +201,7 @@ impl Correlator {
             .previous
             .get_or_insert_with(|| PreviousFrames::new(nodes));
         std::mem::swap(&mut previous.last, &mut previous.before_last);
+        previous.last_step = self.frame_step;
         for (p, node) in previous.last.iter_mut().zip(&self.field.nodes) {
             *p = (node.status == NodeStatus::Ok).then_some((node.u_px, node.v_px));
         }

@@ -37,21 +37,11 @@ impl Correlator {
             ReferenceMode::Fixed => false,
             ReferenceMode::Incremental => true,
             ReferenceMode::Auto {
-                max_displacement_zoi_fraction,
+                max_deformation_px,
                 min_mean_score,
-            } => {
-                let limit = max_displacement_zoi_fraction * self.settings.zoi_px as f64;
-                let (mut largest, mut score_sum, mut count) = (0.0f64, 0.0, 0.0);
-                for (k, result) in self.frame.results.iter().enumerate() {
-                    if result.status == NodeStatus::Ok {
-                        let _ = k;
-                        largest = largest.max(result.u_px.abs()).max(result.v_px.abs());
-                        score_sum += result.score;
-                        count += 1.0;
-                    }
-                }
-                count > 0.0 && (largest > limit || score_sum / count < min_mean_score)
-            }
+            } => self
+                .renewal_signals()
+                .call_for_renewal(max_deformation_px, min_mean_score),
         };
         if !replace || self.field.valid == 0 {
             return;
@@ -87,6 +77,7 @@ impl Correlator {
             width_px: self.width_px,
             height_px: self.height_px,
         });
+
         for (r, &base) in self.reference.nodes.iter_mut().zip(&self.scratch.pairs) {
             r.base_px = base;
         }

@@ -69,11 +69,16 @@ impl Correlator {
         whole_mesh: Option<AffineFit>,
     ) -> Option<(f64, f64)> {
         match previous.last[k] {
-            // A node moving steadily (a ramp) is where its last step takes it: the last
-            // value plus the last change (at a reversal this overshoots by one step, which
-            // the integer search takes back).
+            // A node moving steadily (a ramp) is where its last velocity takes it: the last
+            // value plus the last change, scaled by the camera frames since the last one over
+            // those between the last two (frames dropped by a busy correlator would otherwise
+            // leave every prediction short by the steps missed; at a reversal this overshoots
+            // by a step, which the integer search takes back).
             Some(p) => Some(match previous.before_last[k] {
-                Some(q) => (2.0 * p.0 - q.0, 2.0 * p.1 - q.1),
+                Some(q) => {
+                    let r = self.frame_step as f64 / previous.last_step.max(1) as f64;
+                    (p.0 + r * (p.0 - q.0), p.1 + r * (p.1 - q.1))
+                }
                 None => p,
             }),
             // A node without a previous value (it failed or was outside the image) starts from

@@ -37,6 +37,9 @@ pub(super) struct Reference {
     /// frame needs the global displacement).
     pub global_stale: bool,
     pub frames_since: u64,
+    /// Nodes refused in the first frame against this reference (None before it), see
+    /// `renewal.rs`.
+    pub refused_first: Option<usize>,
     /// This reference is still the origin (the image the mesh was defined in).
     pub is_origin: bool,
 }
@@ -63,8 +66,10 @@ pub(super) struct Origin {
 pub(super) struct PreviousFrames {
     /// The last frame's (None: no usable value).
     pub last: Vec<Option<(f64, f64)>>,
-    /// The frame before: with `last`, each node's velocity per frame.
+    /// The frame before: with `last`, each node's velocity.
     pub before_last: Vec<Option<(f64, f64)>>,
+    /// Camera frames from the one before last to the last (1 unless frames were dropped).
+    pub last_step: u64,
 }
 
 /// What the frames since the mesh was defined measured.
@@ -117,6 +122,7 @@ impl PreviousFrames {
         Self {
             last: vec![None; nodes],
             before_last: vec![None; nodes],
+            last_step: 1,
         }
     }
 }

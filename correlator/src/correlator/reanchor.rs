@@ -42,7 +42,8 @@ impl Correlator {
                 gradient,
             });
         }
-        self.measure_against_origin(image);
+        // Carried by an extrapolation, up to pixels off: the full search.
+        self.measure_against_origin(image, false);
         for (entry, &(result, score)) in self.scratch.entries.iter().zip(&self.scratch.reanchored) {
             let k = entry.node;
             let node = &mut self.field.nodes[k];
@@ -87,7 +88,9 @@ impl Correlator {
                 gradient,
             });
         }
-        self.measure_against_origin(image);
+        // Each guess is the node's total displacement just measured (within a pixel of what the
+        // origin gives): the prediction's shortcut, the full search where it is not confirmed.
+        self.measure_against_origin(image, true);
         for (entry, &(result, score)) in self.scratch.entries.iter().zip(&self.scratch.reanchored) {
             if result.status == NodeStatus::Ok && score >= self.settings.min_zncc {
                 self.scratch.pairs[entry.node] = (result.u_px, result.v_px);
@@ -97,8 +100,9 @@ impl Correlator {
 
     /// Each of `entries` (node, total displacement, gradient) measured against the origin:
     /// its ZOI there correlated with `image` through the gradient, and the final check; the
-    /// results and their ZNCC go to `reanchored`, in the order of `entries`.
-    fn measure_against_origin(&mut self, image: Image) {
+    /// results and their ZNCC go to `reanchored`, in the order of `entries`. `predicted`: the
+    /// guesses are within a pixel (see [`ZoiSearch::predicted`]).
+    fn measure_against_origin(&mut self, image: Image, predicted: bool) {
         let (n, pad) = (self.settings.zoi_px, self.fft_pad_px);
         let offset = (n - self.fft_px) as f64 / 2.0 - pad as f64;
         // A measurement, not a guess, when IC-GN has no origin coefficients: the paper's iterations.
@@ -148,7 +152,7 @@ impl Correlator {
                 guess_px: entry.guess_px,
                 warp: Some(entry.gradient),
                 iterations,
-                predicted: false,
+                predicted,
             };
             let result = engine.correlate_uncached(origin, image, search);
             // The FFT ZOI's centre is `offset` px from the node's when an odd subset holds an

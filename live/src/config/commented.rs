@@ -43,7 +43,7 @@ const COMMENTS: &[(&str, &str)] = &[
     ("correlator.step_px", ""),
     ("correlator.threads", ""),
     ("correlator.strain", "Node strain measure: log (m = 0), green (m = 1), nominal (m = 1/2) or small."),
-    ("correlator.reference", "Reference: fixed, incremental (consecutive frames) or auto (renewed when the\ndisplacement or the score call for it, mesh followed)."),
+    ("correlator.reference", "Reference: fixed, incremental (consecutive frames) or auto (renewed when the\ncorrelation degrades: the ZOIs' deformation since the reference, the score or\nthe nodes refused; never for a rigid motion; mesh followed)."),
     ("correlator.guess", "Initial guess per ZOI: auto (previous field or significant global (U0, V0),\nfailed nodes grown from verified neighbours, keypoints when too few verify),\npredict (previous field, neighbours) or correli (paper)."),
     ("correlator.min_zncc", "A node is ok only when the ZNCC of its reference ZOI with the frame, sampled at\nits displacement and local gradient, reaches this (0 < min_zncc < 1)."),
     ("correlator.gradient_correction", "Remove, to first order, the rigid ZOI's bias under a displacement gradient\n(beyond the paper; false = CORRELI-GD as published)."),

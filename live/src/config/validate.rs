@@ -177,7 +177,7 @@ impl RunConfig {
             step_px: c.step_px,
             threads: c.threads,
             strain: c.strain,
-            reference: correlator::ReferenceMode::of_kind(c.reference),
+            reference: correlator::ReferenceMode::of_kind(c.reference, c.method),
             guess: c.guess,
             min_zncc: c.min_zncc,
             gradient_correction: c.gradient_correction,
