@@ -355,6 +355,7 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
     // points for a meaningful screenshot: 40 stretch increments of 0.002 of a ramp to 1.5 at
     // 0.01 /s, reached whatever the machine's speed as long as the ramp runs (a run whose
     // campaign ended first fails here at once, naming the page's counts, not at the guard).
+    // (Before the first report the identification has no `points`: guarded, not read.)
     let coefficients = until("an identification on 40 points on the page", || {
         let run = bench.child("run");
         assert!(
@@ -365,7 +366,7 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
         );
         let c = browser.eval(
             "const id = dash.last && dash.last.identification; \
-             return !!id && id.points.uniaxial >= 40 \
+             return !!id && !!id.points && id.points.uniaxial >= 40 \
              && document.getElementById('coefficients').textContent;",
         );
         let c = c.as_str()?.to_string();
