@@ -30,6 +30,8 @@ pub enum GeometryError {
 /// Where the solution of a load stopped, and why.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SolveError {
+    #[error(transparent)]
+    Geometry(#[from] GeometryError),
     #[error("element {element} inverted by the load (det C = {det_c} at Gauss point {point}) at load factor {load_factor}, last converged {converged_load_factor}")]
     ElementInverted {
         element: usize,

@@ -39,19 +39,15 @@ fn main() {
         .mesh()
         .expect("the default cruciform");
     let law = material::InvariantLaw::smactane();
-    let sheet = membrane::Membrane::new(
-        &specimen.mesh,
-        specimen.thickness_mm,
-        &law,
-        membrane::Wrinkling::default(),
-    )
-    .expect("a sheet");
     let started = Instant::now();
-    let clamps = specimen.clamps_at(membrane::GripStretch {
-        x: stretch,
-        y: stretch,
-    });
-    let solved = membrane::solve(&sheet, &clamps, membrane::NewtonSettings::default())
+    let solved = specimen
+        .solve_at(
+            &law,
+            membrane::GripStretch {
+                x: stretch,
+                y: stretch,
+            },
+        )
         .expect("a converged state");
     println!(
         "cruciform at grip stretch {stretch}: {} nodes, solved from rest in {:.0} ms",

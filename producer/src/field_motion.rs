@@ -575,15 +575,9 @@ mod tests {
     fn hermite_between_exact_points_of_one_element_is_within_1e_3_px() {
         let specimen = CruciformGeometry::default().mesh().unwrap();
         let law = material::InvariantLaw::smactane();
-        let sheet = membrane::Membrane::new(
-            &specimen.mesh,
-            specimen.thickness_mm,
-            &law,
-            membrane::Wrinkling::default(),
-        )
-        .unwrap();
-        let clamps = specimen.clamps_at(membrane::GripStretch { x: 1.5, y: 1.5 });
-        let solved = membrane::solve(&sheet, &clamps, membrane::NewtonSettings::default()).unwrap();
+        let solved = specimen
+            .solve_at(&law, membrane::GripStretch { x: 1.5, y: 1.5 })
+            .unwrap();
         let reference = ReferenceMesh::new(specimen.mesh);
         let view = View {
             mm_per_px: 0.16,

@@ -4,8 +4,13 @@
 use super::cruciform::CruciformGeometry;
 use super::strip::StripGeometry;
 use super::Specimen;
+use crate::assembly::Membrane;
 use crate::boundary::Clamp;
+use crate::constitutive::Wrinkling;
 use crate::error::GeometryError;
+use crate::error::SolveError;
+use crate::law::SheetLaw;
+use crate::solver::{solve, Equilibrium, NewtonSettings};
 use serde::{Deserialize, Serialize};
 
 /// The specimens of the paper.
@@ -102,6 +107,18 @@ impl GripStretch {
 }
 
 impl Specimen {
+    /// The equilibrium of every grip pulled to `stretch` (aligned) under `law`, solved from
+    /// rest with the default wrinkling and Newton settings: a solved state in one call, for
+    /// examples and tests that film or integrate one.
+    pub fn solve_at<L: SheetLaw + ?Sized>(
+        &self,
+        law: &L,
+        stretch: GripStretch,
+    ) -> Result<Equilibrium, SolveError> {
+        let sheet = Membrane::new(&self.mesh, self.thickness_mm, law, Wrinkling::default())?;
+        solve(&sheet, &self.clamps_at(stretch), NewtonSettings::default())
+    }
+
     /// Every grip pulled to `stretch` (aligned; misalignment is a grip's own
     /// [`super::Grip::clamp`]).
     pub fn clamps_at(&self, stretch: GripStretch) -> Vec<Clamp> {
