@@ -23,7 +23,7 @@ mod element_map;
 use std::sync::Arc;
 
 use element_map::QuadraticMap;
-use membrane::{sample_at, ElementGrid, Location, Mesh};
+use membrane::{sample_at, ElementGrid, Location, Mesh, PointSample};
 
 use crate::error::ProducerError;
 use crate::motion::{inverse, mul_mat, Mat2, Vec2};
@@ -178,15 +178,8 @@ impl FieldMotion {
     /// Displacement u(X) = φ(X) − X at the reference image point `p_px`, px; None off the
     /// specimen. The frame's ground truth.
     pub fn displacement_px(&self, p_px: Vec2) -> Option<Vec2> {
-        let location = self
-            .reference
-            .grid
-            .locate(&self.reference.mesh, self.view.to_mm(p_px))?;
-        let s = sample_at(&self.reference.mesh, &self.u_mm, location)?;
-        Some([
-            s.displacement_mm[0] / self.view.mm_per_px,
-            s.displacement_mm[1] / self.view.mm_per_px,
-        ])
+        let u = self.sample(p_px)?.displacement_mm;
+        Some([u[0] / self.view.mm_per_px, u[1] / self.view.mm_per_px])
     }
 
     /// x = φ(X), px; None off the specimen.
@@ -198,11 +191,17 @@ impl FieldMotion {
     /// F(X) = ∂φ/∂X at the reference image point `p_px` (the same in px as in mm); None off the
     /// specimen.
     pub fn gradient(&self, p_px: Vec2) -> Option<Mat2> {
-        let location = self
-            .reference
+        Some(self.sample(p_px)?.f)
+    }
+
+    /// The field at the reference image point `p_px` (located by the mesh's own shape
+    /// functions, to the truth's precision); None off the specimen.
+    fn sample(&self, p_px: Vec2) -> Option<PointSample> {
+        let reference = &self.reference;
+        let location = reference
             .grid
-            .locate(&self.reference.mesh, self.view.to_mm(p_px))?;
-        Some(sample_at(&self.reference.mesh, &self.u_mm, location)?.f)
+            .locate(&reference.mesh, self.view.to_mm(p_px))?;
+        sample_at(&reference.mesh, &self.u_mm, location)
     }
 
     /// X = φ⁻¹(x), px; None where the image point `x_px` shows no material.
@@ -255,26 +254,17 @@ impl FieldMotion {
     #[inline]
     fn locate_current(&self, x_px: Vec2, hint: &mut RowHint) -> Option<Location> {
         let x_mm = self.view.to_mm(x_px);
-        let near = hint.and_then(|h| {
-            self.current_maps[h.element]
-                .natural(x_mm, (h.xi, h.eta))
-                .map(|(xi, eta)| Location {
-                    element: h.element,
-                    xi,
-                    eta,
-                })
-        });
-        let location = near.or_else(|| {
-            self.current_grid.candidates(x_mm).find_map(|e| {
-                self.current_maps[e]
-                    .natural(x_mm, (1.0 / 3.0, 1.0 / 3.0))
-                    .map(|(xi, eta)| Location {
-                        element: e,
-                        xi,
-                        eta,
-                    })
-            })
-        });
+        let in_element = |element: usize, start: (f64, f64)| {
+            let (xi, eta) = self.current_maps[element].natural(x_mm, start)?;
+            Some(Location { element, xi, eta })
+        };
+        let location = hint
+            .and_then(|h| in_element(h.element, (h.xi, h.eta)))
+            .or_else(|| {
+                self.current_grid
+                    .candidates(x_mm)
+                    .find_map(|e| in_element(e, (1.0 / 3.0, 1.0 / 3.0)))
+            });
         *hint = location;
         location
     }
