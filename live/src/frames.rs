@@ -4,7 +4,8 @@
 //! control, the log strains the rig aimed at then: empty cells otherwise), the latency,
 //! and, for simulated frames, the correlator's actual error against the ground truth.
 
-use crate::truth;
+use crate::truth::{self, NodeErrors};
+use producer::FieldMotion;
 use std::collections::VecDeque;
 use std::fmt::Write as _;
 use wire::{FieldHeader, FieldNode, GroundTruth, RigState, StrainMeasure};
@@ -217,32 +218,63 @@ fn cauchy_mpa(rig: &RigState, force_n: [f64; 2]) -> [f64; 2] {
     ]
 }
 
-/// The field's errors against the ground truth, its origin frame's truth `origin`: the mean
-/// and max node displacement error (px), and the measured minus true gauge log strain.
+/// What a field is compared with: the homogeneous motion of its origin frame (the field's own
+/// header holds the current one), or the finite-element fields of its origin frame and of its
+/// own frame (the specimen as a structure).
+#[derive(Clone, Copy)]
+pub enum OriginTruth<'a> {
+    Motion(&'a GroundTruth),
+    Field {
+        origin: &'a FieldMotion,
+        current: &'a FieldMotion,
+    },
+}
+
+/// The field's errors against the ground truth: the mean and max node displacement error
+/// (px), and the measured minus true gauge log strain.
 fn truth_errors(
     header: &FieldHeader,
     nodes: &[FieldNode],
-    origin: &GroundTruth,
+    origin: OriginTruth<'_>,
+    node_errors: &mut NodeErrors,
 ) -> (Option<[f64; 2]>, Option<[f64; 2]>) {
-    let current = &header.truth;
-    let displacement_error_px =
-        truth::displacement_error(nodes, current, origin).map(|(mean, max, _)| [mean, max]);
+    let each = |e| node_errors.record(e);
     let log = header.gauge_of(StrainMeasure::Log);
-    let log_strain_error = truth::relative_gradient(current, origin)
-        .and_then(|f| truth::log_strain(&f))
-        .map(|t| [log.exx - t[0], log.eyy - t[1]]);
-    (displacement_error_px, log_strain_error)
+    let strain_error = |t: [f64; 3]| [log.exx - t[0], log.eyy - t[1]];
+    match origin {
+        OriginTruth::Motion(origin) => {
+            let current = &header.truth;
+            let displacement_error_px = truth::displacement_error(nodes, current, origin, each)
+                .map(|(mean, max, _)| [mean, max]);
+            let log_strain_error = truth::relative_gradient(current, origin)
+                .and_then(|f| truth::log_strain(&f))
+                .map(strain_error);
+            (displacement_error_px, log_strain_error)
+        }
+        OriginTruth::Field { origin, current } => {
+            match truth::field_errors(nodes, current, origin, each) {
+                Some(e) => (
+                    Some([e.mean_px, e.max_px]),
+                    truth::log_strain(&e.mean_gradient).map(strain_error),
+                ),
+                None => (None, None),
+            }
+        }
+    }
 }
 
 impl FrameRow {
     /// Builds the row of one field. `rig` is the field's rig sample, `origin_truth` the truth
-    /// of the frame its node positions are measured in (its origin frame), `t0_ns` the
+    /// of the frame its node positions are measured in (its origin frame; with a
+    /// finite-element specimen, both frames' fields), each node's error going to
+    /// `node_errors`, `t0_ns` the
     /// run's start and `seen_ns` when the monitor received the field.
     pub fn new(
         header: &FieldHeader,
         nodes: &[FieldNode],
         rig: Option<&RigState>,
-        origin_truth: Option<&GroundTruth>,
+        origin_truth: Option<OriginTruth<'_>>,
+        node_errors: &mut NodeErrors,
         t0_ns: u64,
         seen_ns: u64,
     ) -> FrameRow {
@@ -261,7 +293,9 @@ impl FrameRow {
         let cauchy_mpa = rig.zip(force_n).map(|(s, f)| cauchy_mpa(s, f));
         let (displacement_error_px, log_strain_error) = origin_truth
             .filter(|_| header.has_truth == 1)
-            .map_or((None, None), |origin| truth_errors(header, nodes, origin));
+            .map_or((None, None), |origin| {
+                truth_errors(header, nodes, origin, node_errors)
+            });
         let ms = |ns: u64| ns as f64 * 1e-6;
         FrameRow {
             frame_id: header.frame_id,
@@ -357,6 +391,7 @@ mod tests {
             deformation_gradient: [lx, 0.0, 0.0, 1.0 / lx.sqrt()],
             translation_px: [0.0, 0.0],
             centre_px: [64.0, 64.0],
+            ..GroundTruth::IDENTITY
         };
         let mut header = FieldHeader {
             frame_id: 12,
@@ -395,7 +430,8 @@ mod tests {
             &header,
             &nodes,
             Some(&rig),
-            Some(&GroundTruth::IDENTITY),
+            Some(OriginTruth::Motion(&GroundTruth::IDENTITY)),
+            &mut NodeErrors::default(),
             1_000_000_000,
             2_060_000_000,
         );
@@ -421,7 +457,15 @@ mod tests {
         rig.control_mode = wire::RigControl::Held as u32;
         rig.target_log_exx = 0.405_465_1;
         rig.target_log_eyy = -0.2;
-        let strained = FrameRow::new(&header, &nodes, Some(&rig), None, 0, 0);
+        let strained = FrameRow::new(
+            &header,
+            &nodes,
+            Some(&rig),
+            None,
+            &mut NodeErrors::default(),
+            0,
+            0,
+        );
         assert_eq!(strained.target_log, Some([0.405_465_1, -0.2]));
         line.clear();
         strained.write_csv(&mut line);
@@ -431,7 +475,15 @@ mod tests {
         row.write_csv(&mut line);
         // Without rig sample and truth: empty cells, same count.
         header.has_truth = 0;
-        let row = FrameRow::new(&header, &nodes, None, None, 0, 0);
+        let row = FrameRow::new(
+            &header,
+            &nodes,
+            None,
+            None,
+            &mut NodeErrors::default(),
+            0,
+            0,
+        );
         line.clear();
         row.write_csv(&mut line);
         assert_eq!(line.trim_end().split(',').count(), COLUMNS.len());
@@ -471,7 +523,7 @@ mod tests {
             rig_sample_id: wire::NO_RIG_SAMPLE,
             ..FieldHeader::default()
         };
-        let row = FrameRow::new(&field, &[], None, None, 0, 0);
+        let row = FrameRow::new(&field, &[], None, None, &mut NodeErrors::default(), 0, 0);
         let mut line = String::new();
         row.write_csv_for(&mut line, false);
         assert_eq!(

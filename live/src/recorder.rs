@@ -2,9 +2,12 @@
 //! rig samples and frame truths, writes `frames.csv` and every Nth field as it goes, records
 //! the latencies, and remembers what the status line and the final figures need.
 
-use crate::frames::{FrameRow, RigHistory, TruthHistory};
+use crate::frames::{FrameRow, OriginTruth, RigHistory, TruthHistory};
 use crate::latency::{FieldLatencyParts, Latency};
 use crate::results::ResultsDir;
+use crate::truth::NodeErrors;
+use producer::specimen_states::SpecimenStates;
+use producer::View;
 use wire::files::{write_atomic, FileError, RowFile};
 use wire::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, RigState};
 
@@ -20,6 +23,9 @@ pub struct RecorderSettings {
     /// The camera's frames carry the ground truth (simulated): `frames.csv` has the truth
     /// columns. A real camera's has none: the columns are absent.
     pub truth: bool,
+    /// The simulated camera's scale (mm per px): how it films a finite-element specimen,
+    /// whose field is the truth node by node.
+    pub mm_per_px: f64,
 }
 
 pub struct Recorder {
@@ -30,6 +36,16 @@ pub struct Recorder {
     t0_ns: u64,
     rigs: RigHistory,
     truths: TruthHistory,
+    /// The finite-element specimen's solves (the truth of its frames), and the frames' size.
+    specimen: SpecimenStates,
+    frame_size_px: Option<[u32; 2]>,
+    /// Fields of a finite-element specimen whose truth could not be made (its solves not
+    /// received), and samples refused.
+    pub fields_without_truth: u64,
+    pub specimen_refused: u64,
+    /// Fields compared with the truth, and every valid node's error in them.
+    pub fields_compared: u64,
+    pub node_errors: NodeErrors,
     pub latency_field: Latency,
     /// Where the field latency goes: waiting, correlating, delivering.
     pub latency_field_parts: FieldLatencyParts,
@@ -77,6 +93,12 @@ impl Recorder {
             t0_ns,
             rigs: RigHistory::new(RIG_HISTORY),
             truths: TruthHistory::new(TRUTH_HISTORY),
+            specimen: SpecimenStates::new(),
+            frame_size_px: None,
+            fields_without_truth: 0,
+            specimen_refused: 0,
+            fields_compared: 0,
+            node_errors: NodeErrors::default(),
             latency_field: Latency::new(),
             latency_field_parts: FieldLatencyParts::default(),
             latency_identification: Latency::new(),
@@ -98,6 +120,39 @@ impl Recorder {
         })
     }
 
+    /// The finite-element fields of a field's origin frame and of its own frame, when they
+    /// show the specimen as a structure: None when they do not, `Some(None)` when the fields
+    /// cannot be made (a solve not received).
+    #[allow(clippy::type_complexity)]
+    fn specimen_fields(
+        &self,
+        header: &FieldHeader,
+        origin: &wire::GroundTruth,
+    ) -> Option<Option<(producer::FieldMotion, producer::FieldMotion)>> {
+        let current = &header.truth;
+        let (Some(origin_id), Some(current_id)) =
+            (origin.specimen_solve(), current.specimen_solve())
+        else {
+            return None;
+        };
+        let Some([width, height]) = self.frame_size_px else {
+            return Some(None);
+        };
+        let view = View {
+            mm_per_px: self.settings.mm_per_px,
+            centre_px: [
+                (f64::from(width) - 1.0) / 2.0,
+                (f64::from(height) - 1.0) / 2.0,
+            ],
+            centre_mm: [0.0, 0.0],
+        };
+        let field = |id, grip_mm: &[f64; 4]| self.specimen.field(id, grip_mm, view).ok();
+        Some(
+            field(origin_id, &origin.specimen_grip_mm)
+                .zip(field(current_id, &current.specimen_grip_mm)),
+        )
+    }
+
     fn note_error(&mut self, result: Result<(), FileError>) {
         if let Err(e) = result {
             if self.write_error.is_none() {
@@ -111,6 +166,7 @@ impl Recorder {
     pub fn on_frame(&mut self, header: &FrameHeader, pixels: &[u16]) {
         self.frames_seen += 1;
         self.last_frame_id = Some(header.frame_id);
+        self.frame_size_px = Some([header.width_px, header.height_px]);
         if header.has_truth == 1 {
             self.truths.push(header.frame_id, header.truth);
         }
@@ -121,6 +177,21 @@ impl Recorder {
         if new_sequence && header.validate(pixels.len()).is_ok() {
             // One copy per sequence (the frame stays in shared memory otherwise).
             self.sequence_first_frame = Some((*header, pixels.to_vec()));
+        }
+    }
+
+    /// The solves of a finite-element specimen received so far.
+    pub fn specimen_solves_received(&self) -> u64 {
+        self.specimen.received()
+    }
+
+    /// A solved state of the finite-element specimen (`specimen`); a refused one is said once.
+    pub fn on_specimen(&mut self, header: &wire::SpecimenHeader, payload: &[f64]) {
+        if let Err(e) = self.specimen.push(header, payload) {
+            if self.specimen_refused == 0 {
+                eprintln!("run: specimen state refused (its frames get no truth): {e}");
+            }
+            self.specimen_refused += 1;
         }
     }
 
@@ -150,8 +221,32 @@ impl Recorder {
             wire::NO_RIG_SAMPLE => self.rigs.at_time(header.t_capture_ns),
             id => self.rigs.get(id),
         };
-        let origin = self.truths.get(header.origin_frame_id);
-        let row = FrameRow::new(header, nodes, rig, origin, self.t0_ns, seen_ns);
+        let origin = self.truths.get(header.origin_frame_id).copied();
+        // The origin frame's solve is named by every field of its sequence: keep it.
+        if let Some(id) = origin.and_then(|o| o.specimen_solve()) {
+            self.specimen.pin(id);
+        }
+        let fields = origin.and_then(|o| self.specimen_fields(header, &o));
+        let origin_truth = match (&origin, &fields) {
+            (Some(o), None) => Some(OriginTruth::Motion(o)),
+            (_, Some(Some((origin, current)))) => Some(OriginTruth::Field { origin, current }),
+            _ => None,
+        };
+        let row = FrameRow::new(
+            header,
+            nodes,
+            rig,
+            origin_truth,
+            &mut self.node_errors,
+            self.t0_ns,
+            seen_ns,
+        );
+        if origin_truth.is_some() {
+            self.fields_compared += 1;
+        }
+        if matches!(fields, Some(None)) {
+            self.fields_without_truth += 1;
+        }
         if let Some(case) = rig.map(|s| s.load_case as usize).filter(|&c| c < 3) {
             let stretch = row.stretch[0].max(row.stretch[1]);
             if header.valid_nodes > 0 && stretch.is_finite() {

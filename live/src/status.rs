@@ -161,6 +161,7 @@ mod tests {
             fields_every: 10,
             vtk: false,
             truth: true,
+            mm_per_px: 0.015,
         };
         let mut recorder = Recorder::new(&results, settings, 0).unwrap();
         let mut rig = RigState {

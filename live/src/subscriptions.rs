@@ -14,6 +14,9 @@ pub struct Subscriptions {
     fields: SliceSubscriber<FieldNode, FieldHeader>,
     rig: ValueSubscriber<RigState>,
     reports: ValueSubscriber<IdentificationReport>,
+    /// The finite-element specimen's solves: the truth of its frames. Not woken on (a rig
+    /// sample always follows a solve).
+    specimen: SliceSubscriber<f64, wire::SpecimenHeader>,
 }
 
 impl Subscriptions {
@@ -23,6 +26,7 @@ impl Subscriptions {
             fields: SliceSubscriber::create(node, &services::FIELDS).context("monitor")?,
             rig: ValueSubscriber::create(node, &services::RIG_STATE).context("monitor")?,
             reports: ValueSubscriber::create(node, &services::IDENTIFICATION).context("monitor")?,
+            specimen: SliceSubscriber::create(node, &services::SPECIMEN).context("monitor")?,
         })
     }
 
@@ -36,13 +40,17 @@ impl Subscriptions {
         ]
     }
 
-    /// Takes every pending sample of every service into `recorder` (rig states first: fields
-    /// name them).
+    /// Takes every pending sample of every service into `recorder` (specimen solves, then rig
+    /// states: frames and fields name them).
     pub fn drain(&self, recorder: &mut Recorder) -> anyhow::Result<()> {
         self.frames.clear_events();
         self.fields.clear_events();
         self.rig.clear_events();
         self.reports.clear_events();
+        self.specimen.clear_events();
+        while let Some(solve) = self.specimen.receive().context("monitor")? {
+            recorder.on_specimen(solve.user_header(), solve.payload());
+        }
         while let Some(state) = self.rig.receive().context("monitor")? {
             recorder.on_rig(state);
         }

@@ -5,6 +5,7 @@
 //! relative gradient F_k F_o⁻¹.
 
 use nalgebra::{Matrix2, SymmetricEigen, Vector2};
+use producer::FieldMotion;
 use wire::{FieldNode, GroundTruth, NodeStatus};
 
 fn gradient(truth: &GroundTruth) -> Matrix2<f64> {
@@ -52,6 +53,7 @@ pub fn displacement_error(
     nodes: &[FieldNode],
     current: &GroundTruth,
     origin: &GroundTruth,
+    mut each: impl FnMut(f64),
 ) -> Option<(f64, f64, usize)> {
     let (mut sum, mut max, mut count) = (0.0, 0.0f64, 0usize);
     for node in nodes {
@@ -63,11 +65,104 @@ pub fn displacement_error(
         let truth = forward(current, material) - x0;
         let measured = Vector2::new(f64::from(node.u_px), f64::from(node.v_px));
         let error = (measured - truth).norm();
+        each(error);
         sum += error;
         max = max.max(error);
         count += 1;
     }
     (count > 0).then(|| (sum / count as f64, max, count))
+}
+
+/// Mean and largest displacement error (px) over the valid nodes against a finite-element
+/// field (the specimen as a structure), node by node: the node at x0 in the origin frame's
+/// image is the material point X = φ_o⁻¹(x0), which the current frame shows at φ_k(X). A node
+/// on no material (the room behind the specimen) has no truth and is not counted. Also the
+/// log strain of the valid nodes' mean relative gradient F_k F_o⁻¹ (the gauge's truth).
+pub fn field_errors(
+    nodes: &[FieldNode],
+    current: &FieldMotion,
+    origin: &FieldMotion,
+    mut each: impl FnMut(f64),
+) -> Option<FieldErrors> {
+    let (mut sum, mut max, mut count) = (0.0, 0.0f64, 0usize);
+    let mut gradient_sum = Matrix2::zeros();
+    for node in nodes {
+        if node.status != NodeStatus::Ok as u32 {
+            continue;
+        }
+        let x0 = [f64::from(node.x_px), f64::from(node.y_px)];
+        let Some(material) = origin.inverse(x0) else {
+            continue;
+        };
+        let (Some(x), Some(f_k), Some(f_o)) = (
+            current.forward(material),
+            current.gradient(material),
+            origin.gradient(material),
+        ) else {
+            continue;
+        };
+        let truth = Vector2::new(x[0] - x0[0], x[1] - x0[1]);
+        let measured = Vector2::new(f64::from(node.u_px), f64::from(node.v_px));
+        let error = (measured - truth).norm();
+        each(error);
+        sum += error;
+        max = max.max(error);
+        count += 1;
+        let f_k = Matrix2::new(f_k[0][0], f_k[0][1], f_k[1][0], f_k[1][1]);
+        let f_o = Matrix2::new(f_o[0][0], f_o[0][1], f_o[1][0], f_o[1][1]);
+        gradient_sum += f_k * f_o.try_inverse()?;
+    }
+    (count > 0).then(|| FieldErrors {
+        mean_px: sum / count as f64,
+        max_px: max,
+        nodes: count,
+        mean_gradient: gradient_sum / count as f64,
+    })
+}
+
+/// What [`field_errors`] finds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FieldErrors {
+    pub mean_px: f64,
+    pub max_px: f64,
+    /// Valid nodes on material, compared.
+    pub nodes: usize,
+    /// Their mean relative gradient F_k F_o⁻¹ (image to image).
+    pub mean_gradient: Matrix2<f64>,
+}
+
+/// Every node's displacement error of a run (px), for its percentiles.
+#[derive(Debug)]
+pub struct NodeErrors {
+    /// In µpx, 3 significant digits, up to 1000 px (a larger error counts as 1000 px).
+    histogram: hdrhistogram::Histogram<u64>,
+}
+
+const MICRO_PX_MAX: u64 = 1_000_000_000;
+
+impl Default for NodeErrors {
+    fn default() -> Self {
+        NodeErrors {
+            histogram: hdrhistogram::Histogram::new_with_bounds(1, MICRO_PX_MAX, 3)
+                .expect("valid histogram bounds"),
+        }
+    }
+}
+
+impl NodeErrors {
+    pub fn record(&mut self, error_px: f64) {
+        let micro = (error_px * 1e6).round().clamp(1.0, MICRO_PX_MAX as f64) as u64;
+        self.histogram.saturating_record(micro);
+    }
+
+    pub fn count(&self) -> u64 {
+        self.histogram.len()
+    }
+
+    /// The error below which a share `quantile` of the nodes lie (px); None before any.
+    pub fn quantile_px(&self, quantile: f64) -> Option<f64> {
+        (self.count() > 0).then(|| self.histogram.value_at_quantile(quantile) as f64 * 1e-6)
+    }
 }
 
 #[cfg(test)]
@@ -79,6 +174,7 @@ mod tests {
             deformation_gradient: [lx, 0.0, 0.0, ly],
             translation_px: [0.0, 0.0],
             centre_px: centre,
+            ..GroundTruth::IDENTITY
         }
     }
 
@@ -89,6 +185,7 @@ mod tests {
             deformation_gradient: [1.2 * a.cos(), -a.sin(), 1.2 * a.sin(), a.cos()],
             translation_px: [3.0, -2.0],
             centre_px: [50.0, 40.0],
+            ..GroundTruth::IDENTITY
         };
         let p = Vector2::new(10.0, 70.0);
         let back = inverse(&t, forward(&t, p)).unwrap();
@@ -127,11 +224,11 @@ mod tests {
             status: NodeStatus::OutsideImage as u32,
             ..FieldNode::default()
         });
-        let (mean, max, count) = displacement_error(&nodes, &current, &origin).unwrap();
+        let (mean, max, count) = displacement_error(&nodes, &current, &origin, |_| {}).unwrap();
         assert_eq!(count, 3);
         assert!(mean < 1e-4 && max < 1e-4, "{mean} {max}");
         nodes[0].v_px = 0.5;
-        let (_, max, _) = displacement_error(&nodes, &current, &origin).unwrap();
+        let (_, max, _) = displacement_error(&nodes, &current, &origin, |_| {}).unwrap();
         assert!((max - 0.5).abs() < 1e-4);
     }
 }

@@ -8,7 +8,8 @@
 //! ([`Wrinkling`]). The specimens of the paper are meshed in code ([`specimens`]), clamped by
 //! grips moving as rigid bodies ([`Clamp`]), and solved by Newton with line search and load
 //! stepping ([`solve`], warm-started from an earlier equilibrium: [`solve_from`]), its tangent
-//! condensed on the grips ([`condense`]); a failure names its state and reason ([`SolveError`]). A path of grip
+//! condensed on the grips ([`condense`]) and the field followed to nearby grips through its modes
+//! ([`GripLinearField`]); a failure names its state and reason ([`SolveError`]). A path of grip
 //! stretches ([`solve_path`]) gives nodal fields ([`nodal`]) written as VTK and CSV ([`output`]).
 //! Units: mm, N, MPa.
 
@@ -19,6 +20,7 @@ pub mod boundary;
 pub mod condensed;
 pub mod constitutive;
 pub mod error;
+pub mod grip_field;
 pub mod law;
 pub mod mesh;
 pub mod nodal;
@@ -37,6 +39,7 @@ pub use boundary::{Clamp, Held, RigidMotion};
 pub use condensed::{condense, Condensed};
 pub use constitutive::{MembraneState, Wrinkling};
 pub use error::{GeometryError, SolveError};
+pub use grip_field::GripLinearField;
 pub use law::{InvariantDerivatives, MembraneLaw, SheetLaw};
 pub use mesh::Mesh;
 pub use nodal::{NodalField, NodeFailure};

@@ -27,6 +27,7 @@ mod scenario;
 pub mod settings;
 mod simulated;
 mod source;
+pub mod specimen_states;
 pub mod speckle;
 #[cfg(feature = "process")]
 pub mod stream;

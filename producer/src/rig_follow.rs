@@ -19,9 +19,11 @@
 //! reason, and the shell skips and counts the frame instead of clamping.
 
 use crate::error::ProducerError;
+use crate::field_motion::{FieldMotion, View};
 use crate::motion::{mul_mat, rotation, Affine, Motion};
 use crate::simulated::{motion_reach_px, SimulatedCamera, SimulatedConfig};
 use crate::source::{FrameDims, FrameInfo, FrameSource, Truth};
+use crate::specimen_states::{SpecimenStates, StateError};
 use wire::RigState;
 
 /// `FrameHeader::scenario_id` of rig-driven frames (beyond the [`crate::ScenarioKind`] ids).
@@ -160,6 +162,12 @@ pub enum BeyondEnvelope {
         rotation_rad: f64,
         max_rotation_rad: f64,
     },
+    #[error(
+        "specimen solve {solve_id} not received: the camera does not film a state it does not have"
+    )]
+    SolveMissing { solve_id: u64 },
+    #[error("specimen solve {solve_id} followed to the grips of this sample turns an element inside out")]
+    SolveUnusable { solve_id: u64 },
     #[error("centre offset {axis} {value_mm:.4} mm beyond ±{max_mm} mm (--max-offset-mm)")]
     Offset {
         /// `X` or `Y`.
@@ -202,6 +210,10 @@ pub struct RigKinematics {
     pub rotation_rad: f64,
     /// Specimen centre offset along rig X and Y, mm.
     pub centre_offset_mm: [f64; 2],
+    /// The specimen's solve and grip displacements (mm) when it is a finite-element
+    /// structure (`RigState::specimen_solve`): the camera films that field, and the fields
+    /// above are the filmed region's mean.
+    pub specimen: Option<(u64, [f64; 4])>,
 }
 
 impl RigKinematics {
@@ -214,6 +226,7 @@ impl RigKinematics {
             stretch_y: 1.0,
             rotation_rad: 0.0,
             centre_offset_mm: [0.0, 0.0],
+            specimen: None,
         }
     }
 }
@@ -227,6 +240,7 @@ impl From<&RigState> for RigKinematics {
             stretch_y: state.specimen_stretch_y,
             rotation_rad: state.specimen_rotation_rad,
             centre_offset_mm: state.specimen_centre_offset_mm,
+            specimen: state.specimen_solve(),
         }
     }
 }
@@ -348,8 +362,9 @@ impl RigFollower {
                 f,
                 translation_px,
                 centre_px,
-                homogeneous: true,
+                homogeneous: k.specimen.is_none(),
                 scenario_id: RIG_SCENARIO_ID,
+                specimen: k.specimen,
             },
         }
     }
@@ -407,6 +422,7 @@ impl RigFollower {
                                     ox * self.config.mm_per_px,
                                     oy * self.config.mm_per_px,
                                 ],
+                                specimen: None,
                             };
                             motions.push(self.motion_of(&k).motion);
                         }
@@ -427,6 +443,9 @@ pub struct RigCamera {
     follower: RigFollower,
     reach_px: f64,
     next_index: u64,
+    /// The finite-element specimen's solves received, and the field of the next frame.
+    specimen: SpecimenStates,
+    field: Option<FieldMotion>,
 }
 
 impl RigCamera {
@@ -456,6 +475,8 @@ impl RigCamera {
             follower,
             reach_px,
             next_index: 0,
+            specimen: SpecimenStates::new(),
+            field: None,
         })
     }
 
@@ -484,9 +505,52 @@ impl RigCamera {
         self.follower.push_kinematics(kinematics);
     }
 
-    /// What the next frame would show.
-    pub fn next_motion(&self) -> NextMotion {
-        self.follower.next_motion()
+    /// Takes a received `specimen` sample.
+    pub fn push_specimen(
+        &mut self,
+        header: &wire::SpecimenHeader,
+        payload: &[f64],
+    ) -> Result<(), StateError> {
+        self.specimen.push(header, payload)
+    }
+
+    /// The specimen's solves received.
+    pub fn specimen_states(&self) -> &SpecimenStates {
+        &self.specimen
+    }
+
+    /// How the camera sees the specimen: its centre at the image centre, the follower's scale.
+    pub fn view(&self) -> View {
+        View {
+            mm_per_px: self.follower.config().mm_per_px,
+            centre_px: self.follower.centre_px(),
+            centre_mm: [0.0, 0.0],
+        }
+    }
+
+    /// What the next frame would show; for a finite-element specimen, its field is prepared
+    /// here (a solve not received, or one whose field cannot be filmed, skips the frame).
+    pub fn next_motion(&mut self) -> NextMotion {
+        self.field = None;
+        let next = self.follower.next_motion();
+        let NextMotion::Ready(motion) = &next else {
+            return next;
+        };
+        let Some((solve_id, grip_mm)) = motion.truth.specimen else {
+            return next;
+        };
+        let reason = match self.specimen.field(solve_id, &grip_mm, self.view()) {
+            Ok(field) => {
+                self.field = Some(field);
+                return next;
+            }
+            Err(StateError::Unknown(_)) => BeyondEnvelope::SolveMissing { solve_id },
+            Err(_) => BeyondEnvelope::SolveUnusable { solve_id },
+        };
+        NextMotion::Beyond {
+            sample_id: motion.sample_id,
+            reason,
+        }
     }
 
     /// Renders `motion` (from [`RigCamera::next_motion`]) as the next frame into `out`.
@@ -496,7 +560,17 @@ impl RigCamera {
         out: &mut [u16],
     ) -> Result<FrameInfo, ProducerError> {
         let index = self.next_index;
-        self.camera.render_frame(&motion.motion, index, out)?;
+        match (&self.field, motion.truth.specimen) {
+            (Some(field), Some(_)) => self.camera.render_field_frame(field, index, out)?,
+            (None, Some((solve_id, _))) => {
+                return Err(ProducerError::InvalidParameter {
+                    name: "specimen solve".to_owned(),
+                    value: solve_id.to_string(),
+                    expected: "a frame prepared by next_motion".to_owned(),
+                })
+            }
+            _ => self.camera.render_frame(&motion.motion, index, out)?,
+        }
         self.next_index += 1;
         Ok(FrameInfo {
             index,
@@ -528,6 +602,7 @@ mod tests {
             stretch_y: sy,
             rotation_rad: rot_deg.to_radians(),
             centre_offset_mm: offset_mm,
+            specimen: None,
         }
     }
 
@@ -582,6 +657,7 @@ mod tests {
             ],
             translation_px: m.truth.translation_px,
             centre_px: m.truth.centre_px,
+            ..wire::GroundTruth::IDENTITY
         };
         for p in [[0.0, 0.0], [100.0, 80.0], [13.5, 61.25]] {
             let u = m.motion.displacement(p);

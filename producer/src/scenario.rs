@@ -457,6 +457,7 @@ impl Scenario {
             centre_px: c,
             homogeneous: motion.is_homogeneous(),
             scenario_id: self.kind.id(),
+            specimen: None,
         }
     }
 }

@@ -8,6 +8,7 @@
 
 use crate::camera::{Blur, CameraModel};
 use crate::error::ProducerError;
+use crate::field_motion::FieldMotion;
 use crate::motion::Motion;
 use crate::parallel::for_row_bands;
 use crate::render_exact::ExactRenderer;
@@ -266,10 +267,27 @@ impl SimulatedCamera {
     /// Renders the noiseless pattern values p in [0, 1] of `motion` into the internal buffer and
     /// returns it (for tests and tools).
     pub fn render_pattern(&mut self, motion: &Motion) -> &[f32] {
+        self.render_shown_pattern(Shown::Motion(motion))
+    }
+
+    /// [`Self::render_pattern`] of a finite-element field.
+    pub fn render_field_pattern(&mut self, field: &FieldMotion) -> &[f32] {
+        self.render_shown_pattern(Shown::Field(field))
+    }
+
+    fn render_shown_pattern(&mut self, shown: Shown<'_>) -> &[f32] {
         let width = self.config.width as usize;
-        match &self.renderer {
-            Renderer::Fast(fast) => fast.render(motion, width, &mut self.pattern),
-            Renderer::Exact(exact) => exact.render(&self.speckle, motion, width, &mut self.pattern),
+        match (&self.renderer, shown) {
+            (Renderer::Fast(fast), Shown::Motion(m)) => fast.render(m, width, &mut self.pattern),
+            (Renderer::Fast(fast), Shown::Field(f)) => {
+                fast.render_field(f, width, &mut self.pattern)
+            }
+            (Renderer::Exact(exact), Shown::Motion(m)) => {
+                exact.render(&self.speckle, m, width, &mut self.pattern)
+            }
+            (Renderer::Exact(exact), Shown::Field(f)) => {
+                exact.render_field(&self.speckle, f, width, &mut self.pattern)
+            }
         }
         if let Some(blur) = &mut self.blur {
             blur.apply(&mut self.pattern, width, self.config.threads.max(1));
@@ -284,6 +302,26 @@ impl SimulatedCamera {
         frame_index: u64,
         out: &mut [u16],
     ) -> Result<(), ProducerError> {
+        self.render_shown_frame(Shown::Motion(motion), frame_index, out)
+    }
+
+    /// [`Self::render_frame`] of a finite-element field (the room behind the specimen shows
+    /// [`crate::BACKDROP`]).
+    pub fn render_field_frame(
+        &mut self,
+        field: &FieldMotion,
+        frame_index: u64,
+        out: &mut [u16],
+    ) -> Result<(), ProducerError> {
+        self.render_shown_frame(Shown::Field(field), frame_index, out)
+    }
+
+    fn render_shown_frame(
+        &mut self,
+        shown: Shown<'_>,
+        frame_index: u64,
+        out: &mut [u16],
+    ) -> Result<(), ProducerError> {
         check_buffer(self.dims(), out)?;
         let (width, threads) = (self.config.width as usize, self.config.threads.max(1));
         let camera = &self.config.camera;
@@ -294,19 +332,31 @@ impl SimulatedCamera {
                 for_row_bands(out, width, threads, |first_row, band| {
                     let mut pattern_row = vec![0f32; width];
                     for (r, row) in band.chunks_exact_mut(width).enumerate() {
-                        fast.render_row(motion, first_row + r, &mut pattern_row);
+                        match shown {
+                            Shown::Motion(m) => fast.render_row(m, first_row + r, &mut pattern_row),
+                            Shown::Field(f) => {
+                                fast.render_field_row(f, first_row + r, &mut pattern_row)
+                            }
+                        }
                         camera.expose_row(frame_index, first_row + r, &pattern_row, row);
                     }
                 })
             }
             _ => {
-                self.render_pattern(motion);
+                self.render_shown_pattern(shown);
                 let camera = &self.config.camera;
                 camera.expose(frame_index, &self.pattern, width, out, threads);
             }
         }
         Ok(())
     }
+}
+
+/// What a frame shows: a motion of the whole image, or a finite-element field.
+#[derive(Clone, Copy)]
+enum Shown<'a> {
+    Motion(&'a Motion),
+    Field(&'a FieldMotion),
 }
 
 impl FrameSource for SimulatedCamera {

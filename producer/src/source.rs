@@ -20,6 +20,10 @@ pub struct Truth {
     pub homogeneous: bool,
     /// Stable numeric id of the scenario kind, see [`crate::ScenarioKind::id`].
     pub scenario_id: u32,
+    /// The specimen's solve and the grips' displacements (mm) whose finite-element field the
+    /// frame shows (`wire::GroundTruth::specimen_solve_id`); the fields above are then the
+    /// filmed region's mean.
+    pub specimen: Option<(u64, [f64; 4])>,
 }
 
 /// What a source says about the frame it wrote.

@@ -13,7 +13,7 @@ use crate::{FrameDims, FrameInfo, FrameSource, NextMotion, ProducerError, RigCam
 use iceoryx2::prelude::*;
 use std::time::{Duration, Instant};
 use wire::frame::pixel_checksum;
-use wire::pubsub::{SlicePublisher, ValueSubscriber};
+use wire::pubsub::{SlicePublisher, SliceSubscriber, ValueSubscriber};
 use wire::{services, FrameHeader, GroundTruth, Instance, InstanceError, RigState};
 
 #[cfg(feature = "genicam")]
@@ -114,6 +114,9 @@ pub enum StreamError {
     Wire(#[from] InstanceError),
     #[error(transparent)]
     Source(#[from] ProducerError),
+    /// A `specimen` sample the camera cannot read (another layout, a malformed mesh).
+    #[error("specimen state refused: {0}")]
+    Specimen(#[from] crate::specimen_states::StateError),
     #[cfg(feature = "genicam")]
     #[error(transparent)]
     Camera(#[from] crate::genicam::device::GenicamError),
@@ -275,7 +278,12 @@ impl Shell {
                     ],
                     translation_px: truth.translation_px,
                     centre_px: truth.centre_px,
+                    ..GroundTruth::IDENTITY
                 };
+                if let Some((solve_id, grip_mm)) = truth.specimen {
+                    header.truth.specimen_solve_id = solve_id;
+                    header.truth.specimen_grip_mm = grip_mm;
+                }
             }
             sent_header = *header;
             Ok::<_, ProducerError>(true)
@@ -331,7 +339,15 @@ pub fn stream_following_rig(
     let mut shell = Shell::open(instance, camera.dims(), settings, &mut on_event)?;
     let rig: ValueSubscriber<RigState> =
         ValueSubscriber::create(&shell.node, &services::RIG_STATE)?;
+    // A finite-element specimen's solves (a rig of a homogeneous sheet publishes none). Taken
+    // before the rig's samples, which name them.
+    let specimen: SliceSubscriber<f64, wire::SpecimenHeader> =
+        SliceSubscriber::create(&shell.node, &services::SPECIMEN)?;
     let drain = |camera: &mut RigCamera, report: &mut StreamReport| -> Result<(), StreamError> {
+        specimen.clear_events();
+        while let Some(sample) = specimen.receive()? {
+            camera.push_specimen(sample.user_header(), sample.payload())?;
+        }
         rig.clear_events();
         while let Some(state) = rig.receive()? {
             camera.push(&state);

@@ -24,6 +24,7 @@ mod from_settings;
 pub use from_settings::RigProcessSettings;
 mod resume;
 mod shell;
+mod specimen_port;
 
 /// The rig's place on an instance, one for the simulated rig and the CSV follower: the claim
 /// of the `rig` role (a second rig is refused), its node (dead nodes of the instance cleaned,

@@ -82,7 +82,18 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
         report.latency_identification_ms.p50,
     );
     if let Some(error) = report.displacement_error_mean_px {
-        println!("run: mean displacement error against the ground truth {error:.4} px");
+        match &report.truth {
+            Some(t) => println!(
+                "run: mean displacement error against the ground truth ({}) {error:.4} px, node p99 {:.4} px{}",
+                t.compared_with,
+                t.node_error_p99_px.unwrap_or(f64::NAN),
+                match t.fields_without_truth {
+                    0 => String::new(),
+                    n => format!(" ({n} field(s) without truth: their solves not received)"),
+                }
+            ),
+            None => println!("run: mean displacement error against the ground truth {error:.4} px"),
+        }
     }
     match &report.acceptance {
         Some(a) => println!(

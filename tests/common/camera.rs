@@ -255,6 +255,7 @@ pub fn affine(
         deformation_gradient: [f[0][0], f[0][1], f[1][0], f[1][1]],
         translation_px,
         centre_px,
+        ..GroundTruth::IDENTITY
     };
     (motion, truth)
 }

@@ -106,7 +106,7 @@ impl GradientSource {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FieldNode.v4")
+    type_name("dicstream.FieldNode.v5")
 )]
 pub struct FieldNode {
     /// ZOI centre in the reference image (px).
@@ -140,7 +140,7 @@ pub struct FieldNode {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.GaugeStrain.v4")
+    type_name("dicstream.GaugeStrain.v5")
 )]
 pub struct GaugeStrain {
     pub exx: f64,
@@ -154,7 +154,7 @@ pub struct GaugeStrain {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FieldHeader.v4")
+    type_name("dicstream.FieldHeader.v5")
 )]
 pub struct FieldHeader {
     pub layout_version: u32,

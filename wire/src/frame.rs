@@ -13,7 +13,7 @@ use iceoryx2::prelude::ZeroCopySend;
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.GroundTruth.v4")
+    type_name("dicstream.GroundTruth.v5")
 )]
 pub struct GroundTruth {
     /// Deformation gradient, row-major: `[F11, F12, F21, F22]` (dimensionless).
@@ -22,7 +22,19 @@ pub struct GroundTruth {
     pub translation_px: [f64; 2],
     /// Centre of the deformation in reference coordinates (px).
     pub centre_px: [f64; 2],
+    /// The specimen's solved state (`specimen` service, [`crate::SpecimenHeader::solve_id`])
+    /// whose finite-element field this frame shows, or [`NO_SPECIMEN_SOLVE`] when the motion
+    /// above is the whole truth. With a solve, the field is the solve's nodal displacements
+    /// followed to `specimen_grip_mm` through its grip modes, and the homogeneous map above is
+    /// the filmed region's mean.
+    pub specimen_solve_id: u64,
+    /// The grips' axial displacements (mm, in the solve's grip order; unused slots 0) the
+    /// frame was taken at.
+    pub specimen_grip_mm: [f64; 4],
 }
+
+/// [`GroundTruth::specimen_solve_id`] of a frame whose truth is the homogeneous motion alone.
+pub const NO_SPECIMEN_SOLVE: u64 = u64::MAX;
 
 impl GroundTruth {
     /// No motion: the reference configuration.
@@ -30,7 +42,14 @@ impl GroundTruth {
         deformation_gradient: [1.0, 0.0, 0.0, 1.0],
         translation_px: [0.0, 0.0],
         centre_px: [0.0, 0.0],
+        specimen_solve_id: NO_SPECIMEN_SOLVE,
+        specimen_grip_mm: [0.0; 4],
     };
+
+    /// The specimen's solve this frame shows, when its truth is a finite-element field.
+    pub fn specimen_solve(&self) -> Option<u64> {
+        (self.specimen_solve_id != NO_SPECIMEN_SOLVE).then_some(self.specimen_solve_id)
+    }
 
     /// Displacement u(X) = x - X of the reference point `(x_px, y_px)` under this motion.
     pub fn displacement_px(&self, x_px: f64, y_px: f64) -> (f64, f64) {
@@ -49,7 +68,7 @@ impl GroundTruth {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FrameHeader.v4")
+    type_name("dicstream.FrameHeader.v5")
 )]
 pub struct FrameHeader {
     /// Always [`crate::LAYOUT_VERSION`]; checked by every reader.
@@ -223,6 +242,7 @@ mod tests {
             deformation_gradient: [angle.cos(), -angle.sin(), angle.sin(), angle.cos()],
             translation_px: [0.5, -0.25],
             centre_px: [100.0, 50.0],
+            ..GroundTruth::IDENTITY
         };
         let (u, v) = truth.displacement_px(100.0, 50.0);
         assert!((u - 0.5).abs() < 1e-12 && (v + 0.25).abs() < 1e-12);

@@ -14,7 +14,7 @@ pub const MAX_RANKED: usize = 8;
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RankedModel.v4")
+    type_name("dicstream.RankedModel.v5")
 )]
 pub struct RankedModel {
     /// NUL-padded model name (identifier crate names), see [`crate::text`].
@@ -29,7 +29,7 @@ pub struct RankedModel {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.IdentificationReport.v4")
+    type_name("dicstream.IdentificationReport.v5")
 )]
 pub struct IdentificationReport {
     pub layout_version: u32,

@@ -8,11 +8,12 @@ use crate::field::{FieldHeader, FieldNode, GaugeStrain};
 use crate::frame::{FrameHeader, GroundTruth};
 use crate::identification::{IdentificationReport, RankedModel};
 use crate::rig::{ActuatorState, RigCommand, RigReply, RigState};
+use crate::specimen::SpecimenHeader;
 use crate::LAYOUT_VERSION;
 use std::mem::{offset_of, size_of};
 
 /// The version the figures below describe.
-const CHECKED_VERSION: u32 = 4;
+const CHECKED_VERSION: u32 = 5;
 
 const _: () = assert!(
     LAYOUT_VERSION == CHECKED_VERSION,
@@ -21,7 +22,7 @@ const _: () = assert!(
 
 const _: () = {
     assert!(
-        size_of::<GroundTruth>() == 64,
+        size_of::<GroundTruth>() == 104,
         "GroundTruth changed size: bump LAYOUT_VERSION"
     );
     assert!(
@@ -36,10 +37,18 @@ const _: () = {
         offset_of!(GroundTruth, centre_px) == 48,
         "GroundTruth::centre_px moved: bump LAYOUT_VERSION"
     );
+    assert!(
+        offset_of!(GroundTruth, specimen_solve_id) == 64,
+        "GroundTruth::specimen_solve_id moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(GroundTruth, specimen_grip_mm) == 72,
+        "GroundTruth::specimen_grip_mm moved: bump LAYOUT_VERSION"
+    );
 };
 const _: () = {
     assert!(
-        size_of::<FrameHeader>() == 136,
+        size_of::<FrameHeader>() == 176,
         "FrameHeader changed size: bump LAYOUT_VERSION"
     );
     assert!(
@@ -83,19 +92,19 @@ const _: () = {
         "FrameHeader::truth moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(FrameHeader, pixel_checksum) == 112,
+        offset_of!(FrameHeader, pixel_checksum) == 152,
         "FrameHeader::pixel_checksum moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(FrameHeader, sequence_id) == 120,
+        offset_of!(FrameHeader, sequence_id) == 160,
         "FrameHeader::sequence_id moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(FrameHeader, reserved) == 124,
+        offset_of!(FrameHeader, reserved) == 164,
         "FrameHeader::reserved moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(FrameHeader, t_camera_ns) == 128,
+        offset_of!(FrameHeader, t_camera_ns) == 168,
         "FrameHeader::t_camera_ns moved: bump LAYOUT_VERSION"
     );
 };
@@ -181,7 +190,7 @@ const _: () = {
 };
 const _: () = {
     assert!(
-        size_of::<FieldHeader>() == 288,
+        size_of::<FieldHeader>() == 328,
         "FieldHeader changed size: bump LAYOUT_VERSION"
     );
     assert!(
@@ -257,23 +266,23 @@ const _: () = {
         "FieldHeader::truth moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(FieldHeader, u_mean_px) == 168,
+        offset_of!(FieldHeader, u_mean_px) == 208,
         "FieldHeader::u_mean_px moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(FieldHeader, v_mean_px) == 176,
+        offset_of!(FieldHeader, v_mean_px) == 216,
         "FieldHeader::v_mean_px moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(FieldHeader, gauge) == 184,
+        offset_of!(FieldHeader, gauge) == 224,
         "FieldHeader::gauge moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(FieldHeader, sequence_id) == 280,
+        offset_of!(FieldHeader, sequence_id) == 320,
         "FieldHeader::sequence_id moved: bump LAYOUT_VERSION"
     );
     assert!(
-        offset_of!(FieldHeader, gradient_source) == 284,
+        offset_of!(FieldHeader, gradient_source) == 324,
         "FieldHeader::gradient_source moved: bump LAYOUT_VERSION"
     );
 };
@@ -309,7 +318,7 @@ const _: () = {
 };
 const _: () = {
     assert!(
-        size_of::<RigState>() == 408,
+        size_of::<RigState>() == 448,
         "RigState changed size: bump LAYOUT_VERSION"
     );
     assert!(
@@ -391,6 +400,14 @@ const _: () = {
     assert!(
         offset_of!(RigState, target_log_eyy) == 400,
         "RigState::target_log_eyy moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(RigState, specimen_solve_id) == 408,
+        "RigState::specimen_solve_id moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(RigState, specimen_grip_mm) == 416,
+        "RigState::specimen_grip_mm moved: bump LAYOUT_VERSION"
     );
 };
 const _: () = {
@@ -519,5 +536,48 @@ const _: () = {
     assert!(
         offset_of!(IdentificationReport, ranking) == 320,
         "IdentificationReport::ranking moved: bump LAYOUT_VERSION"
+    );
+};
+
+const _: () = {
+    assert!(
+        size_of::<SpecimenHeader>() == 104,
+        "SpecimenHeader changed size: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(SpecimenHeader, layout_version) == 0,
+        "SpecimenHeader::layout_version moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(SpecimenHeader, grips) == 4,
+        "SpecimenHeader::grips moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(SpecimenHeader, solve_id) == 8,
+        "SpecimenHeader::solve_id moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(SpecimenHeader, t_sim_s) == 16,
+        "SpecimenHeader::t_sim_s moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(SpecimenHeader, node_count) == 24,
+        "SpecimenHeader::node_count moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(SpecimenHeader, element_count) == 28,
+        "SpecimenHeader::element_count moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(SpecimenHeader, mesh_fingerprint) == 32,
+        "SpecimenHeader::mesh_fingerprint moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(SpecimenHeader, grip_mm) == 40,
+        "SpecimenHeader::grip_mm moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(SpecimenHeader, grip_force_n) == 72,
+        "SpecimenHeader::grip_force_n moved: bump LAYOUT_VERSION"
     );
 };

@@ -34,22 +34,24 @@ pub mod services;
 #[cfg(feature = "ipc")]
 pub mod shm;
 pub mod signals;
+pub mod specimen;
 pub mod stats;
 pub mod text;
 pub mod toml_hint;
 
 pub use clock::monotonic_ns;
 pub use field::{FieldHeader, FieldNode, GaugeStrain, GradientSource, NodeStatus, StrainMeasure};
-pub use frame::{FrameHeader, GroundTruth};
+pub use frame::{FrameHeader, GroundTruth, NO_SPECIMEN_SOLVE};
 pub use identification::IdentificationReport;
 #[cfg(feature = "ipc")]
 pub use instance::{Instance, InstanceError};
 pub use rig::{ActuatorState, RigCommand, RigCommandKind, RigControl, RigReply, RigState};
+pub use specimen::{SpecimenError, SpecimenHeader, SpecimenParts};
 
 /// Version of every layout in this crate. Bump it (and the `#[type_name]` suffixes, which
 /// embed it) whenever a field changes: processes of different versions then refuse to connect
 /// instead of misreading each other.
-pub const LAYOUT_VERSION: u32 = 4;
+pub const LAYOUT_VERSION: u32 = 5;
 
 /// Marks an absent rig sample id (a frame not taken under a rig, e.g. a replayed image).
 pub const NO_RIG_SAMPLE: u64 = u64::MAX;

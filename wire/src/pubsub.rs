@@ -109,6 +109,11 @@ where
         })
     }
 
+    /// The longest slice this publisher takes.
+    pub fn max_len(&self) -> usize {
+        self.max_len
+    }
+
     /// Loans a slice of `len` elements in shared memory, lets `fill` write the header and every
     /// element in place (no copy), sends it and wakes the subscribers. `fill` returns `false` to
     /// send nothing (the loan goes back). Returns how many subscribers received the sample.

@@ -15,7 +15,7 @@ pub const AXIS_NAMES: [&str; 3] = ["X", "Y", "Z"];
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.ActuatorState.v4")
+    type_name("dicstream.ActuatorState.v5")
 )]
 pub struct ActuatorState {
     pub position_mm: f64,
@@ -30,11 +30,11 @@ pub struct ActuatorState {
 
 /// One decimated sample of the rig.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RigState.v4")
+    type_name("dicstream.RigState.v5")
 )]
 pub struct RigState {
     pub layout_version: u32,
@@ -75,9 +75,51 @@ pub struct RigState {
     /// through [`RigState::strain_target`].
     pub target_log_exx: f64,
     pub target_log_eyy: f64,
+    /// The specimen's last solved state (`specimen` service) when the specimen is a
+    /// finite-element structure, else [`crate::NO_SPECIMEN_SOLVE`]; and the grips' axial
+    /// displacements at this sample (mm, the solve's grip order), to which the solve's field is
+    /// followed through its grip modes (`SpecimenHeader`).
+    pub specimen_solve_id: u64,
+    pub specimen_grip_mm: [f64; 4],
+}
+
+impl Default for RigState {
+    /// Zeros, but no specimen solve ([`crate::NO_SPECIMEN_SOLVE`]): a zero id would name one.
+    fn default() -> Self {
+        RigState {
+            layout_version: 0,
+            program_state: 0,
+            sample_id: 0,
+            t_sim_s: 0.0,
+            t_published_ns: 0,
+            actuators: [ActuatorState::default(); 6],
+            axis_centre_mm: [0.0; 3],
+            axis_elongation_mm: [0.0; 3],
+            specimen_stretch_x: 0.0,
+            specimen_stretch_y: 0.0,
+            specimen_rotation_rad: 0.0,
+            specimen_centre_offset_mm: [0.0; 2],
+            specimen_section_x_mm2: 0.0,
+            specimen_section_y_mm2: 0.0,
+            load_case: 0,
+            hydraulics_on: 0,
+            test_index: 0,
+            control_mode: 0,
+            target_log_exx: 0.0,
+            target_log_eyy: 0.0,
+            specimen_solve_id: crate::NO_SPECIMEN_SOLVE,
+            specimen_grip_mm: [0.0; 4],
+        }
+    }
 }
 
 impl RigState {
+    /// The specimen's solve and the grips' displacements, when the specimen is a structure.
+    pub fn specimen_solve(&self) -> Option<(u64, [f64; 4])> {
+        (self.specimen_solve_id != crate::NO_SPECIMEN_SOLVE)
+            .then_some((self.specimen_solve_id, self.specimen_grip_mm))
+    }
+
     /// The strain target (ln λx, ln λy), when a strain-controlled test sets one (its control
     /// mode is strain or held, and both targets are finite).
     pub fn strain_target(&self) -> Option<[f64; 2]> {
@@ -174,7 +216,7 @@ impl RigCommandKind {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RigCommand.v4")
+    type_name("dicstream.RigCommand.v5")
 )]
 pub struct RigCommand {
     pub layout_version: u32,
@@ -208,7 +250,7 @@ impl RigCommand {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RigReply.v4")
+    type_name("dicstream.RigReply.v5")
 )]
 pub struct RigReply {
     pub layout_version: u32,

@@ -87,6 +87,20 @@ pub const IDENTIFICATION: ServiceSpec = ServiceSpec {
     safe_overflow: true,
 };
 
+/// The finite-element specimen's solved states (a few per second, a few hundred kB each):
+/// the latest is kept for late joiners. Readers copy what they keep (the camera and the
+/// recorder: the solves frames still name), so small queues do.
+pub const SPECIMEN: ServiceSpec = ServiceSpec {
+    name: "specimen",
+    max_publishers: 1,
+    max_subscribers: 4,
+    subscriber_buffer: 4,
+    subscriber_borrowed: 1,
+    history: 1,
+    publisher_loans: 2,
+    safe_overflow: true,
+};
+
 /// Request-response name of the rig's command port.
 pub const RIG_COMMAND: &str = "rig/command";
 

@@ -78,6 +78,7 @@ impl Stopped<'_> {
             latency_field_parts_ms: recorder.latency_field_parts.percentiles(),
             latency_identification_ms: recorder.latency_identification.percentiles(),
             displacement_error_mean_px,
+            truth: super::report::TruthReport::of(recorder),
             acceptance: judged.acceptance,
             acceptance_skipped: judged.skipped,
             camera_source: config.camera.source,

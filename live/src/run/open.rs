@@ -68,6 +68,7 @@ impl<'a> Run<'a> {
             fields_every: config.run.fields_every,
             vtk: config.run.vtk,
             truth: config.camera.source.has_truth(),
+            mm_per_px: config.camera.mm_per_px,
         };
         let recorder = Recorder::new(&prepared.results, settings, t0_ns)?;
         let dashboard = crate::dashboard_view::start(config, &prepared.name)?;

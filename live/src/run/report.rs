@@ -8,6 +8,41 @@ use crate::latency::Percentiles;
 use serde::Serialize;
 use std::path::PathBuf;
 
+/// The correlator's error against the ground truth, node by node.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct TruthReport {
+    /// `homogeneous motion` (the sheet's one stretch), or `finite-element field` (the
+    /// specimen as a structure: each node against the solved field it shows).
+    pub compared_with: &'static str,
+    pub fields_compared: u64,
+    /// Fields of a finite-element specimen whose solves were not received: no truth.
+    pub fields_without_truth: u64,
+    /// The specimen's solved states received (`specimen` service).
+    pub specimen_solves: u64,
+    /// Valid nodes compared, over all fields, and their error percentiles (px).
+    pub nodes_compared: u64,
+    pub node_error_p50_px: Option<f64>,
+    pub node_error_p99_px: Option<f64>,
+}
+
+impl TruthReport {
+    pub fn of(recorder: &crate::recorder::Recorder) -> Option<TruthReport> {
+        let solves = recorder.specimen_solves_received();
+        (recorder.fields_compared + recorder.fields_without_truth > 0).then(|| TruthReport {
+            compared_with: match solves {
+                0 => "homogeneous motion",
+                _ => "finite-element field",
+            },
+            fields_compared: recorder.fields_compared,
+            fields_without_truth: recorder.fields_without_truth,
+            specimen_solves: solves,
+            nodes_compared: recorder.node_errors.count(),
+            node_error_p50_px: recorder.node_errors.quantile_px(0.5),
+            node_error_p99_px: recorder.node_errors.quantile_px(0.99),
+        })
+    }
+}
+
 /// What the run did, also written as `summary.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct RunReport {
@@ -43,6 +78,9 @@ pub struct RunReport {
     /// Mean over frames of the mean node displacement error against the truth (px), and the
     /// worst node error of the run.
     pub displacement_error_mean_px: Option<f64>,
+    /// Node by node against the ground truth (simulated cameras): what the truth was and the
+    /// nodes' error percentiles.
+    pub truth: Option<TruthReport>,
     pub acceptance: Option<Acceptance>,
     /// Why there is no acceptance although a law was identified: a real camera or machine
     /// has no ground truth to compare with.

@@ -3,6 +3,7 @@
 //! loop turn is one publication period: commands, the newest field, the period, its
 //! publication, a flush every 50 ms, the pacing.
 
+use super::specimen_port::{self, SpecimenPort};
 use super::{
     command::handle, refuse_strain_resume, restart_note, resume, settings_fingerprint,
     shm_needed_bytes, strain_message, to_wire, ProcessError, ProcessOptions, ProcessSummary, Speed,
@@ -52,6 +53,8 @@ pub(super) struct RigShell {
     last_flush: Instant,
     /// The mounted specimen's failed solve was said (once per specimen).
     fault_said: bool,
+    /// The structure's solved states on `specimen`.
+    specimen: SpecimenPort,
 }
 
 impl RigShell {
@@ -118,6 +121,7 @@ impl RigShell {
             },
             last_flush: started,
             fault_said: false,
+            specimen: SpecimenPort::new(),
         })
     }
 
@@ -221,13 +225,22 @@ impl RigShell {
     fn publish(&mut self) -> Result<(), ProcessError> {
         let control = self.session.control_columns();
         let target = control.target_log.unwrap_or([f64::NAN; 2]);
-        let published = RigState {
-            test_index: self.session.test_index,
+        let test_index = self.session.test_index;
+        let mut published = RigState {
+            test_index,
             control_mode: control.mode as u32,
             target_log_exx: target[0],
             target_log_eyy: target[1],
             ..to_wire(&self.session.rig, self.summary.samples_published)
         };
+        // A structure's solve first, so a reader of this sample can have the solve it names.
+        if let Some(structure) = self.session.rig.specimen().and_then(|s| s.structure()) {
+            self.specimen
+                .publish(&self.port.node, structure, test_index)?;
+            let positions = published.actuators.map(|a| a.position_mm);
+            (published.specimen_solve_id, published.specimen_grip_mm) =
+                specimen_port::solve_at(structure, test_index, &positions);
+        }
         self.port.publisher.publish(published)?;
         self.field_clock.record(
             published.sample_id,

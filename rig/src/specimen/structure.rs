@@ -144,8 +144,8 @@ pub struct SolverFigures {
     pub max_iterations_per_solve: u64,
 }
 
-/// The last solved state, for the camera's side (a later `specimen` service): the reference
-/// mesh, the nodal displacements and an id that grows with each solve.
+/// The last solved state, for the camera's side (the `specimen` service): the reference mesh,
+/// the nodal displacements, the grips' displacement modes and an id that grows with each solve.
 #[derive(Clone, Copy, Debug)]
 pub struct SolvedState<'a> {
     /// 0 at rest, then one more per converged solve.
@@ -159,6 +159,8 @@ pub struct SolvedState<'a> {
     pub grips: usize,
     pub grip_mm: &'a [f64; MAX_GRIPS],
     pub grip_force_n: &'a [f64; MAX_GRIPS],
+    /// Per grip: the nodal displacement per mm of its axial motion (two per node, mm/mm).
+    pub modes: &'a [Vec<f64>],
 }
 
 #[derive(Clone, Debug)]
@@ -178,6 +180,9 @@ pub struct Structure {
     linear: Linearisation,
     /// The linearisation at rest (the small-strain stiffness), where a slack sheet goes back.
     rest: Linearisation,
+    /// The grips' displacement modes at the last solve, and at rest.
+    modes: Vec<Vec<f64>>,
+    rest_modes: Vec<Vec<f64>>,
     /// No grip pulls: the sheet is slack, at rest.
     slack: bool,
     /// Each grip's reference distance from the specimen's centre along its axis (mm).
@@ -257,6 +262,8 @@ impl Structure {
         }
         let mut structure = Structure {
             rest: Linearisation::at_rest(meshed.grips.len()),
+            modes: Vec::new(),
+            rest_modes: Vec::new(),
             slack: false,
             distance_mm,
             linear: Linearisation::at_rest(meshed.grips.len()),
@@ -285,6 +292,7 @@ impl Structure {
             .map_err(|error| StructureError::Solve { shape, error })?;
         structure.id = 0;
         structure.rest = structure.linear.clone();
+        structure.rest_modes = structure.modes.clone();
         Ok(structure)
     }
 
@@ -334,6 +342,19 @@ impl Structure {
             grips: self.linear.grips,
             grip_mm: &self.linear.grip_mm,
             grip_force_n: &self.linear.force_n,
+            modes: &self.modes,
+        }
+    }
+
+    /// The grips' axial displacements (mm) at the rig's actuator positions: the prediction's,
+    /// or the positions themselves while the sheet is slack (no force, no give). With
+    /// [`Structure::solved`], what the camera films: the solve followed to these grips through
+    /// its modes (`membrane::GripLinearField`).
+    pub fn grip_mm_at(&self, position_mm: &[f64; ACTUATOR_COUNT]) -> [f64; MAX_GRIPS] {
+        if self.slack {
+            self.positions(position_mm)
+        } else {
+            self.predict(position_mm).grip_mm
         }
     }
 
@@ -389,6 +410,7 @@ impl Structure {
                 self.slack = true;
                 if self.linear != self.rest {
                     self.linear = self.rest.clone();
+                    self.modes = self.rest_modes.clone();
                     self.equilibrium.displacement_mm.fill(0.0);
                     self.solved_t_s = t_s;
                     self.id += 1;
@@ -533,6 +555,7 @@ impl Structure {
         self.solved_t_s = t_s;
         self.equilibrium = equilibrium;
         self.linear = linear;
+        self.modes = condensed.modes;
         Ok(())
     }
 }

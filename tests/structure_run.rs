@@ -1,0 +1,50 @@
+//! `dicstream run` on the specimen as a structure (`[specimen] model = "structure"`), with
+//! real processes: the rig publishes its solved states on `specimen`, the camera films the
+//! finite-element field of each state, and the run compares every correlated node with that
+//! field (issue "the specimen is a structure", deliverable 4).
+
+mod common;
+
+use common::bench_run::{config, rows, start_run, summary, SHORT_CAMPAIGN};
+use common::Run;
+
+#[test]
+fn a_run_on_the_structure_compares_every_node_with_the_filmed_field() {
+    let mut run = Run::new("run_structure");
+    let extra = format!("{SHORT_CAMPAIGN}[specimen]\nmodel = \"structure\"\n");
+    let config = config(&run, "", &extra);
+    let out = run.dir.join("out");
+    start_run(&mut run, "run", &config, &out, &["--no-dashboard"]);
+    let (status, stdout, stderr) = run.child("run").wait();
+    // The acceptance divides forces by the gauge's sections, wrong on a heterogeneous field
+    // (issue "identification from the whole field"): completed, doubtful (2), or passed.
+    assert!(
+        matches!(status.code(), Some(0 | 2)),
+        "{status:?}\n{stdout}\n{stderr}"
+    );
+    let summary = summary(&out);
+    let truth = &summary["truth"];
+    assert_eq!(truth["compared_with"], "finite-element field", "{summary}");
+    assert!(truth["specimen_solves"].as_u64().unwrap() > 10, "{truth}");
+    assert_eq!(truth["fields_without_truth"], 0, "{truth}");
+    assert_eq!(truth["fields_compared"], summary["fields"], "{truth}");
+    // Node by node against the field the images show: the correlator's usual error at this
+    // speckle and noise. (Against the homogeneous mean motion instead, a 1024 px run of the
+    // same campaign was off by 0.35 px on average: the field is not homogeneous in view.)
+    let p99 = truth["node_error_p99_px"].as_f64().unwrap();
+    assert!(p99 < 0.05, "node error p99 {p99} px\n{truth}");
+    // Every row says its error: no frame of the structure went without its truth.
+    let header = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    let columns: Vec<&str> = header.lines().next().unwrap().split(',').collect();
+    let mean = columns
+        .iter()
+        .position(|c| *c == "disp_error_mean_px")
+        .unwrap();
+    let rows = rows(&out.join("frames.csv"));
+    assert!(rows.len() > 20, "{} rows", rows.len());
+    for row in &rows {
+        let error: f64 = row[mean].parse().unwrap_or_else(|_| panic!("{row:?}"));
+        assert!(error < 0.05, "{row:?}");
+    }
+    assert!(stdout.contains("(finite-element field)"), "{stdout}");
+}
