@@ -4,6 +4,7 @@
 
 use crate::frames::{FrameRow, OriginTruth, RigHistory, TruthHistory};
 use crate::latency::{FieldLatencyParts, Latency};
+use crate::origin_frames::OriginFrames;
 use crate::results::ResultsDir;
 use crate::truth::NodeErrors;
 use producer::specimen_states::SpecimenStates;
@@ -63,8 +64,8 @@ pub struct Recorder {
     /// running one's so far: a restarted correlator counts from 0.
     pub frames_dropped_by_ended_correlators: u64,
     pub frames_dropped_by_correlator: u64,
-    /// First frame of the latest frame sequence (the correlator's origin for it).
-    pub sequence_first_frame: Option<(FrameHeader, Vec<u16>)>,
+    /// The image the latest sequence's fields are measured in (its origin frame).
+    pub origin_frames: OriginFrames,
     /// The most strained field of the latest sequence (largest gauge log strain), for the
     /// strain map: its header and nodes.
     pub peak_field: Option<(FieldHeader, Vec<FieldNode>)>,
@@ -111,7 +112,7 @@ impl Recorder {
             rig_samples_seen: 0,
             frames_dropped_by_ended_correlators: 0,
             frames_dropped_by_correlator: 0,
-            sequence_first_frame: None,
+            origin_frames: OriginFrames::default(),
             peak_field: None,
             max_stretch: [1.0; 3],
             row: String::with_capacity(1024),
@@ -170,14 +171,7 @@ impl Recorder {
         if header.has_truth == 1 {
             self.truths.push(header.frame_id, header.truth);
         }
-        let new_sequence = self
-            .sequence_first_frame
-            .as_ref()
-            .is_none_or(|(first, _)| first.sequence_id != header.sequence_id);
-        if new_sequence && header.validate(pixels.len()).is_ok() {
-            // One copy per sequence (the frame stays in shared memory otherwise).
-            self.sequence_first_frame = Some((*header, pixels.to_vec()));
-        }
+        self.origin_frames.on_frame(header, pixels);
     }
 
     /// The solves of a finite-element specimen received so far.
@@ -221,6 +215,8 @@ impl Recorder {
             wire::NO_RIG_SAMPLE => self.rigs.at_time(header.t_capture_ns),
             id => self.rigs.get(id),
         };
+        self.origin_frames
+            .on_field(header.sequence_id, header.origin_frame_id);
         let origin = self.truths.get(header.origin_frame_id).copied();
         // The origin frame's solve is named by every field of its sequence: keep it.
         if let Some(id) = origin.and_then(|o| o.specimen_solve()) {

@@ -74,17 +74,21 @@ pub(super) fn write(config: &RunConfig, results: &ResultsDir, recorder: &Recorde
     Outputs { strain_map, notes }
 }
 
-/// The most strained field of the last test over the image its mesh is defined in, as
-/// `strain_map.png` (none without both, or when the field is of another sequence).
+/// The most strained field of the last test over the image its mesh is defined in (its origin
+/// frame), as `strain_map.png`; none without a field, an error saying why without the image.
 fn strain_map(results: &ResultsDir, recorder: &Recorder) -> anyhow::Result<Option<StrainMapInfo>> {
-    let (Some((frame, pixels)), Some((header, nodes))) =
-        (&recorder.sequence_first_frame, &recorder.peak_field)
-    else {
+    let Some((header, nodes)) = &recorder.peak_field else {
         return Ok(None);
     };
-    if header.origin_frame_id != frame.frame_id {
-        return Ok(None);
-    }
+    let (frame, pixels) = recorder
+        .origin_frames
+        .get(header.origin_frame_id)
+        .map_err(|why| {
+            anyhow::anyhow!(
+                "the field of frame {} cannot be drawn: {why}",
+                header.frame_id
+            )
+        })?;
     let field = crate::recorder::to_correlator_field(header, nodes);
     let path = results.path("strain_map.png");
     let range = crate::figures::strain_map(&path, pixels, frame.width_px as usize, &field)?;
