@@ -166,6 +166,56 @@ fn monitor_refuses_a_bad_address_naming_it() {
     );
 }
 
+#[test]
+fn monitor_refuses_an_instance_nothing_runs_on_naming_the_running_ones() {
+    let mut bench = Run::new("monitor_nosuch");
+    let instance = bench.name().to_string();
+    let args = producer_args(&instance);
+    bench
+        .spawn(
+            "producer",
+            &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        )
+        .wait_for_stderr("producer ready", |l| l.contains("ready"));
+    let nosuch = format!("{instance}_nosuch");
+    let monitor = bench.spawn(
+        "monitor",
+        &[
+            "monitor",
+            "--instance",
+            &nosuch,
+            "--dashboard",
+            "127.0.0.1:0",
+        ],
+    );
+    assert_eq!(monitor.wait_exit().code(), Some(1));
+    let stderr = monitor.stderr();
+    assert!(
+        stderr.contains(&format!("no process runs on instance {nosuch}"))
+            && stderr.contains(&format!("{instance} (producer)"))
+            && stderr.contains("--wait"),
+        "{stderr}"
+    );
+    // Waiting for it is asked for: it serves.
+    let waiting = bench.spawn(
+        "waiting",
+        &[
+            "monitor",
+            "--instance",
+            &nosuch,
+            "--dashboard",
+            "127.0.0.1:0",
+            "--wait",
+        ],
+    );
+    waiting.wait_for_stderr("dashboard URL", |l| l.contains("http://"));
+    assert!(waiting.stderr().contains("waiting for one"));
+    waiting.signal(libc::SIGINT);
+    waiting.wait_exit();
+    bench.child("producer").signal(libc::SIGINT);
+    bench.child("producer").wait_exit();
+}
+
 /// A run long enough to watch (interrupted once the checks are done).
 fn write_config(dir: &std::path::Path) -> PathBuf {
     std::fs::create_dir_all(dir).unwrap();

@@ -16,10 +16,47 @@ pub struct MonitorArgs {
     /// address serves other machines too, with a warning
     #[arg(long, default_value = address::DEFAULT)]
     pub dashboard: String,
+    /// Serve even though no process runs on the instance yet (a run about to start)
+    #[arg(long)]
+    pub wait: bool,
+}
+
+/// Refuses an instance on which no process runs (unless waiting for one), naming the
+/// instances that have some.
+fn check_running(instance: &str, wait: bool) -> anyhow::Result<()> {
+    let held = wire::owner::held();
+    if held.iter().any(|h| h.instance == instance) {
+        return Ok(());
+    }
+    let mut running: Vec<String> = Vec::new();
+    for h in &held {
+        match running.last_mut() {
+            Some(last) if last.starts_with(&format!("{} (", h.instance)) => {
+                last.truncate(last.len() - 1);
+                last.push_str(&format!(", {})", h.role));
+            }
+            _ => running.push(format!("{} ({})", h.instance, h.role)),
+        }
+    }
+    let others = match running.is_empty() {
+        true => "no instance runs on this machine".to_string(),
+        false => format!("running: {}", running.join("; ")),
+    };
+    if wait {
+        eprintln!(
+            "monitor: no process runs on instance {instance} yet ({others}); waiting for one"
+        );
+        return Ok(());
+    }
+    anyhow::bail!(
+        "no process runs on instance {instance} ({others}); `dicstream run` prints its instance \
+         at start, or add --wait to watch one about to start"
+    )
 }
 
 pub fn run(args: MonitorArgs) -> anyhow::Result<()> {
     let addr = address::parse(&args.dashboard)?;
+    check_running(&args.instance, args.wait)?;
     if let Some(warning) = address::exposure_warning(&addr) {
         eprintln!("{warning}");
     }

@@ -83,6 +83,45 @@ fn claim_in(dir: &Path, instance: &str, role: &str) -> Result<Owner, ClaimError>
     }
 }
 
+/// A role held on an instance by a live process.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Held {
+    pub instance: String,
+    pub role: String,
+    pub pid: u32,
+}
+
+/// Every role held by a live process, sorted by instance then role. A claim file whose pid is
+/// gone (its owner was killed before it could remove it) is not listed.
+pub fn held() -> Vec<Held> {
+    held_in(&owners_dir())
+}
+
+fn held_in(dir: &Path) -> Vec<Held> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut held: Vec<Held> = entries
+        .flatten()
+        .filter_map(|entry| {
+            let name = entry.file_name().into_string().ok()?;
+            let (instance, role) = name.rsplit_once('.')?;
+            let pid: u32 = std::fs::read_to_string(entry.path())
+                .ok()?
+                .trim()
+                .parse()
+                .ok()?;
+            Path::new(&format!("/proc/{pid}")).exists().then(|| Held {
+                instance: instance.to_string(),
+                role: role.to_string(),
+                pid,
+            })
+        })
+        .collect();
+    held.sort_by(|a, b| (&a.instance, &a.role).cmp(&(&b.instance, &b.role)));
+    held
+}
+
 impl Drop for Owner {
     fn drop(&mut self) {
         // Removed while locked; the lock goes with the descriptor.
@@ -109,6 +148,21 @@ mod tests {
         drop(first);
         assert!(!dir.join("inst.producer").exists());
         let again = claim_in(&dir, "inst", "producer").unwrap();
+        let listed = held_in(&dir);
+        assert_eq!(listed.len(), 3, "{listed:?}");
+        assert_eq!(
+            listed[0],
+            Held {
+                instance: "inst".into(),
+                role: "producer".into(),
+                pid: std::process::id()
+            }
+        );
+        assert_eq!(listed[2].instance, "inst2");
+        // A file left by a process that is gone is not a holder.
+        std::fs::write(dir.join("dead.rig"), "4294967295").unwrap();
+        assert_eq!(held_in(&dir).len(), 3);
+        std::fs::remove_file(dir.join("dead.rig")).unwrap();
         drop((again, other_role, other_instance));
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
         std::fs::remove_dir_all(&dir).unwrap();
