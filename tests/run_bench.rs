@@ -124,6 +124,23 @@ fn bad_configurations_are_refused_at_start_with_the_key_named() {
     }
 }
 
+#[test]
+fn a_dashboard_address_in_use_is_refused_before_anything_is_written() {
+    let mut run = Run::new("run_port_in_use");
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = taken.local_addr().unwrap().to_string();
+    let out = run.dir.join("out");
+    let out_arg = out.display().to_string();
+    let (status, _, stderr) =
+        run.run_to_end("run", &["run", "--dashboard", &addr, "--out", &out_arg]);
+    assert!(!status.success());
+    assert!(
+        stderr.contains(&addr) && stderr.contains("in use"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "a refused run made its results folder");
+}
+
 /// `bench pipeline --json` prints the JSON alone on stdout (the run's own lines go to stderr).
 #[test]
 fn bench_pipeline_json_is_json_alone() {

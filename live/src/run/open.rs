@@ -56,7 +56,8 @@ pub(super) struct Run<'a> {
 impl<'a> Run<'a> {
     /// Opens the run: the children's supervisor, the monitor's node and ports, the recorder
     /// and the dashboard; `summary.json` says `running` from here on (`finish` replaces it).
-    pub(super) fn open(options: &'a RunOptions, prepared: Prepared) -> anyhow::Result<Run<'a>> {
+    pub(super) fn open(options: &'a RunOptions, mut prepared: Prepared) -> anyhow::Result<Run<'a>> {
+        let dashboard = prepared.dashboard.take();
         let config = &options.config;
         let started = Instant::now();
         let monitor_cpu_at_start_s = crate::children::own_cpu_s();
@@ -71,7 +72,6 @@ impl<'a> Run<'a> {
             mm_per_px: config.camera.mm_per_px,
         };
         let recorder = Recorder::new(&prepared.results, settings, t0_ns)?;
-        let dashboard = crate::dashboard_view::start(config, &prepared.name)?;
         start::write_running(
             &prepared.results,
             &prepared.name,

@@ -1,5 +1,6 @@
 //! Before a run holds anything: the shared memory of earlier runs that died is removed, the
-//! instance claimed, the free space of `/dev/shm` checked, the results folder made (an earlier
+//! instance claimed, the free space of `/dev/shm` checked, the dashboard started (its address
+//! taken before anything is written), the results folder made (an earlier
 //! run found in it set aside) with the configuration's copy, and the line saying where it all
 //! goes printed.
 
@@ -17,6 +18,9 @@ pub(super) struct Prepared {
     pub(super) name: String,
     pub(super) results: ResultsDir,
     pub(super) start: RunStart,
+    /// The dashboard, serving before the results folder is made: an address in use stops the
+    /// run with nothing written.
+    pub(super) dashboard: Option<dashboard::Dashboard>,
 }
 
 impl Prepared {
@@ -38,6 +42,7 @@ impl Prepared {
         // Before anything is written or started: a second run on this instance is refused.
         let owner = instance.claim("run")?;
         wire::shm::ensure_free(wire::shm::SHM_PATH, shm_needed_bytes(config)?)?;
+        let dashboard = crate::dashboard_view::start(config, &name)?;
         let (results, previous_run_moved_to) = results_folder(options)?;
         let start = RunStart::now(&results, previous_run_moved_to);
         write_config(config, &results)?;
@@ -48,6 +53,7 @@ impl Prepared {
             name,
             results,
             start,
+            dashboard,
         })
     }
 }
