@@ -53,7 +53,7 @@ const COMMENTS: &[(&str, &str)] = &[
     ("rig.log_hz", ""),
     ("rig.seed", ""),
     ("rig.source", "simulated (the campaign below) or csv-follow (a test machine's CSV log, [rig.csv])."),
-    ("[[rig.tests]]", "The campaign, in order: each test mounts its specimen (uniaxial: a 100 x 20 x 2 mm\nstrip; equibiaxial: a 100 x 100 x 2 mm cruciform centre), ramps the elongation to\n`stretch` at `rate_per_s` in centroid control, holds, unloads. A test alone may\ninstead be strain-controlled (the correlator's fields close the loop):\ncontrol = \"strain\", kind = uniaxial | equibiaxial | pure_shear | biaxial,\nratio = ln(ly)/ln(lx) (biaxial), stretch = the larger measured stretch,\nrate_per_s = log strain rate; stale_s = 1.5, min_valid_nodes = 16,\non_interlock = \"resume\" | \"stop\"."),
+    ("[[rig.tests]]", "The campaign, in order: each test mounts its specimen (uniaxial: a 100 x 20 x 2 mm\nstrip; equibiaxial: a 100 x 100 x 2 mm cruciform centre), ramps the elongation to\n`stretch` at `rate_per_s` in centroid control, holds, unloads. A test alone may\ninstead be strain-controlled (the correlator's fields close the loop):\ncontrol = \"strain\", kind = uniaxial | equibiaxial | pure_shear | biaxial,\nratio = ln(ly)/ln(lx) (biaxial), stretch = the larger measured stretch,\nrate_per_s = log strain rate; stale_s = 0.6, min_valid_nodes = 16,\non_interlock = \"resume\" | \"stop\"."),
     ("rig.tests.kind", ""),
     ("rig.tests.stretch", ""),
     ("rig.tests.rate_per_s", ""),
