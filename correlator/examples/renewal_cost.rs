@@ -4,9 +4,15 @@
 //! frame, then the renewals, the medians of renewing and other frames, and the searches of the
 //! frames right after a renewal.
 //!
-//! `cargo run --release -p correlator --example renewal_cost -- [SIZE] [FRAMES] [STRETCH] [METHOD] [DEFORMATION]`
-//! (defaults 1024, 120, 2.0, correli, the automatic reference's default deformation limit): the ramp goes from λ 1 to STRETCH in FRAMES frames about
-//! the image centre (the live bench's ramp at 12 frames/s: 1024², 120 frames to λ 2).
+//! `cargo run --release -p correlator --example renewal_cost -- [SIZE] [FRAMES] [STRETCH] [METHOD] [DEFORMATION] [PATH]`
+//! (defaults 1024, 120, 2.0, correli, the automatic reference's default deformation limit
+//! (`-` for it), `eager`): the ramp goes from λ 1 to STRETCH in FRAMES frames about
+//! the image centre (the live bench's ramp at 12 frames/s: 1024², 120 frames to λ 2), then
+//! back to λ 1 five times faster (the bench's unloading). PATH `eager` correlates with
+//! `Correlator::correlate` (a renewing frame measures its bases against the origin at once);
+//! `live` as the live process does: `correlate_field`, then `renew_reference`, then a quarter
+//! of the pending bases per frame (`measure_pending_bases`, `ORIGIN_PASS_FRAMES`),
+//! each part timed: a frame's cost is the sum of the three.
 
 use correlator::settings::{Method, ReferenceKind};
 use correlator::{Correlator, CorrelatorSettings, NodeStatus, ReferenceMode};
@@ -21,7 +27,12 @@ fn main() {
     let frames: usize = arg(1, "120").parse().expect("FRAMES");
     let final_stretch: f64 = arg(2, "2.0").parse().expect("STRETCH");
     let method: Method = arg(3, "correli").parse().expect("METHOD");
-    let reference = match args.get(4) {
+    let live = match arg(5, "eager").as_str() {
+        "eager" => false,
+        "live" => true,
+        other => panic!("PATH {other:?}: eager or live"),
+    };
+    let reference = match args.get(4).filter(|a| *a != "-") {
         Some(px) => ReferenceMode::Auto {
             max_deformation_px: px.parse().expect("DEFORMATION"),
             min_mean_score: 0.5,
@@ -33,8 +44,18 @@ fn main() {
     let extent = [-margin, size as f64 + margin];
     let speckle = Speckle::new(SpeckleParams::default(), extent, extent);
     let renderer = FastRenderer::new(&speckle, extent, extent, 4, 2);
+    // The ramp, then the unloading five times faster.
+    let unload = frames.div_ceil(5);
+    let stretch_at = |k: usize| {
+        let loaded = if k <= frames {
+            k as f64 / frames as f64
+        } else {
+            1.0 - (k - frames) as f64 / unload as f64
+        };
+        1.0 + (final_stretch - 1.0) * loaded
+    };
     let render = |k: usize| {
-        let stretch = 1.0 + (final_stretch - 1.0) * k as f64 / frames as f64;
+        let stretch = stretch_at(k);
         let motion = Motion::Affine(Affine {
             f: [[stretch, 0.0], [0.0, 1.0 / stretch.sqrt()]],
             translation_px: [0.0, 0.0],
@@ -57,17 +78,34 @@ fn main() {
     let mut renewed_before = false;
     let (mut worst_gauge, mut worst_node, mut error_sum, mut error_count) =
         (0.0f64, 0.0f64, 0.0, 0);
-    for k in 1..=frames {
+    // Each frame's cost and whether it renewed.
+    let mut costs = Vec::new();
+    let ms_since = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    for k in 1..=frames + unload {
         let pixels = render(k);
         let searches = correlator.fft_searches();
         let t = Instant::now();
-        correlator.correlate(&pixels).expect("correlate");
-        let ms = t.elapsed().as_secs_f64() * 1e3;
+        let (mut renew_ms, mut origin_ms) = (0.0, 0.0);
+        let field_ms;
+        if live {
+            correlator.correlate_field(&pixels, 1).expect("correlate");
+            field_ms = ms_since(t);
+            let t = Instant::now();
+            correlator.renew_reference(&pixels).expect("renew");
+            renew_ms = ms_since(t);
+            let t = Instant::now();
+            correlator.measure_pending_bases();
+            origin_ms = ms_since(t);
+        } else {
+            correlator.correlate(&pixels).expect("correlate");
+            field_ms = ms_since(t);
+        }
+        let ms = ms_since(t);
         let searched = correlator.fft_searches() - searches;
         let field = correlator.field();
         let renewed = field.reference_updated;
         // The truth: u = (λ − 1)(x − c), v = (1/√λ − 1)(y − c) at each node.
-        let stretch = 1.0 + (final_stretch - 1.0) * k as f64 / frames as f64;
+        let stretch = stretch_at(k);
         let (mut sum, mut worst, mut count) = (0.0f64, 0.0f64, 0usize);
         for node in field.nodes.iter().filter(|n| n.status == NodeStatus::Ok) {
             let u = (stretch - 1.0) * (node.x_px - c);
@@ -83,7 +121,7 @@ fn main() {
         error_count += count;
         worst_node = worst_node.max(worst);
         println!(
-            "frame {k:4}: {ms:7.1} ms, {searched:5} FFT searches, {} of {} valid, log exx {:.4} (error {gauge_error:.1e}), node error mean {:.4} worst {worst:.3} px{}",
+            "frame {k:4}: {ms:7.1} ms (field {field_ms:.1}, renewal {renew_ms:.1}, origin {origin_ms:.1}), {searched:5} FFT searches, {} of {} valid, log exx {:.4} (error {gauge_error:.1e}), node error mean {:.4} worst {worst:.3} px{}",
             field.valid,
             field.nodes.len(),
             field.gauge.log.exx,
@@ -99,11 +137,30 @@ fn main() {
             others.push(ms);
         }
         renewed_before = renewed;
+        costs.push((ms, renewed));
     }
     let median = |v: &mut Vec<f64>| {
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
     };
+    // A renewing frame and the three after it (those that do not renew themselves).
+    let after_ms: Vec<f64> = (0..4)
+        .map(|d| {
+            let mut v: Vec<f64> = (0..costs.len())
+                .filter(|&i| costs[i].1 && i + d < costs.len() && (d == 0 || !costs[i + d].1))
+                .map(|i| costs[i + d].0)
+                .collect();
+            median(&mut v)
+        })
+        .collect();
+    println!(
+        "median cost of a renewing frame and of the next three: {:.1}, {:.1}, {:.1}, {:.1} ms ({} path)",
+        after_ms[0],
+        after_ms[1],
+        after_ms[2],
+        after_ms[3],
+        if live { "live" } else { "eager" }
+    );
     let renewals = renewing.len();
     println!(
         "{method} {size}² to λ {final_stretch} in {frames} frames: {renewals} renewals; median frame {:.1} ms renewing, {:.1} ms otherwise; node error mean {:.4} px, worst {worst_node:.3} px; worst gauge log exx error {worst_gauge:.1e}; FFT searches in the frames after a renewal: {:?}",

@@ -44,6 +44,12 @@ struct RefNode {
     status: NodeStatus,
 }
 
+/// Frames over which the live path measures a renewed reference's bases against the origin,
+/// a part after each frame's field is out ([`Correlator::measure_pending_bases`]): a renewal
+/// then adds a quarter of that measurement to each of the next four frames instead of all of it
+/// to one.
+pub const ORIGIN_PASS_FRAMES: usize = 4;
+
 /// Rings of neighbours whose affine fit places a failed node at a reference update.
 const EXTRAPOLATION_RINGS: usize = 2;
 /// Rings of never-lost neighbours whose affine fit carries a node whose material is out of
@@ -143,6 +149,24 @@ fn compose_gradients(a: Mat2, b: Mat2) -> Mat2 {
         }
     }
     out
+}
+
+/// When a renewal measures the new reference's bases against the origin.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum OriginBases {
+    /// At the renewal ([`Correlator::correlate_after`]).
+    Now,
+    /// Later, a part at a time ([`Correlator::measure_pending_bases`], the live path).
+    Deferred,
+}
+
+/// Whose B-spline coefficients an IC-GN measurement against the origin samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FrameCoefficients {
+    /// The frame just correlated.
+    Frame,
+    /// The current reference.
+    Reference,
 }
 
 /// Which valid nodes an affine fit may use.
@@ -265,6 +289,8 @@ impl Correlator {
                 frames_since: 0,
                 refused_first: None,
                 is_origin: true,
+                origin_pending: Vec::with_capacity(nodes),
+                origin_next_node: 0,
             },
             origin: None,
             origin_generation: 0,
@@ -324,6 +350,7 @@ impl Correlator {
             };
         }
         self.history.restart();
+        self.reference.origin_pending.clear();
         self.set_origin_pixels(pixels);
         self.reference.is_origin = true;
         self.take_reference(pixels, false);
@@ -394,6 +421,7 @@ impl Correlator {
             };
         }
         self.history.restart();
+        self.reference.origin_pending.clear();
         // The saved state holds the current reference, not the frame the mesh was defined in
         // (unless they are the same: every base is zero).
         self.reference.is_origin = base_px.iter().all(|&b| b == (0.0, 0.0));
@@ -532,12 +560,32 @@ impl Correlator {
     /// [`Correlator::correlate`] of the camera frame `frame_step` frames after the last one
     /// correlated (a live correlator that dropped frames while busy): the predictions extrapolate
     /// each node's velocity over that many frames, so they still place the ZOIs within a pixel
-    /// and the integer search is still skipped.
+    /// and the integer search is still skipped. A frame that renews the reference
+    /// (`Field::reference_updated`) has become it when this returns, its bases measured
+    /// against the origin.
     pub fn correlate_after(
         &mut self,
         pixels: &[u16],
         frame_step: u64,
     ) -> Result<&Field, SettingsError> {
+        self.correlate_field(pixels, frame_step)?;
+        if self.field.reference_updated {
+            self.renew(pixels, OriginBases::Now);
+        }
+        Ok(&self.field)
+    }
+
+    /// The live path's [`Correlator::correlate_after`]: the frame's field, and whether the
+    /// frame is to become the reference (`Field::reference_updated`), without renewing it yet:
+    /// the caller publishes the field first, then calls [`Correlator::renew_reference`] with
+    /// the same pixels before the next frame. A renewal's work is then off the latency of the
+    /// frame that calls for it.
+    pub fn correlate_field(
+        &mut self,
+        pixels: &[u16],
+        frame_step: u64,
+    ) -> Result<&Field, SettingsError> {
+        self.field.reference_updated = false;
         self.frame_step = frame_step.max(1);
         self.check_size("deformed", pixels)?;
         if self.reference.pixels.is_none() {
@@ -565,8 +613,37 @@ impl Correlator {
             self.refine_icgn(image);
         }
         self.assemble(image);
-        self.update_reference(pixels);
+        self.decide_renewal();
         Ok(&self.field)
+    }
+
+    /// After [`Correlator::correlate_field`] said `reference_updated`: its frame (`pixels`, the
+    /// same image) becomes the reference. Its bases, the total displacements it measured
+    /// through the references before it, are measured against the origin later, a part at a
+    /// time ([`Correlator::measure_pending_bases`]), instead of at once as
+    /// [`Correlator::correlate_after`] does (the renewal's largest cost). Does nothing when the
+    /// last field did not call for a renewal, or was already renewed.
+    pub fn renew_reference(&mut self, pixels: &[u16]) -> Result<(), SettingsError> {
+        self.check_size("deformed", pixels)?;
+        if self.field.reference_updated && self.reference.frames_since > 0 {
+            self.renew(pixels, OriginBases::Deferred);
+        }
+        Ok(())
+    }
+
+    /// Bases of the current reference still to be measured against the origin (after
+    /// [`Correlator::renew_reference`]).
+    pub fn pending_bases(&self) -> usize {
+        self.reference.origin_pending.len()
+    }
+
+    /// Measures the next part of the pending bases against the origin (a part is the mesh
+    /// over [`ORIGIN_PASS_FRAMES`]: the reference's ZOIs of the origin correlated with the
+    /// reference image, each from its base, and the final check) and corrects those that
+    /// verify. Returns true when this measured the last one: the bases changed since the
+    /// renewal (a saved state is worth writing again).
+    pub fn measure_pending_bases(&mut self) -> bool {
+        self.measure_some_pending_bases(self.mesh.len().div_ceil(ORIGIN_PASS_FRAMES))
     }
 
     /// Least-squares gradient of the current results over the 3x3 nodes around k (ZOI centres).

@@ -48,7 +48,7 @@ mod verify;
 mod window;
 mod zoi;
 
-pub use correlator::Correlator;
+pub use correlator::{Correlator, ORIGIN_PASS_FRAMES};
 pub use field::{Field, GaugeStrains, Node, NodeStatus, Strain2};
 pub use settings::{
     CorrelatorSettings, GuessMode, Method, ReferenceMode, Roi, SettingsError, StrainMeasure,

@@ -9,15 +9,20 @@
 //!   released at once and counted as skipped; gaps in frame ids (the camera's safe overflow
 //!   dropped them before they reached us) are counted as lost. Dropped = skipped + lost.
 //! - A frame is correlated straight from shared memory (no copy) and its sample is released as
-//!   soon as `correlate` returns (the correlator copies a new reference itself). The frames
+//!   soon as its field is out and the reference renewed (the correlator copies a new reference
+//!   itself). The frames
 //!   dropped since the last one correlated are told to the correlator, whose predictions then
 //!   extrapolate over them (`Correlator::correlate_after`).
 //! - Lost frames: `frames` keeps two samples per subscriber (`wire::services::FRAMES`); while a
 //!   frame takes longer than two frame periods, the camera's safe overflow replaces the oldest
 //!   waiting one, and its id never arrives. Skipped frames did arrive but were older than the
 //!   newest when the correlator was free again.
-//! - A new reference is handed to the state folder's writer thread (`state/writer.rs`), which
-//!   saves it off the frame path.
+//! - A field that calls for a new reference is published first; its frame becomes the reference
+//!   after (`Correlator::renew_reference`), and the new bases are measured against the origin a
+//!   quarter of the mesh after each frame (`Correlator::measure_pending_bases`): a renewal's work
+//!   is off the renewing frame's latency and spread over the next frames.
+//! - A new reference (and again its bases once measured against the origin) is handed to the
+//!   state folder's writer thread (`state/writer.rs`), which saves it off the frame path.
 //! - A field is written in place into a loaned `[FieldNode]` slice and sent.
 //! - A bad frame (header inconsistent with its payload, unknown bit depth, another size than the
 //!   reference) is a logged error for that frame (rate-limited); the process goes on.
@@ -485,7 +490,7 @@ impl Live {
         node: &Node<ipc::Service>,
         sample: iceoryx2::sample::Sample<ipc::Service, [u16], FrameHeader>,
         t_received_ns: u64,
-        state: Option<&mut StateWriter>,
+        mut state: Option<&mut StateWriter>,
     ) -> Result<(), ProcessError> {
         let header = *sample.user_header();
         let pixels: &[u16] = sample.payload();
@@ -508,32 +513,19 @@ impl Live {
             _ => 1,
         };
         let t = Instant::now();
-        correlator.correlate_after(pixels, frame_step)?;
+        correlator.correlate_field(pixels, frame_step)?;
         self.last_correlated = Some((header.sequence_id, header.frame_id));
         let correlate_ns = t.elapsed().as_nanos() as u64;
         self.warn_few_valid(header.frame_id);
-        // The frame is no longer needed: the correlator copied it if it became the reference.
-        drop(sample);
         self.run_hist.record_ns(correlate_ns);
         self.window_hist.record_ns(correlate_ns);
         self.summary.frames_correlated += 1;
-        let renewed = self.field().reference_updated;
-        if renewed {
-            self.reference_frame_id = Some(header.frame_id);
-        }
-        self.summary.reference_frame_id = self.reference_frame_id;
-        // Handed to the writer before the field goes out: the state folder holds the reference
-        // field k left behind once the writer is done, an earlier one of the same origin
-        // until then (`state/writer.rs`). A new origin (the first frame, a new sequence) is
-        // written before its first field goes out: a restart must never resume on the
-        // previous origin's reference once a field of the new one was seen.
-        if let Some(state) = state {
-            if new_origin || renewed {
-                self.save_reference(state)?;
-            }
-            if new_origin {
-                state.flush()?;
-            }
+        // A new origin (the first frame, a new sequence) is written before its first field
+        // goes out: a restart must never resume on the previous origin's reference once a
+        // field of the new one was seen.
+        if let Some(state) = state.as_deref_mut().filter(|_| new_origin) {
+            self.save_reference(state)?;
+            state.flush()?;
         }
         let times = FieldTimes {
             reference_frame_id,
@@ -542,7 +534,39 @@ impl Live {
             correlate_ns,
             frames_dropped: self.summary.frames_dropped(),
         };
-        self.publish_field(&header, times)
+        self.publish_field(&header, times)?;
+        // The field is out: a renewal it called for is made now, its bases measured against
+        // the origin a part per frame from here (`Correlator::renew_reference`). Handed to the
+        // writer after the field: the state folder holds an earlier reference of the same
+        // origin until the writer is done (`state/writer.rs`).
+        let correlator = self.correlator.as_mut().expect("made above");
+        if correlator.field().reference_updated {
+            correlator.renew_reference(pixels)?;
+            self.reference_frame_id = Some(header.frame_id);
+            if let Some(state) = state.as_deref_mut() {
+                self.save_reference(state)?;
+            }
+        }
+        self.summary.reference_frame_id = self.reference_frame_id;
+        // The frame is no longer needed: the correlator copied it if it became the reference.
+        drop(sample);
+        self.measure_pending_bases(state)
+    }
+
+    /// A part of the current reference's bases measured against the origin (a pass takes
+    /// [`crate::ORIGIN_PASS_FRAMES`] frames); the reference saved again when the pass is
+    /// complete.
+    fn measure_pending_bases(
+        &mut self,
+        state: Option<&mut StateWriter>,
+    ) -> Result<(), ProcessError> {
+        let correlator = self.correlator.as_mut().expect("made above");
+        if correlator.pending_bases() > 0 && correlator.measure_pending_bases() {
+            if let Some(state) = state {
+                self.save_reference(state)?;
+            }
+        }
+        Ok(())
     }
 
     /// The last field (a correlator exists once a frame was handled).

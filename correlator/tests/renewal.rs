@@ -122,3 +122,93 @@ fn a_deformation_renews_the_reference_and_the_prediction_survives_it() {
         assert_eq!(searched, 0, "frame {k} after a renewal searched");
     }
 }
+
+/// The live path (`correlate_field`, then `renew_reference`, then `measure_pending_bases` a
+/// part per frame) measures the new reference's bases against the origin after the renewal,
+/// not in it: right after the renewal the bases are those measured through the references
+/// before it, and once the pass is done (`ORIGIN_PASS_FRAMES` parts) they are those the eager
+/// path (`correlate`) measured at the renewal, and so are the next fields.
+#[test]
+fn the_live_path_measures_the_bases_against_the_origin_after_the_renewal() {
+    let centre = [(SIZE as f64 - 1.0) / 2.0; 2];
+    let frame = |k: usize| {
+        let e = 0.01 * k as f64;
+        render(
+            SIZE,
+            SIZE,
+            24.0,
+            stretch(e, -0.5 * e, centre),
+            0.02,
+            100 + k as u64,
+        )
+    };
+    let mut eager = Correlator::new(settings(), SIZE, SIZE).unwrap();
+    let mut live = Correlator::new(settings(), SIZE, SIZE).unwrap();
+    eager.set_reference(&frame(0)).unwrap();
+    live.set_reference(&frame(0)).unwrap();
+    let bases = |c: &Correlator| c.reference_base_px().collect::<Vec<_>>();
+    let largest_difference = |a: &[(f64, f64)], b: &[(f64, f64)]| {
+        a.iter()
+            .zip(b)
+            .map(|(p, q)| (p.0 - q.0).hypot(p.1 - q.1))
+            .fold(0.0f64, f64::max)
+    };
+    let (mut renewals, mut k) = (0, 0usize);
+    // Two renewals: the second one's bases are measured against the origin (the first
+    // reference is the origin, whose frame measured its bases against it directly).
+    while renewals < 2 {
+        k += 1;
+        assert!(k < 20, "no second renewal");
+        let pixels = frame(k);
+        let renewed = eager.correlate(&pixels).unwrap().reference_updated;
+        let field = live.correlate_field(&pixels, 1).unwrap();
+        assert_eq!(field.reference_updated, renewed, "frame {k}");
+        assert_eq!(live.pending_bases(), 0, "frame {k}");
+        if !renewed {
+            live.measure_pending_bases();
+            continue;
+        }
+        renewals += 1;
+        live.renew_reference(&pixels).unwrap();
+        assert_eq!(live.reference_pixels(), eager.reference_pixels());
+        if renewals == 1 {
+            assert_eq!(
+                live.pending_bases(),
+                0,
+                "the origin's own frame measured them"
+            );
+            assert!(largest_difference(&bases(&live), &bases(&eager)) < 1e-9);
+            continue;
+        }
+        let chained = bases(&live);
+        let measured = bases(&eager);
+        // Every node is valid: every base waits for its measurement.
+        assert_eq!(live.pending_bases(), live.field().nodes.len());
+        // Each part measures its share; the last one says so.
+        for part in 1..=correlator::ORIGIN_PASS_FRAMES {
+            let done = live.measure_pending_bases();
+            assert_eq!(done, part == correlator::ORIGIN_PASS_FRAMES, "part {part}");
+        }
+        assert_eq!(live.pending_bases(), 0);
+        assert!(!live.measure_pending_bases());
+        let before = largest_difference(&chained, &measured);
+        let after = largest_difference(&bases(&live), &measured);
+        eprintln!("frame {k}: bases off the eager path's by {before:.4} px before the pass, {after:.6} px after");
+        assert!(
+            after < 2e-3 && after < 0.5 * before,
+            "{before} then {after}"
+        );
+    }
+    // The next frame measures the same field on both paths.
+    let pixels = frame(k + 1);
+    let a = eager.correlate(&pixels).unwrap().clone();
+    let b = live.correlate_field(&pixels, 1).unwrap();
+    assert_eq!(a.valid, b.valid);
+    let worst = a
+        .nodes
+        .iter()
+        .zip(&b.nodes)
+        .map(|(p, q)| (p.u_px - q.u_px).hypot(p.v_px - q.v_px))
+        .fold(0.0f64, f64::max);
+    assert!(worst < 5e-3, "{worst} px");
+}

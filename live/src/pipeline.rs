@@ -2,13 +2,16 @@
 //! correlator and identifier run as processes sharing the machine's cores, the camera
 //! following a uniaxial test that lasts the requested time; the figures are the per-frame
 //! latency from capture to field published and to identification published, the sustained
-//! rate, the frames the correlator never measured (`pipeline/gaps.rs`: where and why), and the
+//! rate, the frames the correlator never measured (`pipeline/gaps.rs`: where and why), what the
+//! reference renewals cost the fields around them (`pipeline/renewals.rs`), and the
 //! CPU each process used. With
 //! `--fps max` trials at increasing rates find the highest rate without a dropped frame.
 
 mod gaps;
+mod renewals;
 
 pub use gaps::FrameGaps;
+pub use renewals::{FieldCostMs, RenewalCosts};
 
 use crate::config::{RunConfig, TestSection};
 use crate::latency::{FieldLatencyPartsMs, Percentiles};
@@ -49,6 +52,8 @@ pub struct PipelineResult {
     pub cpu_cores: BTreeMap<String, f64>,
     /// The frames not correlated: where the ids go missing and why.
     pub frame_gaps: FrameGaps,
+    /// What the reference renewals cost the fields around them.
+    pub renewal_costs: RenewalCosts,
     pub results: PathBuf,
 }
 
@@ -127,6 +132,9 @@ fn result_of(report: &RunReport, fps: f64) -> PipelineResult {
         latency_field_parts_ms: report.latency_field_parts_ms,
         cpu_cores: report.cpu_cores.clone(),
         frame_gaps: FrameGaps::of_results(&report.results),
+        renewal_costs: RenewalCosts::of_frames_csv(
+            &std::fs::read_to_string(report.results.join("frames.csv")).unwrap_or_default(),
+        ),
         results: report.results.clone(),
     }
 }

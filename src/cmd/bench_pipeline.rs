@@ -38,7 +38,8 @@ pub struct PipelineBenchArgs {
     /// Print one JSON object (keys fps_sustained, frames, dropped, latency_ms{field,
     /// identification}{p50,p90,p99,p999,max}, latency_field_parts_ms{waiting, correlating,
     /// delivering}, cpu_cores, frame_gaps{missing, gaps, longest, after_renewal, skipped,
-    /// lost}) instead of text.
+    /// lost}, renewal_costs{renewals, renewing, after[3], others: {fields, waiting,
+    /// correlating, latency}}) instead of text.
     #[arg(long)]
     pub json: bool,
 }
@@ -72,10 +73,26 @@ fn describe(r: &PipelineResult) -> String {
         split(g.skipped),
         split(g.lost)
     );
+    let c = &r.renewal_costs;
+    let cost = |name: &str, f: &live::pipeline::FieldCostMs| {
+        format!(
+            "{name} {:.1} / {:.1} / {:.1}",
+            f.waiting, f.correlating, f.latency
+        )
+    };
+    let renewals = format!(
+        "{} reference renewal(s); medians of waiting / correlating / latency, ms: {}, {}, {}, {}, {}",
+        c.renewals,
+        cost("renewing field", &c.renewing),
+        cost("next", &c.after[0]),
+        cost("second", &c.after[1]),
+        cost("third", &c.after[2]),
+        cost("others", &c.others)
+    );
     let budget = r.field_p99_budget_ms();
     let field_p99 = r.latency_ms.get("field").map_or(f64::NAN, |p| p.p99);
     format!(
-        "{:.1} frames/s asked, {:.2} sustained; {} frames, {} dropped\n  latency from capture to {}\n    of which {}, {}, {} ms\n    field p99 {field_p99:.1} ms against the work's {budget:.1} ms (correlating p99 + one period): {}\n  latency from capture to {}\n  {gaps}\n  CPU (100 % = one core): {}\n  results: {}",
+        "{:.1} frames/s asked, {:.2} sustained; {} frames, {} dropped\n  latency from capture to {}\n    of which {}, {}, {} ms\n    field p99 {field_p99:.1} ms against the work's {budget:.1} ms (correlating p99 + one period): {}\n  latency from capture to {}\n  {}\n  {gaps}\n  CPU (100 % = one core): {}\n  results: {}",
         r.fps_requested,
         r.fps_sustained,
         r.frames,
@@ -86,6 +103,7 @@ fn describe(r: &PipelineResult) -> String {
         part("delivering", &parts.delivering),
         if field_p99 <= budget { "within" } else { "over: frames queue" },
         l("identification"),
+        renewals,
         cpu.join(", "),
         r.results.display()
     )

@@ -4,7 +4,7 @@
 //! the new bases, and the affine fits of neighbouring nodes that place, carry and check nodes.
 
 use super::{
-    to_mat2, AffineFit, Correlator, Support, CARRY_RINGS, EXTRAPOLATION_RINGS,
+    to_mat2, AffineFit, Correlator, OriginBases, Support, CARRY_RINGS, EXTRAPOLATION_RINGS,
     MIN_EXTRAPOLATION_NODES,
 };
 use crate::field::NodeStatus;
@@ -30,10 +30,11 @@ impl Correlator {
         sums.gradient().map_or([[0.0; 2]; 2], to_mat2)
     }
 
-    pub(super) fn update_reference(&mut self, pixels: &[u16]) {
+    /// Whether the frame just assembled is to become the reference (`Field::reference_updated`,
+    /// see `renewal.rs`); the renewal itself is [`Self::renew`].
+    pub(super) fn decide_renewal(&mut self) {
         self.reference.frames_since += 1;
-        self.field.reference_updated = false;
-        let replace = match self.settings.reference {
+        let renew = match self.settings.reference {
             ReferenceMode::Fixed => false,
             ReferenceMode::Incremental => true,
             ReferenceMode::Auto {
@@ -43,9 +44,12 @@ impl Correlator {
                 .renewal_signals()
                 .call_for_renewal(max_deformation_px, min_mean_score),
         };
-        if !replace || self.field.valid == 0 {
-            return;
-        }
+        self.field.reference_updated = renew && self.field.valid > 0;
+    }
+
+    /// The frame just assembled (`pixels`) becomes the reference. `origin`: when its bases are
+    /// measured against the origin (see [`OriginBases`]).
+    pub(super) fn renew(&mut self, pixels: &[u16], origin: OriginBases) {
         // New base = total displacement. A node that failed (typically one whose followed point
         // left the image) gets the displacement the affine fit of its valid neighbours
         // extrapolates to it: its followed point keeps moving with the material, so it stays
@@ -72,11 +76,17 @@ impl Correlator {
                     })
             };
         }
-        self.bases_from_origin(Image {
-            pixels,
-            width_px: self.width_px,
-            height_px: self.height_px,
-        });
+        match origin {
+            OriginBases::Now => {
+                self.reference.origin_pending.clear();
+                self.bases_from_origin(Image {
+                    pixels,
+                    width_px: self.width_px,
+                    height_px: self.height_px,
+                });
+            }
+            OriginBases::Deferred => self.defer_bases_from_origin(),
+        }
 
         for (r, &base) in self.reference.nodes.iter_mut().zip(&self.scratch.pairs) {
             r.base_px = base;
@@ -91,7 +101,6 @@ impl Correlator {
         }
         self.take_reference(pixels, self.settings.method.is_icgn());
         self.reference.is_origin = false;
-        self.field.reference_updated = true;
     }
 
     /// Least-squares affine fit of the total displacement of the valid nodes within `rings`

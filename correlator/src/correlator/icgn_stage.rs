@@ -10,7 +10,7 @@
 //! `not_converged` at the iteration cap, `low_zncc` when the final check fails).
 
 use super::parts::SubsetState;
-use super::{Correlator, Entry};
+use super::{Correlator, Entry, FrameCoefficients};
 use crate::field::NodeStatus;
 use crate::icgn::bspline::Coefficients;
 use crate::icgn::shape::{Order, Warp};
@@ -83,9 +83,10 @@ impl Correlator {
     }
 
     /// IC-GN of node k's subset in the origin frame against the frame whose coefficients the
-    /// correlator holds, from `guess_px` and `gradient` (`reanchor`): the subset is prepared in
-    /// the engine's scratch. None without IC-GN or without the origin's coefficients.
-    pub(super) fn origin_icgn(&self) -> Option<OriginIcgn<'_>> {
+    /// correlator holds (`coefficients`: the frame's, or the current reference's), from
+    /// `guess_px` and `gradient` (`reanchor`): the subset is prepared in the engine's scratch.
+    /// None without IC-GN or without the origin's coefficients.
+    pub(super) fn origin_icgn(&self, coefficients: FrameCoefficients) -> Option<OriginIcgn<'_>> {
         if !self.settings.method.is_icgn() {
             return None;
         }
@@ -97,7 +98,10 @@ impl Correlator {
                 height_px: self.height_px,
             },
             origin_coefficients: origin.coefficients.as_ref()?,
-            frame_coefficients: self.coefficients.as_ref()?,
+            frame_coefficients: match coefficients {
+                FrameCoefficients::Frame => self.coefficients.as_ref()?,
+                FrameCoefficients::Reference => self.reference.coefficients.as_ref()?,
+            },
             n: self.settings.zoi_px,
             order: self.order(),
             max_iterations: self.settings.max_iterations,

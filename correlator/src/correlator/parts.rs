@@ -42,6 +42,13 @@ pub(super) struct Reference {
     pub refused_first: Option<usize>,
     /// This reference is still the origin (the image the mesh was defined in).
     pub is_origin: bool,
+    /// Live renewals: the nodes whose base (the total displacement the renewing frame
+    /// measured through the references before it) still waits for its measurement against
+    /// the origin, in the order they are measured (`reanchor.rs`,
+    /// `Correlator::measure_pending_bases`); empty when none is pending.
+    pub origin_pending: Vec<Entry>,
+    /// The node the next pass against the origin starts from (where the last one stopped).
+    pub origin_next_node: usize,
 }
 
 /// Whether a node's IC-GN reference subset is prepared.

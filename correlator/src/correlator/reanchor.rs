@@ -12,7 +12,9 @@
 //! restored from a saved reference whose `origin.state` is missing) the returned nodes stay as
 //! measured.
 
-use super::{to_mat2, Correlator, Entry, Support, CARRY_RINGS, EXTRAPOLATION_RINGS};
+use super::{
+    to_mat2, Correlator, Entry, FrameCoefficients, Support, CARRY_RINGS, EXTRAPOLATION_RINGS,
+};
 use crate::field::NodeStatus;
 use crate::interpolate::Mat2;
 use crate::pool::SharedSlice;
@@ -43,7 +45,7 @@ impl Correlator {
             });
         }
         // Carried by an extrapolation, up to pixels off: the full search.
-        self.measure_against_origin(image, false);
+        self.measure_against_origin(image, false, FrameCoefficients::Frame);
         for (entry, &(result, score)) in self.scratch.entries.iter().zip(&self.scratch.reanchored) {
             let k = entry.node;
             let node = &mut self.field.nodes[k];
@@ -74,23 +76,12 @@ impl Correlator {
         if self.origin.is_none() || self.reference.is_origin {
             return;
         }
-        self.scratch.entries.clear();
-        for k in 0..self.field.nodes.len() {
-            if self.field.nodes[k].status != NodeStatus::Ok {
-                continue;
-            }
-            let gradient: Mat2 = self
-                .affine_fit(Some(k), EXTRAPOLATION_RINGS, None, Support::Valid)
-                .map_or([[0.0; 2]; 2], |fit| to_mat2(fit.gradient));
-            self.scratch.entries.push(Entry {
-                node: k,
-                guess_px: self.scratch.pairs[k],
-                gradient,
-            });
-        }
+        let mut entries = std::mem::take(&mut self.scratch.entries);
+        self.origin_entries(0, &mut entries);
+        self.scratch.entries = entries;
         // Each guess is the node's total displacement just measured (within a pixel of what the
         // origin gives): the prediction's shortcut, the full search where it is not confirmed.
-        self.measure_against_origin(image, true);
+        self.measure_against_origin(image, true, FrameCoefficients::Frame);
         for (entry, &(result, score)) in self.scratch.entries.iter().zip(&self.scratch.reanchored) {
             if result.status == NodeStatus::Ok && score >= self.settings.min_zncc {
                 self.scratch.pairs[entry.node] = (result.u_px, result.v_px);
@@ -98,11 +89,88 @@ impl Correlator {
         }
     }
 
+    /// The entries of [`Self::bases_from_origin`] (the `ok` nodes, each with its new base and
+    /// the gradient of its neighbours' fit) into `entries`, from node `first` round the mesh.
+    fn origin_entries(&self, first: usize, entries: &mut Vec<Entry>) {
+        entries.clear();
+        let nodes = self.field.nodes.len();
+        for k in (first..nodes).chain(0..first.min(nodes)) {
+            if self.field.nodes[k].status != NodeStatus::Ok {
+                continue;
+            }
+            let gradient: Mat2 = self
+                .affine_fit(Some(k), EXTRAPOLATION_RINGS, None, Support::Valid)
+                .map_or([[0.0; 2]; 2], |fit| to_mat2(fit.gradient));
+            entries.push(Entry {
+                node: k,
+                guess_px: self.scratch.pairs[k],
+                gradient,
+            });
+        }
+    }
+
+    /// [`Self::bases_from_origin`] left to [`Correlator::measure_pending_bases`]: the entries
+    /// are kept (`reference.origin_pending`), the new reference starts from the bases measured
+    /// through the references before it. The pass starts where the last one stopped, so that
+    /// renewals closer together than a pass still measure every node in turn.
+    pub(super) fn defer_bases_from_origin(&mut self) {
+        let mut pending = std::mem::take(&mut self.reference.origin_pending);
+        if self.origin.is_some() && !self.reference.is_origin {
+            self.origin_entries(self.reference.origin_next_node, &mut pending);
+        } else {
+            pending.clear();
+        }
+        self.reference.origin_pending = pending;
+    }
+
+    /// Measures the next `max_nodes` pending bases of the current reference against the origin
+    /// (see [`Self::defer_bases_from_origin`]) and corrects those that verify, as
+    /// [`Self::bases_from_origin`] would have at the renewal: the node's ZOI stays where the
+    /// reference put it, its followed point moves by the correction (`offset_px`). Returns true
+    /// when this completed the reference's pass.
+    pub(super) fn measure_some_pending_bases(&mut self, max_nodes: usize) -> bool {
+        let pending = self.reference.origin_pending.len();
+        if pending == 0 || max_nodes == 0 {
+            return false;
+        }
+        let take = max_nodes.min(pending);
+        self.scratch.entries.clear();
+        self.scratch
+            .entries
+            .extend(self.reference.origin_pending.drain(..take));
+        let Some(pixels) = self.reference.pixels.take() else {
+            return false;
+        };
+        let image = Image {
+            pixels: &pixels,
+            width_px: self.width_px,
+            height_px: self.height_px,
+        };
+        self.measure_against_origin(image, true, FrameCoefficients::Reference);
+        self.reference.pixels = Some(pixels);
+        for (entry, &(result, score)) in self.scratch.entries.iter().zip(&self.scratch.reanchored) {
+            let r = &mut self.reference.nodes[entry.node];
+            if result.status == NodeStatus::Ok && score >= self.settings.min_zncc {
+                let correction = (result.u_px - r.base_px.0, result.v_px - r.base_px.1);
+                r.base_px = (result.u_px, result.v_px);
+                r.offset_px.0 += correction.0;
+                r.offset_px.1 += correction.1;
+            }
+            self.reference.origin_next_node = (entry.node + 1) % self.mesh.len();
+        }
+        self.reference.origin_pending.is_empty()
+    }
+
     /// Each of `entries` (node, total displacement, gradient) measured against the origin:
     /// its ZOI there correlated with `image` through the gradient, and the final check; the
     /// results and their ZNCC go to `reanchored`, in the order of `entries`. `predicted`: the
     /// guesses are within a pixel (see [`ZoiSearch::predicted`]).
-    fn measure_against_origin(&mut self, image: Image, predicted: bool) {
+    fn measure_against_origin(
+        &mut self,
+        image: Image,
+        predicted: bool,
+        coefficients: FrameCoefficients,
+    ) {
         let (n, pad) = (self.settings.zoi_px, self.fft_pad_px);
         let offset = (n - self.fft_px) as f64 / 2.0 - pad as f64;
         // A measurement, not a guess, when IC-GN has no origin coefficients: the paper's iterations.
@@ -122,7 +190,7 @@ impl Correlator {
         let (entries, top_left) = (&self.scratch.entries, &self.mesh.top_left);
         let out = SharedSlice::new(&mut reanchored);
         // IC-GN methods measure with IC-GN: the origin's subset prepared on the fly.
-        let icgn = self.origin_icgn();
+        let icgn = self.origin_icgn(coefficients);
         let min_zncc = self.settings.min_zncc;
         self.pool.run(entries.len(), &|engine, i| {
             let entry = entries[i];

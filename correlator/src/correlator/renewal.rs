@@ -1,6 +1,7 @@
 //! When the automatic reference is renewed: when the correlation against it degrades, not when
-//! the material has merely moved. A renewal costs a frame's worth of work (the new bases
-//! measured against the origin, every node's reference prepared), and each reference adds the
+//! the material has merely moved. A renewal costs several frames' worth of work (the new bases
+//! measured against the origin, spread over the next frames on the live path, and every node's
+//! reference prepared), and each reference adds the
 //! noise of one more image to the total displacement; a rigid motion, however large, costs the
 //! correlation nothing, since each ZOI is placed at its prediction (the previous frames) before
 //! it is correlated. What does degrade a match against an old reference:
