@@ -592,6 +592,16 @@ impl Live {
                     return Ok(None);
                 }
                 let (nx, ny) = correlator.mesh_size();
+                let roi = correlator.roi();
+                let region = format!(
+                    "over x {}-{} y {}-{}, {} in the region ({})",
+                    roi.x_px,
+                    roi.x_px + roi.width_px,
+                    roi.y_px,
+                    roi.y_px + roi.height_px,
+                    correlator.nodes_in_region(),
+                    correlator.settings().region
+                );
                 if self.publisher.is_none() {
                     self.open_publisher(node, nx * ny)?;
                 }
@@ -599,7 +609,7 @@ impl Live {
                 self.origin_frame_id = header.frame_id;
                 self.sequence_id = Some(header.sequence_id);
                 eprintln!(
-                    "correlator: frame {} ({w}x{h} px, {} bit) is the reference; mesh {nx}x{ny} nodes",
+                    "correlator: frame {} ({w}x{h} px, {} bit) is the reference; mesh {nx}x{ny} nodes {region}",
                     header.frame_id, header.bit_depth
                 );
                 Ok(Some(true))
