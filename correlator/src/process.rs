@@ -592,13 +592,9 @@ impl Live {
                     return Ok(None);
                 }
                 let (nx, ny) = correlator.mesh_size();
-                let roi = correlator.roi();
                 let region = format!(
-                    "over x {}-{} y {}-{}, {} in the region ({})",
-                    roi.x_px,
-                    roi.x_px + roi.width_px,
-                    roi.y_px,
-                    roi.y_px + roi.height_px,
+                    "over {}, {} in the region ({})",
+                    correlator.roi().extent(),
                     correlator.nodes_in_region(),
                     correlator.settings().region
                 );

@@ -23,6 +23,20 @@ impl std::fmt::Display for Roi {
     }
 }
 
+impl Roi {
+    /// Its pixel columns and rows as a summary says them: `x 16-2032 y 16-573` (the first
+    /// pixel and one past the last).
+    pub fn extent(&self) -> String {
+        format!(
+            "x {}-{} y {}-{}",
+            self.x_px,
+            self.x_px + self.width_px,
+            self.y_px,
+            self.y_px + self.height_px
+        )
+    }
+}
+
 /// Strain measure of the per-node strains (the gauge gives all four): wire's, the one the
 /// `fields` header names.
 pub use wire::StrainMeasure;

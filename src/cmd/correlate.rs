@@ -204,7 +204,6 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
 /// (x and y the mesh rectangle's first pixel and one past its last; with several frames the
 /// last frame's valid count and the fewest).
 fn summary_line(correlator: &Correlator, valid: &[usize]) -> String {
-    let roi = correlator.roi();
     let region = &correlator.settings().region;
     let shape = region
         .shape_description()
@@ -219,11 +218,8 @@ fn summary_line(correlator: &Correlator, valid: &[usize]) -> String {
         ),
     };
     format!(
-        "correlate: ROI x {}-{} y {}-{}{shape}, {} nodes{valid_text}",
-        roi.x_px,
-        roi.x_px + roi.width_px,
-        roi.y_px,
-        roi.y_px + roi.height_px,
+        "correlate: ROI {}{shape}, {} nodes{valid_text}",
+        correlator.roi().extent(),
         correlator.nodes_in_region(),
     )
 }
