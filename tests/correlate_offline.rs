@@ -432,3 +432,150 @@ fn unrelated_images_are_refused_and_named() {
     assert_eq!(frames[0]["statuses"]["ok"], frames[0]["nodes"]);
     assert_eq!(frames[1]["statuses"]["ok"], 0);
 }
+
+/// A region of the reference, deformed wildly outside a polygon (beyond a triangle's long side,
+/// another speckle altogether): the nodes whose ZOI leaves the triangle are `outside_region`
+/// (not failed, not counted in the warning), every node inside is `ok`, the summary line and
+/// `summary.json` say how many were measured; a mask of the same shape measures the same nodes.
+#[test]
+fn a_polygon_measures_its_nodes_and_marks_the_others_outside() {
+    let dir = TempDir::new("polygon");
+    let reference = dir.0.join("ref.png");
+    write_png(&reference, &render(W, H, &translation(0.0, 0.0).0, 1), W, H);
+    let moved = render(W, H, &translation(0.4, -0.3).0, 2);
+    let other = unrelated_speckle(W, H, 3);
+    // The triangle 8,8 180,8 8,150: (x − 8) / 172 + (y − 8) / 142 < 1 within its two straight
+    // sides. The material moved up to a few pixels beyond the long side; past it, other material.
+    let side = |x: f64, y: f64| (x - 8.0) / 172.0 + (y - 8.0) / 142.0;
+    let deformed: Vec<u16> = (0..W * H)
+        .map(|k| {
+            let (x, y) = ((k % W) as f64, (k / W) as f64);
+            if side(x, y) < 1.08 {
+                moved[k]
+            } else {
+                other[k]
+            }
+        })
+        .collect();
+    let def = dir.0.join("def.png");
+    write_png(&def, &deformed, W, H);
+    let polygon = "8,8 180,8 8,150";
+    let run = |region: &[&str], out: &Path| {
+        let mut args = vec!["correlate", path(&reference), path(&def)];
+        args.extend_from_slice(&["--zoi", "16", "--step", "8", "--out", path(out)]);
+        args.extend_from_slice(region);
+        let output = dicstream(&args);
+        let stderr = String::from_utf8_lossy(&output.stderr).to_string();
+        assert!(output.status.success(), "{stderr}");
+        let csv = std::fs::read_to_string(out.join("field_0001.csv")).unwrap();
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        (stderr, csv, summary)
+    };
+    let (stderr, csv, summary) = run(&["--polygon", polygon], &dir.0.join("out"));
+    assert!(!stderr.contains("warning"), "{stderr}");
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let (mut inside, mut outside) = (0, 0);
+    for row in &rows {
+        let (x, y): (f64, f64) = (row[0].parse().unwrap(), row[1].parse().unwrap());
+        // The ZOI's far corner pixel (its centre + 7.5 px) decides: the other sides are the
+        // mesh's own bounds.
+        let far = side(x + 7.5, y + 7.5);
+        match row[9] {
+            "ok" => {
+                inside += 1;
+                assert!(far < 1.0, "{row:?}");
+            }
+            "outside_region" => {
+                outside += 1;
+                assert!(far > 0.99, "{row:?}");
+            }
+            status => panic!("{status}: {row:?}"),
+        }
+    }
+    assert!(inside >= 50 && outside >= 50, "{inside} {outside}");
+    assert!(
+        stderr.contains(&format!(
+            "(polygon 3 vertices), {inside} nodes, {inside} valid"
+        )),
+        "{stderr}"
+    );
+    assert_eq!(summary["settings"]["nodes_in_region"], inside);
+    assert_eq!(summary["settings"]["region"]["polygons"][0], polygon);
+    let frame = &summary["frames"][0];
+    assert_eq!(frame["valid"], inside);
+    assert_eq!(frame["nodes_in_region"], inside);
+    assert_eq!(frame["statuses"]["outside_region"], outside);
+    // The same region as a mask image: the same nodes, the same field.
+    let mask: Vec<u16> = (0..W * H)
+        .map(|k| {
+            let (x, y) = ((k % W) as f64, (k / W) as f64);
+            u16::from(x >= 8.0 && y >= 8.0 && side(x, y) < 1.0)
+        })
+        .collect();
+    let mask_file = dir.0.join("mask.png");
+    write_png(&mask_file, &mask, W, H);
+    let (_, mask_csv, _) = run(&["--mask", path(&mask_file)], &dir.0.join("out_mask"));
+    assert_eq!(mask_csv, csv);
+    // Without the region, the nodes on the other material fail (and are no outside_region).
+    let (_, _, all) = run(&[], &dir.0.join("out_all"));
+    let frame = &all["frames"][0];
+    assert_eq!(frame["statuses"]["outside_region"], 0);
+    assert!(frame["valid"].as_u64() < frame["nodes"].as_u64(), "{frame}");
+}
+
+/// Every bad region is refused before anything is written, naming its setting.
+#[test]
+fn bad_regions_are_refused_naming_the_setting() {
+    let dir = TempDir::new("bad_region");
+    let reference = dir.0.join("ref.png");
+    write_png(&reference, &render(W, H, &translation(0.0, 0.0).0, 1), W, H);
+    let small_mask = dir.0.join("small_mask.png");
+    write_png(&small_mask, &vec![1u16; 100 * 100], 100, 100);
+    let black_mask = dir.0.join("black_mask.png");
+    write_png(&black_mask, &vec![0u16; W * H], W, H);
+    let garbage = dir.0.join("garbage.png");
+    std::fs::write(&garbage, b"not an image").unwrap();
+    let out = dir.0.join("out");
+    let cases: [(&[&str], &str); 7] = [
+        (&["--polygon", "10,10 100,10"], "has 2 vertices"),
+        (
+            &["--polygon", "10,10 100,100 100,10 10,100"],
+            "crosses itself",
+        ),
+        (
+            &["--polygon", "10,10 300,10 10,100"],
+            "outside the 192x160 px image",
+        ),
+        (
+            &["--polygon", "10,10 30,10 30,30 10,30"],
+            "smaller than one 32 px ZOI",
+        ),
+        (
+            &["--mask", path(&small_mask)],
+            "is 100x100 px, expected 192x160 px",
+        ),
+        (&["--mask", path(&garbage)], "cannot be read"),
+        (&["--mask", path(&black_mask)], "is empty"),
+    ];
+    for (region, needle) in cases {
+        let mut args = vec!["correlate", path(&reference), path(&reference)];
+        args.extend_from_slice(region);
+        args.extend_from_slice(&["--out", path(&out)]);
+        let output = dicstream(&args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.contains(needle), "{needle:?} not in {stderr}");
+        assert!(
+            stderr.contains(region[0]),
+            "{:?} not named in {stderr}",
+            region[0]
+        );
+        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+    }
+}

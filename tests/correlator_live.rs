@@ -69,7 +69,8 @@ fn live_translation_matches_the_truth() {
         let h = field.header;
         assert_eq!(h.reference_frame_id, 0);
         assert_eq!(h.frames_dropped, 0);
-        assert_eq!((h.mesh_cols, h.mesh_rows), (15, 15));
+        // The default region: 256 px less half a ZOI (16 px) on each side, 224 px: 13 nodes.
+        assert_eq!((h.mesh_cols, h.mesh_rows), (13, 13));
         assert_eq!((h.zoi_px, h.step_px), (32, 16));
         assert_eq!(h.strain_measure, StrainMeasure::Log as u32);
         assert_eq!(h.valid_nodes as usize, field.nodes.len(), "all nodes valid");

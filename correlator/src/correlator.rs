@@ -235,8 +235,16 @@ impl Correlator {
         height_px: usize,
     ) -> Result<Self, SettingsError> {
         settings.validate()?;
-        let roi = settings.resolve_roi(width_px, height_px)?;
-        let mesh = Mesh::new(roi, settings.zoi_px, settings.step_px);
+        let region = settings.resolve_region(width_px, height_px)?;
+        let mesh = Mesh::of_region(&region, settings.zoi_px, settings.step_px);
+        if mesh.measured() == 0 {
+            return Err(SettingsError::RegionSmallerThanZoi {
+                region: settings.region.to_string(),
+                zoi_px: settings.zoi_px,
+            });
+        }
+        // Where the mesh is: the global correlation and the keypoints look there.
+        let roi = region.mesh_rect;
         let nodes = mesh.len();
         let fft_px = settings.fft_zoi_px();
         let n2 = spectrum_len(fft_px);
@@ -311,8 +319,14 @@ impl Correlator {
         &self.settings
     }
 
+    /// The rectangle the mesh covers: the ROI, or the bounding box of the region's shape in it.
     pub fn roi(&self) -> Roi {
         self.roi
+    }
+
+    /// Nodes whose ZOI lies inside the region (the others are `outside_region` in every field).
+    pub fn nodes_in_region(&self) -> usize {
+        self.mesh.measured()
     }
 
     /// Mesh size (nx, ny).
@@ -509,7 +523,9 @@ impl Correlator {
             );
             let (tx, ty) = ((x - half).round(), (y - half).round());
             r.offset_px = (x - (tx + half), y - (ty + half));
-            if image.contains_block(tx as i64, ty as i64, n) {
+            if !self.mesh.in_region[k] {
+                r.status = NodeStatus::OutsideRegion;
+            } else if image.contains_block(tx as i64, ty as i64, n) {
                 r.top_left = (tx as usize, ty as usize);
                 r.status = NodeStatus::Ok;
             } else {

@@ -93,11 +93,19 @@ impl Field {
         self.nodes.iter().filter(|n| n.status == status).count()
     }
 
-    /// The statuses other than `ok` that occur, with their counts, as `word count, ...`
-    /// (empty when every node is `ok`): why nodes were refused, in one line.
+    /// Nodes whose ZOI lies inside the region (all but the `outside_region` ones): the nodes
+    /// measured.
+    pub fn in_region(&self) -> usize {
+        self.nodes.len() - self.count(NodeStatus::OutsideRegion)
+    }
+
+    /// The statuses other than `ok` and `outside_region` that occur, with their counts, as
+    /// `word count, ...` (empty when every node in the region is `ok`): why nodes were refused,
+    /// in one line.
     pub fn refusals(&self) -> String {
         NodeStatus::ALL[1..]
             .iter()
+            .filter(|&&s| s != NodeStatus::OutsideRegion)
             .map(|&s| (s, self.count(s)))
             .filter(|&(_, c)| c > 0)
             .map(|(s, c)| format!("{} {c}", s.name()))

@@ -1,6 +1,7 @@
 //! CORRELI-GD digital image correlation on a parallel mesh of zones of interest, and strains.
 //!
-//! Chevalier, Calloch, Hild, Marco, section 3.b: a centred 2^p ROI (or the user's), one global
+//! Chevalier, Calloch, Hild, Marco, section 3.b: a centred 2^p ROI (here by default the whole
+//! image less half a ZOI, or the user's rectangle, polygons or mask: [`region`]), one global
 //! FFT correlation for the mean integer displacement (U0, V0), then per ZOI of 2^s px every
 //! δx px: integer FFT correlation and move, modified Hanning window (eq. 9), 3x3 quadratic
 //! sub-pixel peak, Fourier-shift iterations (eqs. 5-7) while the interpolated maximum increases.
@@ -39,6 +40,7 @@ mod pool;
 #[cfg(feature = "process")]
 pub mod process;
 mod real_fft2d;
+pub mod region;
 pub mod settings;
 mod simd;
 pub mod state;
@@ -50,6 +52,7 @@ mod zoi;
 
 pub use correlator::{Correlator, ORIGIN_PASS_FRAMES};
 pub use field::{Field, GaugeStrains, Node, NodeStatus, Strain2};
+pub use region::{Polygon, Region, RoiChoice};
 pub use settings::{
     CorrelatorSettings, GuessMode, Method, ReferenceMode, Roi, SettingsError, StrainMeasure,
     DEFAULT_MIN_ZNCC,

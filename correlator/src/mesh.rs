@@ -1,5 +1,7 @@
-//! The mesh of ZOI centres in the ROI, and its centre-outwards ring order.
+//! The mesh of ZOI centres in the ROI, which of them are in the region, and its
+//! centre-outwards ring order.
 
+use crate::region::ResolvedRegion;
 use crate::settings::Roi;
 
 pub struct Mesh {
@@ -12,6 +14,8 @@ pub struct Mesh {
     /// `ring_order[ring_starts[k]..ring_starts[k + 1]]` is ring k.
     pub ring_starts: Vec<usize>,
     pub ring_of: Vec<usize>,
+    /// Whether node k's ZOI lies wholly inside the region (the others are `outside_region`).
+    pub in_region: Vec<bool>,
 }
 
 impl Mesh {
@@ -52,7 +56,22 @@ impl Mesh {
             ring_order,
             ring_starts,
             ring_of,
+            in_region: vec![true; nx * ny],
         }
+    }
+
+    /// The mesh over the region's rectangle, its nodes whose ZOI leaves the region marked.
+    pub fn of_region(region: &ResolvedRegion, zoi_px: usize, step_px: usize) -> Self {
+        let mut mesh = Mesh::new(region.mesh_rect, zoi_px, step_px);
+        for (inside, &top_left) in mesh.in_region.iter_mut().zip(&mesh.top_left) {
+            *inside = region.contains_block(top_left, zoi_px);
+        }
+        mesh
+    }
+
+    /// Nodes whose ZOI lies inside the region.
+    pub fn measured(&self) -> usize {
+        self.in_region.iter().filter(|&&inside| inside).count()
     }
 
     pub fn len(&self) -> usize {

@@ -616,6 +616,12 @@ impl Live {
                     return Ok(None);
                 }
                 let (nx, ny) = correlator.mesh_size();
+                let region = format!(
+                    "over {}, {} in the region ({})",
+                    correlator.roi().extent(),
+                    correlator.nodes_in_region(),
+                    correlator.settings().region
+                );
                 if self.publisher.is_none() {
                     self.open_publisher(node, nx * ny)?;
                 }
@@ -623,7 +629,7 @@ impl Live {
                 self.origin_frame_id = header.frame_id;
                 self.sequence_id = Some(header.sequence_id);
                 eprintln!(
-                    "correlator: frame {} ({w}x{h} px, {} bit) is the reference; mesh {nx}x{ny} nodes",
+                    "correlator: frame {} ({w}x{h} px, {} bit) is the reference; mesh {nx}x{ny} nodes {region}",
                     header.frame_id, header.bit_depth
                 );
                 Ok(Some(true))

@@ -1,5 +1,6 @@
 //! User settings of the correlator and their validation.
 
+use crate::region::{Region, ResolvedRegion};
 use thiserror::Error;
 
 /// Region of interest in the reference image, in pixels (x = column, y = row of the top-left pixel).
@@ -18,6 +19,20 @@ impl std::fmt::Display for Roi {
             f,
             "{},{},{},{}",
             self.x_px, self.y_px, self.width_px, self.height_px
+        )
+    }
+}
+
+impl Roi {
+    /// Its pixel columns and rows as a summary says them: `x 16-2032 y 16-573` (the first
+    /// pixel and one past the last).
+    pub fn extent(&self) -> String {
+        format!(
+            "x {}-{} y {}-{}",
+            self.x_px,
+            self.x_px + self.width_px,
+            self.y_px,
+            self.y_px + self.height_px
         )
     }
 }
@@ -167,8 +182,9 @@ pub struct CorrelatorSettings {
     pub method: Method,
     /// Distance between neighbouring ZOI centres, delta x = delta y, 1 ..= zoi_px.
     pub step_px: usize,
-    /// Region of interest; `None` = the largest centred 2^p square (the paper).
-    pub roi: Option<Roi>,
+    /// Where to measure: a rectangle (the whole image less half a ZOI by default, the paper's
+    /// centred 2^p square, or x,y,w,h) and polygons or a mask inside it (`region.rs`).
+    pub region: Region,
     /// Measure of the per-node strains.
     pub strain: StrainMeasure,
     pub reference: ReferenceMode,
@@ -204,7 +220,7 @@ impl Default for CorrelatorSettings {
             zoi_px: 32,
             method: Method::default(),
             step_px: 16,
-            roi: None,
+            region: Region::default(),
             strain: StrainMeasure::Log,
             reference: ReferenceMode::Fixed,
             guess: GuessMode::Auto,
@@ -237,13 +253,13 @@ pub enum SettingsError {
     StrainWindow { nodes: usize },
     #[error("image {width_px}x{height_px} px is too small: expected at least 16x16 px")]
     ImageTooSmall { width_px: usize, height_px: usize },
-    #[error("ROI {roi} (x,y,width,height) does not fit in the {width_px}x{height_px} px image")]
+    #[error("ROI {roi} (x,y,width,height) does not fit in the {width_px}x{height_px} px image (--roi, [correlator.region] roi)")]
     RoiOutside {
         roi: Roi,
         width_px: usize,
         height_px: usize,
     },
-    #[error("ZOI {zoi_px} px is larger than the ROI ({roi_width_px}x{roi_height_px} px): choose a smaller --zoi or a larger ROI")]
+    #[error("ZOI {zoi_px} px is larger than the ROI ({roi_width_px}x{roi_height_px} px): choose a smaller --zoi or a larger ROI (--roi, [correlator.region] roi)")]
     ZoiLargerThanRoi {
         zoi_px: usize,
         roi_width_px: usize,
@@ -257,6 +273,44 @@ pub enum SettingsError {
         width_px: usize,
         height_px: usize,
     },
+    #[error("polygon {} of the region (--polygon, [correlator.region] polygons) \"{polygon}\" has {vertices} vertices: a polygon needs at least 3", index + 1)]
+    PolygonTooFewVertices {
+        index: usize,
+        polygon: String,
+        vertices: usize,
+    },
+    #[error("polygon {} of the region (--polygon, [correlator.region] polygons) \"{polygon}\" crosses itself: edges {} and {} meet (vertices in order around the outline, edge k from vertex k to k + 1)", index + 1, edges.0, edges.1)]
+    PolygonSelfCrossing {
+        index: usize,
+        polygon: String,
+        edges: (usize, usize),
+    },
+    #[error("polygon {} of the region (--polygon, [correlator.region] polygons) \"{polygon}\" has vertex {x},{y} outside the {width_px}x{height_px} px image (expected 0 <= x <= {width_px}, 0 <= y <= {height_px})", index + 1)]
+    PolygonOutside {
+        index: usize,
+        polygon: String,
+        x: f64,
+        y: f64,
+        width_px: usize,
+        height_px: usize,
+    },
+    #[error("mask {} (--mask, [correlator.region] mask) cannot be read: {reason}", path.display())]
+    MaskUnreadable {
+        path: std::path::PathBuf,
+        reason: String,
+    },
+    #[error("mask {} (--mask, [correlator.region] mask) is {width_px}x{height_px} px, expected {expected_width_px}x{expected_height_px} px like the images", path.display())]
+    MaskSize {
+        path: std::path::PathBuf,
+        width_px: usize,
+        height_px: usize,
+        expected_width_px: usize,
+        expected_height_px: usize,
+    },
+    #[error("the region ({region}) is empty: no pixel of the ROI is inside its polygons and mask (--roi, --polygon, --mask; [correlator.region])")]
+    EmptyRegion { region: String },
+    #[error("the region ({region}) is smaller than one {zoi_px} px ZOI: no node's ZOI fits inside it (a larger region: --roi, --polygon, --mask, [correlator.region]; or a smaller --zoi)")]
+    RegionSmallerThanZoi { region: String, zoi_px: usize },
     #[error("minimum relative node score {fraction} is invalid: expected 0 <= fraction < 1")]
     MinRelativeScore { fraction: f64 },
     #[error("minimum ZNCC {min_zncc} is invalid: expected 0 < min_zncc < 1")]
@@ -365,39 +419,14 @@ impl CorrelatorSettings {
         }
     }
 
-    /// The ROI used for an image of this size: the user's, or the largest centred 2^p square.
-    pub fn resolve_roi(&self, width_px: usize, height_px: usize) -> Result<Roi, SettingsError> {
-        if width_px < 16 || height_px < 16 {
-            return Err(SettingsError::ImageTooSmall {
-                width_px,
-                height_px,
-            });
-        }
-        let roi = match self.roi {
-            Some(roi) => {
-                let fits = roi.width_px > 0
-                    && roi.height_px > 0
-                    && roi.x_px + roi.width_px <= width_px
-                    && roi.y_px + roi.height_px <= height_px;
-                if !fits {
-                    return Err(SettingsError::RoiOutside {
-                        roi,
-                        width_px,
-                        height_px,
-                    });
-                }
-                roi
-            }
-            None => centred_power_of_two_square(width_px, height_px),
-        };
-        if self.zoi_px > roi.width_px || self.zoi_px > roi.height_px {
-            return Err(SettingsError::ZoiLargerThanRoi {
-                zoi_px: self.zoi_px,
-                roi_width_px: roi.width_px,
-                roi_height_px: roi.height_px,
-            });
-        }
-        Ok(roi)
+    /// The region for an image of this size (its rectangle, the mesh's rectangle, its
+    /// pixels), every refusal naming its setting.
+    pub fn resolve_region(
+        &self,
+        width_px: usize,
+        height_px: usize,
+    ) -> Result<ResolvedRegion, SettingsError> {
+        self.region.resolve(width_px, height_px, self.zoi_px)
     }
 }
 

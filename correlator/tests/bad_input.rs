@@ -49,7 +49,7 @@ fn zoi_larger_than_roi() {
     };
     let error = Correlator::new(
         CorrelatorSettings {
-            roi: Some(roi),
+            region: correlator::Region::rect(roi),
             ..settings(64, 16)
         },
         256,
@@ -77,7 +77,7 @@ fn step_zero_and_roi_outside() {
     };
     let error = Correlator::new(
         CorrelatorSettings {
-            roi: Some(roi),
+            region: correlator::Region::rect(roi),
             ..settings(32, 16)
         },
         256,
@@ -123,8 +123,13 @@ fn flat_images_are_low_contrast() {
     let (w, h) = (128, 128);
     let speckle = render(w, h, 4.0, translation(0.0, 0.0), 0.01, 1);
     let flat = vec![1000u16; w * h];
-    // Flat deformed image.
-    let mut correlator = Correlator::new(settings(32, 16), w, h).unwrap();
+    // Flat deformed image. Over the whole image, as written (the default margin's 96 px ROI
+    // leaves too little texture in the half-flat image below for a global guess or keypoints).
+    let whole = CorrelatorSettings {
+        region: correlator::Region::centred_pow2(),
+        ..settings(32, 16)
+    };
+    let mut correlator = Correlator::new(whole, w, h).unwrap();
     correlator.set_reference(&speckle).unwrap();
     let field = correlator.correlate(&flat).unwrap();
     assert_eq!(field.valid, 0);
@@ -153,7 +158,13 @@ fn flat_images_are_low_contrast() {
     half[..w * h / 2].fill(3000);
     correlator.set_reference(&half).unwrap();
     let field = correlator.correlate(&half).unwrap();
-    assert!(field.valid > 0 && field.valid < field.nodes.len());
+    assert!(
+        field.valid > 0 && field.valid < field.nodes.len(),
+        "{} valid of {}: {}",
+        field.valid,
+        field.nodes.len(),
+        field.refusals()
+    );
 }
 
 #[test]

@@ -94,7 +94,7 @@ fn sample14_l1_chirp_rms() {
         let settings = CorrelatorSettings {
             zoi_px,
             step_px: 8,
-            roi: Some(roi),
+            region: correlator::Region::rect(roi),
             ..Default::default()
         };
         let mut correlator = Correlator::new(settings, w, h).unwrap();
@@ -150,7 +150,7 @@ fn sample14_smaller_zones_follow_the_fast_end() {
             let settings = CorrelatorSettings {
                 zoi_px,
                 step_px: 8,
-                roi: Some(correlator::Roi {
+                region: correlator::Region::rect(correlator::Roi {
                     x_px: 0,
                     y_px: 0,
                     width_px: w,

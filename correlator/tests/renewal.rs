@@ -17,7 +17,7 @@ fn settings() -> CorrelatorSettings {
     CorrelatorSettings {
         reference: ReferenceMode::AUTO_DEFAULT,
         // Inside the image: no node leaves it, so none searches for want of a prediction.
-        roi: Some(Roi {
+        region: correlator::Region::rect(Roi {
             x_px: 64,
             y_px: 64,
             width_px: 128,

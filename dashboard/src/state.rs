@@ -315,9 +315,9 @@ impl LiveState {
                 }
             }
         }
-        let status_counts: Vec<Value> = (0..7u32)
-            .filter_map(NodeStatus::from_code)
-            .map(|s| {
+        let status_counts: Vec<Value> = NodeStatus::ALL
+            .iter()
+            .map(|&s| {
                 let count = self.nodes.iter().filter(|n| n.status == s as u32).count();
                 json!({"status": s.name(), "code": s as u32, "count": count})
             })

@@ -333,6 +333,7 @@ pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correla
         Some(wire::NodeStatus::LowZncc) => S::LowZncc,
         Some(wire::NodeStatus::Inconsistent) => S::Inconsistent,
         Some(wire::NodeStatus::NoGuess) => S::NoGuess,
+        Some(wire::NodeStatus::OutsideRegion) => S::OutsideRegion,
         Some(wire::NodeStatus::OutsideImage) | None => S::OutsideImage,
     };
     let wire_nodes = nodes;

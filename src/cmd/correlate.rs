@@ -10,8 +10,8 @@ use super::named_arg::named;
 use anyhow::{anyhow, bail, Context, Result};
 use correlator::settings::{Method, ReferenceKind};
 use correlator::{
-    Correlator, CorrelatorSettings, Field, GaugeStrains, GuessMode, ReferenceMode, Roi,
-    StrainMeasure,
+    Correlator, CorrelatorSettings, Field, GaugeStrains, GuessMode, Polygon, ReferenceMode, Region,
+    RoiChoice, StrainMeasure,
 };
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -40,9 +40,19 @@ pub struct CorrelationArgs {
     /// Distance between ZOI centres in px (1 ..= ZOI).
     #[arg(long, default_value_t = defaults().step_px)]
     pub step: usize,
-    /// Region of interest x,y,w,h in px (default: the largest centred 2^p square).
-    #[arg(long, value_parser = parse_roi)]
-    pub roi: Option<Roi>,
+    /// The rectangle measured: margin (the whole image less half a ZOI on each side, so that a
+    /// border node can move by the integer search's reach before its ZOI leaves the image),
+    /// centred-pow2 (the paper's largest centred 2^p square) or x,y,w,h in px.
+    #[arg(long, default_value_t = RoiChoice::Margin)]
+    pub roi: RoiChoice,
+    /// A polygon in image px, "x,y x,y x,y ..." (at least 3 vertices, not crossing itself,
+    /// inside the image); repeat for several (their union). A node is measured only when its
+    /// whole ZOI lies inside the region; the others are outside_region.
+    #[arg(long = "polygon", value_name = "X,Y X,Y X,Y...")]
+    pub polygons: Vec<Polygon>,
+    /// A mask image the size of the images (PNG, TIFF or BMP): non-zero pixels are measured.
+    #[arg(long)]
+    pub mask: Option<PathBuf>,
     /// Strain measure of the node strains (the gauge is given in all four).
     #[arg(long, value_parser = named::<StrainMeasure>(), default_value_t = defaults().strain)]
     pub strain: StrainMeasure,
@@ -75,7 +85,11 @@ impl CorrelationArgs {
             zoi_px: self.zoi,
             method: self.method,
             step_px: self.step,
-            roi: self.roi,
+            region: Region {
+                roi: self.roi,
+                polygons: self.polygons.clone(),
+                mask: self.mask.clone(),
+            },
             strain: self.strain,
             reference: ReferenceMode::of_kind(reference, self.method),
             guess: self.guess,
@@ -111,26 +125,6 @@ pub struct CorrelateArgs {
     pub png: bool,
 }
 
-pub(crate) fn parse_roi(text: &str) -> Result<Roi> {
-    let values: Vec<usize> = text
-        .split(',')
-        .map(|v| v.trim().parse::<usize>())
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|_| anyhow!("ROI '{text}': expected four non-negative integers x,y,w,h"))?;
-    match values[..] {
-        [x_px, y_px, width_px, height_px] => Ok(Roi {
-            x_px,
-            y_px,
-            width_px,
-            height_px,
-        }),
-        _ => bail!(
-            "ROI '{text}': expected four values x,y,w,h, got {}",
-            values.len()
-        ),
-    }
-}
-
 impl CorrelateArgs {
     fn settings(&self) -> CorrelatorSettings {
         self.correlation.settings(self.reference_mode)
@@ -164,6 +158,7 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
     let settings_value = settings_json(&args, &correlator);
     let mut frames = Vec::new();
     let mut frames_with_valid_nodes = 0usize;
+    let mut valid = Vec::with_capacity(args.deformed.len());
     for (i, path) in args.deformed.iter().enumerate() {
         let index = i + 1;
         let image = load(path)?;
@@ -180,6 +175,7 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
         let field = correlator.correlate(&image.pixels)?;
         let elapsed_ms = t.elapsed().as_secs_f64() * 1e3;
         frames_with_valid_nodes += usize::from(field.valid > 0);
+        valid.push(field.valid);
         warn_if_few_valid(path, field, progress.as_ref());
         write_field_files(&args, &reference, field, index)?;
         frames.push(frame_json(index, path, field, elapsed_ms));
@@ -189,17 +185,43 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
             serde_json::to_string_pretty(&summary)?.as_bytes(),
         )?;
         if let Some(bar) = &progress {
-            bar.set_message(format!("{} valid of {}", field.valid, field.nodes.len()));
+            bar.set_message(format!("{} valid of {}", field.valid, field.in_region()));
             bar.inc(1);
         }
     }
     if let Some(bar) = progress {
         bar.finish();
     }
+    eprintln!("{}", summary_line(&correlator, &valid));
     if frames_with_valid_nodes == 0 {
         return Err(nothing_measured(&args));
     }
     Ok(())
+}
+
+/// The line after the run: where it measured and how much of it is valid, e.g.
+/// `correlate: ROI x 16-2032 y 16-573 (polygon 5 vertices), 3906 nodes, 3890 valid`
+/// (x and y the mesh rectangle's first pixel and one past its last; with several frames the
+/// last frame's valid count and the fewest).
+fn summary_line(correlator: &Correlator, valid: &[usize]) -> String {
+    let region = &correlator.settings().region;
+    let shape = region
+        .shape_description()
+        .map_or(format!(" ({})", region.roi), |shape| format!(" ({shape})"));
+    let valid_text = match valid {
+        [] => String::new(),
+        [one] => format!(", {one} valid"),
+        [.., last] => format!(
+            ", {last} valid in the last of {} frames (fewest {})",
+            valid.len(),
+            valid.iter().min().copied().unwrap_or(0)
+        ),
+    };
+    format!(
+        "correlate: ROI {}{shape}, {} nodes{valid_text}",
+        correlator.roi().extent(),
+        correlator.nodes_in_region(),
+    )
 }
 
 /// A progress bar over `frames` frames, on a terminal only.
@@ -219,12 +241,12 @@ fn progress_bar(frames: usize) -> Option<indicatif::ProgressBar> {
 
 /// A warning (above the progress bar, if any) when fewer than half of the nodes are valid.
 fn warn_if_few_valid(path: &Path, field: &Field, progress: Option<&indicatif::ProgressBar>) {
-    if 2 * field.valid < field.nodes.len() {
+    if 2 * field.valid < field.in_region() {
         let warning = format!(
             "warning: {}: only {} of {} nodes valid ({})",
             path.display(),
             field.valid,
-            field.nodes.len(),
+            field.in_region(),
             field.refusals()
         );
         match progress {
@@ -278,6 +300,7 @@ fn frame_json(index: usize, path: &Path, field: &Field, elapsed_ms: f64) -> serd
         "index": index,
         "file": path.display().to_string(),
         "nodes": field.nodes.len(),
+        "nodes_in_region": field.in_region(),
         "valid": field.valid,
         "u_mean": field.u_mean_px,
         "v_mean": field.v_mean_px,
@@ -331,7 +354,9 @@ fn settings_json(args: &CorrelateArgs, correlator: &Correlator) -> serde_json::V
         "zoi": args.correlation.zoi,
         "step": args.correlation.step,
         "roi": [roi.x_px, roi.y_px, roi.width_px, roi.height_px],
+        "region": correlator.settings().region,
         "mesh": [nx, ny],
+        "nodes_in_region": correlator.nodes_in_region(),
         "strain": correlator.settings().strain.name(),
         "reference_mode": args.reference_mode.name(),
         "guess": format!("{:?}", args.correlation.guess).to_lowercase(),

@@ -54,12 +54,15 @@ pub enum NodeStatus {
     /// No guess could be trusted for this node (the global correlation peak was not
     /// significant and no other guess verified), so it was not measured.
     NoGuess = 6,
+    /// Not measured: the node's ZOI does not lie wholly inside the region the user chose
+    /// (polygons, mask). Never a failure.
+    OutsideRegion = 7,
 }
 
 crate::named!(NodeStatus, "node status", {
     Ok => "ok", NotConverged => "not_converged", LowContrast => "low_contrast",
     OutsideImage => "outside_image", LowZncc => "low_zncc", Inconsistent => "inconsistent",
-    NoGuess => "no_guess",
+    NoGuess => "no_guess", OutsideRegion => "outside_region",
 });
 
 impl NodeStatus {
@@ -248,7 +251,8 @@ mod tests {
         assert_eq!(StrainMeasure::from_code(9), None);
         assert_eq!(NodeStatus::from_code(2), Some(NodeStatus::LowContrast));
         assert_eq!(NodeStatus::from_code(4), Some(NodeStatus::LowZncc));
-        assert_eq!(NodeStatus::from_code(7), None);
+        assert_eq!(NodeStatus::from_code(7), Some(NodeStatus::OutsideRegion));
+        assert_eq!(NodeStatus::from_code(8), None);
         assert_eq!(StrainMeasure::Log.name(), "log");
         for g in GradientSource::ALL {
             assert_eq!(GradientSource::from_code(g as u32), Some(g));

@@ -175,6 +175,8 @@ pub struct CorrelatorSection {
     pub min_zncc: f64,
     /// First-order correction of the rigid ZOI's bias under a displacement gradient.
     pub gradient_correction: bool,
+    /// `[correlator.region]`: where the correlator measures (the rectangle, polygons, a mask).
+    pub region: correlator::Region,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -321,6 +323,7 @@ impl Default for CorrelatorSection {
             guess: d.guess,
             min_zncc: d.min_zncc,
             gradient_correction: d.gradient_correction,
+            region: d.region,
         }
     }
 }

@@ -208,3 +208,63 @@ fn a_bare_word_value_is_named_with_the_fix() {
     assert!(!text.contains("not a TOML value"), "{text}");
     assert!(text.contains("run.toml"), "{text}");
 }
+
+/// `[correlator.region]`: read typed, unknown keys and bad shapes refused naming the key, and
+/// the region passed to the correlator with its mask's path made absolute.
+#[test]
+fn the_region_is_read_checked_and_passed_on() {
+    let config = RunConfig::from_toml(
+        "[correlator.region]\nroi = \"centred-pow2\"\npolygons = [\"100,100 900,100 500,900\"]\n",
+        "t.toml",
+    )
+    .unwrap();
+    config.validate().unwrap();
+    let settings = config.correlator_settings().unwrap();
+    assert_eq!(settings.region.roi, correlator::RoiChoice::CentredPow2);
+    assert_eq!(
+        settings.region.polygons[0].to_string(),
+        "100,100 900,100 500,900"
+    );
+    let round = RunConfig::from_toml(&config.to_toml(), "round").unwrap();
+    assert_eq!(round, config);
+    let refuse = |toml: &str, expected: &str| {
+        let checked = RunConfig::from_toml(toml, "t.toml").and_then(|config| config.validate());
+        let error = format!("{:#}", checked.unwrap_err());
+        assert!(error.contains(expected), "{toml}: {error}");
+    };
+    refuse("[correlator.region]\nrio = \"margin\"\n", "rio");
+    refuse("[correlator.region]\nroi = \"whole\"\n", "centred-pow2");
+    refuse(
+        "[correlator.region]\npolygons = [\"1,1 2,2\"]\n",
+        "[correlator.region] polygons",
+    );
+    refuse(
+        "[correlator.region]\npolygons = [\"10,10 2000,10 10,500\"]\n",
+        "outside the 1024x1024 px image",
+    );
+    refuse(
+        "[correlator.region]\nmask = \"no_such_mask.png\"\n",
+        "[correlator.region] mask",
+    );
+    // A relative mask is the run's folder's: the correlator gets it absolute.
+    let dir = std::env::temp_dir().join(format!("region_mask_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mask = dir.join("mask.png");
+    image::GrayImage::from_pixel(1024, 1024, image::Luma([1]))
+        .save(&mask)
+        .unwrap();
+    let config = RunConfig::from_toml(
+        &format!("[correlator.region]\nmask = {:?}\n", mask.to_str().unwrap()),
+        "t.toml",
+    )
+    .unwrap();
+    config.validate().unwrap();
+    assert!(config
+        .correlator_settings()
+        .unwrap()
+        .region
+        .mask
+        .unwrap()
+        .is_absolute());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

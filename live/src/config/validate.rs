@@ -181,13 +181,24 @@ impl RunConfig {
             guess: c.guess,
             min_zncc: c.min_zncc,
             gradient_correction: c.gradient_correction,
+            region: correlator::Region {
+                // The correlator process reads the mask: from wherever it runs.
+                mask: c
+                    .region
+                    .mask
+                    .as_deref()
+                    .map(std::path::absolute)
+                    .transpose()
+                    .with_context(|| format!("[correlator.region] mask {:?}", c.region.mask))?,
+                ..c.region.clone()
+            },
             ..correlator::CorrelatorSettings::default()
         };
         settings
             .validate()
             .map_err(|e| anyhow!("[correlator] {e}"))?;
         settings
-            .resolve_roi(
+            .resolve_region(
                 self.camera.width_px as usize,
                 self.camera.height_px as usize,
             )

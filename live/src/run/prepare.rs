@@ -117,10 +117,12 @@ pub fn shm_needed_bytes(config: &RunConfig) -> anyhow::Result<u64> {
     let frames =
         producer::stream::frames_shm_bytes(config.camera.width_px, config.camera.height_px);
     let settings = config.correlator_settings()?;
-    let roi = settings.resolve_roi(
-        config.camera.width_px as usize,
-        config.camera.height_px as usize,
-    )?;
+    let roi = settings
+        .resolve_region(
+            config.camera.width_px as usize,
+            config.camera.height_px as usize,
+        )?
+        .mesh_rect;
     let nodes = (roi.width_px / settings.step_px + 1) * (roi.height_px / settings.step_px + 1);
     let fields = wire::services::FIELDS.shm_bytes(
         std::mem::size_of::<wire::FieldHeader>(),

@@ -134,19 +134,24 @@ impl CorrelateBench {
     }
 
     /// The options' settings with another method and ZOI. Image files are correlated over
-    /// the whole image, rendered speckle over the default ROI.
+    /// the whole image, rendered speckle over the paper's centred 2^p square (the whole image
+    /// when it is a power of two: the figures of the README).
     fn settings_with(&self, method: Method, zoi_px: usize, threads: usize) -> CorrelatorSettings {
-        let roi = (!self.rendered).then_some(correlator::Roi {
-            x_px: 0,
-            y_px: 0,
-            width_px: self.width_px(),
-            height_px: self.height_px(),
-        });
+        let region = if self.rendered {
+            correlator::Region::centred_pow2()
+        } else {
+            correlator::Region::rect(correlator::Roi {
+                x_px: 0,
+                y_px: 0,
+                width_px: self.width_px(),
+                height_px: self.height_px(),
+            })
+        };
         CorrelatorSettings {
             method,
             zoi_px,
             step_px: self.args.step,
-            roi,
+            region,
             threads,
             guess: self.args.guess,
             ..CorrelatorSettings::default()
