@@ -47,6 +47,17 @@ fn producer_args(instance: &str) -> Vec<String> {
     .to_vec()
 }
 
+/// Starts the test's camera on `instance` and waits until it is ready.
+fn start_producer(bench: &mut Run, instance: &str) {
+    let args = producer_args(instance);
+    bench
+        .spawn(
+            "producer",
+            &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        )
+        .wait_for_stderr("producer ready", |l| l.contains("ready"));
+}
+
 fn frames_seen(snapshot: &Value) -> u64 {
     snapshot["frames"]["seen"].as_u64().unwrap()
 }
@@ -55,13 +66,7 @@ fn frames_seen(snapshot: &Value) -> u64 {
 fn monitor_serves_a_read_only_event_stream_with_growing_snapshots_and_images() {
     let mut bench = Run::new("sse");
     let instance = bench.name().to_string();
-    let args = producer_args(&instance);
-    bench
-        .spawn(
-            "producer",
-            &args.iter().map(String::as_str).collect::<Vec<_>>(),
-        )
-        .wait_for_stderr("producer ready", |l| l.contains("ready"));
+    start_producer(&mut bench, &instance);
     let monitor = bench.spawn(
         "monitor",
         &[
@@ -170,13 +175,7 @@ fn monitor_refuses_a_bad_address_naming_it() {
 fn monitor_refuses_an_instance_nothing_runs_on_naming_the_running_ones() {
     let mut bench = Run::new("monitor_nosuch");
     let instance = bench.name().to_string();
-    let args = producer_args(&instance);
-    bench
-        .spawn(
-            "producer",
-            &args.iter().map(String::as_str).collect::<Vec<_>>(),
-        )
-        .wait_for_stderr("producer ready", |l| l.contains("ready"));
+    start_producer(&mut bench, &instance);
     let nosuch = format!("{instance}_nosuch");
     let monitor = bench.spawn(
         "monitor",

@@ -55,7 +55,7 @@ pub fn displacement_error(
     origin: &GroundTruth,
     mut each: impl FnMut(f64),
 ) -> Option<(f64, f64, usize)> {
-    let (mut sum, mut max, mut count) = (0.0, 0.0f64, 0usize);
+    let mut errors = ErrorSum::default();
     for node in nodes {
         if node.status != NodeStatus::Ok as u32 {
             continue;
@@ -63,14 +63,33 @@ pub fn displacement_error(
         let x0 = Vector2::new(f64::from(node.x_px), f64::from(node.y_px));
         let material = inverse(origin, x0)?;
         let truth = forward(current, material) - x0;
+        each(errors.add(node, truth));
+    }
+    errors.mean_max_count()
+}
+
+/// The running mean and max of the nodes' displacement errors.
+#[derive(Default)]
+struct ErrorSum {
+    sum: f64,
+    max: f64,
+    count: usize,
+}
+
+impl ErrorSum {
+    /// Adds the error of `node`'s measured displacement against `truth` (px), and returns it.
+    fn add(&mut self, node: &FieldNode, truth: Vector2<f64>) -> f64 {
         let measured = Vector2::new(f64::from(node.u_px), f64::from(node.v_px));
         let error = (measured - truth).norm();
-        each(error);
-        sum += error;
-        max = max.max(error);
-        count += 1;
+        self.sum += error;
+        self.max = self.max.max(error);
+        self.count += 1;
+        error
     }
-    (count > 0).then(|| (sum / count as f64, max, count))
+
+    fn mean_max_count(&self) -> Option<(f64, f64, usize)> {
+        (self.count > 0).then(|| (self.sum / self.count as f64, self.max, self.count))
+    }
 }
 
 /// Mean and largest displacement error (px) over the valid nodes against a finite-element
@@ -84,7 +103,7 @@ pub fn field_errors(
     origin: &FieldMotion,
     mut each: impl FnMut(f64),
 ) -> Option<FieldErrors> {
-    let (mut sum, mut max, mut count) = (0.0, 0.0f64, 0usize);
+    let mut errors = ErrorSum::default();
     let mut gradient_sum = Matrix2::zeros();
     for node in nodes {
         if node.status != NodeStatus::Ok as u32 {
@@ -102,19 +121,15 @@ pub fn field_errors(
             continue;
         };
         let truth = Vector2::new(x[0] - x0[0], x[1] - x0[1]);
-        let measured = Vector2::new(f64::from(node.u_px), f64::from(node.v_px));
-        let error = (measured - truth).norm();
-        each(error);
-        sum += error;
-        max = max.max(error);
-        count += 1;
+        each(errors.add(node, truth));
         let f_k = Matrix2::new(f_k[0][0], f_k[0][1], f_k[1][0], f_k[1][1]);
         let f_o = Matrix2::new(f_o[0][0], f_o[0][1], f_o[1][0], f_o[1][1]);
         gradient_sum += f_k * f_o.try_inverse()?;
     }
-    (count > 0).then(|| FieldErrors {
-        mean_px: sum / count as f64,
-        max_px: max,
+    let (mean_px, max_px, count) = errors.mean_max_count()?;
+    Some(FieldErrors {
+        mean_px,
+        max_px,
         nodes: count,
         mean_gradient: gradient_sum / count as f64,
     })
