@@ -139,14 +139,7 @@ impl Recorder {
         let Some([width, height]) = self.frame_size_px else {
             return Some(None);
         };
-        let view = View {
-            mm_per_px: self.settings.mm_per_px,
-            centre_px: [
-                (f64::from(width) - 1.0) / 2.0,
-                (f64::from(height) - 1.0) / 2.0,
-            ],
-            centre_mm: [0.0, 0.0],
-        };
+        let view = View::centred(self.settings.mm_per_px, width, height);
         let field = |id, grip_mm: &[f64; 4]| self.specimen.field(id, grip_mm, view).ok();
         Some(
             field(origin_id, &origin.specimen_grip_mm)

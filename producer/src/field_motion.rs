@@ -46,6 +46,20 @@ pub struct View {
 }
 
 impl View {
+    /// The rig camera's view: the specimen's centre (0, 0 mm) at the centre of a `width_px` ×
+    /// `height_px` image, `mm_per_px` on both axes. What the camera films and the truth is
+    /// computed in.
+    pub fn centred(mm_per_px: f64, width_px: u32, height_px: u32) -> View {
+        View {
+            mm_per_px,
+            centre_px: [
+                (f64::from(width_px) - 1.0) / 2.0,
+                (f64::from(height_px) - 1.0) / 2.0,
+            ],
+            centre_mm: [0.0, 0.0],
+        }
+    }
+
     /// Specimen mm of image px.
     pub fn to_mm(&self, p_px: Vec2) -> [f64; 2] {
         [

@@ -521,11 +521,8 @@ impl RigCamera {
 
     /// How the camera sees the specimen: its centre at the image centre, the follower's scale.
     pub fn view(&self) -> View {
-        View {
-            mm_per_px: self.follower.config().mm_per_px,
-            centre_px: self.follower.centre_px(),
-            centre_mm: [0.0, 0.0],
-        }
+        let dims = self.camera.dims();
+        View::centred(self.follower.config().mm_per_px, dims.width, dims.height)
     }
 
     /// What the next frame would show; for a finite-element specimen, its field is prepared
