@@ -62,8 +62,8 @@ pub enum ProcessError {
     },
     #[error("reference image {label} is flat: no ZOI has texture to correlate")]
     FlatReference { label: String },
-    #[error(transparent)]
-    WaitSetCreate(#[from] iceoryx2::waitset::WaitSetCreateError),
+    #[error("{0}")]
+    WaitSetCreate(#[from] wire::resources::WaitSetError),
     #[error(transparent)]
     WaitSetAttach(#[from] iceoryx2::waitset::WaitSetAttachmentError),
     #[error(transparent)]

@@ -80,7 +80,7 @@ pub fn feed(
         let instance = wire::Instance::new(instance).map_err(err)?;
         let (node, _) = instance.create_node("dashboard").map_err(err)?;
         let ports = Ports::open(&node)?;
-        let waitset = wire::signals::waitset().map_err(|e| err(format!("WaitSet: {e:?}")))?;
+        let waitset = wire::signals::waitset().map_err(|e| err(e.to_string()))?;
         Ok((node, ports, waitset))
     })();
     let (_node, ports, waitset) = match opened {

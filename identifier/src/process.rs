@@ -58,8 +58,8 @@ pub enum ProcessError {
     Journal(#[from] crate::journal::JournalError),
     #[error("{0}")]
     File(#[from] wire::files::FileError),
-    #[error(transparent)]
-    WaitSetCreate(#[from] iceoryx2::waitset::WaitSetCreateError),
+    #[error("{0}")]
+    WaitSetCreate(#[from] wire::resources::WaitSetError),
     #[error(transparent)]
     WaitSetAttach(#[from] iceoryx2::waitset::WaitSetAttachmentError),
     #[error(transparent)]

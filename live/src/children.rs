@@ -83,6 +83,26 @@ pub struct Exit {
     pub last_lines: Vec<String>,
 }
 
+/// A child that ended before it said it was ready: its exit.
+#[derive(Debug)]
+pub struct StoppedBeforeReady(pub Exit);
+
+impl std::fmt::Display for StoppedBeforeReady {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let exit = &self.0;
+        write!(
+            f,
+            "{} (pid {}) stopped before it was ready ({}):\n  {}",
+            exit.role.name(),
+            exit.pid,
+            exit.how,
+            exit.last_lines.join("\n  ")
+        )
+    }
+}
+
+impl std::error::Error for StoppedBeforeReady {}
+
 /// Describes an exit status the way a test engineer reads it.
 pub fn describe_status(status: ExitStatus) -> String {
     if let Some(code) = status.code() {
@@ -282,14 +302,7 @@ impl Supervisor {
             }
             self.reap();
             if let Some(at) = self.exited.iter().position(|e| e.role == role) {
-                let exit = self.exited.remove(at);
-                anyhow::bail!(
-                    "{} (pid {}) stopped before it was ready ({}):\n  {}",
-                    role.name(),
-                    exit.pid,
-                    exit.how,
-                    exit.last_lines.join("\n  ")
-                );
+                return Err(StoppedBeforeReady(self.exited.remove(at)).into());
             }
             let now = Instant::now();
             if now >= deadline {

@@ -114,6 +114,9 @@ pub enum StreamError {
     Wire(#[from] InstanceError),
     #[error(transparent)]
     Source(#[from] ProducerError),
+    /// The process's WaitSet could not be made (for want of descriptors: exit 71).
+    #[error("{0}")]
+    WaitSet(#[from] wire::resources::WaitSetError),
     /// A `specimen` sample the camera cannot read (another layout, a malformed mesh).
     #[error("specimen state refused: {0}")]
     Specimen(#[from] crate::specimen_states::StateError),
@@ -359,7 +362,7 @@ pub fn stream_following_rig(
     drain(camera, &mut shell.report)?;
     if camera.follower().latest().is_none() {
         on_event(StreamEvent::WaitingForRig);
-        let waitset = wire::signals::waitset().map_err(|e| wait_error(&e))?;
+        let waitset = wire::signals::waitset()?;
         let _guard = waitset
             .attach_notification(rig.listener())
             .map_err(|e| wait_error(&e))?;

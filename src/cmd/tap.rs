@@ -165,8 +165,7 @@ pub fn run(args: TapArgs) -> anyhow::Result<()> {
         );
     }
     let tap = Tap::open(&node, kind)?;
-    let waitset =
-        wire::signals::waitset().map_err(|e| anyhow::anyhow!("creating the WaitSet: {e:?}"))?;
+    let waitset = anyhow::Context::context(wire::signals::waitset(), "tap")?;
     let sample_guard = waitset
         .attach_notification(tap.listener())
         .map_err(|e| anyhow::anyhow!("attaching {} to the WaitSet: {e:?}", kind.name()))?;

@@ -41,6 +41,13 @@ pub fn code_of(error: &(dyn std::error::Error + 'static)) -> Option<u8> {
         }
         #[cfg(feature = "ipc")]
         if error
+            .downcast_ref::<crate::resources::WaitSetError>()
+            .is_some_and(|w| w.out_of_resources)
+        {
+            return Some(RESOURCES);
+        }
+        #[cfg(feature = "ipc")]
+        if error
             .downcast_ref::<crate::resources::ConnectionError>()
             .is_some()
             || matches!(

@@ -79,6 +79,19 @@ pub struct ConnectionError {
     pub resources: Resources,
 }
 
+/// A WaitSet (the process's sleep on its services and signals) that could not be created;
+/// for want of resources (descriptors), the process stops with [`crate::exit::RESOURCES`],
+/// naming them.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot create a WaitSet ({detail}); {resources}")]
+pub struct WaitSetError {
+    /// iceoryx2's error.
+    pub detail: String,
+    /// iceoryx2 said its resources were insufficient.
+    pub out_of_resources: bool,
+    pub resources: Resources,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -73,10 +73,15 @@ pub fn name(signal: libc::c_int) -> String {
 /// A WaitSet that leaves signals to this module (iceoryx2's default would install its own
 /// SIGINT/SIGTERM handler over ours and report SIGCONT's EINTR as an interrupt).
 #[cfg(feature = "ipc")]
-pub fn waitset() -> Result<WaitSet<ipc::Service>, WaitSetCreateError> {
+pub fn waitset() -> Result<WaitSet<ipc::Service>, crate::resources::WaitSetError> {
     WaitSetBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
+        .map_err(|e| crate::resources::WaitSetError {
+            detail: format!("{e:?}"),
+            out_of_resources: matches!(e, WaitSetCreateError::InsufficientResources),
+            resources: crate::resources::Resources::now(),
+        })
 }
 
 #[cfg(test)]

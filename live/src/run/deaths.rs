@@ -28,6 +28,14 @@ const NOT_RESTARTED: [(u8, &str); 4] = [
     ),
 ];
 
+/// Why an exit of code `code` is not restarted, if it is not.
+pub(super) fn not_restarted_why(code: Option<i32>) -> Option<&'static str> {
+    NOT_RESTARTED
+        .iter()
+        .find(|(c, _)| code == Some(i32::from(*c)))
+        .map(|(_, why)| *why)
+}
+
 /// `<role> (pid N) died: <how>`, with its last lines.
 fn death_report(exit: &Exit) -> String {
     let last_lines = match exit.last_lines.is_empty() {
@@ -52,10 +60,7 @@ impl Run<'_> {
         self.incidents
             .faults
             .push(format!("{} {}", role.name(), exit.how));
-        if let Some((_, why)) = NOT_RESTARTED
-            .iter()
-            .find(|(code, _)| exit.code == Some(i32::from(*code)))
-        {
+        if let Some(why) = not_restarted_why(exit.code) {
             bail!("{report}\n({why})");
         }
         let config = self.config();

@@ -4,7 +4,7 @@
 
 use super::open::{Phase, Run};
 use super::Ending;
-use anyhow::{anyhow, bail};
+use anyhow::{anyhow, bail, Context};
 use iceoryx2::prelude::*;
 use std::rc::Rc;
 use std::time::{Duration, Instant};
@@ -65,7 +65,7 @@ impl Run<'_> {
 
     fn event_loop(&mut self) -> anyhow::Result<Ending> {
         let subscriptions = Rc::clone(&self.subscriptions);
-        let waitset = wire::signals::waitset().map_err(waitset_error)?;
+        let waitset = wire::signals::waitset().context("monitor")?;
         let _guards = subscriptions
             .listeners()
             .into_iter()

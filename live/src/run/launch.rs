@@ -2,7 +2,7 @@
 
 use super::open::Run;
 use super::READY_TIMEOUT;
-use crate::children::Role;
+use crate::children::{Role, StoppedBeforeReady};
 use crate::config::{CameraSource, RunConfig};
 
 /// Consumers first, so that nothing the rig and the camera publish is missed.
@@ -52,6 +52,20 @@ impl Run<'_> {
     /// opened says what may be missing.
     fn wait_ready_at_start(&mut self, role: Role) -> anyhow::Result<bool> {
         let ready = self.supervisor.wait_ready(role, READY_TIMEOUT);
+        // A child that ended before it was ready is a fault of the run, named as a death is,
+        // and an exit a restart would repeat (no descriptors, say) says so.
+        let ready = ready.map_err(|e| match e.downcast_ref::<StoppedBeforeReady>() {
+            Some(StoppedBeforeReady(exit)) => {
+                self.incidents
+                    .faults
+                    .push(format!("{} {}", exit.role.name(), exit.how));
+                match super::deaths::not_restarted_why(exit.code) {
+                    Some(why) => anyhow::anyhow!("{e}\n({why})"),
+                    None => e,
+                }
+            }
+            None => e,
+        });
         match (role, self.config().camera.source) {
             (Role::Producer, CameraSource::Genicam) => ready.map_err(|e| {
                 e.context(
