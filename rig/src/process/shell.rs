@@ -43,6 +43,8 @@ pub(super) struct RigShell {
     // Ports on the node drop before it (fields drop in declaration order): `port` last.
     server: CommandServer,
     fields: Option<FieldSubscriber>,
+    /// The structure's solved states on `specimen`.
+    specimen: SpecimenPort,
     port: StatePort,
     field_clock: FieldClock,
     log: Option<RowFile>,
@@ -53,8 +55,6 @@ pub(super) struct RigShell {
     last_flush: Instant,
     /// The mounted specimen's failed solve was said (once per specimen).
     fault_said: bool,
-    /// The structure's solved states on `specimen`.
-    specimen: SpecimenPort,
 }
 
 impl RigShell {
