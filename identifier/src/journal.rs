@@ -18,11 +18,9 @@ pub const PER_CASE_HEADER: &str = "case,stretch,nominal_stress_mpa,frame_id";
 /// Why a journal could not be read back (lines counted from 1, the header included).
 #[derive(Debug, thiserror::Error)]
 pub enum JournalError {
-    #[error("journal {}: {reason}", .path.display())]
-    Read {
-        path: PathBuf,
-        reason: std::io::Error,
-    },
+    /// The file could not be read (its exit code, out of descriptors or not, follows it).
+    #[error("journal: {0}")]
+    Read(#[source] wire::files::FileError),
     #[error("journal {}: header {header:?}, expected {HEADER:?}", .path.display())]
     Header { path: PathBuf, header: String },
     #[error("journal {}: written by an earlier version (header {PER_CASE_HEADER:?}: one stress a point, where a biaxial state has two); move it aside to start a new path", .path.display())]
@@ -51,10 +49,11 @@ pub fn read(path: &Path) -> Result<Vec<JournalPoint>, JournalError> {
         Ok(bytes) => bytes,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
         Err(reason) => {
-            return Err(JournalError::Read {
+            return Err(JournalError::Read(wire::files::FileError {
                 path: path.to_path_buf(),
+                what: "read",
                 reason,
-            })
+            }))
         }
     };
     let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);

@@ -167,9 +167,13 @@ impl Supervisor {
     /// Starts `dicstream <role> <args...>`.
     pub fn spawn(&mut self, role: Role, args: Vec<String>) -> anyhow::Result<u32> {
         let generation = self.next_generation(role, args);
-        let pipe = || format!("{}: cannot make a pipe", role.name());
-        let (reader, writer) = std::io::pipe().with_context(pipe)?;
-        let writer_err = writer.try_clone().with_context(pipe)?;
+        // Out of descriptors, the supervisor says so with its limit.
+        let pipe = |e: std::io::Error| {
+            let note = wire::descriptors::note_for(&e);
+            anyhow::Error::from(e).context(format!("{}: cannot make a pipe{note}", role.name()))
+        };
+        let (reader, writer) = std::io::pipe().map_err(pipe)?;
+        let writer_err = writer.try_clone().map_err(pipe)?;
         let mut command = Command::new(&self.exe);
         command
             .arg(role.name())
@@ -179,9 +183,11 @@ impl Supervisor {
             .stderr(writer_err)
             .process_group(0);
         with_parent_death_signal(&mut command);
-        let child = command
-            .spawn()
-            .with_context(|| format!("cannot start {} {}", self.exe.display(), role.name()))?;
+        let child = command.spawn().map_err(|e| {
+            let note = wire::descriptors::note_for(&e);
+            let start = format!("cannot start {} {}{note}", self.exe.display(), role.name());
+            anyhow::Error::from(e).context(start)
+        })?;
         // The parent's copies of the pipe's writing ends: the log thread then sees the end of
         // the output when the child exits.
         drop(command);

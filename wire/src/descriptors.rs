@@ -35,6 +35,19 @@ pub fn exhausted_text(open: Option<u64>, limit: Option<u64>) -> String {
     )
 }
 
+/// After an I/O error of running out of descriptors, which and their limit ("" otherwise).
+pub fn note_for(reason: &std::io::Error) -> String {
+    match reason.raw_os_error() {
+        // EMFILE: this process holds as many as its limit allows.
+        Some(libc::EMFILE) => {
+            let limit = limit();
+            format!("; {}", exhausted_text(limit, limit))
+        }
+        Some(libc::ENFILE) => "; the system's table of open files is full (ENFILE)".into(),
+        _ => String::new(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

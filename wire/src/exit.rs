@@ -52,7 +52,10 @@ pub fn code_of(error: &(dyn std::error::Error + 'static)) -> Option<u8> {
             .is_some()
             || matches!(
                 error.downcast_ref::<crate::instance::InstanceError>(),
-                Some(crate::instance::InstanceError::Connection(_))
+                Some(
+                    crate::instance::InstanceError::Connection(_)
+                        | crate::instance::InstanceError::OutOfResources { .. }
+                )
             )
         {
             return Some(RESOURCES);
@@ -139,5 +142,36 @@ mod tests {
             "{}",
             exit.message
         );
+    }
+
+    #[cfg(feature = "ipc")]
+    #[test]
+    fn a_service_or_node_not_made_for_want_of_descriptors_asks_for_resources() {
+        let exhausted = crate::resources::Resources {
+            open_descriptors: Some(63),
+            descriptor_limit: Some(64),
+            shm_free_bytes: Some(1 << 30),
+        };
+        let error = crate::instance::InstanceError::OutOfResources {
+            what: "open service \"specimen\"".into(),
+            detail: "ResourceCreationFailed".into(),
+            resources: exhausted,
+        };
+        let exit = in_context("producer process", &error);
+        assert_eq!(exit.code, RESOURCES);
+        assert!(
+            exit.message.starts_with(
+                "producer process: cannot open service \"specimen\": ResourceCreationFailed; \
+                 file descriptors exhausted: 63 open of the limit 64"
+            ),
+            "{}",
+            exit.message
+        );
+        // The same error with descriptors to spare is not a resources fault.
+        let other = crate::instance::InstanceError::Service {
+            service: "specimen".into(),
+            detail: "ResourceCreationFailed".into(),
+        };
+        assert_eq!(in_context("producer process", &other).code, 1);
     }
 }

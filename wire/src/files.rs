@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 /// `source()` (an error chain printed with `{:#}` says it once); a process out of file
 /// descriptors says so with its limit.
 #[derive(Debug, thiserror::Error)]
-#[error("cannot {what} {}: {reason}{}", .path.display(), descriptors_note(.reason))]
+#[error("cannot {what} {}: {reason}{}", .path.display(), crate::descriptors::note_for(.reason))]
 pub struct FileError {
     pub path: PathBuf,
     /// `write`, `create`, `open`, `rename to`...
@@ -43,19 +43,6 @@ impl FileError {
             self.reason.raw_os_error(),
             Some(libc::EMFILE) | Some(libc::ENFILE)
         )
-    }
-}
-
-/// After an I/O error of running out of descriptors, which and their limit ("" otherwise).
-fn descriptors_note(reason: &std::io::Error) -> String {
-    match reason.raw_os_error() {
-        // EMFILE: this process holds as many as its limit allows.
-        Some(libc::EMFILE) => {
-            let limit = crate::descriptors::limit();
-            format!("; {}", crate::descriptors::exhausted_text(limit, limit))
-        }
-        Some(libc::ENFILE) => "; the system's table of open files is full (ENFILE)".into(),
-        _ => String::new(),
     }
 }
 

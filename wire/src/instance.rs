@@ -41,6 +41,15 @@ pub enum InstanceError {
     },
     #[error("{0}")]
     Io(String),
+    /// A node or a service that could not be made while the process's descriptors were
+    /// exhausted (exit code [`crate::exit::RESOURCES`]: a restart would fail the same way).
+    /// `what` says what, e.g. `open service "frames"`.
+    #[error("cannot {what}: {detail}; {resources}")]
+    OutOfResources {
+        what: String,
+        detail: String,
+        resources: crate::resources::Resources,
+    },
     /// A subscriber that could not connect to a publisher (exit code
     /// [`crate::exit::RESOURCES`]).
     #[error(transparent)]
@@ -136,7 +145,18 @@ impl Instance {
             // Signals are handled by `crate::signals` (installed first thing in `main`).
             .signal_handling_mode(SignalHandlingMode::Disabled)
             .create::<ipc::Service>()
-            .map_err(|e| node_error(format!("{e:?}; {}", crate::resources::Resources::now())))?;
+            .map_err(|e| {
+                let resources = crate::resources::Resources::now();
+                if resources.descriptors_exhausted() {
+                    InstanceError::OutOfResources {
+                        what: format!("create the {role} node"),
+                        detail: format!("{e:?}"),
+                        resources,
+                    }
+                } else {
+                    node_error(format!("{e:?}; {resources}"))
+                }
+            })?;
         Ok((node, removed))
     }
 

@@ -19,10 +19,20 @@ mod connect;
 
 type Ipc = ipc::Service;
 
+/// A service that could not be opened; with the descriptors exhausted, a resources fault.
 fn service_error(spec: &ServiceSpec, detail: impl Debug) -> InstanceError {
-    InstanceError::Service {
-        service: spec.name.to_string(),
-        detail: format!("{detail:?}; {}", crate::resources::Resources::now()),
+    let resources = crate::resources::Resources::now();
+    if resources.descriptors_exhausted() {
+        InstanceError::OutOfResources {
+            what: format!("open service {:?}", spec.name),
+            detail: format!("{detail:?}"),
+            resources,
+        }
+    } else {
+        InstanceError::Service {
+            service: spec.name.to_string(),
+            detail: format!("{detail:?}; {resources}"),
+        }
     }
 }
 
