@@ -549,7 +549,8 @@ impl Correlator {
             let (p, w) = unsafe { (plain.slice_mut(k * n2, n2), windowed.slice_mut(k * nn, nn)) };
             let mut sensitivity = GradientSensitivity::default();
             let (x0, y0) = (r.top_left.0 + pad, r.top_left.1 + pad);
-            let ok = engine.prepare_reference(image, x0, y0, p, w, &mut sensitivity);
+            let ok = engine.prepare_reference(image, x0, y0, p, w, &mut sensitivity)
+                && !engine.reference_has_flat_side();
             unsafe { sensitivities.write(k, sensitivity) };
             if !ok {
                 r.status = NodeStatus::LowContrast;

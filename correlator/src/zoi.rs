@@ -17,6 +17,8 @@ use crate::simd::{dot, F32x4};
 use crate::window::modified_hanning_2d;
 use rustfft::num_complex::Complex32;
 
+mod flat_side;
+
 /// A ZOI whose grey-level standard deviation is below this (in image counts) is `LowContrast`.
 pub const MIN_STD_COUNTS: f32 = 0.5;
 /// Sub-pixel iterations stop when the correction is below this (px).
@@ -343,7 +345,7 @@ impl ZoiEngine {
         assert_eq!(plain.len(), spectrum_len(n));
         assert_eq!(windowed.len(), n * n);
         *sensitivity = GradientSensitivity::default();
-        let contrast_ok = self.extract_zero_mean(image, x0, y0);
+        let contrast_ok = self.extract_zero_mean(image, x0, y0).is_some();
         if !contrast_ok {
             plain.fill(Complex32::new(0.0, 0.0));
             windowed.fill(0.0);
@@ -494,8 +496,18 @@ impl ZoiEngine {
         Some((sum_sq.sum() / (n * n) as f32).sqrt() >= MIN_STD_COUNTS)
     }
 
-    /// Copies the n x n block at (x0, y0) into `g_spatial` minus its mean; false if flat.
-    fn extract_zero_mean(&mut self, image: Image, x0: usize, y0: usize) -> bool {
+    /// Whether the ZOI [`ZoiEngine::prepare_reference`] last read runs off the specimen onto a
+    /// flat backdrop along one of its sides (`flat_side`): a reference ZOI must be textured
+    /// throughout.
+    pub fn reference_has_flat_side(&self) -> bool {
+        let n = self.n;
+        let std = (self.g_spatial.iter().map(|g| g * g).sum::<f32>() / (n * n) as f32).sqrt();
+        flat_side::has_flat_side(&self.g_spatial, n, std)
+    }
+
+    /// Copies the n x n block at (x0, y0) into `g_spatial` minus its mean; its standard
+    /// deviation, None if flat.
+    fn extract_zero_mean(&mut self, image: Image, x0: usize, y0: usize) -> Option<f32> {
         let n = self.n;
         // Exact integer sum of the u16 pixels (n² <= 65536 values: fits in u64 with room).
         let mut sum = 0u64;
@@ -518,7 +530,7 @@ impl ZoiEngine {
             sum_sq = sum_sq.mul_add(g, g);
         }
         let std = (sum_sq.sum() / (n * n) as f32).sqrt();
-        std >= MIN_STD_COUNTS
+        (std >= MIN_STD_COUNTS).then_some(std)
     }
 
     /// Writes w (g - weighted mean) into `out`, row y at `out[offset + y * stride..][..n]`;
@@ -779,7 +791,10 @@ impl ZoiEngine {
         if !deformed.contains_block(gx, gy, n) {
             return Err(NodeStatus::OutsideImage);
         }
-        if !self.extract_zero_mean(deformed, gx as usize, gy as usize) {
+        if self
+            .extract_zero_mean(deformed, gx as usize, gy as usize)
+            .is_none()
+        {
             return Err(NodeStatus::LowContrast);
         }
         place.origin_px = (place.ix as f64, place.iy as f64);
