@@ -58,6 +58,17 @@ fn symmetric_eigen(s: &Mat2) -> ([f64; 2], [f64; 2]) {
     ([mean + radius, mean - radius], [theta.cos(), theta.sin()])
 }
 
+/// In-plane principal stretches λ1 ≥ λ2 of the deformation gradient `f` (the square roots
+/// of the eigenvalues of B = F Fᵀ); None when F is not finite or not invertible.
+pub fn principal_stretches(f: &Mat2) -> Option<[f64; 2]> {
+    let det_f = det(f);
+    if f.iter().flatten().any(|v| !v.is_finite()) || det_f.is_nan() || det_f <= 0.0 {
+        return None;
+    }
+    let ([b1, b2], _) = symmetric_eigen(&mul(f, &transpose(f)));
+    Some([b1.sqrt(), b2.max(0.0).sqrt()])
+}
+
 /// The stress of a node whose in-plane deformation gradient is `f` (F = I + ∇u, reference to
 /// current), under `model` with parameters `p` (MPa).
 pub fn node_stress(model: &Model, p: &[f64], f: &Mat2) -> Result<NodeStress, NodeStressError> {

@@ -17,6 +17,7 @@ pub mod frames;
 pub mod latency;
 pub mod leftovers;
 pub mod liveness;
+pub mod mechanics_figures;
 pub mod origin_frames;
 pub mod pipeline;
 pub mod recorder;

@@ -1,5 +1,6 @@
 //! The files a run writes at its end from what it recorded: the latency histograms (also
-//! rewritten during the run), `latency.png`, the identification figures and `strain_map.png`.
+//! rewritten during the run), `latency.png`, the identification figures, `strain_map.png`,
+//! `forces.png` and `stretch_states.png`.
 //! A file that cannot be written is a note, never the end of the others.
 
 use super::StrainMapInfo;
@@ -66,6 +67,19 @@ pub(super) fn write(config: &RunConfig, results: &ResultsDir, recorder: &Recorde
     let models = &config.identifier.models.0;
     let figures = crate::figures::identification_figures(&results.root, &results.journal(), models);
     keep("identification figures", figures.map(|_| ()));
+    keep(
+        "forces.png",
+        crate::mechanics_figures::forces_png(&results.rig_csv(), &results.path("forces.png"))
+            .map(|_| ()),
+    );
+    keep(
+        "stretch_states.png",
+        crate::mechanics_figures::stretch_states_png(
+            &results.fields(),
+            &results.path("stretch_states.png"),
+        )
+        .map(|_| ()),
+    );
     let strain_map = strain_map(results, recorder);
     let strain_map = strain_map.unwrap_or_else(|e| {
         keep("strain_map.png", Err(e));

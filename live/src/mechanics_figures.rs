@@ -1,0 +1,239 @@
+//! The run's mechanical figures, drawn at the end from what the run wrote: each actuator's
+//! force against time (`forces.png`, from `rig.csv`: on a cruciform, each arm's), and the
+//! states the measured field reached in the (λ1, λ2) plane, a point per valid node of every
+//! saved field (`stretch_states.png`, the paper's Fig. 5) with the canonical paths (uniaxial
+//! λ2 = λ1^-1/2, pure shear λ2 = 1, equibiaxial λ2 = λ1) that the gauge route is limited to.
+
+use identifier::plot::{chart, Series};
+use std::path::{Path, PathBuf};
+
+/// Points per canonical path drawn.
+const PATH_SAMPLES: usize = 60;
+
+/// An actuator whose force never reaches this fraction of the largest one's peak only shows
+/// its load cell's noise (the Z pair of a planar test): left out.
+const IDLE_FRACTION: f64 = 0.1;
+
+/// Each actuator's force (kN, as `rig.csv` logs it) against time (s): one series per
+/// actuator that carried a load ([`IDLE_FRACTION`]).
+pub fn actuator_forces(rig_csv: &str) -> anyhow::Result<Vec<Series>> {
+    let mut lines = rig_csv.lines();
+    let header: Vec<&str> = lines
+        .next()
+        .ok_or_else(|| anyhow::anyhow!("rig.csv is empty"))?
+        .split(',')
+        .collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| anyhow::anyhow!("rig.csv has no column {name}"))
+    };
+    let time = column("t_s")?;
+    let actuators = rig::ids::ActuatorId::ALL
+        .iter()
+        .map(|id| Ok((id.name(), column(&format!("{}_force_kn", id.name()))?)))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let mut series: Vec<Series> = actuators
+        .iter()
+        .map(|(name, _)| Series {
+            label: format!("actuator {name}"),
+            points: Vec::new(),
+            markers: false,
+        })
+        .collect();
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        let number = |k: usize| cells.get(k).and_then(|c| c.parse::<f64>().ok());
+        // A row cut by a kill (the log's last) lacks cells: it is left out.
+        let Some(t_s) = number(time) else { continue };
+        for (s, (_, k)) in series.iter_mut().zip(&actuators) {
+            if let Some(force_kn) = number(*k).filter(|f| f.is_finite()) {
+                s.points.push((t_s, force_kn));
+            }
+        }
+    }
+    let peak = |s: &Series| s.points.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
+    let largest = series.iter().map(peak).fold(0.0, f64::max);
+    series.retain(|s| largest > 0.0 && peak(s) >= IDLE_FRACTION * largest);
+    Ok(series)
+}
+
+/// `forces.png` from the run's `rig.csv`; false when there is none (a run following a
+/// machine's CSV) or no actuator carried a force.
+pub fn forces_png(rig_csv: &Path, path: &Path) -> anyhow::Result<bool> {
+    let text = match std::fs::read_to_string(rig_csv) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
+        Err(e) => anyhow::bail!("{}: {e}", rig_csv.display()),
+    };
+    let series = actuator_forces(&text)?;
+    if series.is_empty() {
+        return Ok(false);
+    }
+    chart(path, "actuator forces", "time (s)", "force (kN)", &series)?;
+    Ok(true)
+}
+
+/// The in-plane principal stretches (λ1 ≥ λ2) of every `ok` node of a field CSV (the
+/// correlator's contract: `status` and the gradient `du_dx,du_dy,dv_dx,dv_dy`).
+pub fn node_stretches(field_csv: &str) -> anyhow::Result<Vec<(f64, f64)>> {
+    let mut lines = field_csv.lines();
+    let header: Vec<&str> = lines
+        .next()
+        .ok_or_else(|| anyhow::anyhow!("empty field file"))?
+        .split(',')
+        .collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| anyhow::anyhow!("the field file has no column {name}"))
+    };
+    let status = column("status")?;
+    let gradient = [
+        column("du_dx")?,
+        column("du_dy")?,
+        column("dv_dx")?,
+        column("dv_dy")?,
+    ];
+    let mut points = Vec::new();
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        if cells.get(status) != Some(&"ok") {
+            continue;
+        }
+        let g: Option<Vec<f64>> = gradient
+            .iter()
+            .map(|&k| cells.get(k).and_then(|c| c.parse().ok()))
+            .collect();
+        let Some(g) = g else { continue };
+        let f = [[1.0 + g[0], g[1]], [g[2], 1.0 + g[3]]];
+        if let Some([l1, l2]) = identifier::field_stress::principal_stretches(&f) {
+            points.push((l1, l2));
+        }
+    }
+    Ok(points)
+}
+
+/// The field files of `fields_dir` (`field_*.csv`), in frame order.
+fn field_files(fields_dir: &Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(fields_dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "csv")
+                && p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with("field_"))
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// The canonical paths over λ1 in [1, `max_l1`]: uniaxial, pure shear, equibiaxial.
+fn canonical_paths(max_l1: f64) -> Vec<Series> {
+    let path = |label: &str, l2: &dyn Fn(f64) -> f64| Series {
+        label: label.to_string(),
+        points: (0..=PATH_SAMPLES)
+            .map(|i| 1.0 + (max_l1 - 1.0) * i as f64 / PATH_SAMPLES as f64)
+            .map(|l1| (l1, l2(l1)))
+            .collect(),
+        markers: false,
+    };
+    vec![
+        path("uniaxial (λ2 = λ1^-1/2)", &|l1| 1.0 / l1.sqrt()),
+        path("pure shear (λ2 = 1)", &|_| 1.0),
+        path("equibiaxial (λ2 = λ1)", &|l1| l1),
+    ]
+}
+
+/// `stretch_states.png` from the saved fields; the number of node states drawn (0: no
+/// figure, no valid node with a gradient).
+pub fn stretch_states_png(fields_dir: &Path, path: &Path) -> anyhow::Result<usize> {
+    let mut states = Vec::new();
+    for file in field_files(fields_dir) {
+        let text = std::fs::read_to_string(&file)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+        states
+            .extend(node_stretches(&text).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?);
+    }
+    if states.is_empty() {
+        return Ok(0);
+    }
+    let max_l1 = states.iter().map(|s| s.0).fold(1.0, f64::max);
+    let mut series = vec![Series {
+        label: format!("nodes of the saved fields ({} states)", states.len()),
+        points: states.clone(),
+        markers: true,
+    }];
+    series.extend(canonical_paths(max_l1));
+    chart(
+        path,
+        "states the field reached (paper Fig. 5)",
+        "λ1 (larger in-plane principal stretch)",
+        "λ2",
+        &series,
+    )?;
+    Ok(states.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_actuators_force_is_read_against_time_and_idle_ones_left_out() {
+        let mut header = String::from("t_s,program");
+        for id in rig::ids::ActuatorId::ALL {
+            header.push_str(&format!(",{}_force_kn", id.name()));
+        }
+        let row = |t: f64, x: f64| {
+            let mut r = format!("{t},1");
+            for id in rig::ids::ActuatorId::ALL {
+                // The others show their load cell's noise.
+                let f = if id.name().starts_with('X') { x } else { 0.01 };
+                r.push_str(&format!(",{f}"));
+            }
+            r
+        };
+        // The last row was cut by a kill.
+        let text = format!("{header}\n{}\n{}\n0.2,1,0.", row(0.0, 0.0), row(0.1, 1.5));
+        let series = actuator_forces(&text).unwrap();
+        let labels: Vec<&str> = series.iter().map(|s| s.label.as_str()).collect();
+        assert_eq!(labels, ["actuator X+", "actuator X-"]);
+        assert_eq!(series[0].points, [(0.0, 0.0), (0.1, 1.5), (0.2, 0.0)]);
+        assert!(actuator_forces("t_s,x\n1,2").is_err());
+    }
+
+    #[test]
+    fn a_nodes_principal_stretches_come_from_its_gradient_and_only_ok_nodes_count() {
+        let header = correlator::output::CSV_HEADER;
+        // Equibiaxial 1.2 rotated by 30°: F = R diag(1.2, 1.2); a uniaxial 1.44 along y:
+        // F = diag(1/1.2, 1.44).
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let rotated = [1.2 * c - 1.0, -1.2 * s, 1.2 * s, 1.2 * c - 1.0];
+        let uniaxial = [1.0 / 1.2 - 1.0, 0.0, 0.0, 0.44];
+        let row = |status: &str, g: [f64; 4]| {
+            format!(
+                "0,0,0,0,0,0,0,1,3,{status},{},{},{},{}",
+                g[0], g[1], g[2], g[3]
+            )
+        };
+        let text = format!(
+            "{header}\n{}\n{}\n{}",
+            row("ok", rotated),
+            row("ok", uniaxial),
+            row("low_zncc", uniaxial)
+        );
+        let points = node_stretches(&text).unwrap();
+        assert_eq!(points.len(), 2);
+        let close =
+            |a: (f64, f64), b: (f64, f64)| (a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12;
+        assert!(close(points[0], (1.2, 1.2)), "{points:?}");
+        assert!(close(points[1], (1.44, 1.0 / 1.2)), "{points:?}");
+        assert!(node_stretches("x,y,u,v\n1,2,3,4").is_err());
+    }
+}
