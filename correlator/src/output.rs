@@ -97,15 +97,33 @@ pub struct ColourRange {
     pub high: f64,
 }
 
+/// The narrowest range of a strain map: 0.2 %, ten times the strain noise of a good field, so a
+/// uniform field shows one colour.
+pub const MIN_STRAIN_SPAN: f64 = 0.002;
+/// The narrowest range of a displacement map, px.
+pub const MIN_DISPLACEMENT_SPAN_PX: f64 = 0.1;
+
+/// The colour map's colour at `t` in [0, 1] (0 blue, 0.5 green, 1 red), RGB in [0, 255].
+pub fn blue_to_red(t: f64) -> [f64; 3] {
+    [
+        255.0 * t,
+        255.0 * (1.0 - (2.0 * t - 1.0).abs()),
+        255.0 * (1.0 - t),
+    ]
+}
+
 /// RGB bytes (row-major, 3 per pixel) of the grey image `grey` (`width` px wide), overlaid
 /// inside the mesh with a blue-to-red map of `value` (bilinear between valid nodes; range =
 /// the 2nd to 98th percentile of the valid nodes' values, so that a few outliers do not flatten
-/// the map; values beyond saturate). Returns the range used.
+/// the map; values beyond saturate), widened about its middle to `min_span` at least, so that
+/// a uniform field shows one colour rather than its noise stretched over the whole map.
+/// Returns the range used.
 pub fn colour_map_rgb(
     grey: &[u16],
     width: usize,
     field: &Field,
     value: impl Fn(&Node) -> f64,
+    min_span: f64,
 ) -> (Vec<u8>, ColourRange) {
     assert!(width > 0 && grey.len().is_multiple_of(width), "image shape");
     let (w, h) = (width, grey.len() / width);
@@ -122,7 +140,9 @@ pub fn colour_map_rgb(
     let (lo, hi) = if valid.is_empty() {
         (0.0, 0.0)
     } else {
-        (quantile(0.02), quantile(0.98))
+        let (lo, hi) = (quantile(0.02), quantile(0.98));
+        let widen = (min_span - (hi - lo)).max(0.0) / 2.0;
+        (lo - widen, hi + widen)
     };
     let span = if hi > lo { hi - lo } else { 1.0 };
     let mut rgb = vec![0u8; w * h * 3];
@@ -168,12 +188,7 @@ pub fn colour_map_rgb(
                 if weight <= 1e-9 {
                     continue;
                 }
-                let t = ((sum / weight - lo) / span).clamp(0.0, 1.0);
-                let colour = [
-                    255.0 * t,
-                    255.0 * (1.0 - (2.0 * t - 1.0).abs()),
-                    255.0 * (1.0 - t),
-                ];
+                let colour = blue_to_red(((sum / weight - lo) / span).clamp(0.0, 1.0));
                 let px = &mut rgb[3 * (y * w + x)..3 * (y * w + x) + 3];
                 for (c, &col) in px.iter_mut().zip(&colour) {
                     *c = (0.35 * *c as f64 + 0.65 * col) as u8;
@@ -270,7 +285,7 @@ mod tests {
     fn colour_map_spans_the_valid_values() {
         let f = field();
         let grey = vec![100u16; 16 * 12];
-        let (rgb, range) = colour_map_rgb(&grey, 16, &f, |n| n.exx);
+        let (rgb, range) = colour_map_rgb(&grey, 16, &f, |n| n.exx, MIN_STRAIN_SPAN);
         assert_eq!(rgb.len(), 16 * 12 * 3);
         assert_eq!(
             range,
@@ -285,5 +300,21 @@ mod tests {
         assert!(px(14, 2)[0] > px(14, 2)[2]);
         // Outside the mesh: grey.
         assert_eq!(px(0, 0), &[255, 255, 255]);
+    }
+
+    #[test]
+    fn a_uniform_field_is_drawn_on_the_narrowest_range_about_its_value() {
+        let f = field();
+        let grey = vec![100u16; 16 * 12];
+        // exx 0.5 + 1e-4 x: noise about a uniform value.
+        let (_, range) = colour_map_rgb(&grey, 16, &f, |n| 0.5 + 1e-4 * n.exx, MIN_STRAIN_SPAN);
+        assert!(
+            (range.high - range.low - MIN_STRAIN_SPAN).abs() < 1e-12,
+            "{range:?}"
+        );
+        assert!(
+            (0.5 + 1.5e-4 - (range.low + range.high) / 2.0).abs() < 1e-12,
+            "{range:?}"
+        );
     }
 }

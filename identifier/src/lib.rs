@@ -31,6 +31,7 @@ pub mod kinematics;
 /// The law lives in its own crate (`material`), shared with the rig; re-exported here.
 pub use material as law;
 pub mod lsq;
+pub mod map_figure;
 pub mod models;
 pub mod online;
 pub mod plot;

@@ -166,14 +166,19 @@ fn bounds(series: &[Series]) -> Option<(f64, f64, f64, f64)> {
     (x0 < x1 && y0 <= y1).then_some((x0, x1, y0, y1))
 }
 
-/// The RGB image encoded as a PNG and written atomically at `path`.
+/// The RGB image of a chart's size encoded as a PNG and written atomically at `path`.
 fn write_png(path: &Path, rgb: &[u8]) -> Result<(), PlotError> {
+    write_png_sized(path, rgb, SIZE_PX)
+}
+
+/// The RGB image of `size_px` (width, height) encoded as a PNG and written atomically at `path`.
+pub fn write_png_sized(path: &Path, rgb: &[u8], size_px: (u32, u32)) -> Result<(), PlotError> {
     let mut png = Vec::new();
     image::ImageEncoder::write_image(
         image::codecs::png::PngEncoder::new(&mut png),
         rgb,
-        SIZE_PX.0,
-        SIZE_PX.1,
+        size_px.0,
+        size_px.1,
         image::ExtendedColorType::Rgb8,
     )
     .map_err(|e| PlotError(format!("{}: cannot encode the PNG: {e}", path.display())))?;

@@ -42,26 +42,38 @@ pub fn identification_figures(
     )?)
 }
 
-/// RGB colour map of a field's exx over its origin image, as PNG at `path`; returns the
-/// strain range from blue to red.
+/// The colour map of a field's exx over its origin image, with its title (the strain measure,
+/// the frame) and a colour bar of its range in %, as PNG at `path`; returns the strain range
+/// from blue to red (at least [`correlator::output::MIN_STRAIN_SPAN`] wide).
 pub fn strain_map(
     path: &Path,
     grey: &[u16],
     width: usize,
     field: &correlator::Field,
+    title: &str,
 ) -> anyhow::Result<[f64; 2]> {
-    let (rgb, range) = correlator::output::colour_map_rgb(grey, width, field, |n| n.exx);
-    let height = grey.len() / width;
-    let mut bytes = Vec::new();
-    image::ImageEncoder::write_image(
-        image::codecs::png::PngEncoder::new(&mut bytes),
-        &rgb,
-        width as u32,
-        height as u32,
-        image::ExtendedColorType::Rgb8,
+    let (rgb, range) = correlator::output::colour_map_rgb(
+        grey,
+        width,
+        field,
+        |n| n.exx,
+        correlator::output::MIN_STRAIN_SPAN,
+    );
+    let label = |v: f64| format!("{:+.2} %", 100.0 * v);
+    identifier::map_figure::write(
+        path,
+        &identifier::map_figure::MapFigure {
+            rgb: &rgb,
+            width_px: width,
+            height_px: grey.len() / width,
+            title,
+            low: range.low,
+            high: range.high,
+            label: &label,
+            colour: &correlator::output::blue_to_red,
+        },
     )
     .with_context(|| path.display().to_string())?;
-    wire::files::write_atomic(path, &bytes)?;
     Ok([range.low, range.high])
 }
 

@@ -284,11 +284,21 @@ fn write_field_files(
         let magnitude = |n: &correlator::Node| n.u_px.hypot(n.v_px);
         write(
             &args.out.join(format!("u_{index:04}.png")),
-            &colour_map(reference, field, magnitude)?,
+            &colour_map(
+                reference,
+                field,
+                magnitude,
+                correlator::output::MIN_DISPLACEMENT_SPAN_PX,
+            )?,
         )?;
         write(
             &args.out.join(format!("exx_{index:04}.png")),
-            &colour_map(reference, field, |n| n.exx)?,
+            &colour_map(
+                reference,
+                field,
+                |n| n.exx,
+                correlator::output::MIN_STRAIN_SPAN,
+            )?,
         )?;
     }
     Ok(())
@@ -373,12 +383,14 @@ fn colour_map(
     reference: &producer::Image16,
     field: &Field,
     value: impl Fn(&correlator::Node) -> f64,
+    min_span: f64,
 ) -> Result<Vec<u8>> {
     let (rgb, _range) = correlator::output::colour_map_rgb(
         &reference.pixels,
         reference.width as usize,
         field,
         value,
+        min_span,
     );
     let (w, h) = (reference.width as usize, reference.height as usize);
     let mut bytes = Vec::new();

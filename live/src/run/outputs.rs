@@ -105,11 +105,16 @@ fn strain_map(results: &ResultsDir, recorder: &Recorder) -> anyhow::Result<Optio
         })?;
     let field = crate::recorder::to_correlator_field(header, nodes);
     let path = results.path("strain_map.png");
-    let range = crate::figures::strain_map(&path, pixels, frame.width_px as usize, &field)?;
+    let measure = wire::StrainMeasure::from_code(header.strain_measure).map_or("?", |m| m.name());
+    let title = format!(
+        "exx ({measure} strain), frame {} from frame {}",
+        header.frame_id, header.origin_frame_id
+    );
+    let range = crate::figures::strain_map(&path, pixels, frame.width_px as usize, &field, &title)?;
     Ok(Some(StrainMapInfo {
         frame_id: header.frame_id,
         origin_frame_id: header.origin_frame_id,
-        measure: wire::StrainMeasure::from_code(header.strain_measure).map_or("?", |m| m.name()),
+        measure,
         exx_blue_to_red: range,
     }))
 }
