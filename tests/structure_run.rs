@@ -10,16 +10,16 @@ use common::bench_run::{
 };
 use common::Run;
 
-/// The short campaign on the structure, with `run`'s configuration.
-fn structure_config(run: &Run) -> std::path::PathBuf {
+/// The short campaign on the structure, with `run_keys` in `[run]`.
+fn structure_config(run: &Run, run_keys: &str) -> std::path::PathBuf {
     let extra = format!("{SHORT_CAMPAIGN}[specimen]\nmodel = \"structure\"\n");
-    config(run, "", &extra)
+    config(run, run_keys, &extra)
 }
 
 #[test]
 fn a_run_on_the_structure_compares_every_node_with_the_filmed_field() {
     let mut run = Run::new("run_structure");
-    let config = structure_config(&run);
+    let config = structure_config(&run, "");
     let out = run.dir.join("out");
     start_run(&mut run, "run", &config, &out, &["--no-dashboard"]);
     let (status, stdout, stderr) = run.child("run").wait();
@@ -62,7 +62,8 @@ fn a_run_on_the_structure_compares_every_node_with_the_filmed_field() {
 #[test]
 fn a_rig_killed_mid_test_on_the_structure_leaves_no_field_without_its_truth() {
     let mut run = Run::new("kill_rig_structure");
-    let config = structure_config(&run);
+    // VTK fields too: their time series must list every one written, the kill notwithstanding.
+    let config = structure_config(&run, "vtk = true");
     let out = run.dir.join("out");
     let parent = start_run(
         &mut run,
@@ -90,6 +91,31 @@ fn a_rig_killed_mid_test_on_the_structure_leaves_no_field_without_its_truth() {
     assert_eq!(truth["fields_compared"], summary["fields"], "{truth}");
     let p99 = truth["node_error_p99_px"].as_f64().unwrap();
     assert!(p99 < 0.05, "node error p99 {p99} px\n{truth}");
+    let fields = out.join("fields");
+    let series: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fields.join("fields.vtk.series")).unwrap())
+            .unwrap();
+    let listed: Vec<&str> = series["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["name"].as_str().unwrap())
+        .collect();
+    let mut written: Vec<String> = std::fs::read_dir(&fields)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".vtk"))
+        .collect();
+    written.sort();
+    assert!(!written.is_empty());
+    assert_eq!(listed, written, "{series}");
+    let times: Vec<f64> = series["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["time"].as_f64().unwrap())
+        .collect();
+    assert!(times.windows(2).all(|t| t[0] < t[1]), "{times:?}");
     assert!(
         run.instance.leftover_files().is_empty(),
         "{:?}",

@@ -26,6 +26,7 @@ pub mod run;
 pub mod status;
 pub mod subscriptions;
 pub mod truth;
+pub mod vtk_series;
 
 pub use config::RunConfig;
 pub use run::{run, Ending, RunOptions, RunReport};

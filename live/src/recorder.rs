@@ -73,6 +73,8 @@ pub struct Recorder {
     pub max_stretch: [f64; 3],
     row: String,
     text: String,
+    /// The VTK fields written so far, as one time series (`fields/fields.vtk.series`).
+    vtk_series: crate::vtk_series::VtkSeries,
     /// Errors writing results (the run goes on, the error is reported once).
     pub write_error: Option<FileError>,
 }
@@ -113,6 +115,7 @@ impl Recorder {
             frames_dropped_by_ended_correlators: 0,
             frames_dropped_by_correlator: 0,
             origin_frames: OriginFrames::default(),
+            vtk_series: crate::vtk_series::VtkSeries::new(),
             peak_field: None,
             max_stretch: [1.0; 3],
             row: String::with_capacity(1024),
@@ -310,7 +313,15 @@ impl Recorder {
                 &format!("dicstream run field of frame {}", header.frame_id),
                 &mut self.text,
             );
-            write_atomic(&stem.with_extension("vtk"), self.text.as_bytes())?;
+            let vtk = stem.with_extension("vtk");
+            write_atomic(&vtk, self.text.as_bytes())?;
+            let name = vtk.file_name().map(|n| n.to_string_lossy().into_owned());
+            let time_s = header.t_capture_ns.saturating_sub(self.t0_ns) as f64 * 1e-9;
+            self.vtk_series.push(name.unwrap_or_default(), time_s);
+            write_atomic(
+                &self.results.fields().join(crate::vtk_series::FILE_NAME),
+                self.vtk_series.to_json().as_bytes(),
+            )?;
         }
         Ok(())
     }
