@@ -435,4 +435,8 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
     let run = bench.child("run");
     run.signal(libc::SIGINT);
     assert_eq!(run.wait_exit().code(), Some(130), "{}", run.stderr());
+    // The page says the run ended (interrupted mid-test), not "reconnecting".
+    until("the page saying the run ended", || {
+        (read_page(&browser)["conn"] == "run ended").then_some(())
+    });
 }

@@ -394,6 +394,13 @@ function connect() {
   es.addEventListener('snapshot', (e) => {
     try { update(JSON.parse(e.data)); } catch (err) { console.error(err); }
   });
+  // The server is stopping (the run is over): no reconnecting, and what ended.
+  es.addEventListener('end', () => {
+    es.close();
+    const finished = dash.last && dash.last.rig && dash.last.rig.program === 'finished';
+    $('conn').textContent = finished ? 'test finished' : 'run ended';
+    $('conn').className = finished ? 'good' : 'warn';
+  });
 }
 for (const id of ['component', 'map-measure', 'range-mode', 'range-min', 'range-max', 'show-mesh', 'show-map']) {
   $(id).addEventListener('change', drawSpecimen);

@@ -1,6 +1,7 @@
 //! `/events`: snapshots as server-sent events on the viewer's own connection, until the viewer
 //! goes, stops reading (an event not taken within the write timeout drops it) or the hub
-//! stops.
+//! stops; then an `end` event tells the page the run is over (it stops reconnecting and says
+//! so, rather than "reconnecting").
 
 use super::limits::Limits;
 use super::timed::Timed;
@@ -40,4 +41,5 @@ pub fn stream(stream: &TcpStream, hub: &Hub, limits: &Limits, head_only: bool) {
             return;
         }
     }
+    let _ = out.write_all(b"event: end\ndata: {}\n\n");
 }
