@@ -269,6 +269,9 @@ pub struct ZoiEngine {
     /// Spectra of a ZOI that is not in the reference cache ([`Self::correlate_uncached`]).
     uncached_plain: Vec<Complex32>,
     uncached_windowed: Vec<f32>,
+    /// The sub-pixel sums run on AVX2 + FMA ([`sums_avx2`]): the CPU has them and n is a
+    /// multiple of 8.
+    avx2: bool,
     pub profile: bool,
     pub split: TimeSplit,
     /// Integer FFT searches this engine ran (a confirmed prediction runs none): a count, not
@@ -319,6 +322,7 @@ impl ZoiEngine {
             phase_y: vec![zero; n],
             uncached_plain: vec![zero; spectrum_len(n)],
             uncached_windowed: vec![0.0; n * n],
+            avx2: sums_avx2_available(n),
             profile: false,
             split: TimeSplit::default(),
             searches: 0,
@@ -526,6 +530,24 @@ impl ZoiEngine {
     fn window_rows(&self, out: &mut [f32], stride: usize, offset: usize) -> Option<f32> {
         let n = self.n;
         assert!(stride >= n && out.len() >= offset + (n - 1) * stride + n);
+        let floor = MIN_STD_COUNTS * self.window_sum.sqrt();
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where sums_avx2::available() returned true.
+            let sum_sq = unsafe {
+                sums_avx2::window_rows(
+                    &self.window,
+                    &self.g_spatial,
+                    self.window_sum,
+                    n,
+                    out,
+                    stride,
+                    offset,
+                )
+            };
+            let norm = sum_sq.sqrt();
+            return (norm.is_finite() && norm >= floor).then_some(norm);
+        }
         let mean = F32x4::splat(dot(&self.window, &self.g_spatial) / self.window_sum);
         let mut sum_sq = F32x4::zero();
         for (y, (w_row, g_row)) in self
@@ -544,7 +566,6 @@ impl ZoiEngine {
             }
         }
         let norm = sum_sq.sum().sqrt();
-        let floor = MIN_STD_COUNTS * self.window_sum.sqrt();
         (norm.is_finite() && norm >= floor).then_some(norm)
     }
 
@@ -963,6 +984,14 @@ impl ZoiEngine {
         assert!(centre.0.unsigned_abs() < PAD as u64 && centre.1.unsigned_abs() < PAD as u64);
         assert!(n.is_multiple_of(4) && reference.len() == n * n);
         let x0 = (PAD as i64 + centre.0 - 1) as usize;
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            let dy = [centre.1 - 1, centre.1, centre.1 + 1];
+            // SAFETY: `avx2` is set only where sums_avx2::available() returned true.
+            let sums =
+                unsafe { sums_avx2::correlation_3x3(reference, &self.extended, n, stride, x0, dy) };
+            return sums.map(|row| row.map(|v| v * scale));
+        }
         let mut out = [[0.0f32; 3]; 3];
         for (r, out_row) in out.iter_mut().enumerate() {
             let dy = centre.1 + r as i64 - 1;
@@ -1002,6 +1031,22 @@ impl ZoiEngine {
         } else {
             (at.0, at.1, self.correlation_3x3(reference, at, scale))
         }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod sums_avx2;
+
+/// Whether a ZOI of side n runs its sub-pixel sums on AVX2 + FMA.
+fn sums_avx2_available(n: usize) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        n.is_multiple_of(8) && sums_avx2::available()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = n;
+        false
     }
 }
 
