@@ -367,6 +367,19 @@ impl ZoiEngine {
         ok
     }
 
+    /// The windowed ZOI of [`Self::prepare_reference`] alone, into `windowed`; false when the
+    /// ZOI has too little contrast (`windowed` then holds nothing of use).
+    fn prepare_windowed(
+        &mut self,
+        image: Image,
+        x0: usize,
+        y0: usize,
+        windowed: &mut [f32],
+    ) -> bool {
+        assert!(image.contains_block(x0 as i64, y0 as i64, self.n));
+        self.extract_zero_mean(image, x0, y0) && self.window_into(windowed).is_some()
+    }
+
     /// The first-order response of the windowed correlation peak to a displacement gradient,
     /// for the reference ZOI: `g_spatial` holds it zero-mean, `f_w` windowed (w (f − mean_w),
     /// any scale). At the peak, Σ f_w ∇(w g_d) = 0, g_d the deformed ZOI moved back by the
@@ -606,13 +619,11 @@ impl ZoiEngine {
         if !(guess_px.0.is_finite() && guess_px.1.is_finite()) {
             return ZoiResult::with_status(NodeStatus::NoGuess, 0);
         }
-        let warp = search
-            .warp
-            .filter(|&g| g.iter().flatten().all(|v| v.is_finite()) && warp_worth_it(g, self.n));
+        let warp = self.usable_warp(search.warp);
         let a = warp.map(identity_plus);
         if search.predicted {
             if let Some(result) =
-                self.correlate_predicted(reference, deformed, &search, warp, &mut timer)
+                self.correlate_predicted(reference.windowed, deformed, &search, warp, &mut timer)
             {
                 return result;
             }
@@ -634,11 +645,17 @@ impl ZoiEngine {
         Self::result(origin, estimate, warp, &search)
     }
 
+    /// The gradient a ZOI is sampled through: `warp` when finite and worth it.
+    fn usable_warp(&self, warp: Option<Mat2>) -> Option<Mat2> {
+        warp.filter(|&g| g.iter().flatten().all(|v| v.is_finite()) && warp_worth_it(g, self.n))
+    }
+
     /// [`Self::correlate`] from a prediction without the integer search; None when the
     /// prediction is not confirmed or the ZOI cannot be cut there (the full search decides).
+    /// It needs the reference's windowed ZOI only (`windowed`).
     fn correlate_predicted(
         &mut self,
-        reference: &ReferenceSpectra,
+        windowed: &[f32],
         deformed: Image,
         search: &ZoiSearch,
         warp: Option<Mat2>,
@@ -672,9 +689,7 @@ impl ZoiEngine {
         self.fft.forward(&self.g_spatial, &mut self.g_spectrum);
         timer.lap(&mut self.split.fft_ns);
         let max = search.iterations.max;
-        let estimate = self
-            .subpixel(reference.windowed, start, max, true, timer)
-            .ok()?;
+        let estimate = self.subpixel(windowed, start, max, true, timer).ok()?;
         Some(Self::result(place.origin_px, estimate, warp, search))
     }
 
@@ -876,18 +891,39 @@ impl ZoiEngine {
     }
 
     /// [`Self::correlate`] for a ZOI of another image than the cached references (a node's
-    /// ZOI in the frame its mesh was defined in): its spectra are prepared in the engine's own
-    /// buffers first. `LowContrast` when that ZOI is flat.
+    /// ZOI in the frame its mesh was defined in): its data are prepared in the engine's own
+    /// buffers first, and only those the correlation uses: a prediction the windowed
+    /// correlation confirms needs the windowed ZOI alone, not its spectrum nor its gradient
+    /// sensitivity. The same result as [`Self::correlate`] with [`Self::prepare_reference`]'s
+    /// spectra. `LowContrast` when that ZOI is flat.
     pub fn correlate_uncached(
         &mut self,
         reference: Image,
         deformed: Image,
-        search: ZoiSearch,
+        mut search: ZoiSearch,
     ) -> ZoiResult {
         let mut plain = std::mem::take(&mut self.uncached_plain);
         let mut windowed = std::mem::take(&mut self.uncached_windowed);
-        let mut sensitivity = GradientSensitivity::default();
         let (x0, y0) = search.top_left_px;
+        let finite = search.guess_px.0.is_finite() && search.guess_px.1.is_finite();
+        if search.predicted && finite {
+            let mut timer = Timer::start(self.profile);
+            let shortcut = if self.prepare_windowed(reference, x0, y0, &mut windowed) {
+                timer.lap(&mut self.split.window_ns);
+                let warp = self.usable_warp(search.warp);
+                self.correlate_predicted(&windowed, deformed, &search, warp, &mut timer)
+            } else {
+                Some(ZoiResult::with_status(NodeStatus::LowContrast, 0))
+            };
+            if let Some(result) = shortcut {
+                self.uncached_plain = plain;
+                self.uncached_windowed = windowed;
+                return result;
+            }
+            // Not confirmed: the full search, as `correlate` runs it after the same attempt.
+            search.predicted = false;
+        }
+        let mut sensitivity = GradientSensitivity::default();
         let result = if self.prepare_reference(
             reference,
             x0,
