@@ -969,6 +969,20 @@ impl ZoiEngine {
         fill(&mut self.phase_x, d.0, scale);
         fill(&mut self.phase_y, d.1, 1.0);
         // Half-spectrum layout: index kx * n + ky, kx in 0..=n/2.
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where sums_avx2::available() returned true.
+            unsafe {
+                sums_avx2::phase_ramp(
+                    &self.g_spectrum,
+                    &self.phase_x[..=n / 2],
+                    &self.phase_y,
+                    &mut self.work,
+                )
+            };
+            self.fft.inverse(&mut self.work, &mut self.g_spatial);
+            return;
+        }
         for kx in 0..=n / 2 {
             let px = self.phase_x[kx];
             let row = &mut self.work[kx * n..(kx + 1) * n];

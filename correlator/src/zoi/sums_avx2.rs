@@ -1,5 +1,6 @@
 //! The AVX2 + FMA twins of the sub-pixel iterations' sums in [`super::ZoiEngine`]: the 3x3
-//! windowed correlation values and the windowing of the deformed ZOI. The portable (SSE) sums
+//! windowed correlation values, the windowing of the deformed ZOI and the Fourier shift's
+//! phase ramp (four complex products per instruction sequence). The portable (SSE) sums
 //! run each value in one chain of dependent adds, so they wait on the add latency (a 3x3 at
 //! 32 px, 9216 products, took about 0.9 µs); here the nine values of a 3x3 accumulate in nine
 //! independent 8-lane FMA chains in one pass over the rows, and the windowing's sums in two
@@ -8,11 +9,13 @@
 //!
 //! The caller checks [`available`] (std caches the CPU's answer) and a ZOI side that is a
 //! multiple of 8. Only the 8-value loads and stores are unsafe, each on a slice of at least 8
-//! values.
+//! values, and the views of complex slices as their f32 pairs.
 
+use rustfft::num_complex::Complex32;
 use std::arch::x86_64::{
-    __m256, _mm256_fmadd_ps, _mm256_loadu_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_setzero_ps,
-    _mm256_storeu_ps, _mm256_sub_ps,
+    __m256, _mm256_fmadd_ps, _mm256_fmaddsub_ps, _mm256_loadu_ps, _mm256_movehdup_ps,
+    _mm256_moveldup_ps, _mm256_mul_ps, _mm256_permute_ps, _mm256_set1_ps, _mm256_setr_ps,
+    _mm256_setzero_ps, _mm256_storeu_ps, _mm256_sub_ps,
 };
 
 /// Whether this CPU runs this module's functions.
@@ -37,6 +40,60 @@ fn store8(v: __m256, out: &mut [f32]) {
     let out = &mut out[..8];
     // SAFETY: writes the 8 values of `out`.
     unsafe { _mm256_storeu_ps(out.as_mut_ptr(), v) }
+}
+
+/// Four complex products a b, each complex number two lanes (re, im).
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn complex_mul(a: __m256, b: __m256) -> __m256 {
+    let swapped = _mm256_permute_ps(a, 0xB1);
+    // Even lanes a.re b.re − a.im b.im, odd lanes a.im b.re + a.re b.im.
+    _mm256_fmaddsub_ps(
+        a,
+        _mm256_moveldup_ps(b),
+        _mm256_mul_ps(swapped, _mm256_movehdup_ps(b)),
+    )
+}
+
+/// The values of a complex slice as re, im pairs.
+fn as_floats(values: &[Complex32]) -> &[f32] {
+    // SAFETY: Complex32 is `repr(C)` { re: f32, im: f32 }: 2 len f32 values, same alignment.
+    unsafe { std::slice::from_raw_parts(values.as_ptr().cast::<f32>(), 2 * values.len()) }
+}
+
+/// [`as_floats`] for a mutable slice.
+fn as_floats_mut(values: &mut [Complex32]) -> &mut [f32] {
+    // SAFETY: as in `as_floats`, and the borrow is exclusive.
+    unsafe { std::slice::from_raw_parts_mut(values.as_mut_ptr().cast::<f32>(), 2 * values.len()) }
+}
+
+/// The Fourier shift's phase ramp on the half spectrum `g` (rows of n, `phase_x.len()` of
+/// them): `work[kx n + ky]` = g[kx n + ky] (phase_x[kx] phase_y[ky]), the products of
+/// `ZoiEngine::shift_into_spatial` four bins at a time.
+///
+/// # Safety
+/// [`available`] returned true.
+#[target_feature(enable = "avx2,fma")]
+pub unsafe fn phase_ramp(
+    g: &[Complex32],
+    phase_x: &[Complex32],
+    phase_y: &[Complex32],
+    work: &mut [Complex32],
+) {
+    let n = phase_y.len();
+    assert!(n.is_multiple_of(4) && g.len() == work.len() && g.len() >= phase_x.len() * n);
+    let (py, g) = (as_floats(phase_y), as_floats(g));
+    let work = as_floats_mut(work);
+    for (kx, px) in phase_x.iter().enumerate() {
+        let px = _mm256_setr_ps(px.re, px.im, px.re, px.im, px.re, px.im, px.re, px.im);
+        let row = 2 * kx * n;
+        let mut c = 0;
+        while c < 2 * n {
+            let pxy = complex_mul(px, load8(&py[c..]));
+            store8(complex_mul(load8(&g[row + c..]), pxy), &mut work[row + c..]);
+            c += 8;
+        }
+    }
 }
 
 /// The sum of the 8 lanes.
@@ -151,7 +208,38 @@ pub unsafe fn window_rows(
 
 #[cfg(test)]
 mod tests {
-    use super::super::{ZoiEngine, PAD};
+    use super::super::{spectrum_len, ZoiEngine, PAD};
+    use rustfft::num_complex::Complex32;
+
+    /// The phase ramp gives the portable products g (px py) to rounding.
+    #[test]
+    fn the_avx2_phase_ramp_is_the_portable_one() {
+        if !super::available() {
+            return;
+        }
+        for n in [8usize, 16, 32] {
+            let unit = |a: f32| Complex32::new(a.cos(), a.sin());
+            let g: Vec<Complex32> = (0..spectrum_len(n))
+                .map(|i| Complex32::new((i as f32 * 0.7).sin() * 50.0, (i as f32 * 0.3).cos()))
+                .collect();
+            let phase_x: Vec<Complex32> =
+                (0..=n / 2).map(|k| unit(k as f32 * 0.37) * 0.01).collect();
+            let phase_y: Vec<Complex32> = (0..n).map(|k| unit(k as f32 * -0.81)).collect();
+            let mut work = vec![Complex32::new(0.0, 0.0); spectrum_len(n)];
+            // SAFETY: available() returned true.
+            unsafe { super::phase_ramp(&g, &phase_x, &phase_y, &mut work) };
+            for kx in 0..=n / 2 {
+                for ky in 0..n {
+                    let i = kx * n + ky;
+                    let expected = g[i] * (phase_x[kx] * phase_y[ky]);
+                    assert!(
+                        (work[i] - expected).norm() <= 1e-6 * g[i].norm().max(1.0),
+                        "{n} {i}"
+                    );
+                }
+            }
+        }
+    }
 
     /// A speckle-like ZOI: sums of sines, any scale.
     fn texture(n: usize, phase: f32) -> Vec<f32> {
