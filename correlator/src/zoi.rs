@@ -271,6 +271,9 @@ pub struct ZoiEngine {
     /// Spectra of a ZOI that is not in the reference cache ([`Self::correlate_uncached`]).
     uncached_plain: Vec<Complex32>,
     uncached_windowed: Vec<f32>,
+    /// The sub-pixel sums run on AVX2 + FMA ([`sums_avx2`]): the CPU has them and n is a
+    /// multiple of 8.
+    avx2: bool,
     pub profile: bool,
     pub split: TimeSplit,
     /// Integer FFT searches this engine ran (a confirmed prediction runs none): a count, not
@@ -321,6 +324,7 @@ impl ZoiEngine {
             phase_y: vec![zero; n],
             uncached_plain: vec![zero; spectrum_len(n)],
             uncached_windowed: vec![0.0; n * n],
+            avx2: sums_avx2_available(n),
             profile: false,
             split: TimeSplit::default(),
             searches: 0,
@@ -363,6 +367,19 @@ impl ZoiEngine {
             windowed.fill(0.0);
         }
         ok
+    }
+
+    /// The windowed ZOI of [`Self::prepare_reference`] alone, into `windowed`; false when the
+    /// ZOI has too little contrast (`windowed` then holds nothing of use).
+    fn prepare_windowed(
+        &mut self,
+        image: Image,
+        x0: usize,
+        y0: usize,
+        windowed: &mut [f32],
+    ) -> bool {
+        assert!(image.contains_block(x0 as i64, y0 as i64, self.n));
+        self.extract_zero_mean(image, x0, y0) && self.window_into(windowed).is_some()
     }
 
     /// The first-order response of the windowed correlation peak to a displacement gradient,
@@ -538,6 +555,24 @@ impl ZoiEngine {
     fn window_rows(&self, out: &mut [f32], stride: usize, offset: usize) -> Option<f32> {
         let n = self.n;
         assert!(stride >= n && out.len() >= offset + (n - 1) * stride + n);
+        let floor = MIN_STD_COUNTS * self.window_sum.sqrt();
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where sums_avx2::available() returned true.
+            let sum_sq = unsafe {
+                sums_avx2::window_rows(
+                    &self.window,
+                    &self.g_spatial,
+                    self.window_sum,
+                    n,
+                    out,
+                    stride,
+                    offset,
+                )
+            };
+            let norm = sum_sq.sqrt();
+            return (norm.is_finite() && norm >= floor).then_some(norm);
+        }
         let mean = F32x4::splat(dot(&self.window, &self.g_spatial) / self.window_sum);
         let mut sum_sq = F32x4::zero();
         for (y, (w_row, g_row)) in self
@@ -556,7 +591,6 @@ impl ZoiEngine {
             }
         }
         let norm = sum_sq.sum().sqrt();
-        let floor = MIN_STD_COUNTS * self.window_sum.sqrt();
         (norm.is_finite() && norm >= floor).then_some(norm)
     }
 
@@ -597,13 +631,11 @@ impl ZoiEngine {
         if !(guess_px.0.is_finite() && guess_px.1.is_finite()) {
             return ZoiResult::with_status(NodeStatus::NoGuess, 0);
         }
-        let warp = search
-            .warp
-            .filter(|&g| g.iter().flatten().all(|v| v.is_finite()) && warp_worth_it(g, self.n));
+        let warp = self.usable_warp(search.warp);
         let a = warp.map(identity_plus);
         if search.predicted {
             if let Some(result) =
-                self.correlate_predicted(reference, deformed, &search, warp, &mut timer)
+                self.correlate_predicted(reference.windowed, deformed, &search, warp, &mut timer)
             {
                 return result;
             }
@@ -625,11 +657,17 @@ impl ZoiEngine {
         Self::result(origin, estimate, warp, &search)
     }
 
+    /// The gradient a ZOI is sampled through: `warp` when finite and worth it.
+    fn usable_warp(&self, warp: Option<Mat2>) -> Option<Mat2> {
+        warp.filter(|&g| g.iter().flatten().all(|v| v.is_finite()) && warp_worth_it(g, self.n))
+    }
+
     /// [`Self::correlate`] from a prediction without the integer search; None when the
     /// prediction is not confirmed or the ZOI cannot be cut there (the full search decides).
+    /// It needs the reference's windowed ZOI only (`windowed`).
     fn correlate_predicted(
         &mut self,
-        reference: &ReferenceSpectra,
+        windowed: &[f32],
         deformed: Image,
         search: &ZoiSearch,
         warp: Option<Mat2>,
@@ -663,9 +701,7 @@ impl ZoiEngine {
         self.fft.forward(&self.g_spatial, &mut self.g_spectrum);
         timer.lap(&mut self.split.fft_ns);
         let max = search.iterations.max;
-        let estimate = self
-            .subpixel(reference.windowed, start, max, true, timer)
-            .ok()?;
+        let estimate = self.subpixel(windowed, start, max, true, timer).ok()?;
         Some(Self::result(place.origin_px, estimate, warp, search))
     }
 
@@ -870,18 +906,39 @@ impl ZoiEngine {
     }
 
     /// [`Self::correlate`] for a ZOI of another image than the cached references (a node's
-    /// ZOI in the frame its mesh was defined in): its spectra are prepared in the engine's own
-    /// buffers first. `LowContrast` when that ZOI is flat.
+    /// ZOI in the frame its mesh was defined in): its data are prepared in the engine's own
+    /// buffers first, and only those the correlation uses: a prediction the windowed
+    /// correlation confirms needs the windowed ZOI alone, not its spectrum nor its gradient
+    /// sensitivity. The same result as [`Self::correlate`] with [`Self::prepare_reference`]'s
+    /// spectra. `LowContrast` when that ZOI is flat.
     pub fn correlate_uncached(
         &mut self,
         reference: Image,
         deformed: Image,
-        search: ZoiSearch,
+        mut search: ZoiSearch,
     ) -> ZoiResult {
         let mut plain = std::mem::take(&mut self.uncached_plain);
         let mut windowed = std::mem::take(&mut self.uncached_windowed);
-        let mut sensitivity = GradientSensitivity::default();
         let (x0, y0) = search.top_left_px;
+        let finite = search.guess_px.0.is_finite() && search.guess_px.1.is_finite();
+        if search.predicted && finite {
+            let mut timer = Timer::start(self.profile);
+            let shortcut = if self.prepare_windowed(reference, x0, y0, &mut windowed) {
+                timer.lap(&mut self.split.window_ns);
+                let warp = self.usable_warp(search.warp);
+                self.correlate_predicted(&windowed, deformed, &search, warp, &mut timer)
+            } else {
+                Some(ZoiResult::with_status(NodeStatus::LowContrast, 0))
+            };
+            if let Some(result) = shortcut {
+                self.uncached_plain = plain;
+                self.uncached_windowed = windowed;
+                return result;
+            }
+            // Not confirmed: the full search, as `correlate` runs it after the same attempt.
+            search.predicted = false;
+        }
+        let mut sensitivity = GradientSensitivity::default();
         let result = if self.prepare_reference(
             reference,
             x0,
@@ -927,6 +984,20 @@ impl ZoiEngine {
         fill(&mut self.phase_x, d.0, scale);
         fill(&mut self.phase_y, d.1, 1.0);
         // Half-spectrum layout: index kx * n + ky, kx in 0..=n/2.
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where sums_avx2::available() returned true.
+            unsafe {
+                sums_avx2::phase_ramp(
+                    &self.g_spectrum,
+                    &self.phase_x[..=n / 2],
+                    &self.phase_y,
+                    &mut self.work,
+                )
+            };
+            self.fft.inverse(&mut self.work, &mut self.g_spatial);
+            return;
+        }
         for kx in 0..=n / 2 {
             let px = self.phase_x[kx];
             let row = &mut self.work[kx * n..(kx + 1) * n];
@@ -978,6 +1049,14 @@ impl ZoiEngine {
         assert!(centre.0.unsigned_abs() < PAD as u64 && centre.1.unsigned_abs() < PAD as u64);
         assert!(n.is_multiple_of(4) && reference.len() == n * n);
         let x0 = (PAD as i64 + centre.0 - 1) as usize;
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            let dy = [centre.1 - 1, centre.1, centre.1 + 1];
+            // SAFETY: `avx2` is set only where sums_avx2::available() returned true.
+            let sums =
+                unsafe { sums_avx2::correlation_3x3(reference, &self.extended, n, stride, x0, dy) };
+            return sums.map(|row| row.map(|v| v * scale));
+        }
         let mut out = [[0.0f32; 3]; 3];
         for (r, out_row) in out.iter_mut().enumerate() {
             let dy = centre.1 + r as i64 - 1;
@@ -1017,6 +1096,22 @@ impl ZoiEngine {
         } else {
             (at.0, at.1, self.correlation_3x3(reference, at, scale))
         }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod sums_avx2;
+
+/// Whether a ZOI of side n runs its sub-pixel sums on AVX2 + FMA.
+fn sums_avx2_available(n: usize) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        n.is_multiple_of(8) && sums_avx2::available()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = n;
+        false
     }
 }
 

@@ -143,3 +143,71 @@ fn a_prediction_several_pixels_off_falls_back_to_the_full_search() {
         );
     }
 }
+
+/// A ZOI of another image (`correlate_uncached`, the measurements against the origin) prepares
+/// only what its correlation uses, and gives what the cached reference gives: the same
+/// displacement (to 1e-9 px), score, status and iterations, and the same integer searches, for
+/// a confirmed prediction, one several pixels off, without a prediction, warped, and flat.
+#[test]
+fn an_uncached_zoi_correlates_as_a_cached_one() {
+    let reference = speckle((0.0, 0.0));
+    let flat = vec![3000u16; SIZE * SIZE];
+    let shift = (1.37, -0.71);
+    let deformed = speckle(shift);
+    let warps = [None, Some([[0.02, -0.01], [0.015, -0.03]])];
+    let guesses = [(1.4, -0.7), (1.0, -1.0), (5.4, -3.7)];
+    let mut cases = 0;
+    for reference in [&reference, &flat] {
+        for warp in warps {
+            for guess_px in guesses {
+                for predicted in [true, false] {
+                    let search = ZoiSearch {
+                        top_left_px: TOP_LEFT,
+                        guess_px,
+                        warp,
+                        iterations: SubpixelIterations::paper(10),
+                        predicted,
+                    };
+                    let mut cached_engine = ZoiEngine::new(N);
+                    let mut plain = vec![Complex32::new(0.0, 0.0); spectrum_len(N)];
+                    let mut windowed = vec![0.0; N * N];
+                    let mut sensitivity = GradientSensitivity::default();
+                    let contrast = cached_engine.prepare_reference(
+                        image(reference),
+                        TOP_LEFT.0,
+                        TOP_LEFT.1,
+                        &mut plain,
+                        &mut windowed,
+                        &mut sensitivity,
+                    );
+                    let spectra = ReferenceSpectra {
+                        plain: &plain,
+                        windowed: &windowed,
+                    };
+                    let cached = if contrast {
+                        cached_engine.correlate(&spectra, image(&deformed), search)
+                    } else {
+                        ZoiResult::with_status(NodeStatus::LowContrast, 0)
+                    };
+                    let mut engine = ZoiEngine::new(N);
+                    // Twice on one engine: nothing of a ZOI stays behind for the next.
+                    for _ in 0..2 {
+                        let uncached =
+                            engine.correlate_uncached(image(reference), image(&deformed), search);
+                        let context = format!("{warp:?} {guess_px:?} {predicted}");
+                        assert!((uncached.u_px - cached.u_px).abs() <= 1e-9, "{context}");
+                        assert!((uncached.v_px - cached.v_px).abs() <= 1e-9, "{context}");
+                        assert_eq!(uncached.score, cached.score, "{context}");
+                        assert_eq!(uncached.status, cached.status, "{context}");
+                        assert_eq!(uncached.iterations, cached.iterations, "{context}");
+                        assert_eq!(uncached.warp_gradient, cached.warp_gradient, "{context}");
+                    }
+                    assert_eq!(engine.searches, 2 * cached_engine.searches);
+                    cases += usize::from(contrast && cached.status == NodeStatus::Ok);
+                }
+            }
+        }
+    }
+    // Every measurable case measured: 2 warps x 3 guesses x 2 on the speckle.
+    assert_eq!(cases, 12);
+}
