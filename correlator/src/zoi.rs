@@ -379,7 +379,7 @@ impl ZoiEngine {
         windowed: &mut [f32],
     ) -> bool {
         assert!(image.contains_block(x0 as i64, y0 as i64, self.n));
-        self.extract_zero_mean(image, x0, y0) && self.window_into(windowed).is_some()
+        self.extract_zero_mean(image, x0, y0).is_some() && self.window_into(windowed).is_some()
     }
 
     /// The first-order response of the windowed correlation peak to a displacement gradient,
