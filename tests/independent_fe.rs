@@ -32,6 +32,15 @@ fn felupe_available() -> bool {
         .is_ok_and(|o| o.status.success())
 }
 
+/// Asserts the command succeeded, with its stderr if not.
+fn succeeded(output: &std::process::Output) {
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
 /// The membrane's grip force (N) at the grip stretch `stretch`.
 fn membrane_force_n(run: &Run, stretch: f64) -> f64 {
     let config = run.dir.join("strip.toml");
@@ -57,11 +66,7 @@ fn membrane_force_n(run: &Run, stretch: f64) -> f64 {
         .args(["--out", out.to_str().unwrap(), "--json"])
         .output()
         .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    succeeded(&output);
     let summary: Value = serde_json::from_slice(&output.stdout).unwrap();
     summary["states"][0]["grip_axial_force_n"]["x+"]
         .as_f64()
@@ -91,11 +96,7 @@ fn felupe_force_n(stretch: f64) -> (f64, f64) {
         .args(["40", "8", "2"])
         .output()
         .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    succeeded(&output);
     let stdout = String::from_utf8_lossy(&output.stdout);
     let last = stdout.lines().last().unwrap_or_default();
     let result: Value =

@@ -160,7 +160,10 @@ impl FieldRoute {
         }
         let placed = self.placed.as_deref().unwrap_or_default();
         let mut fields = vec![];
-        for p in placed.iter().filter(|p| p.is_cut || self.config.central_ramps) {
+        for p in placed
+            .iter()
+            .filter(|p| p.is_cut || self.config.central_ramps)
+        {
             match p.ramp.quadrature(&grid, material) {
                 Ok(q) => fields.push((q, p.grip)),
                 Err(_) => self.counters.virtual_fields_dropped += 1,
@@ -366,7 +369,13 @@ mod tests {
         );
         let c = route.counters;
         assert_eq!(
-            (c.offered, c.kept, c.not_loading, c.without_gradients, c.without_forces),
+            (
+                c.offered,
+                c.kept,
+                c.not_loading,
+                c.without_gradients,
+                c.without_forces
+            ),
             (6, 1, 2, 2, 1)
         );
         // A cut and a central ramp per arm.
@@ -385,7 +394,10 @@ mod tests {
             ..config()
         };
         let mut route = FieldRoute::new(config.clone());
-        for (k, (lx, ly)) in [(1.1, 1.1), (1.3, 1.05), (1.2, 1.4)].into_iter().enumerate() {
+        for (k, (lx, ly)) in [(1.1, 1.1), (1.3, 1.05), (1.2, 1.4)]
+            .into_iter()
+            .enumerate()
+        {
             let g = grid([[lx, 0.0], [0.0, ly]]);
             let placed = place_fields(&config.layout, &g).unwrap();
             // Each grip's force: what its arm's cut carries under the truth.

@@ -14,21 +14,32 @@ const PATH_SAMPLES: usize = 60;
 /// its load cell's noise (the Z pair of a planar test): left out.
 const IDLE_FRACTION: f64 = 0.1;
 
+/// The CSV `text`'s header (`what` names the file in errors) and its data lines.
+type Columns<'a> = (Vec<&'a str>, std::str::Lines<'a>);
+
+fn header<'a>(text: &'a str, what: &str) -> anyhow::Result<Columns<'a>> {
+    let mut lines = text.lines();
+    let names = lines
+        .next()
+        .ok_or_else(|| anyhow::anyhow!("{what} is empty"))?
+        .split(',')
+        .collect();
+    Ok((names, lines))
+}
+
+/// The index of column `name` of `names`, or an error naming it and the file.
+fn column(names: &[&str], name: &str, what: &str) -> anyhow::Result<usize> {
+    names
+        .iter()
+        .position(|h| *h == name)
+        .ok_or_else(|| anyhow::anyhow!("{what} has no column {name}"))
+}
+
 /// Each actuator's force (kN, as `rig.csv` logs it) against time (s): one series per
 /// actuator that carried a load ([`IDLE_FRACTION`]).
 pub fn actuator_forces(rig_csv: &str) -> anyhow::Result<Vec<Series>> {
-    let mut lines = rig_csv.lines();
-    let header: Vec<&str> = lines
-        .next()
-        .ok_or_else(|| anyhow::anyhow!("rig.csv is empty"))?
-        .split(',')
-        .collect();
-    let column = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .ok_or_else(|| anyhow::anyhow!("rig.csv has no column {name}"))
-    };
+    let (names, lines) = header(rig_csv, "rig.csv")?;
+    let column = |name: &str| column(&names, name, "rig.csv");
     let time = column("t_s")?;
     let actuators = rig::ids::ActuatorId::ALL
         .iter()
@@ -78,18 +89,8 @@ pub fn forces_png(rig_csv: &Path, path: &Path) -> anyhow::Result<bool> {
 /// The in-plane principal stretches (λ1 ≥ λ2) of every `ok` node of a field CSV (the
 /// correlator's contract: `status` and the gradient `du_dx,du_dy,dv_dx,dv_dy`).
 pub fn node_stretches(field_csv: &str) -> anyhow::Result<Vec<(f64, f64)>> {
-    let mut lines = field_csv.lines();
-    let header: Vec<&str> = lines
-        .next()
-        .ok_or_else(|| anyhow::anyhow!("empty field file"))?
-        .split(',')
-        .collect();
-    let column = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .ok_or_else(|| anyhow::anyhow!("the field file has no column {name}"))
-    };
+    let (names, lines) = header(field_csv, "the field file")?;
+    let column = |name: &str| column(&names, name, "the field file");
     let status = column("status")?;
     let gradient = [
         column("du_dx")?,
