@@ -7,6 +7,9 @@
 use identifier::plot::{chart, Series};
 use std::path::{Path, PathBuf};
 
+/// The λ axis of `stretch_states.png` reaches this at least.
+const MIN_MAX_STRETCH: f64 = 1.1;
+
 /// Points per canonical path drawn.
 const PATH_SAMPLES: usize = 60;
 
@@ -164,7 +167,8 @@ pub fn stretch_states_png(fields_dir: &Path, path: &Path) -> anyhow::Result<usiz
     if states.is_empty() {
         return Ok(0);
     }
-    let max_l1 = states.iter().map(|s| s.0).fold(1.0, f64::max);
+    // At least to λ1 1.1: a field at rest (rigid motion, λ1 = 1 everywhere) still has axes.
+    let max_l1 = states.iter().map(|s| s.0).fold(MIN_MAX_STRETCH, f64::max);
     let mut series = vec![Series {
         label: format!("nodes of the saved fields ({} states)", states.len()),
         points: states.clone(),
@@ -236,5 +240,23 @@ mod tests {
         assert!(close(points[0], (1.2, 1.2)), "{points:?}");
         assert!(close(points[1], (1.44, 1.0 / 1.2)), "{points:?}");
         assert!(node_stretches("x,y,u,v\n1,2,3,4").is_err());
+    }
+
+    #[test]
+    fn a_field_at_rest_still_makes_its_figure() {
+        let dir =
+            std::env::temp_dir().join(format!("dicstream-stretch-states-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let row = "0,0,0,0,0,0,0,1,3,ok,0,0,0,0";
+        let header = correlator::output::CSV_HEADER;
+        std::fs::write(
+            dir.join("field_000010.csv"),
+            format!("{header}\n{row}\n{row}\n"),
+        )
+        .unwrap();
+        let png = dir.join("stretch_states.png");
+        assert_eq!(stretch_states_png(&dir, &png).unwrap(), 2);
+        assert!(png.exists());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
