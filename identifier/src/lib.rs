@@ -13,6 +13,8 @@
 //! - [`section_cut`]: the force through a band across an arm, the paper's section cut as a
 //!   virtual field.
 //! - [`vfm`]: the virtual fields method over the cuts of all frames of a test.
+//! - [`field_layout`]: where the cuts and ramps go, from the cruciform and the view.
+//! - [`field_route`]: the frames of a test kept for the field route, fitted together.
 //! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
 //! - [`plot`]: PNG plots of the data, fits, f(I1) and g(I2) (plotters, bitmap backend).
 //! - [`online`]: pairing strains with rig forces, accumulating the load path, refitting (no IPC).
@@ -23,6 +25,8 @@
 #![forbid(unsafe_code)]
 
 pub mod data;
+pub mod field_layout;
+pub mod field_route;
 pub mod field_stress;
 pub mod fit;
 pub mod gradient;

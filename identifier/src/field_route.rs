@@ -1,0 +1,412 @@
+//! The field route on line (issue 25 deliverable 3): the frames of one test, each a measured
+//! field on the reference grid with its grips' forces and the virtual fields its view holds
+//! (`field_layout`), fitted all together by the virtual fields method (`vfm`). Pure: the
+//! process hands it grids in mm, forces in N and the specimen's outline.
+//!
+//! Kept frames: the loading branch only, one frame each time the gauge's largest |log strain|
+//! has grown by `min_level_increment` since the last kept one (so a test's frames stay few and
+//! distinct whatever the frame rate), at most `max_frames`. What is not kept is counted by
+//! reason, never fitted in part: a field without gradients, one whose grip forces have no
+//! matching rig sample, a virtual field with a hole (dropped for that frame, counted).
+
+use crate::field_layout::{place_fields, ArmLayout, LayoutError, PlacedField};
+use crate::models::Model;
+use crate::section_cut::FieldGrid;
+use crate::tapered_ramp::RampQuadrature;
+use crate::vfm::{fit, CutObservation, VfmError, VfmFit, VirtualField};
+
+/// Settings of the field route.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldRouteConfig {
+    pub layout: ArmLayout,
+    pub thickness_mm: f64,
+    /// Models fitted, ranked by AIC.
+    pub models: Vec<Model>,
+    pub min_level_increment: f64,
+    pub max_frames: usize,
+    /// Kept frames before the first fit.
+    pub min_frames_to_fit: usize,
+    /// Also the ramps through the centre (the equibiaxial states), not only the cuts.
+    pub central_ramps: bool,
+}
+
+/// One kept frame.
+#[derive(Clone, Debug)]
+pub struct FieldFrame {
+    pub frame_id: u64,
+    pub grid: FieldGrid,
+    /// Grip forces in [`crate::field_layout::GRIPS`] order, N, tension positive.
+    pub forces_n: [f64; 4],
+    /// The virtual fields whose quadrature held, with their grip.
+    pub fields: Vec<(RampQuadrature, usize)>,
+}
+
+/// What happened to the frames offered, by reason.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct FieldCounters {
+    pub offered: u64,
+    pub kept: u64,
+    /// Not a new loading state (the gauge has not grown enough since the last kept frame).
+    pub not_loading: u64,
+    /// The field carries no gradients (layout without them, or no valid node).
+    pub without_gradients: u64,
+    /// No rig sample matches the frame's.
+    pub without_forces: u64,
+    /// The frame limit was reached.
+    pub over_limit: u64,
+    /// Virtual fields dropped for a frame (a hole where the field varies, or no stress).
+    pub virtual_fields_dropped: u64,
+}
+
+/// Why a frame was not kept.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameOutcome {
+    Kept,
+    NotLoading,
+    WithoutGradients,
+    WithoutForces,
+    OverLimit,
+}
+
+/// A model's fit over the kept frames.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldFit {
+    pub model: Model,
+    pub fit: VfmFit,
+    /// m ln(RSS/m) + 2 k over the m force equations (as the gauge route's).
+    pub aic: f64,
+}
+
+/// The fits of all models (best AIC first) and the models refused, with why.
+#[derive(Clone, Debug, Default)]
+pub struct FieldFits {
+    pub fits: Vec<FieldFit>,
+    pub refused: Vec<(String, String)>,
+    pub frames: usize,
+    /// Largest principal stretch of any node the fit used, and the smallest.
+    pub stretch_range: [f64; 2],
+}
+
+/// The frames of the test so far.
+pub struct FieldRoute {
+    config: FieldRouteConfig,
+    placed: Option<Vec<PlacedField>>,
+    frames: Vec<FieldFrame>,
+    last_level: f64,
+    pub counters: FieldCounters,
+}
+
+impl FieldRoute {
+    pub fn new(config: FieldRouteConfig) -> Self {
+        Self {
+            config,
+            placed: None,
+            frames: vec![],
+            last_level: 0.0,
+            counters: FieldCounters::default(),
+        }
+    }
+
+    pub fn frames(&self) -> &[FieldFrame] {
+        &self.frames
+    }
+
+    /// Offers a frame: its grid (None: no gradients), its grips' forces (None: no matching
+    /// sample), the gauge's largest |log strain| `level`, and the specimen's outline. A view
+    /// that crosses no arm is an error (the first frame says it).
+    pub fn push(
+        &mut self,
+        frame_id: u64,
+        grid: Option<FieldGrid>,
+        forces_n: Option<[f64; 4]>,
+        level: f64,
+        material: &dyn Fn([f64; 2]) -> bool,
+    ) -> Result<FrameOutcome, LayoutError> {
+        self.counters.offered += 1;
+        let outcome = self.offer(frame_id, grid, forces_n, level, material)?;
+        let c = &mut self.counters;
+        match outcome {
+            FrameOutcome::Kept => c.kept += 1,
+            FrameOutcome::NotLoading => c.not_loading += 1,
+            FrameOutcome::WithoutGradients => c.without_gradients += 1,
+            FrameOutcome::WithoutForces => c.without_forces += 1,
+            FrameOutcome::OverLimit => c.over_limit += 1,
+        }
+        Ok(outcome)
+    }
+
+    fn offer(
+        &mut self,
+        frame_id: u64,
+        grid: Option<FieldGrid>,
+        forces_n: Option<[f64; 4]>,
+        level: f64,
+        material: &dyn Fn([f64; 2]) -> bool,
+    ) -> Result<FrameOutcome, LayoutError> {
+        if level < self.last_level + self.config.min_level_increment {
+            return Ok(FrameOutcome::NotLoading);
+        }
+        let Some(grid) = grid.filter(|g| g.gradients.iter().any(Option::is_some)) else {
+            return Ok(FrameOutcome::WithoutGradients);
+        };
+        let Some(forces_n) = forces_n else {
+            return Ok(FrameOutcome::WithoutForces);
+        };
+        if self.frames.len() >= self.config.max_frames {
+            return Ok(FrameOutcome::OverLimit);
+        }
+        if self.placed.is_none() {
+            self.placed = Some(place_fields(&self.config.layout, &grid)?);
+        }
+        let placed = self.placed.as_deref().unwrap_or_default();
+        let mut fields = vec![];
+        for p in placed.iter().filter(|p| p.is_cut || self.config.central_ramps) {
+            match p.ramp.quadrature(&grid, material) {
+                Ok(q) => fields.push((q, p.grip)),
+                Err(_) => self.counters.virtual_fields_dropped += 1,
+            }
+        }
+        self.last_level = level;
+        self.frames.push(FieldFrame {
+            frame_id,
+            grid,
+            forces_n,
+            fields,
+        });
+        Ok(FrameOutcome::Kept)
+    }
+
+    /// Every kept frame's virtual fields as equations.
+    fn observations(&self) -> Vec<CutObservation<'_>> {
+        self.frames
+            .iter()
+            .flat_map(|frame| {
+                frame.fields.iter().map(move |(q, grip)| CutObservation {
+                    grid: &frame.grid,
+                    cut: VirtualField::Ramp(q),
+                    thickness_mm: self.config.thickness_mm,
+                    force_n: frame.forces_n[*grip],
+                })
+            })
+            .collect()
+    }
+
+    /// Fits every model to all kept frames (None before `min_frames_to_fit`). Linear models
+    /// first; a nonlinear one starts from the Mooney-Rivlin fit ([`start_from_mooney`]).
+    pub fn fit(&self) -> Option<FieldFits> {
+        if self.frames.len() < self.config.min_frames_to_fit {
+            return None;
+        }
+        let obs = self.observations();
+        let mut out = FieldFits {
+            frames: self.frames.len(),
+            stretch_range: self.stretch_range(),
+            ..FieldFits::default()
+        };
+        let mooney = fit(&Model::Mooney, &obs, &[0.0, 0.0]);
+        for model in &self.config.models {
+            let result = if *model == Model::Mooney {
+                mooney.clone()
+            } else {
+                match start_for(model, mooney.as_ref().ok()) {
+                    Some(start) => fit(model, &obs, &start),
+                    None => {
+                        out.refused.push((
+                            model.name(),
+                            "no starting point (the Mooney-Rivlin fit failed)".into(),
+                        ));
+                        continue;
+                    }
+                }
+            };
+            match result {
+                Ok(fit) => {
+                    let (m, k) = (fit.equations as f64, fit.params.len() as f64);
+                    let rss = fit.rms_n.powi(2) * m;
+                    let aic = m * (rss.max(f64::MIN_POSITIVE) / m).ln() + 2.0 * k;
+                    out.fits.push(FieldFit {
+                        model: model.clone(),
+                        fit,
+                        aic,
+                    });
+                }
+                Err(e) => out.refused.push((model.name(), refusal(&e))),
+            }
+        }
+        out.fits.sort_by(|a, b| a.aic.total_cmp(&b.aic));
+        Some(out)
+    }
+
+    /// The range of principal stretches of the nodes the kept frames' fields weigh.
+    fn stretch_range(&self) -> [f64; 2] {
+        let mut range = [f64::INFINITY, f64::NEG_INFINITY];
+        for frame in &self.frames {
+            for f in frame.grid.gradients.iter().flatten() {
+                let c = [
+                    f[0][0] * f[0][0] + f[1][0] * f[1][0],
+                    f[0][0] * f[0][1] + f[1][0] * f[1][1],
+                    f[0][1] * f[0][1] + f[1][1] * f[1][1],
+                ];
+                let (mean, radius) = (0.5 * (c[0] + c[2]), (0.5 * (c[0] - c[2])).hypot(c[1]));
+                range[0] = range[0].min((mean - radius).max(0.0).sqrt());
+                range[1] = range[1].max((mean + radius).sqrt());
+            }
+        }
+        range
+    }
+}
+
+fn refusal(error: &VfmError) -> String {
+    error.to_string()
+}
+
+/// A nonlinear model's start from the Mooney-Rivlin fit (C10, C01): Lambert-Diani-Rey's ln f
+/// and ln g at their constants, Gent's and Arruda-Boyce's μ = 2 (C10 + C01) with a moderate
+/// limit; other models are linear or get no start.
+pub fn start_from_mooney(model: &Model, c10: f64, c01: f64) -> Option<Vec<f64>> {
+    let positive = |v: f64, fallback: f64| if v > 0.0 { v } else { fallback };
+    let c10 = positive(c10, 0.1);
+    let c01 = positive(c01, 0.1 * c10);
+    Some(match model {
+        Model::LambertDianiRey { f_degree, g_degree } => {
+            let mut p = vec![0.0; f_degree + g_degree + 2];
+            p[0] = c10.ln();
+            p[f_degree + 1] = c01.ln();
+            p
+        }
+        Model::Gent => vec![2.0 * (c10 + c01), 30.0],
+        Model::ArrudaBoyce => vec![2.0 * (c10 + c01), 5.0],
+        m if m.linear_params().iter().all(|&l| l) => vec![0.0; m.param_names().len()],
+        _ => return None,
+    })
+}
+
+fn start_for(model: &Model, mooney: Option<&VfmFit>) -> Option<Vec<f64>> {
+    if model.linear_params().iter().all(|&l| l) {
+        return Some(vec![0.0; model.param_names().len()]);
+    }
+    let m = mooney?;
+    start_from_mooney(model, m.params[0], m.params[1])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::LoadCase;
+
+    /// A homogeneous grid (±80 mm, 2.5 mm) of the cruciform's default layout, every node at F.
+    fn grid(f: [[f64; 2]; 2]) -> FieldGrid {
+        let n = 65;
+        FieldGrid {
+            cols: n,
+            rows: n,
+            x0_mm: -80.0,
+            y0_mm: -80.0,
+            step_mm: 2.5,
+            gradients: vec![Some(f); n * n],
+        }
+    }
+
+    fn config() -> FieldRouteConfig {
+        FieldRouteConfig {
+            layout: ArmLayout {
+                arm_width_mm: 100.0,
+                fillet_radius_mm: 20.0,
+            },
+            thickness_mm: 2.0,
+            models: vec![Model::Mooney, Model::NeoHookean],
+            min_level_increment: 0.01,
+            max_frames: 4,
+            min_frames_to_fit: 2,
+            central_ramps: true,
+        }
+    }
+
+    /// Everything is material: the quadratures hold wherever there are nodes.
+    fn everywhere(_: [f64; 2]) -> bool {
+        true
+    }
+
+    #[test]
+    fn frames_are_kept_on_the_loading_branch_and_bad_ones_counted() {
+        let mut route = FieldRoute::new(config());
+        let (l1, l2) = LoadCase::Equibiaxial.in_plane_stretches(1.1);
+        let f = [[l1, 0.0], [0.0, l2]];
+        let forces = Some([10.0; 4]);
+        let offer = |route: &mut FieldRoute, id, g, forces, level| {
+            route.push(id, g, forces, level, &everywhere).unwrap()
+        };
+        assert_eq!(
+            offer(&mut route, 1, Some(grid(f)), forces, 0.005),
+            FrameOutcome::NotLoading
+        );
+        assert_eq!(
+            offer(&mut route, 2, None, forces, 0.02),
+            FrameOutcome::WithoutGradients
+        );
+        let empty = FieldGrid {
+            gradients: vec![None; 65 * 65],
+            ..grid(f)
+        };
+        assert_eq!(
+            offer(&mut route, 3, Some(empty), forces, 0.02),
+            FrameOutcome::WithoutGradients
+        );
+        assert_eq!(
+            offer(&mut route, 4, Some(grid(f)), None, 0.02),
+            FrameOutcome::WithoutForces
+        );
+        assert_eq!(
+            offer(&mut route, 5, Some(grid(f)), forces, 0.02),
+            FrameOutcome::Kept
+        );
+        assert_eq!(
+            offer(&mut route, 6, Some(grid(f)), forces, 0.025),
+            FrameOutcome::NotLoading
+        );
+        let c = route.counters;
+        assert_eq!(
+            (c.offered, c.kept, c.not_loading, c.without_gradients, c.without_forces),
+            (6, 1, 2, 2, 1)
+        );
+        // A cut and a central ramp per arm.
+        assert_eq!(route.frames()[0].fields.len(), 8);
+        assert!(route.fit().is_none(), "one frame is not a test");
+    }
+
+    /// Homogeneous biaxial frames whose grip forces are what the cuts carry under the true law
+    /// (a homogeneous field is no cruciform's equilibrium: the cuts only): the fit gives the
+    /// law back, ranked, with its stretch range.
+    #[test]
+    fn the_true_forces_give_the_law_back() {
+        let (model, truth) = (Model::Mooney, [0.3, 0.05]);
+        let config = FieldRouteConfig {
+            central_ramps: false,
+            ..config()
+        };
+        let mut route = FieldRoute::new(config.clone());
+        for (k, (lx, ly)) in [(1.1, 1.1), (1.3, 1.05), (1.2, 1.4)].into_iter().enumerate() {
+            let g = grid([[lx, 0.0], [0.0, ly]]);
+            let placed = place_fields(&config.layout, &g).unwrap();
+            // Each grip's force: what its arm's cut carries under the truth.
+            let mut forces = [0.0; 4];
+            for p in placed.iter().filter(|p| p.is_cut) {
+                let q = p.ramp.quadrature(&g, &everywhere).unwrap();
+                forces[p.grip] = q.force_n(&g, &model, &truth, 2.0).unwrap();
+            }
+            let level = (k + 1) as f64 * 0.1;
+            assert_eq!(
+                route.push(k as u64, Some(g), Some(forces), level, &everywhere),
+                Ok(FrameOutcome::Kept)
+            );
+        }
+        let fits = route.fit().unwrap();
+        let mooney = fits.fits.iter().find(|f| f.model == model).unwrap();
+        for (got, want) in mooney.fit.params.iter().zip(truth) {
+            assert!((got - want).abs() < 1e-6 * want, "{mooney:?}");
+        }
+        assert_eq!(fits.fits[0].model, model, "the true family ranks first");
+        assert_eq!(fits.frames, 3);
+        assert!((fits.stretch_range[1] - 1.4).abs() < 1e-12);
+    }
+}
