@@ -66,10 +66,7 @@ fn extent(grid: &FieldGrid) -> ([f64; 2], [f64; 2]) {
 /// across its straight part as far out as the view allows, and a ramp through the centre
 /// tapered to zero one node step inside the view's edge across (where the other arms leave
 /// it); a ramp whose taper has no room is left out.
-pub fn place_fields(
-    layout: &ArmLayout,
-    grid: &FieldGrid,
-) -> Result<Vec<PlacedField>, LayoutError> {
+pub fn place_fields(layout: &ArmLayout, grid: &FieldGrid) -> Result<Vec<PlacedField>, LayoutError> {
     let (x_mm, y_mm) = extent(grid);
     let s = grid.step_mm;
     let half_width = 0.5 * layout.arm_width_mm;
