@@ -231,7 +231,12 @@ impl LiveState {
         self.last_rig = Some(*state);
     }
 
+    /// The gauge route's reports (the field route's are in the run's `identification.json`;
+    /// the dashboard does not draw them yet).
     pub fn on_report(&mut self, report: &IdentificationReport) {
+        if report.route() != Some(wire::identification::ReportRoute::Gauge) {
+            return;
+        }
         self.reports_seen += 1;
         self.latency_identification
             .record_ns(report.t_capture_ns, report.t_published_ns);

@@ -3,11 +3,13 @@
 //! (`field_layout`), fitted all together by the virtual fields method (`vfm`). Pure: the
 //! process hands it grids in mm, forces in N and the specimen's outline.
 //!
-//! Kept frames: the loading branch only, one frame each time the gauge's largest |log strain|
-//! has grown by `min_level_increment` since the last kept one (so a test's frames stay few and
+//! Kept frames: the loading branch only, one frame each time its loading level (the process
+//! gives the mean stretching of the measured nodes) has grown by `min_level_increment` since
+//! the last kept one (so a test's frames stay few and
 //! distinct whatever the frame rate), at most `max_frames`. What is not kept is counted by
 //! reason, never fitted in part: a field without gradients, one whose grip forces have no
-//! matching rig sample, a virtual field with a hole (dropped for that frame, counted).
+//! matching rig sample, one where a grip pulls nothing (a strip's test, not the cruciform's), a
+//! virtual field with a hole (dropped for that frame, counted).
 
 use crate::field_layout::{place_fields, ArmLayout, LayoutError, PlacedField};
 use crate::models::Model;
@@ -54,6 +56,8 @@ pub struct FieldCounters {
     pub without_forces: u64,
     /// The frame limit was reached.
     pub over_limit: u64,
+    /// A grip pulls nothing (another specimen than the cruciform mounted: a strip's test).
+    pub grips_unloaded: u64,
     /// Virtual fields dropped for a frame (a hole where the field varies, or no stress).
     pub virtual_fields_dropped: u64,
 }
@@ -66,6 +70,7 @@ pub enum FrameOutcome {
     WithoutGradients,
     WithoutForces,
     OverLimit,
+    GripsUnloaded,
 }
 
 /// A model's fit over the kept frames.
@@ -83,8 +88,9 @@ pub struct FieldFits {
     pub fits: Vec<FieldFit>,
     pub refused: Vec<(String, String)>,
     pub frames: usize,
-    /// Largest principal stretch of any node the fit used, and the smallest.
-    pub stretch_range: [f64; 2],
+    /// The reach of the nodes the fit used: their largest major principal stretch (the arms'
+    /// uniaxial-like states) and largest minor one (how far the most equibiaxial state went).
+    pub max_stretches: [f64; 2],
 }
 
 /// The frames of the test so far.
@@ -112,7 +118,7 @@ impl FieldRoute {
     }
 
     /// Offers a frame: its grid (None: no gradients), its grips' forces (None: no matching
-    /// sample), the gauge's largest |log strain| `level`, and the specimen's outline. A view
+    /// sample), its loading `level`, and the specimen's outline. A view
     /// that crosses no arm is an error (the first frame says it).
     pub fn push(
         &mut self,
@@ -131,6 +137,7 @@ impl FieldRoute {
             FrameOutcome::WithoutGradients => c.without_gradients += 1,
             FrameOutcome::WithoutForces => c.without_forces += 1,
             FrameOutcome::OverLimit => c.over_limit += 1,
+            FrameOutcome::GripsUnloaded => c.grips_unloaded += 1,
         }
         Ok(outcome)
     }
@@ -152,6 +159,11 @@ impl FieldRoute {
         let Some(forces_n) = forces_n else {
             return Ok(FrameOutcome::WithoutForces);
         };
+        // Every arm of a cruciform under test pulls; a grip at rest is another specimen's
+        // test (the uniaxial strip's), whose field this layout does not describe.
+        if forces_n.iter().any(|&f| f <= 0.0) {
+            return Ok(FrameOutcome::GripsUnloaded);
+        }
         if self.frames.len() >= self.config.max_frames {
             return Ok(FrameOutcome::OverLimit);
         }
@@ -203,7 +215,7 @@ impl FieldRoute {
         let obs = self.observations();
         let mut out = FieldFits {
             frames: self.frames.len(),
-            stretch_range: self.stretch_range(),
+            max_stretches: self.max_stretches(),
             ..FieldFits::default()
         };
         let mooney = fit(&Model::Mooney, &obs, &[0.0, 0.0]);
@@ -216,7 +228,7 @@ impl FieldRoute {
                     None => {
                         out.refused.push((
                             model.name(),
-                            "no starting point (the Mooney-Rivlin fit failed)".into(),
+                            "no starting point for it from the Mooney-Rivlin fit".into(),
                         ));
                         continue;
                     }
@@ -240,9 +252,9 @@ impl FieldRoute {
         Some(out)
     }
 
-    /// The range of principal stretches of the nodes the kept frames' fields weigh.
-    fn stretch_range(&self) -> [f64; 2] {
-        let mut range = [f64::INFINITY, f64::NEG_INFINITY];
+    /// The largest major and minor principal stretches of the kept frames' measured nodes.
+    fn max_stretches(&self) -> [f64; 2] {
+        let mut range = [1.0_f64, 1.0_f64];
         for frame in &self.frames {
             for f in frame.grid.gradients.iter().flatten() {
                 let c = [
@@ -251,8 +263,8 @@ impl FieldRoute {
                     f[0][1] * f[0][1] + f[1][1] * f[1][1],
                 ];
                 let (mean, radius) = (0.5 * (c[0] + c[2]), (0.5 * (c[0] - c[2])).hypot(c[1]));
-                range[0] = range[0].min((mean - radius).max(0.0).sqrt());
-                range[1] = range[1].max((mean + radius).sqrt());
+                range[0] = range[0].max((mean + radius).sqrt());
+                range[1] = range[1].max((mean - radius).max(0.0).sqrt());
             }
         }
         range
@@ -360,6 +372,16 @@ mod tests {
             FrameOutcome::WithoutForces
         );
         assert_eq!(
+            offer(
+                &mut route,
+                5,
+                Some(grid(f)),
+                Some([10.0, 10.0, 0.0, 0.0]),
+                0.02
+            ),
+            FrameOutcome::GripsUnloaded
+        );
+        assert_eq!(
             offer(&mut route, 5, Some(grid(f)), forces, 0.02),
             FrameOutcome::Kept
         );
@@ -376,8 +398,9 @@ mod tests {
                 c.without_gradients,
                 c.without_forces
             ),
-            (6, 1, 2, 2, 1)
+            (7, 1, 2, 2, 1)
         );
+        assert_eq!(c.grips_unloaded, 1);
         // A cut and a central ramp per arm.
         assert_eq!(route.frames()[0].fields.len(), 8);
         assert!(route.fit().is_none(), "one frame is not a test");
@@ -419,6 +442,7 @@ mod tests {
         }
         assert_eq!(fits.fits[0].model, model, "the true family ranks first");
         assert_eq!(fits.frames, 3);
-        assert!((fits.stretch_range[1] - 1.4).abs() < 1e-12);
+        assert!((fits.max_stretches[0] - 1.4).abs() < 1e-12);
+        assert!((fits.max_stretches[1] - 1.2).abs() < 1e-12);
     }
 }

@@ -14,6 +14,7 @@
 //!   virtual field.
 //! - [`vfm`]: the virtual fields method over the cuts of all frames of a test.
 //! - [`field_layout`]: where the cuts and ramps go, from the cruciform and the view.
+//! - [`grip_forces`]: the grips' forces of recent rig samples, by id or by time.
 //! - [`field_route`]: the frames of a test kept for the field route, fitted together.
 //! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
 //! - [`plot`]: PNG plots of the data, fits, f(I1) and g(I2) (plotters, bitmap backend).
@@ -30,6 +31,7 @@ pub mod field_route;
 pub mod field_stress;
 pub mod fit;
 pub mod gradient;
+pub mod grip_forces;
 pub mod journal;
 pub mod kinematics;
 /// The law lives in its own crate (`material`), shared with the rig; re-exported here.

@@ -14,7 +14,11 @@ use wire::{
     services, FieldHeader, FieldNode, IdentificationReport, Instance, RigState, StrainMeasure,
 };
 
+mod field;
 mod shell;
+
+pub use field::FieldRouteSettings;
+use wire::identification::IdentifierRoutes;
 
 /// Settings of the process: what `dicstream run` writes for its identifier (`--settings`),
 /// and what the command line's flags make.
@@ -35,6 +39,16 @@ pub struct ProcessConfig {
     pub idle_timeout: Option<Duration>,
     #[serde(default)]
     pub online: OnlineConfig,
+    /// The routes run: the gauge's (`online`), the whole field's (`field`), or both.
+    #[serde(default = "gauge_route")]
+    pub routes: IdentifierRoutes,
+    /// The field route's view and specimen (needed when `routes` runs it).
+    #[serde(default)]
+    pub field: Option<FieldRouteSettings>,
+}
+
+fn gauge_route() -> IdentifierRoutes {
+    IdentifierRoutes::Gauge
 }
 
 /// What the run did.
@@ -66,6 +80,12 @@ pub enum ProcessError {
     WaitSetRun(#[from] iceoryx2::waitset::WaitSetRunError),
     #[error(transparent)]
     Json(#[from] serde_json::Error),
+    #[error(
+        "the {routes} route needs the field route's settings (the camera's view and the cruciform)"
+    )]
+    NoFieldSettings { routes: IdentifierRoutes },
+    #[error("the field route's specimen: {0}")]
+    Geometry(#[from] membrane::GeometryError),
 }
 
 /// The line printed when the first field comes (`identifier: first field received (frame N)`):
@@ -207,6 +227,7 @@ pub fn run(config: ProcessConfig) -> Result<ProcessSummary, ProcessError> {
         if accepted_any {
             identifier.refit(&publisher)?;
         }
+        identifier.refit_field(&publisher)?;
         if signalled || identifier.limit_reached() {
             break;
         }
@@ -219,9 +240,10 @@ fn final_json(
     summary: &ProcessSummary,
     online: &OnlineIdentifier,
     fits: &[crate::fit::Fit],
+    field_route: Option<serde_json::Value>,
 ) -> Result<String, ProcessError> {
     let points = online.point_counts();
-    let json = serde_json::json!({
+    let mut json = serde_json::json!({
         "points": {"uniaxial": points[0], "equibiaxial": points[1], "pure_shear": points[2], "biaxial_general": online.general_count()},
         "paths": online.path_count(),
         "fields_received": summary.fields_received,
@@ -229,5 +251,8 @@ fn final_json(
         "pairing": {"accepted": online.counters.accepted, "skipped": online.counters.skipped, "dropped": online.counters.dropped},
         "fits": fits.iter().map(fit_json).collect::<Vec<_>>(),
     });
+    if let Some(field_route) = field_route {
+        json["field_route"] = field_route;
+    }
     Ok(serde_json::to_string_pretty(&json)?)
 }

@@ -5,6 +5,7 @@ use identifier::law::InvariantLaw;
 use identifier::online::OnlineConfig;
 use identifier::process::{run, ProcessConfig};
 use std::time::{Duration, Instant};
+use wire::identification::IdentifierRoutes;
 use wire::pubsub::{SlicePublisher, ValuePublisher, ValueSubscriber};
 use wire::{
     services, FieldHeader, FieldNode, GaugeStrain, IdentificationReport, Instance, RigState,
@@ -29,6 +30,8 @@ fn live_process_identifies_smactane() {
         max_fields: Some(2 * STEPS),
         idle_timeout: Some(Duration::from_secs(20)),
         online: OnlineConfig::default(),
+        routes: IdentifierRoutes::Gauge,
+        field: None,
     };
     let worker = std::thread::spawn(move || run(config));
     {
@@ -142,6 +145,8 @@ fn live_process_identifies_smactane() {
         max_fields: None,
         idle_timeout: Some(Duration::from_millis(300)),
         online: OnlineConfig::default(),
+        routes: IdentifierRoutes::Gauge,
+        field: None,
     };
     let summary = run(again).unwrap();
     assert_eq!(summary.points, [STEPS as usize, STEPS as usize, 0]);

@@ -12,6 +12,7 @@ pub mod camera_events;
 pub mod children;
 pub mod config;
 pub mod dashboard_view;
+pub mod field_acceptance;
 pub mod figures;
 pub mod frames;
 pub mod latency;

@@ -59,6 +59,8 @@ pub struct Recorder {
     /// Nodes of the last field (buffer reused).
     pub last_nodes: Vec<FieldNode>,
     pub last_report: Option<IdentificationReport>,
+    /// The field route's last report (`identification`'s reports of `ReportRoute::Field`).
+    pub last_field_report: Option<IdentificationReport>,
     pub rig_samples_seen: u64,
     /// Frames the correlators that have ended skipped (their last `frames_dropped`), and the
     /// running one's so far: a restarted correlator counts from 0.
@@ -111,6 +113,7 @@ impl Recorder {
             last_field: None,
             last_nodes: Vec::new(),
             last_report: None,
+            last_field_report: None,
             rig_samples_seen: 0,
             frames_dropped_by_ended_correlators: 0,
             frames_dropped_by_correlator: 0,
@@ -289,7 +292,13 @@ impl Recorder {
         self.frames_dropped_by_ended_correlators + self.frames_dropped_by_correlator
     }
 
+    /// A gauge-route report is the run's identification (its latency, its last report); the
+    /// field route's is kept apart (`last_field_report`), so neither is mistaken for the other.
     pub fn on_report(&mut self, report: IdentificationReport) {
+        if report.route() != Some(wire::identification::ReportRoute::Gauge) {
+            self.last_field_report = Some(report);
+            return;
+        }
         self.latency_identification
             .record_ns(report.t_published_ns.saturating_sub(report.t_capture_ns));
         self.last_report = Some(report);

@@ -1,11 +1,13 @@
 //! `dicstream identifier`: the live identification process (subscribes to `fields` and
 //! `rig/state`, publishes `identification`, writes the final fits as JSON).
 
+use super::named_arg::named;
 use identifier::models::ModelList;
 use identifier::online::OnlineConfig;
-use identifier::process::{run as run_process, ProcessConfig};
+use identifier::process::{run as run_process, FieldRouteSettings, ProcessConfig};
 use std::path::PathBuf;
 use std::time::Duration;
+use wire::identification::{IdentifierRoutes, ReportRoute};
 
 #[derive(clap::Args, Debug)]
 pub struct IdentifierArgs {
@@ -32,6 +34,18 @@ pub struct IdentifierArgs {
     /// Stop after this many seconds without data.
     #[arg(long)]
     pub idle_timeout_s: Option<f64>,
+    /// The routes run: `gauge` (the gauge's averages), `field` (the whole field of a
+    /// cruciform, by the virtual fields method) or `both`.
+    #[arg(long, default_value = "gauge", value_parser = named::<IdentifierRoutes>())]
+    pub route: IdentifierRoutes,
+    /// The field route's camera view: the image's scale (mm per px), its centre on the
+    /// specimen's (the default cruciform's; other geometries through `--settings`).
+    #[arg(long, default_value_t = 0.16)]
+    pub mm_per_px: f64,
+    #[arg(long, default_value_t = 1024)]
+    pub width_px: u32,
+    #[arg(long, default_value_t = 1024)]
+    pub height_px: u32,
 }
 
 pub fn run(args: IdentifierArgs) -> anyhow::Result<()> {
@@ -85,5 +99,17 @@ fn process_config(args: IdentifierArgs) -> anyhow::Result<ProcessConfig> {
             models,
             ..OnlineConfig::default()
         },
+        routes: args.route,
+        field: args
+            .route
+            .runs(ReportRoute::Field)
+            .then(|| FieldRouteSettings {
+                mm_per_px: args.mm_per_px,
+                width_px: args.width_px,
+                height_px: args.height_px,
+                cruciform: Default::default(),
+                min_level_increment: FieldRouteSettings::DEFAULT_LEVEL_INCREMENT,
+                max_frames: FieldRouteSettings::DEFAULT_MAX_FRAMES,
+            }),
     })
 }

@@ -109,7 +109,7 @@ impl GradientSource {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FieldNode.v5")
+    type_name("dicstream.FieldNode.v6")
 )]
 pub struct FieldNode {
     /// ZOI centre in the reference image (px).
@@ -143,7 +143,7 @@ pub struct FieldNode {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.GaugeStrain.v5")
+    type_name("dicstream.GaugeStrain.v6")
 )]
 pub struct GaugeStrain {
     pub exx: f64,
@@ -157,7 +157,7 @@ pub struct GaugeStrain {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FieldHeader.v5")
+    type_name("dicstream.FieldHeader.v6")
 )]
 pub struct FieldHeader {
     pub layout_version: u32,

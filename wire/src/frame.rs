@@ -13,7 +13,7 @@ use iceoryx2::prelude::ZeroCopySend;
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.GroundTruth.v5")
+    type_name("dicstream.GroundTruth.v6")
 )]
 pub struct GroundTruth {
     /// Deformation gradient, row-major: `[F11, F12, F21, F22]` (dimensionless).
@@ -68,7 +68,7 @@ impl GroundTruth {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.FrameHeader.v5")
+    type_name("dicstream.FrameHeader.v6")
 )]
 pub struct FrameHeader {
     /// Always [`crate::LAYOUT_VERSION`]; checked by every reader.

@@ -8,13 +8,72 @@ pub const MAX_COEFFICIENTS: usize = 8;
 /// How many ranked models a report lists.
 pub const MAX_RANKED: usize = 8;
 
+/// Which route a report comes from ([`IdentificationReport::route`]): the gauge's averages of
+/// canonical tests, or the whole field by the virtual fields method (paper section 4.c).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ReportRoute {
+    #[default]
+    Gauge = 0,
+    Field = 1,
+}
+
+crate::named!(ReportRoute, "identification route", { Gauge => "gauge", Field => "field" });
+
+impl ReportRoute {
+    pub fn from_code(code: u32) -> Option<ReportRoute> {
+        ReportRoute::ALL.into_iter().find(|r| *r as u32 == code)
+    }
+}
+
+/// The routes an identifier runs (`[identifier] route`, `identifier --route`): both publish
+/// on `identification`, each report naming its own. `auto` is the run's default: both when the
+/// specimen is a structure (a cruciform's field holds what the field route needs), the gauge
+/// otherwise ([`IdentifierRoutes::resolved`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum IdentifierRoutes {
+    #[default]
+    Auto,
+    Gauge,
+    Field,
+    Both,
+}
+
+crate::named!(IdentifierRoutes, "identifier route", {
+    Auto => "auto", Gauge => "gauge", Field => "field", Both => "both",
+});
+
+impl IdentifierRoutes {
+    /// `auto` made concrete for a run whose specimen is (or is not) a structure.
+    pub fn resolved(self, structure: bool) -> IdentifierRoutes {
+        match (self, structure) {
+            (IdentifierRoutes::Auto, true) => IdentifierRoutes::Both,
+            (IdentifierRoutes::Auto, false) => IdentifierRoutes::Gauge,
+            (other, _) => other,
+        }
+    }
+
+    /// Whether `route` runs (`auto` unresolved runs the gauge's only).
+    pub fn runs(self, route: ReportRoute) -> bool {
+        matches!(
+            (self, route),
+            (IdentifierRoutes::Both, _)
+                | (
+                    IdentifierRoutes::Auto | IdentifierRoutes::Gauge,
+                    ReportRoute::Gauge
+                )
+                | (IdentifierRoutes::Field, ReportRoute::Field)
+        )
+    }
+}
+
 /// One fitted model in the ranking.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RankedModel.v5")
+    type_name("dicstream.RankedModel.v6")
 )]
 pub struct RankedModel {
     /// NUL-padded model name (identifier crate names), see [`crate::text`].
@@ -29,7 +88,7 @@ pub struct RankedModel {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.IdentificationReport.v5")
+    type_name("dicstream.IdentificationReport.v6")
 )]
 pub struct IdentificationReport {
     pub layout_version: u32,
@@ -49,7 +108,17 @@ pub struct IdentificationReport {
     pub b_count: u32,
     pub rms_mpa: f64,
     pub ranked_count: u32,
+    /// A [`ReportRoute`] code: the gauge route's report, or the field route's (whose `points`
+    /// are zero, `rms_mpa` NaN: its residuals are forces, in `identification.json`).
+    pub route: u32,
     pub ranking: [RankedModel; MAX_RANKED],
+}
+
+impl IdentificationReport {
+    /// The route this report comes from (None: an unknown code).
+    pub fn route(&self) -> Option<ReportRoute> {
+        ReportRoute::from_code(self.route)
+    }
 }
 
 impl Default for IdentificationReport {
@@ -68,6 +137,7 @@ impl Default for IdentificationReport {
             b_count: 0,
             rms_mpa: 0.0,
             ranked_count: 0,
+            route: ReportRoute::Gauge as u32,
             ranking: [RankedModel {
                 name: [0; 24],
                 aic: 0.0,

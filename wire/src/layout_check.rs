@@ -13,7 +13,7 @@ use crate::LAYOUT_VERSION;
 use std::mem::{offset_of, size_of};
 
 /// The version the figures below describe.
-const CHECKED_VERSION: u32 = 5;
+const CHECKED_VERSION: u32 = 6;
 
 const _: () = assert!(
     LAYOUT_VERSION == CHECKED_VERSION,
@@ -532,6 +532,10 @@ const _: () = {
     assert!(
         offset_of!(IdentificationReport, ranked_count) == 312,
         "IdentificationReport::ranked_count moved: bump LAYOUT_VERSION"
+    );
+    assert!(
+        offset_of!(IdentificationReport, route) == 316,
+        "IdentificationReport::route moved: bump LAYOUT_VERSION"
     );
     assert!(
         offset_of!(IdentificationReport, ranking) == 320,

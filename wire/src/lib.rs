@@ -51,7 +51,7 @@ pub use specimen::{SpecimenError, SpecimenHeader, SpecimenParts};
 /// Version of every layout in this crate. Bump it (and the `#[type_name]` suffixes, which
 /// embed it) whenever a field changes: processes of different versions then refuse to connect
 /// instead of misreading each other.
-pub const LAYOUT_VERSION: u32 = 5;
+pub const LAYOUT_VERSION: u32 = 6;
 
 /// Marks an absent rig sample id (a frame not taken under a rig, e.g. a replayed image).
 pub const NO_RIG_SAMPLE: u64 = u64::MAX;

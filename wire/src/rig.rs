@@ -15,7 +15,7 @@ pub const AXIS_NAMES: [&str; 3] = ["X", "Y", "Z"];
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.ActuatorState.v5")
+    type_name("dicstream.ActuatorState.v6")
 )]
 pub struct ActuatorState {
     pub position_mm: f64,
@@ -34,7 +34,7 @@ pub struct ActuatorState {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RigState.v5")
+    type_name("dicstream.RigState.v6")
 )]
 pub struct RigState {
     pub layout_version: u32,
@@ -216,7 +216,7 @@ impl RigCommandKind {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RigCommand.v5")
+    type_name("dicstream.RigCommand.v6")
 )]
 pub struct RigCommand {
     pub layout_version: u32,
@@ -250,7 +250,7 @@ impl RigCommand {
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.RigReply.v5")
+    type_name("dicstream.RigReply.v6")
 )]
 pub struct RigReply {
     pub layout_version: u32,

@@ -23,7 +23,7 @@ pub const ELEMENT_NODES: usize = 6;
 #[cfg_attr(
     feature = "ipc",
     derive(ZeroCopySend),
-    type_name("dicstream.SpecimenHeader.v5")
+    type_name("dicstream.SpecimenHeader.v6")
 )]
 pub struct SpecimenHeader {
     /// Always [`crate::LAYOUT_VERSION`]; checked by every reader.

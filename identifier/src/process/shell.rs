@@ -9,11 +9,14 @@ use crate::fit::Fit;
 use crate::journal::{JournalPoint, JournalWriter};
 use crate::online::{FieldOutcome, FieldSample, OnlineIdentifier};
 use std::time::{Duration, Instant};
+use wire::identification::ReportRoute;
 use wire::pubsub::{SliceSubscriber, ValuePublisher, ValueSubscriber};
 use wire::{FieldHeader, FieldNode, IdentificationReport, RigState};
 
 pub(super) struct Identifier<'c> {
     config: &'c ProcessConfig,
+    /// The field route, when `config.routes` runs it.
+    field: Option<super::field::FieldShell>,
     online: OnlineIdentifier,
     journal: Option<JournalWriter>,
     summary: ProcessSummary,
@@ -41,8 +44,26 @@ impl<'c> Identifier<'c> {
             }
             None => None,
         };
+        let field = if config.routes.runs(ReportRoute::Field) {
+            let settings = config.field.as_ref().ok_or(ProcessError::NoFieldSettings {
+                routes: config.routes,
+            })?;
+            if journal.is_some() {
+                eprintln!(
+                    "identifier: the field route journals nothing: after a restart it refits \
+                     from the fields it receives from then on"
+                );
+            }
+            Some(super::field::FieldShell::new(
+                settings,
+                &config.online.models,
+            )?)
+        } else {
+            None
+        };
         Ok(Self {
             config,
+            field,
             online,
             journal,
             summary: ProcessSummary::default(),
@@ -62,6 +83,9 @@ impl<'c> Identifier<'c> {
         let mut accepted = false;
         while let Some(state) = rig.receive()? {
             self.summary.rig_samples_received += 1;
+            if let Some(field) = self.field.as_mut() {
+                field.on_rig(&state);
+            }
             for (field, outcome) in self.online.push_rig(rig_sample(&state)) {
                 accepted |= self.record(&field, outcome)?;
             }
@@ -74,6 +98,12 @@ impl<'c> Identifier<'c> {
                     super::FIRST_FIELD_LINE,
                     sample.user_header().frame_id
                 );
+            }
+            if let Some(route) = self.field.as_mut() {
+                route.on_field(sample.user_header(), sample.payload());
+            }
+            if !self.config.routes.runs(ReportRoute::Gauge) {
+                continue;
             }
             if let Some(field) = field_sample(sample.user_header()) {
                 let outcome = self.online.push_field(field);
@@ -125,6 +155,21 @@ impl<'c> Identifier<'c> {
         Ok(())
     }
 
+    /// The field route's refit when it is due (new frames, a second since the last), published
+    /// and written.
+    pub fn refit_field(
+        &mut self,
+        publisher: &ValuePublisher<IdentificationReport>,
+    ) -> Result<(), ProcessError> {
+        if let Some(report) = self.field.as_mut().and_then(|f| f.refit(false)) {
+            self.last_activity = Instant::now();
+            publisher.publish(report)?;
+            self.summary.reports_published += 1;
+            self.write_json()?;
+        }
+        Ok(())
+    }
+
     /// `max_fields` received, or idle for the idle timeout.
     pub fn limit_reached(&self) -> bool {
         let config = self.config;
@@ -139,6 +184,10 @@ impl<'c> Identifier<'c> {
     /// The last fits written (those of the restored path when nothing new came), and the
     /// summary.
     pub fn finish(mut self) -> Result<ProcessSummary, ProcessError> {
+        if let Some(field) = self.field.as_mut() {
+            // The last frames' fit, written below (the publisher is gone at the end).
+            let _ = field.refit(true);
+        }
         if self.last_fits.is_empty() {
             // Restored points and nothing new: still report the fits of the path.
             self.last_fits = self.online.refit().unwrap_or_default();
@@ -152,7 +201,13 @@ impl<'c> Identifier<'c> {
     fn write_json(&self) -> Result<(), ProcessError> {
         wire::files::write_atomic(
             &self.config.output_json,
-            final_json(&self.summary, &self.online, &self.last_fits)?.as_bytes(),
+            final_json(
+                &self.summary,
+                &self.online,
+                &self.last_fits,
+                self.field.as_ref().map(|f| f.json()),
+            )?
+            .as_bytes(),
         )?;
         Ok(())
     }

@@ -103,6 +103,7 @@ const COMMENTS: &[(&str, &str)] = &[
     ("specimen.geometry.plane_strain_strip.element_size_mm", ""),
     ("[identifier]", ""),
     ("identifier.models", "Models ranked at each refit (see `dicstream identify --help`), or all."),
+    ("identifier.route", "gauge (the gauge's averages), field (the whole field of the cruciform by the\nvirtual fields method; needs [specimen] model = \"structure\" and a view that\ncrosses the arms: [camera] mm_per_px), both, or auto (both on a structure)."),
 ];
 
 const PREAMBLE: &str =

@@ -263,6 +263,18 @@ pub struct IdentifierSection {
     /// Models ranked at each refit, NAME[,NAME...] or all.
     #[serde(with = "wire::names::text")]
     pub models: ModelList,
+    /// The identification routes: `gauge`, `field` (the whole field of the cruciform, by the
+    /// virtual fields method), `both`, or `auto` (both on a structure, the gauge otherwise).
+    pub route: wire::identification::IdentifierRoutes,
+}
+
+impl RunConfig {
+    /// The identifier's routes, `auto` resolved by the specimen's model.
+    pub fn identifier_routes(&self) -> wire::identification::IdentifierRoutes {
+        self.identifier
+            .route
+            .resolved(self.specimen.model == rig::SpecimenModel::Structure)
+    }
 }
 
 impl Default for RunSection {
@@ -365,6 +377,7 @@ impl Default for IdentifierSection {
             models: identifier::models::ModelList(
                 identifier::online::OnlineConfig::default().models,
             ),
+            route: wire::identification::IdentifierRoutes::Auto,
         }
     }
 }

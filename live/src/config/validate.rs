@@ -17,6 +17,21 @@ impl RunConfig {
         self.validate_camera()?;
         self.correlator_settings()?;
         self.validate_rig()?;
+        self.validate_identifier()?;
+        Ok(())
+    }
+
+    /// The field route needs the specimen as a structure (a cruciform to cut across).
+    fn validate_identifier(&self) -> anyhow::Result<()> {
+        use wire::identification::ReportRoute;
+        let routes = self.identifier_routes();
+        if routes.runs(ReportRoute::Field) && self.specimen.model != rig::SpecimenModel::Structure {
+            anyhow::bail!(
+                "[identifier] route = \"{routes}\" runs the field route, which needs [specimen] \
+                 model = \"structure\" (the cruciform whose arms its cuts cross), not \"{}\"",
+                self.specimen.model
+            );
+        }
         Ok(())
     }
 

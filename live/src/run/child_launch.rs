@@ -217,7 +217,8 @@ pub fn correlator_settings(
     })
 }
 
-/// The identifier's models, its output and journal in the results.
+/// The identifier's models, its routes (the field route with the camera's view and the
+/// cruciform), its output and journal in the results.
 pub fn identifier_settings(
     config: &RunConfig,
     instance: &str,
@@ -233,6 +234,19 @@ pub fn identifier_settings(
             models: config.identifier.models.0.clone(),
             ..Default::default()
         },
+        routes: config.identifier_routes(),
+        field: config
+            .identifier_routes()
+            .runs(wire::identification::ReportRoute::Field)
+            .then_some(identifier::process::FieldRouteSettings {
+                mm_per_px: config.camera.mm_per_px,
+                width_px: config.camera.width_px,
+                height_px: config.camera.height_px,
+                cruciform: config.specimen.geometry.cruciform,
+                min_level_increment:
+                    identifier::process::FieldRouteSettings::DEFAULT_LEVEL_INCREMENT,
+                max_frames: identifier::process::FieldRouteSettings::DEFAULT_MAX_FRAMES,
+            }),
     }
 }
 

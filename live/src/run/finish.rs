@@ -43,7 +43,7 @@ impl Stopped<'_> {
         let results = &self.prepared.results;
         let recorder = &self.recorder;
         let outputs = outputs::write(config, results, recorder);
-        let judged = super::judge::judge(config, recorder);
+        let judged = super::judge::judge(config, recorder, &results.identification_json());
         let displacement_error_mean_px = read_back::mean_displacement_error(&results.frames_csv());
         let machine_csv = read_back::machine_csv_counts(config, results);
         let wall_s = self.started.elapsed().as_secs_f64();
@@ -80,6 +80,7 @@ impl Stopped<'_> {
             displacement_error_mean_px,
             truth: super::report::TruthReport::of(recorder),
             acceptance: judged.acceptance,
+            field_acceptance: judged.field,
             acceptance_skipped: judged.skipped,
             camera_source: config.camera.source,
             rig_source: config.rig.source,

@@ -11,11 +11,17 @@ use wire::IdentificationReport;
 /// The acceptance of the run's last identification, and why there is none if it was skipped.
 pub(super) struct Judged {
     pub(super) acceptance: Option<Acceptance>,
+    /// The field route's, from the identifier's `identification.json`.
+    pub(super) field: Option<crate::field_acceptance::FieldAcceptance>,
     pub(super) skipped: Option<String>,
 }
 
 /// Judges the last identification the run recorded (said on stderr when skipped).
-pub(super) fn judge(config: &RunConfig, recorder: &Recorder) -> Judged {
+pub(super) fn judge(
+    config: &RunConfig,
+    recorder: &Recorder,
+    identification_json: &std::path::Path,
+) -> Judged {
     let has_truth = config.camera.source.has_truth() && config.rig.source == RigSource::Simulated;
     let skipped = (!has_truth && recorder.last_report.is_some()).then(|| {
         format!(
@@ -31,8 +37,18 @@ pub(super) fn judge(config: &RunConfig, recorder: &Recorder) -> Judged {
         .last_report
         .filter(|_| has_truth)
         .map(|report| accept_report(config, recorder, &report));
+    let field = config
+        .identifier_routes()
+        .runs(wire::identification::ReportRoute::Field)
+        .then_some(())
+        .filter(|_| has_truth)
+        .and_then(|_| {
+            let truth = config.law().ok()?;
+            crate::field_acceptance::judge_field(&truth, identification_json)
+        });
     Judged {
         acceptance,
+        field,
         skipped,
     }
 }

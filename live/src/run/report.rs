@@ -82,6 +82,10 @@ pub struct RunReport {
     /// nodes' error percentiles.
     pub truth: Option<TruthReport>,
     pub acceptance: Option<Acceptance>,
+    /// The field route's law against the truth (`[identifier] route` field or both, with a
+    /// ground truth): informative, it does not decide the ending.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub field_acceptance: Option<crate::field_acceptance::FieldAcceptance>,
     /// Why there is no acceptance although a law was identified: a real camera or machine
     /// has no ground truth to compare with.
     pub acceptance_skipped: Option<String>,

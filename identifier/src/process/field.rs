@@ -1,0 +1,293 @@
+//! The field route in the identifier process: each field's nodes to the reference grid in mm
+//! (through the producer's `View::centred`, the one mapping of the camera's px to specimen mm),
+//! the grips' forces of the rig sample the frame names, the pure [`FieldRoute`] fed and refitted
+//! (at most every [`REFIT_INTERVAL`], and at the end), its report published beside the gauge route's.
+//!
+//! Restart: the field route journals nothing. A restarted identifier refits from the fields it
+//! receives after the restart (the frames before it are not re-sent): it says so on stderr and
+//! its `identification.json` counts only what it saw.
+
+use super::ProcessError;
+use crate::field_layout::ArmLayout;
+use crate::field_route::{FieldFits, FieldRoute, FieldRouteConfig, FrameOutcome};
+use crate::grip_forces::{ForceHistory, GripForces};
+use crate::models::Model;
+use crate::section_cut::FieldGrid;
+use membrane::specimens::cruciform::CruciformGeometry;
+use producer::View;
+use serde_json::{json, Value};
+use std::time::{Duration, Instant};
+use wire::identification::{RankedModel, ReportRoute, MAX_COEFFICIENTS, MAX_RANKED};
+use wire::{FieldHeader, FieldNode, IdentificationReport, NodeStatus, RigState};
+
+/// Shortest time between two fits of all frames (a fit of 12 frames takes seconds).
+pub const REFIT_INTERVAL: Duration = Duration::from_secs(5);
+
+/// What the field route needs of the run: the camera's view and the specimen filmed.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FieldRouteSettings {
+    /// The camera's scale and image size: the view is `View::centred` of them.
+    pub mm_per_px: f64,
+    pub width_px: u32,
+    pub height_px: u32,
+    /// The cruciform filmed (its outline, arms and thickness).
+    pub cruciform: CruciformGeometry,
+    /// A frame is kept when the mean stretching of its measured nodes grew by this since the
+    /// last one.
+    #[serde(default = "default_level_increment")]
+    pub min_level_increment: f64,
+    #[serde(default = "default_max_frames")]
+    pub max_frames: usize,
+}
+
+impl FieldRouteSettings {
+    pub const DEFAULT_LEVEL_INCREMENT: f64 = 0.0015;
+    pub const DEFAULT_MAX_FRAMES: usize = 12;
+}
+
+fn default_level_increment() -> f64 {
+    FieldRouteSettings::DEFAULT_LEVEL_INCREMENT
+}
+
+fn default_max_frames() -> usize {
+    FieldRouteSettings::DEFAULT_MAX_FRAMES
+}
+
+/// Cost of the route, ns.
+#[derive(Debug, Default)]
+struct Cost {
+    prepare_ns: Vec<u64>,
+    fit_ns: Vec<u64>,
+    correlate_ns: Vec<u64>,
+}
+
+fn ms(ns: &[u64]) -> Value {
+    if ns.is_empty() {
+        return Value::Null;
+    }
+    let mean = ns.iter().sum::<u64>() as f64 / ns.len() as f64 * 1e-6;
+    let max = *ns.iter().max().unwrap_or(&0) as f64 * 1e-6;
+    json!({"count": ns.len(), "mean": mean, "max": max})
+}
+
+pub(super) struct FieldShell {
+    route: FieldRoute,
+    history: ForceHistory,
+    view: View,
+    mesh: membrane::Mesh,
+    elements: membrane::ElementGrid,
+    /// Why the route stopped (a view that crosses no arm), said once.
+    error: Option<String>,
+    fits: Option<FieldFits>,
+    dirty: bool,
+    last_fit: Option<Instant>,
+    cost: Cost,
+}
+
+impl FieldShell {
+    pub fn new(settings: &FieldRouteSettings, models: &[Model]) -> Result<Self, ProcessError> {
+        let specimen = settings.cruciform.mesh()?;
+        let elements = membrane::ElementGrid::new(&specimen.mesh);
+        let c = &settings.cruciform;
+        Ok(Self {
+            route: FieldRoute::new(FieldRouteConfig {
+                layout: ArmLayout {
+                    arm_width_mm: c.arm_width_mm,
+                    fillet_radius_mm: c.fillet_radius_mm,
+                },
+                thickness_mm: c.thickness_mm,
+                models: models.to_vec(),
+                min_level_increment: settings.min_level_increment,
+                max_frames: settings.max_frames,
+                min_frames_to_fit: 3,
+                central_ramps: true,
+            }),
+            history: ForceHistory::default(),
+            view: View::centred(settings.mm_per_px, settings.width_px, settings.height_px),
+            mesh: specimen.mesh,
+            elements,
+            error: None,
+            fits: None,
+            dirty: false,
+            last_fit: None,
+            cost: Cost::default(),
+        })
+    }
+
+    pub fn on_rig(&mut self, state: &RigState) {
+        let a = &state.actuators;
+        self.history.push(GripForces {
+            sample_id: state.sample_id,
+            t_ns: state.t_published_ns,
+            forces_n: std::array::from_fn(|i| 1e3 * a[i].force_kn),
+        });
+    }
+
+    /// The field's nodes on the reference grid in mm: F = I + ∇u of every `ok` node, None for
+    /// the others; None for a field of another layout (no gradients to read).
+    fn grid(&self, header: &FieldHeader, nodes: &[FieldNode]) -> Option<FieldGrid> {
+        let (cols, rows) = (header.mesh_cols as usize, header.mesh_rows as usize);
+        if header.layout_version != wire::LAYOUT_VERSION || nodes.len() != cols * rows || cols == 0
+        {
+            return None;
+        }
+        let first = [f64::from(nodes[0].x_px), f64::from(nodes[0].y_px)];
+        let origin = self.view.to_mm(first);
+        let next = self
+            .view
+            .to_mm([first[0] + f64::from(header.step_px), first[1]]);
+        let gradients = nodes
+            .iter()
+            .map(|n| {
+                (n.status == NodeStatus::Ok as u32).then(|| {
+                    [
+                        [1.0 + f64::from(n.du_dx), f64::from(n.du_dy)],
+                        [f64::from(n.dv_dx), 1.0 + f64::from(n.dv_dy)],
+                    ]
+                })
+            })
+            .collect();
+        Some(FieldGrid {
+            cols,
+            rows,
+            x0_mm: origin[0],
+            y0_mm: origin[1],
+            step_mm: next[0] - origin[0],
+            gradients,
+        })
+    }
+
+    pub fn on_field(&mut self, header: &FieldHeader, nodes: &[FieldNode]) {
+        if self.error.is_some() {
+            return;
+        }
+        let started = Instant::now();
+        self.cost.correlate_ns.push(header.correlate_ns);
+        let grid = self.grid(header, nodes);
+        let sample = (header.rig_sample_id != wire::NO_RIG_SAMPLE).then_some(header.rig_sample_id);
+        let forces = self.history.find(sample, header.t_capture_ns);
+        let level = grid.as_ref().map_or(0.0, mean_stretching);
+        let (mesh, elements) = (&self.mesh, &self.elements);
+        let material = |x: [f64; 2]| elements.locate(mesh, x).is_some();
+        match self
+            .route
+            .push(header.frame_id, grid, forces, level, &material)
+        {
+            Ok(FrameOutcome::Kept) => self.dirty = true,
+            Ok(_) => {}
+            Err(e) => {
+                eprintln!("identifier: field route stopped: {e}");
+                self.error = Some(e.to_string());
+            }
+        }
+        self.cost
+            .prepare_ns
+            .push(started.elapsed().as_nanos() as u64);
+    }
+
+    /// Refits when new frames came and [`REFIT_INTERVAL`] has passed since the last fit (or `now`);
+    /// the report to publish, if a fit was made.
+    pub fn refit(&mut self, now: bool) -> Option<IdentificationReport> {
+        let due = self.last_fit.is_none_or(|t| t.elapsed() >= REFIT_INTERVAL);
+        if !self.dirty || !(due || now) {
+            return None;
+        }
+        let started = Instant::now();
+        let fits = self.route.fit()?;
+        self.cost.fit_ns.push(started.elapsed().as_nanos() as u64);
+        self.dirty = false;
+        self.last_fit = Some(Instant::now());
+        let report = report(&fits, self.route.frames().last().map(|f| f.frame_id));
+        self.fits = Some(fits);
+        Some(report)
+    }
+
+    /// The route's part of `identification.json`.
+    pub fn json(&self) -> Value {
+        let fits = self.fits.as_ref();
+        json!({
+            "error": self.error,
+            "counters": self.route.counters,
+            "frames": fits.map(|f| f.frames),
+            "max_stretches": fits.map(|f| f.max_stretches),
+            "fits": fits.map(|f| f.fits.iter().map(|fit| {
+                let names = fit.model.param_names();
+                json!({
+                    "model": fit.model.name(),
+                    "params": names.iter().cloned().zip(fit.fit.params.iter().map(|v| json!(v))).collect::<serde_json::Map<String, Value>>(),
+                    "sigma": names.iter().cloned().zip(fit.fit.sigma.iter().map(|s| json!(s.is_finite().then_some(*s)))).collect::<serde_json::Map<String, Value>>(),
+                    "rms_n": fit.fit.rms_n,
+                    "equations": fit.fit.equations,
+                    "condition": fit.fit.condition,
+                    "aic": fit.aic,
+                })
+            }).collect::<Vec<_>>()),
+            "refused": fits.map(|f| f.refused.iter().map(|(m, why)| json!({"model": m, "why": why})).collect::<Vec<_>>()),
+            "cost_ms": {
+                "prepare_per_field": ms(&self.cost.prepare_ns),
+                "fit_all_frames": ms(&self.cost.fit_ns),
+                "correlator_per_field": ms(&self.cost.correlate_ns),
+            },
+        })
+    }
+}
+
+/// The loading level of a field: the mean over its measured nodes of (F11 + F22)/2 − 1 (the
+/// gauge's average would mix the specimen with the room behind it).
+fn mean_stretching(grid: &FieldGrid) -> f64 {
+    let (sum, n) = grid
+        .gradients
+        .iter()
+        .flatten()
+        .fold((0.0, 0usize), |(s, n), f| {
+            (s + 0.5 * (f[0][0] + f[1][1]) - 1.0, n + 1)
+        });
+    if n == 0 {
+        0.0
+    } else {
+        sum / n as f64
+    }
+}
+
+/// The wire report of the field route's fits (best AIC first): their ranking and, when the
+/// paper's law is among them, its a and b. `rms_mpa` is NaN: the route's residuals are forces.
+fn report(fits: &FieldFits, frame_id: Option<u64>) -> IdentificationReport {
+    let mut report = IdentificationReport {
+        route: ReportRoute::Field as u32,
+        rms_mpa: f64::NAN,
+        frame_id: frame_id.unwrap_or(0),
+        ..IdentificationReport::default()
+    };
+    if let Some(fit) = fits
+        .fits
+        .iter()
+        .find(|f| matches!(f.model, Model::LambertDianiRey { .. }))
+    {
+        if let Model::LambertDianiRey { f_degree, .. } = fit.model {
+            let p = &fit.fit.params;
+            let (a, b) = p.split_at(f_degree + 1);
+            for (i, v) in a.iter().take(MAX_COEFFICIENTS).enumerate() {
+                report.a[i] = *v;
+                report.a_stderr[i] = fit.fit.sigma[i];
+            }
+            for (i, v) in b.iter().take(MAX_COEFFICIENTS).enumerate() {
+                report.b[i] = *v;
+                report.b_stderr[i] = fit.fit.sigma[f_degree + 1 + i];
+            }
+            report.a_count = a.len().min(MAX_COEFFICIENTS) as u32;
+            report.b_count = b.len().min(MAX_COEFFICIENTS) as u32;
+        }
+    }
+    for (slot, fit) in report.ranking.iter_mut().zip(&fits.fits) {
+        *slot = RankedModel {
+            name: [0; 24],
+            aic: fit.aic,
+            rms_mpa: f64::NAN,
+        };
+        wire::text::write_fixed(&mut slot.name, &fit.model.name());
+    }
+    report.ranked_count = fits.fits.len().min(MAX_RANKED) as u32;
+    report.t_published_ns = wire::monotonic_ns();
+    report
+}

@@ -1,0 +1,173 @@
+//! The field route's law against the specimen's true one (issue 25's target): the law the
+//! field route ranked first by AIC (`identification.json`'s `field_route`, any family of the
+//! catalogue) against `[specimen]`'s, in uniaxial, equibiaxial and pure-shear nominal stress
+//! over the states the field reached: uniaxial and pure shear up to the largest major
+//! principal stretch of the nodes used, equibiaxial up to the largest minor one. The worst
+//! relative error over (1, max] (200 stretches), as the gauge route's acceptance measures it.
+//! Reported in `summary.json` (`field_acceptance`) beside the gauge route's acceptance; it
+//! does not decide the run's ending.
+
+use crate::acceptance::CaseComparison;
+use identifier::data::LoadCase;
+use identifier::law::InvariantLaw;
+use identifier::models::Model;
+use serde::Serialize;
+use serde_json::Value;
+use std::path::Path;
+
+/// Issue 25's tolerance: 2 % in nominal stress.
+pub const FIELD_TOLERANCE: f64 = 0.02;
+/// Stretches sampled per case.
+const SAMPLES: usize = 200;
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FieldAcceptance {
+    /// The model compared (the field route's best by AIC) and its parameters, in the order of
+    /// its parameter names.
+    pub model: Option<String>,
+    pub params: Vec<f64>,
+    pub max_stretches: Option<[f64; 2]>,
+    pub uniaxial: Option<CaseComparison>,
+    pub equibiaxial: Option<CaseComparison>,
+    pub pure_shear: Option<CaseComparison>,
+    pub frames: Option<u64>,
+    /// The route's counters, cost, fits and refusals, as the identifier wrote them.
+    pub counters: Value,
+    pub cost_ms: Value,
+    pub fits: Value,
+    pub refused: Value,
+    /// Why the route gave nothing (a view that crosses no arm...).
+    pub error: Option<String>,
+    pub tolerance: f64,
+    pub passed: bool,
+}
+
+/// The field route's acceptance from the identifier's JSON (None: the route did not run).
+pub fn judge_field(truth: &InvariantLaw, identification_json: &Path) -> Option<FieldAcceptance> {
+    let text = std::fs::read_to_string(identification_json).ok()?;
+    let json: Value = serde_json::from_str(&text).ok()?;
+    Some(compare(truth, json.get("field_route")?))
+}
+
+/// The model and parameters of one fit of the route's JSON.
+fn law_of(fit: &Value) -> Option<(Model, Vec<f64>)> {
+    let model = Model::parse(fit["model"].as_str()?).ok()?;
+    let params = fit["params"].as_object()?;
+    let p = model
+        .param_names()
+        .iter()
+        .map(|name| params.get(name)?.as_f64())
+        .collect::<Option<Vec<f64>>>()?;
+    Some((model, p))
+}
+
+/// Worst |identified − true| / true over (1, max].
+fn worst(
+    truth: impl Fn(f64) -> f64,
+    identified: impl Fn(f64) -> Option<f64>,
+    max: f64,
+) -> CaseComparison {
+    let mut worst = CaseComparison {
+        max_stretch: max,
+        max_relative_error: 0.0,
+        at_stretch: 1.0,
+    };
+    for k in 1..=SAMPLES {
+        let stretch = 1.0 + (max - 1.0) * k as f64 / SAMPLES as f64;
+        let t = truth(stretch);
+        let error = identified(stretch).map_or(f64::INFINITY, |p| ((p - t) / t).abs());
+        if !error.is_finite() || error > worst.max_relative_error {
+            worst.max_relative_error = error;
+            worst.at_stretch = stretch;
+        }
+    }
+    worst
+}
+
+fn compare(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
+    let best = route["fits"]
+        .as_array()
+        .and_then(|f| f.first())
+        .and_then(law_of);
+    let max_stretches = route["max_stretches"]
+        .as_array()
+        .and_then(|m| Some([m.first()?.as_f64()?, m.get(1)?.as_f64()?]));
+    let (mut uniaxial, mut equibiaxial, mut pure_shear) = (None, None, None);
+    if let (Some((model, p)), Some([major, minor])) = (&best, max_stretches) {
+        let reached = |l: f64| (l > 1.005).then_some(l);
+        let case = |c: LoadCase| move |l: f64| model.nominal_stress_mpa(p, c, l);
+        uniaxial = reached(major).map(|m| {
+            worst(
+                |l| truth.uniaxial_nominal_stress_mpa(l),
+                case(LoadCase::Uniaxial),
+                m,
+            )
+        });
+        equibiaxial = reached(minor).map(|m| {
+            worst(
+                |l| truth.equibiaxial_nominal_stress_mpa(l),
+                case(LoadCase::Equibiaxial),
+                m,
+            )
+        });
+        pure_shear = reached(major).map(|m| {
+            worst(
+                |l| truth.pure_shear_nominal_stress_mpa(l),
+                case(LoadCase::PureShear),
+                m,
+            )
+        });
+    }
+    let within =
+        |c: Option<CaseComparison>| c.is_some_and(|c| c.max_relative_error <= FIELD_TOLERANCE);
+    FieldAcceptance {
+        model: best.as_ref().map(|(m, _)| m.name()),
+        params: best.map(|(_, p)| p).unwrap_or_default(),
+        max_stretches,
+        uniaxial,
+        equibiaxial,
+        pure_shear,
+        frames: route["frames"].as_u64(),
+        counters: route["counters"].clone(),
+        cost_ms: route["cost_ms"].clone(),
+        fits: route["fits"].clone(),
+        refused: route["refused"].clone(),
+        error: route["error"].as_str().map(str::to_string),
+        tolerance: FIELD_TOLERANCE,
+        passed: within(uniaxial) && within(equibiaxial) && within(pure_shear),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn the_true_law_passes_and_another_is_measured() {
+        let truth = InvariantLaw::smactane();
+        let route = |a0: f64| {
+            json!({
+                "frames": 12,
+                "max_stretches": [1.5, 1.3],
+                "fits": [{"model": "lambert-diani-rey:2,2",
+                          "params": {"a0": a0, "a1": -2.52e-2, "a2": 1.40e-3,
+                                     "b0": -1.02, "b1": -3.92e-3, "b2": -5.30e-4}}],
+            })
+        };
+        let exact = compare(&truth, &route(-1.27));
+        assert!(exact.passed, "{exact:?}");
+        assert_eq!(exact.model.as_deref(), Some("lambert-diani-rey:2,2"));
+        assert_eq!(exact.uniaxial.unwrap().max_stretch, 1.5);
+        assert_eq!(exact.equibiaxial.unwrap().max_stretch, 1.3);
+        assert!(exact.pure_shear.unwrap().max_relative_error < 1e-12);
+        // f 5 % stiffer: measured, not passed.
+        let off = compare(&truth, &route(-1.27 + 0.05_f64.ln_1p()));
+        assert!(!off.passed);
+        assert!(off.uniaxial.unwrap().max_relative_error > 0.02, "{off:?}");
+        // A route that fitted nothing is compared on nothing and not passed.
+        let none = compare(&truth, &json!({"error": "crosses no arm", "fits": null}));
+        assert!(!none.passed && none.uniaxial.is_none());
+        assert_eq!(none.error.as_deref(), Some("crosses no arm"));
+    }
+}
