@@ -9,6 +9,7 @@ mod followed;
 mod growth;
 mod guess;
 mod icgn_stage;
+mod neighbour_check;
 mod parts;
 mod reanchor;
 mod renewal;
@@ -57,7 +58,8 @@ const EXTRAPOLATION_RINGS: usize = 2;
 const CARRY_RINGS: usize = 5;
 /// Valid nodes an extrapolating fit needs.
 const MIN_EXTRAPOLATION_NODES: usize = 6;
-/// A node further from the affine fit of its neighbours (within [`EXTRAPOLATION_RINGS`]) than
+/// A node whose displacement since the reference is further from what its neighbours (within
+/// [`EXTRAPOLATION_RINGS`]) predict (`neighbour_check.rs`) than
 /// [`OUTLIER_SCATTER`] times the frame's median distance, bounded to [`OUTLIER_MIN_PX`,
 /// `OUTLIER_MAX_PX`], is inconsistent: about seven standard deviations of the measurement noise,
 /// never less than the half pixel that makes a wrong value, never more than 2 px.

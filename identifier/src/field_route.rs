@@ -4,18 +4,23 @@
 //! process hands it grids in mm, forces in N and the specimen's outline.
 //!
 //! Kept frames: the loading branch only, one frame each time its loading level (the process
-//! gives the mean stretching of the measured nodes) has grown by `min_level_increment` since
-//! the last kept one (so a test's frames stay few and
-//! distinct whatever the frame rate), at most `max_frames`. What is not kept is counted by
-//! reason, never fitted in part: a field without gradients, one whose grip forces have no
-//! matching rig sample, one where a grip pulls nothing (a strip's test, not the cruciform's), a
-//! virtual field with a hole (dropped for that frame, counted).
+//! gives the mean stretching of the measured nodes) has grown by an increment since the last
+//! kept one (so a test's frames stay few and distinct whatever the frame rate). At
+//! `max_frames`, every other kept frame is dropped and the increment doubled: the frames stay
+//! spread over the whole loading, however far it goes. What is not kept is counted by reason,
+//! never fitted in part: a field without gradients, one whose grip forces have no matching rig
+//! sample, one where a grip pulls nothing (a strip's test, not the cruciform's), a virtual field
+//! with a hole or a node whose gradient is inverted (dropped for that frame, counted).
+//!
+//! Each kept frame's equations are compiled when it is kept (`virtual_work::Equations`); a fit
+//! ([`FieldRoute::fit_job`]) owns their concatenation and may run on another thread.
 
 use crate::field_layout::{place_fields, ArmLayout, LayoutError, PlacedField};
 use crate::models::Model;
 use crate::section_cut::FieldGrid;
 use crate::tapered_ramp::RampQuadrature;
-use crate::vfm::{fit, CutObservation, VfmError, VfmFit, VirtualField};
+use crate::vfm::{compile, fit_equations, CutObservation, VfmError, VfmFit, VirtualField};
+use crate::virtual_work::Equations;
 
 /// Settings of the field route.
 #[derive(Clone, Debug, PartialEq)]
@@ -41,6 +46,10 @@ pub struct FieldFrame {
     pub forces_n: [f64; 4],
     /// The virtual fields whose quadrature held, with their grip.
     pub fields: Vec<(RampQuadrature, usize)>,
+    /// Its loading level when kept.
+    pub level: f64,
+    /// Its fields' equations, compiled.
+    pub equations: Equations,
 }
 
 /// What happened to the frames offered, by reason.
@@ -54,8 +63,9 @@ pub struct FieldCounters {
     pub without_gradients: u64,
     /// No rig sample matches the frame's.
     pub without_forces: u64,
-    /// The frame limit was reached.
-    pub over_limit: u64,
+    /// Kept frames dropped again at the frame limit (every other one, to keep the frames
+    /// spread over the loading).
+    pub thinned: u64,
     /// A grip pulls nothing (another specimen than the cruciform mounted: a strip's test).
     pub grips_unloaded: u64,
     /// Virtual fields dropped for a frame (a hole where the field varies, or no stress).
@@ -69,7 +79,6 @@ pub enum FrameOutcome {
     NotLoading,
     WithoutGradients,
     WithoutForces,
-    OverLimit,
     GripsUnloaded,
 }
 
@@ -98,18 +107,22 @@ pub struct FieldRoute {
     config: FieldRouteConfig,
     placed: Option<Vec<PlacedField>>,
     frames: Vec<FieldFrame>,
-    last_level: f64,
+    /// The level a frame must grow by over the last kept one (doubled at each thinning).
+    increment: f64,
     pub counters: FieldCounters,
+    /// Why the last virtual field dropped was (its frame and the reason).
+    pub last_dropped: Option<String>,
 }
 
 impl FieldRoute {
     pub fn new(config: FieldRouteConfig) -> Self {
         Self {
+            increment: config.min_level_increment,
             config,
             placed: None,
             frames: vec![],
-            last_level: 0.0,
             counters: FieldCounters::default(),
+            last_dropped: None,
         }
     }
 
@@ -136,7 +149,6 @@ impl FieldRoute {
             FrameOutcome::NotLoading => c.not_loading += 1,
             FrameOutcome::WithoutGradients => c.without_gradients += 1,
             FrameOutcome::WithoutForces => c.without_forces += 1,
-            FrameOutcome::OverLimit => c.over_limit += 1,
             FrameOutcome::GripsUnloaded => c.grips_unloaded += 1,
         }
         Ok(outcome)
@@ -150,7 +162,7 @@ impl FieldRoute {
         level: f64,
         material: &dyn Fn([f64; 2]) -> bool,
     ) -> Result<FrameOutcome, LayoutError> {
-        if level < self.last_level + self.config.min_level_increment {
+        if !self.is_new_level(level) {
             return Ok(FrameOutcome::NotLoading);
         }
         let Some(grid) = grid.filter(|g| g.gradients.iter().any(Option::is_some)) else {
@@ -164,8 +176,11 @@ impl FieldRoute {
         if forces_n.iter().any(|&f| f <= 0.0) {
             return Ok(FrameOutcome::GripsUnloaded);
         }
-        if self.frames.len() >= self.config.max_frames {
-            return Ok(FrameOutcome::OverLimit);
+        if self.frames.len() >= self.config.max_frames.max(2) {
+            self.thin();
+            if !self.is_new_level(level) {
+                return Ok(FrameOutcome::NotLoading);
+            }
         }
         if self.placed.is_none() {
             self.placed = Some(place_fields(&self.config.layout, &grid)?);
@@ -176,55 +191,138 @@ impl FieldRoute {
             .iter()
             .filter(|p| p.is_cut || self.config.central_ramps)
         {
-            match p.ramp.quadrature(&grid, material) {
+            // A node whose gradient has no stress (inverted) drops the field too.
+            let field = p
+                .ramp
+                .quadrature(&grid, material)
+                .map_err(VfmError::from)
+                .and_then(|q| compile(&[self.observation(&grid, &q, forces_n[p.grip])]).map(|_| q));
+            match field {
                 Ok(q) => fields.push((q, p.grip)),
-                Err(_) => self.counters.virtual_fields_dropped += 1,
+                Err(e) => {
+                    self.counters.virtual_fields_dropped += 1;
+                    self.last_dropped = Some(format!("frame {frame_id}: {e}"));
+                }
             }
         }
-        self.last_level = level;
+        let observations: Vec<_> = fields
+            .iter()
+            .map(|(q, grip)| self.observation(&grid, q, forces_n[*grip]))
+            .collect();
+        let equations = compile(&observations).unwrap_or_default();
         self.frames.push(FieldFrame {
             frame_id,
             grid,
             forces_n,
             fields,
+            level,
+            equations,
         });
         Ok(FrameOutcome::Kept)
     }
 
-    /// Every kept frame's virtual fields as equations.
-    fn observations(&self) -> Vec<CutObservation<'_>> {
-        self.frames
-            .iter()
-            .flat_map(|frame| {
-                frame.fields.iter().map(move |(q, grip)| CutObservation {
-                    grid: &frame.grid,
-                    cut: VirtualField::Ramp(q),
-                    thickness_mm: self.config.thickness_mm,
-                    force_n: frame.forces_n[*grip],
-                })
-            })
-            .collect()
+    /// Grown by the increment since the last kept frame (from rest for the first).
+    fn is_new_level(&self, level: f64) -> bool {
+        level >= self.frames.last().map_or(0.0, |last| last.level) + self.increment
     }
 
-    /// Fits every model to all kept frames (None before `min_frames_to_fit`). Linear models
-    /// first; a nonlinear one starts from the Mooney-Rivlin fit ([`start_from_mooney`]).
-    pub fn fit(&self) -> Option<FieldFits> {
+    /// Drops every other kept frame (the first stays) and doubles the level increment.
+    fn thin(&mut self) {
+        let before = self.frames.len();
+        let mut index = 0;
+        self.frames.retain(|_| {
+            index += 1;
+            index % 2 == 1
+        });
+        self.counters.thinned += (before - self.frames.len()) as u64;
+        self.increment *= 2.0;
+    }
+
+    fn observation<'a>(
+        &self,
+        grid: &'a FieldGrid,
+        field: &'a RampQuadrature,
+        force_n: f64,
+    ) -> CutObservation<'a> {
+        CutObservation {
+            grid,
+            cut: VirtualField::Ramp(field),
+            thickness_mm: self.config.thickness_mm,
+            force_n,
+        }
+    }
+
+    /// What a fit of all kept frames needs, owned (None before `min_frames_to_fit`): it may
+    /// run on another thread.
+    pub fn fit_job(&self) -> Option<FitJob> {
         if self.frames.len() < self.config.min_frames_to_fit {
             return None;
         }
-        let obs = self.observations();
-        let mut out = FieldFits {
+        let mut equations = Equations::default();
+        for frame in &self.frames {
+            equations.append(&frame.equations);
+        }
+        Some(FitJob {
+            equations,
+            models: self.config.models.clone(),
             frames: self.frames.len(),
             max_stretches: self.max_stretches(),
+            last_frame_id: self.frames.last().map(|f| f.frame_id),
+        })
+    }
+
+    /// Fits every model to all kept frames, here ([`FitJob::run`]).
+    pub fn fit(&self) -> Option<FieldFits> {
+        Some(self.fit_job()?.run())
+    }
+
+    /// The largest major and minor principal stretches of the kept frames' measured nodes.
+    fn max_stretches(&self) -> [f64; 2] {
+        let mut range = [1.0_f64, 1.0_f64];
+        for frame in &self.frames {
+            for f in frame.grid.gradients.iter().flatten() {
+                let c = [
+                    f[0][0] * f[0][0] + f[1][0] * f[1][0],
+                    f[0][0] * f[0][1] + f[1][0] * f[1][1],
+                    f[0][1] * f[0][1] + f[1][1] * f[1][1],
+                ];
+                let (mean, radius) = (0.5 * (c[0] + c[2]), (0.5 * (c[0] - c[2])).hypot(c[1]));
+                range[0] = range[0].max((mean + radius).sqrt());
+                range[1] = range[1].max((mean - radius).max(0.0).sqrt());
+            }
+        }
+        range
+    }
+}
+
+/// A fit of all kept frames: the equations and the models.
+#[derive(Clone, Debug)]
+pub struct FitJob {
+    pub equations: Equations,
+    pub models: Vec<Model>,
+    pub frames: usize,
+    pub max_stretches: [f64; 2],
+    /// The last kept frame.
+    pub last_frame_id: Option<u64>,
+}
+
+impl FitJob {
+    /// Fits every model, ranked by AIC. Linear models directly; a nonlinear one starts from
+    /// the Mooney-Rivlin fit ([`start_from_mooney`]).
+    pub fn run(&self) -> FieldFits {
+        let equations = &self.equations;
+        let mut out = FieldFits {
+            frames: self.frames,
+            max_stretches: self.max_stretches,
             ..FieldFits::default()
         };
-        let mooney = fit(&Model::Mooney, &obs, &[0.0, 0.0]);
-        for model in &self.config.models {
+        let mooney = fit_equations(&Model::Mooney, equations, &[0.0, 0.0]);
+        for model in &self.models {
             let result = if *model == Model::Mooney {
                 mooney.clone()
             } else {
                 match start_for(model, mooney.as_ref().ok()) {
-                    Some(start) => fit(model, &obs, &start),
+                    Some(start) => fit_equations(model, equations, &start),
                     None => {
                         out.refused.push((
                             model.name(),
@@ -249,25 +347,7 @@ impl FieldRoute {
             }
         }
         out.fits.sort_by(|a, b| a.aic.total_cmp(&b.aic));
-        Some(out)
-    }
-
-    /// The largest major and minor principal stretches of the kept frames' measured nodes.
-    fn max_stretches(&self) -> [f64; 2] {
-        let mut range = [1.0_f64, 1.0_f64];
-        for frame in &self.frames {
-            for f in frame.grid.gradients.iter().flatten() {
-                let c = [
-                    f[0][0] * f[0][0] + f[1][0] * f[1][0],
-                    f[0][0] * f[0][1] + f[1][0] * f[1][1],
-                    f[0][1] * f[0][1] + f[1][1] * f[1][1],
-                ];
-                let (mean, radius) = (0.5 * (c[0] + c[2]), (0.5 * (c[0] - c[2])).hypot(c[1]));
-                range[0] = range[0].max((mean + radius).sqrt());
-                range[1] = range[1].max((mean - radius).max(0.0).sqrt());
-            }
-        }
-        range
+        out
     }
 }
 
@@ -404,6 +484,30 @@ mod tests {
         // A cut and a central ramp per arm.
         assert_eq!(route.frames()[0].fields.len(), 8);
         assert!(route.fit().is_none(), "one frame is not a test");
+    }
+
+    /// A long loading at the frame limit keeps its frames spread from the first to the
+    /// last level, never only its beginning.
+    #[test]
+    fn at_the_limit_the_frames_stay_spread_over_the_loading() {
+        let mut route = FieldRoute::new(config());
+        let forces = Some([10.0; 4]);
+        for k in 1..=40 {
+            let level = 0.01 * k as f64;
+            let stretch = 1.0 + level;
+            let g = grid([[stretch, 0.0], [0.0, stretch]]);
+            route.push(k, Some(g), forces, level, &everywhere).unwrap();
+        }
+        let levels: Vec<f64> = route.frames().iter().map(|f| f.level).collect();
+        assert!(levels.len() <= 4 && levels.len() >= 3, "{levels:?}");
+        assert_eq!(levels[0], 0.01);
+        assert!(*levels.last().unwrap() >= 0.3, "{levels:?}");
+        assert!(levels.windows(2).all(|w| w[1] > w[0]));
+        assert_eq!(
+            route.counters.kept - route.counters.thinned,
+            levels.len() as u64
+        );
+        assert!(route.counters.thinned > 0);
     }
 
     /// Homogeneous biaxial frames whose grip forces are what the cuts carry under the true law

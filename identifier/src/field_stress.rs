@@ -69,9 +69,23 @@ pub fn principal_stretches(f: &Mat2) -> Option<[f64; 2]> {
     Some([b1.sqrt(), b2.max(0.0).sqrt()])
 }
 
-/// The stress of a node whose in-plane deformation gradient is `f` (F = I + ∇u, reference to
-/// current), under `model` with parameters `p` (MPa).
-pub fn node_stress(model: &Model, p: &[f64], f: &Mat2) -> Result<NodeStress, NodeStressError> {
+/// What a node's stress owes to its kinematics alone: its stretches and, per in-plane
+/// principal direction n_α of B = F Fᵀ, the tensor K_α = (n_α ⊗ n_α) F⁻ᵀ, so that the nominal
+/// stress under any law is P = s1 K1 + s2 K2 with s1, s2 the law's principal Cauchy stresses
+/// (J = 1). A fit that tries many laws on one field computes this once per node.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeKinematics {
+    /// In-plane principal stretches, λ1 ≥ λ2, and the thickness stretch λ3 = 1/(λ1 λ2).
+    pub stretches: [f64; 3],
+    /// Unit principal directions n1, n2 (current configuration), n2 ⟂ n1.
+    pub directions: [[f64; 2]; 2],
+    /// K1, K2: the nominal stress per unit principal Cauchy stress.
+    pub nominal_per_cauchy: [Mat2; 2],
+}
+
+/// The kinematics of a node whose in-plane deformation gradient is `f` (F = I + ∇u, reference
+/// to current).
+pub fn node_kinematics(f: &Mat2) -> Result<NodeKinematics, NodeStressError> {
     if f.iter().flatten().any(|v| !v.is_finite()) {
         return Err(NodeStressError::NotFinite { f: *f });
     }
@@ -81,21 +95,42 @@ pub fn node_stress(model: &Model, p: &[f64], f: &Mat2) -> Result<NodeStress, Nod
     }
     let b = mul(f, &transpose(f));
     let ([b1, b2], n1) = symmetric_eigen(&b);
-    let stretches = [b1.sqrt(), b2.max(0.0).sqrt(), 1.0 / det_f];
-    let [s1, s2] = model
-        .in_plane_cauchy_stress_mpa(p, stretches[0], stretches[1])
-        .ok_or(NodeStressError::OutsideDomain { stretches })?;
-    // σ = s1 n1⊗n1 + s2 n2⊗n2 with n2 ⟂ n1.
     let n2 = [-n1[1], n1[0]];
-    let cauchy_mpa: Mat2 =
-        std::array::from_fn(|i| std::array::from_fn(|j| s1 * n1[i] * n1[j] + s2 * n2[i] * n2[j]));
     // F⁻ᵀ = cof(F) / det F.
     let inverse_transpose = [
         [f[1][1] / det_f, -f[1][0] / det_f],
         [-f[0][1] / det_f, f[0][0] / det_f],
     ];
-    // J = λ1 λ2 λ3 = 1: P = J σ F⁻ᵀ = σ F⁻ᵀ.
-    let nominal_mpa = mul(&cauchy_mpa, &inverse_transpose);
+    let dyad = |n: [f64; 2]| std::array::from_fn(|i| std::array::from_fn(|j| n[i] * n[j]));
+    Ok(NodeKinematics {
+        stretches: [b1.sqrt(), b2.max(0.0).sqrt(), 1.0 / det_f],
+        directions: [n1, n2],
+        nominal_per_cauchy: [n1, n2].map(|n| mul(&dyad(n), &inverse_transpose)),
+    })
+}
+
+impl NodeKinematics {
+    /// The law's in-plane principal Cauchy stresses s1, s2 (MPa) at the node's stretches.
+    pub fn principal_cauchy_mpa(&self, model: &Model, p: &[f64]) -> Option<[f64; 2]> {
+        model.in_plane_cauchy_stress_mpa(p, self.stretches[0], self.stretches[1])
+    }
+}
+
+/// The stress of a node whose in-plane deformation gradient is `f` (F = I + ∇u, reference to
+/// current), under `model` with parameters `p` (MPa).
+pub fn node_stress(model: &Model, p: &[f64], f: &Mat2) -> Result<NodeStress, NodeStressError> {
+    let k = node_kinematics(f)?;
+    let stretches = k.stretches;
+    let [s1, s2] = k
+        .principal_cauchy_mpa(model, p)
+        .ok_or(NodeStressError::OutsideDomain { stretches })?;
+    let [n1, n2] = k.directions;
+    // σ = s1 n1⊗n1 + s2 n2⊗n2; P = J σ F⁻ᵀ = s1 K1 + s2 K2.
+    let cauchy_mpa: Mat2 =
+        std::array::from_fn(|i| std::array::from_fn(|j| s1 * n1[i] * n1[j] + s2 * n2[i] * n2[j]));
+    let [k1, k2] = k.nominal_per_cauchy;
+    let nominal_mpa: Mat2 =
+        std::array::from_fn(|i| std::array::from_fn(|j| s1 * k1[i][j] + s2 * k2[i][j]));
     Ok(NodeStress {
         stretches,
         cauchy_mpa,

@@ -13,6 +13,8 @@
 //! - [`section_cut`]: the force through a band across an arm, the paper's section cut as a
 //!   virtual field.
 //! - [`vfm`]: the virtual fields method over the cuts of all frames of a test.
+//! - [`virtual_work`]: a virtual field's work as weighted nodes; a fit's equations compiled
+//!   once for every trial law.
 //! - [`field_layout`]: where the cuts and ramps go, from the cruciform and the view.
 //! - [`grip_forces`]: the grips' forces of recent rig samples, by id or by time.
 //! - [`field_route`]: the frames of a test kept for the field route, fitted together.
@@ -51,3 +53,4 @@ pub mod stability;
 pub mod subsample;
 pub mod tapered_ramp;
 pub mod vfm;
+pub mod virtual_work;

@@ -13,8 +13,9 @@
 //! F, counted); a longer hole, or one at the band's edge across the arm, drops the cut for the
 //! frame: a cut with a hole is never integrated as if whole.
 
-use crate::field_stress::{node_stress, Mat2, NodeStressError};
+use crate::field_stress::{Mat2, NodeStressError};
 use crate::models::Model;
+use crate::virtual_work::{work_n, WeightedNode};
 
 /// Longest run of missing nodes across the arm that is filled by interpolation.
 pub const MAX_FILLED_HOLE_NODES: usize = 2;
@@ -157,15 +158,12 @@ impl FieldGrid {
     }
 }
 
-/// The force through `cut` of a sheet of reference thickness `thickness_mm` whose measured
-/// field is `grid`, under `model` with parameters `p` (MPa).
-pub fn cut_force(
+/// The weighted nodes of `cut` over the measured field `grid` (holes filled or refused), and
+/// how many of them were filled.
+pub fn cut_weights(
     grid: &FieldGrid,
     cut: &SectionCut,
-    model: &Model,
-    p: &[f64],
-    thickness_mm: f64,
-) -> Result<CutForce, CutError> {
+) -> Result<(Vec<WeightedNode>, usize), CutError> {
     let length_mm = cut.to_mm - cut.from_mm;
     let width_mm = cut.across_to_mm - cut.across_from_mm;
     if !(length_mm > 0.0 && width_mm > 0.0) {
@@ -197,28 +195,48 @@ pub fn cut_force(
         ArmAxis::X => 0,
         ArmAxis::Y => 1,
     };
-    let (mut integral, mut nodes, mut filled) = (0.0, 0, 0);
+    let mut nodes = vec![];
+    let mut filled = 0;
     for &(a, w_along) in &along {
         for &(c, w_across) in &across {
-            let (f, was_filled) = grid.gradient_or_filled(cut, a, c, across_range)?;
-            let (col, row) = FieldGrid::index(cut.axis, a, c);
-            let stress = node_stress(model, p, &f).map_err(|reason| CutError::Stress {
-                cut: *cut,
-                col,
-                row,
-                reason,
-            })?;
-            integral += stress.nominal_mpa[component][component] * w_along * w_across;
-            nodes += 1;
+            let (gradient, was_filled) = grid.gradient_or_filled(cut, a, c, across_range)?;
+            // ∂u*_a/∂X_a = 1/L over the band.
+            let mut weight_mm2 = [[0.0; 2]; 2];
+            weight_mm2[component][component] = w_along * w_across / length_mm;
+            nodes.push(WeightedNode {
+                at: FieldGrid::index(cut.axis, a, c),
+                filled: was_filled,
+                gradient,
+                weight_mm2,
+            });
             filled += usize::from(was_filled);
         }
     }
-    if nodes == 0 {
+    if nodes.is_empty() {
         return Err(CutError::Empty { cut: *cut });
     }
+    Ok((nodes, filled))
+}
+
+/// The force through `cut` of a sheet of reference thickness `thickness_mm` whose measured
+/// field is `grid`, under `model` with parameters `p` (MPa).
+pub fn cut_force(
+    grid: &FieldGrid,
+    cut: &SectionCut,
+    model: &Model,
+    p: &[f64],
+    thickness_mm: f64,
+) -> Result<CutForce, CutError> {
+    let (nodes, filled) = cut_weights(grid, cut)?;
+    let force_n = work_n(&nodes, model, p, thickness_mm).map_err(|failure| CutError::Stress {
+        cut: *cut,
+        col: failure.at.0,
+        row: failure.at.1,
+        reason: failure.reason,
+    })?;
     Ok(CutForce {
-        force_n: thickness_mm * integral / length_mm,
-        nodes,
+        force_n,
+        nodes: nodes.len(),
         filled,
     })
 }

@@ -11,19 +11,23 @@
 //! loaded boundary and ∇u* vanishes where the field is not measured: w must be 1 over the whole
 //! arm where it leaves the field of view, and 0 where the other arms do. Where ∇u* ≠ 0 every
 //! point of the specimen must have a measurement: the caller says which points are material
-//! (the specimen's outline in the reference configuration); a material node without a
-//! measurement there is a hole, and the field is dropped for the frame (never integrated as if
-//! the hole were empty space).
+//! (the specimen's outline in the reference configuration). A material node without a
+//! measurement takes the nearest measured node's within [`MAX_BORROW_RINGS`] (the correlator
+//! loses the nodes whose ZOI runs off the specimen's edge: about ZOI/2/step + 1 of them, and
+//! F varies little across an arm's edge; counted, `RampQuadrature::borrowed`); farther, it is a
+//! hole, and the field is dropped for the frame (never integrated as if the hole were empty
+//! space).
 //!
 //! Quadrature ([`TaperedRamp::quadrature`], built once per frame): each node stands for the
 //! s x s square around it (as for the section cut), and r, w being piecewise linear, the
 //! integrals of r', r, w', w over the square's sides are exact: exact for a stress constant over
 //! each node's square. Where the specimen's (curved) edge crosses a square, its material part is
-//! sampled and carried by the nearest measured node.
+//! sampled (midpoint rule on [`EDGE_SUBSAMPLES`]² points) and carried by the nearest measured
+//! node.
 
-use crate::field_stress::node_stress;
 use crate::models::Model;
 use crate::section_cut::{ArmAxis, FieldGrid};
+use crate::virtual_work::{work_n, WeightedNode};
 
 /// u* = r(X_a) w(X_b) e_a.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,6 +84,16 @@ fn value(points: &[(f64, f64)], t: f64) -> f64 {
         }
     }
     points[points.len() - 1].1
+}
+
+/// The slope at `t` of the piecewise-linear function through `points` (0 beyond the ends).
+fn derivative(points: &[(f64, f64)], t: f64) -> f64 {
+    points
+        .windows(2)
+        .find(|pair| t >= pair[0].0 && t < pair[1].0)
+        .map_or(0.0, |pair| {
+            (pair[1].1 - pair[0].1) / (pair[1].0 - pair[0].0)
+        })
 }
 
 /// ∫ over [lo, hi] of the piecewise-linear function through `points`.
@@ -142,8 +156,8 @@ impl TaperedRamp {
         let half = 0.5 * s;
         let node_at =
             |col: usize, row: usize| [grid.x0_mm + col as f64 * s, grid.y0_mm + row as f64 * s];
-        let measured = |col: usize, row: usize| grid.gradients[row * grid.cols + col].is_some();
         let mut weights = vec![(0.0, 0.0); grid.cols * grid.rows];
+        let mut borrowed = 0;
         for row in 0..grid.rows {
             for col in 0..grid.cols {
                 let x = node_at(col, row);
@@ -163,13 +177,18 @@ impl TaperedRamp {
                     col,
                     row,
                 };
+                // The node whose measurement the square's material takes: its own, or where
+                // the correlator could not measure near the specimen's edge (a ZOI that runs
+                // off it), the nearest measured node within two rings.
+                let owner = nearest_measured(grid, col, row);
                 if whole {
-                    if !measured(col, row) {
+                    let Some((c, r)) = owner else {
                         return Err(hole);
-                    }
+                    };
+                    borrowed += usize::from((c, r) != (col, row));
                     // ∫∫ ∂u*_a/∂X_a and ∫∫ ∂u*_a/∂X_b over the square (mirroring flips both
                     // u*_a and d/dX_a: the first keeps its sign, the second takes it).
-                    let w = &mut weights[row * grid.cols + col];
+                    let w = &mut weights[r * grid.cols + c];
                     w.0 += slope(&ramp, r_lo, r_hi) * integral(&taper, w_lo, w_hi);
                     w.1 += sign * integral(&ramp, r_lo, r_hi) * slope(&taper, w_lo, w_hi);
                     continue;
@@ -177,19 +196,6 @@ impl TaperedRamp {
                 if !corners.iter().any(|&c| c) && !material(x) {
                     continue;
                 }
-                // The node whose measurement the square's material takes.
-                let owner = if measured(col, row) {
-                    Some((col, row))
-                } else {
-                    NEIGHBOURS
-                        .iter()
-                        .map(|d| (col as isize + d[0], row as isize + d[1]))
-                        .filter(|&(c, r)| {
-                            c >= 0 && r >= 0 && (c as usize) < grid.cols && (r as usize) < grid.rows
-                        })
-                        .map(|(c, r)| (c as usize, r as usize))
-                        .find(|&(c, r)| measured(c, r))
-                };
                 let sub = s / EDGE_SUBSAMPLES as f64;
                 let (mut along_term, mut across_term) = (0.0, 0.0);
                 for i in 0..EDGE_SUBSAMPLES {
@@ -202,11 +208,13 @@ impl TaperedRamp {
                         if !material(q) {
                             continue;
                         }
+                        // The midpoint rule: ∇u* where the material was sampled (an exact
+                        // integral over the sub-square would take in u*'s variation beyond the
+                        // specimen's edge).
                         let (qa, qb) = (sign * q[a], q[b]);
-                        let (r0, r1) = (qa - 0.5 * sub, qa + 0.5 * sub);
-                        let (w0, w1) = (qb - 0.5 * sub, qb + 0.5 * sub);
-                        along_term += slope(&ramp, r0, r1) * integral(&taper, w0, w1);
-                        across_term += sign * integral(&ramp, r0, r1) * slope(&taper, w0, w1);
+                        let area = sub * sub;
+                        along_term += derivative(&ramp, qa) * value(&taper, qb) * area;
+                        across_term += sign * value(&ramp, qa) * derivative(&taper, qb) * area;
                     }
                 }
                 if along_term == 0.0 && across_term == 0.0 {
@@ -215,6 +223,7 @@ impl TaperedRamp {
                 let Some((c, r)) = owner else {
                     return Err(hole);
                 };
+                borrowed += usize::from((c, r) != (col, row));
                 let w = &mut weights[r * grid.cols + c];
                 w.0 += along_term;
                 w.1 += across_term;
@@ -222,6 +231,7 @@ impl TaperedRamp {
         }
         Ok(RampQuadrature {
             field: *self,
+            borrowed,
             terms: weights
                 .iter()
                 .enumerate()
@@ -243,18 +253,29 @@ impl TaperedRamp {
 /// Sub-samples per side of a node square that the specimen's edge crosses.
 pub const EDGE_SUBSAMPLES: usize = 4;
 
-/// The measured neighbours a square off the specimen may take its material's measurement from,
-/// nearest first.
-const NEIGHBOURS: [[isize; 2]; 8] = [
-    [-1, 0],
-    [1, 0],
-    [0, -1],
-    [0, 1],
-    [-1, -1],
-    [1, -1],
-    [-1, 1],
-    [1, 1],
-];
+/// Rings of neighbours a square may take its material's measurement from when its own node
+/// has none (the correlator loses about ZOI/2/step + 1 nodes along the specimen's edge).
+pub const MAX_BORROW_RINGS: isize = 2;
+
+/// The node (col, row) itself when measured, else the nearest measured node within
+/// [`MAX_BORROW_RINGS`] (by distance, then the first in scan order).
+fn nearest_measured(grid: &FieldGrid, col: usize, row: usize) -> Option<(usize, usize)> {
+    let measured = |c: isize, r: isize| {
+        c >= 0
+            && r >= 0
+            && (c as usize) < grid.cols
+            && (r as usize) < grid.rows
+            && grid.gradients[r as usize * grid.cols + c as usize].is_some()
+    };
+    let (col, row) = (col as isize, row as isize);
+    let rings = -MAX_BORROW_RINGS..=MAX_BORROW_RINGS;
+    rings
+        .clone()
+        .flat_map(|dr| rings.clone().map(move |dc| (dc, dr)))
+        .filter(|&(dc, dr)| measured(col + dc, row + dr))
+        .min_by_key(|&(dc, dr)| dc * dc + dr * dr)
+        .map(|(dc, dr)| ((col + dc) as usize, (row + dr) as usize))
+}
 
 /// A tapered ramp's quadrature over one frame's measured field: per node, the integrals that
 /// multiply P_aa and P_ab. Built once per frame ([`TaperedRamp::quadrature`]); evaluated for
@@ -262,6 +283,8 @@ const NEIGHBOURS: [[isize; 2]; 8] = [
 #[derive(Clone, Debug, PartialEq)]
 pub struct RampQuadrature {
     field: TaperedRamp,
+    /// Node squares whose material took a neighbour's measurement (their own node had none).
+    borrowed: usize,
     /// (node index in the grid, weight of P_aa, weight of P_ab), mm².
     terms: Vec<(usize, f64, f64)>,
 }
@@ -271,9 +294,40 @@ impl RampQuadrature {
         &self.field
     }
 
+    /// Node squares whose material took a neighbour's measurement.
+    pub fn borrowed(&self) -> usize {
+        self.borrowed
+    }
+
     /// Nodes with a weight.
     pub fn nodes(&self) -> usize {
         self.terms.len()
+    }
+
+    /// The weighted nodes of the quadrature over the measured field `grid` (the one it was
+    /// built on).
+    pub fn weighted_nodes(&self, grid: &FieldGrid) -> Result<Vec<WeightedNode>, RampError> {
+        let (a, b) = self.field.components();
+        self.terms
+            .iter()
+            .map(|&(k, along, across)| {
+                let (col, row) = (k % grid.cols, k / grid.cols);
+                let gradient = grid.gradients[k].ok_or(RampError::Hole {
+                    field: self.field,
+                    col,
+                    row,
+                })?;
+                let mut weight_mm2 = [[0.0; 2]; 2];
+                weight_mm2[a][a] = along;
+                weight_mm2[a][b] = across;
+                Ok(WeightedNode {
+                    at: (col, row),
+                    filled: false,
+                    gradient,
+                    weight_mm2,
+                })
+            })
+            .collect()
     }
 
     /// The force the field's virtual work balances, N, for the measured field `grid` (the one
@@ -286,24 +340,13 @@ impl RampQuadrature {
         p: &[f64],
         thickness_mm: f64,
     ) -> Result<f64, RampError> {
-        let (a, b) = self.field.components();
-        let mut work = 0.0;
-        for &(k, along, across) in &self.terms {
-            let (col, row) = (k % grid.cols, k / grid.cols);
-            let f = grid.gradients[k].ok_or(RampError::Hole {
-                field: self.field,
-                col,
-                row,
-            })?;
-            let stress = node_stress(model, p, &f).map_err(|reason| RampError::Stress {
-                field: self.field,
-                col,
-                row,
-                reason,
-            })?;
-            work += stress.nominal_mpa[a][a] * along + stress.nominal_mpa[a][b] * across;
-        }
-        Ok(thickness_mm * work)
+        let nodes = self.weighted_nodes(grid)?;
+        work_n(&nodes, model, p, thickness_mm).map_err(|failure| RampError::Stress {
+            field: self.field,
+            col: failure.at.0,
+            row: failure.at.1,
+            reason: failure.reason,
+        })
     }
 }
 
@@ -311,6 +354,7 @@ impl RampQuadrature {
 mod tests {
     use super::*;
     use crate::data::LoadCase;
+    use crate::field_stress::node_stress;
 
     #[test]
     fn piecewise_linear_integrals_are_exact() {
@@ -363,11 +407,27 @@ mod tests {
         }
     }
 
+    /// A material node without a measurement takes its nearest measured neighbour's within
+    /// two rings (counted); a hole wider than that drops the field.
     #[test]
     fn a_material_node_without_measurement_drops_the_field() {
         let n = 41;
-        let mut gradients = vec![Some([[1.2, 0.0], [0.0, 0.9]]); n * n];
+        let f = [[1.2, 0.0], [0.0, 0.9]];
+        let mut gradients = vec![Some(f); n * n];
         gradients[20 * n + 20] = None;
+        let small_hole = FieldGrid {
+            cols: n,
+            rows: n,
+            x0_mm: -10.0,
+            y0_mm: -10.0,
+            step_mm: 0.5,
+            gradients: gradients.clone(),
+        };
+        for row in 18..=22 {
+            for col in 18..=22 {
+                gradients[row * n + col] = None;
+            }
+        }
         let grid = FieldGrid {
             cols: n,
             rows: n,
@@ -385,6 +445,17 @@ mod tests {
             zero_half_width_mm: 8.0,
             mirrored: false,
         };
+        let whole = FieldGrid {
+            gradients: vec![Some(f); n * n],
+            ..small_hole.clone()
+        };
+        let filled = field.quadrature(&small_hole, &|_| true).unwrap();
+        assert_eq!(filled.borrowed(), 1);
+        let law = (Model::Mooney, [0.3, 0.05]);
+        let force = |q: &RampQuadrature, g: &FieldGrid| q.force_n(g, &law.0, &law.1, 2.0).unwrap();
+        let reference = field.quadrature(&whole, &|_| true).unwrap();
+        assert_eq!(reference.borrowed(), 0);
+        assert!((force(&filled, &small_hole) - force(&reference, &whole)).abs() < 1e-9);
         let err = field.quadrature(&grid, &|_| true).unwrap_err();
         assert!(
             matches!(
@@ -400,9 +471,10 @@ mod tests {
         // Off the specimen (a pinhole at the node: its square's material takes a neighbour's
         // measurement), the same node is no hole.
         let pinhole = |x: [f64; 2]| x[0].abs() > 0.01 || x[1].abs() > 0.01;
-        let quadrature = field.quadrature(&grid, &pinhole).unwrap();
+        let quadrature = field.quadrature(&small_hole, &pinhole).unwrap();
+        assert_eq!(quadrature.borrowed(), 1);
         assert!(quadrature
-            .force_n(&grid, &Model::Mooney, &[0.3, 0.05], 2.0)
+            .force_n(&small_hole, &Model::Mooney, &[0.3, 0.05], 2.0)
             .is_ok());
     }
 }

@@ -7,10 +7,12 @@
 //! number of the equations' Jacobian says whether the states the field reached separate the
 //! parameters; beyond [`MAX_CONDITION`] the fit is refused rather than reported.
 
+use crate::field_stress::NodeStressError;
 use crate::lsq::{inverse_normal_matrix, levenberg_marquardt, linear_least_squares, LsqError};
 use crate::models::Model;
-use crate::section_cut::{cut_force, CutError, FieldGrid, SectionCut};
+use crate::section_cut::{cut_force, cut_weights, CutError, FieldGrid, SectionCut};
 use crate::tapered_ramp::{RampError, RampQuadrature};
+use crate::virtual_work::{EquationInput, Equations, NodeFailure, WeightedNode};
 use nalgebra::{DMatrix, DVector};
 
 /// Condition number of the scaled Jacobian beyond which the parameters are not told apart.
@@ -26,7 +28,7 @@ pub enum VirtualField<'a> {
 }
 
 impl VirtualField<'_> {
-    /// The force the field's internal virtual work balances, N.
+    /// The force the field's internal virtual work balances, evaluated directly.
     pub fn force_n(
         &self,
         grid: &FieldGrid,
@@ -37,6 +39,14 @@ impl VirtualField<'_> {
         Ok(match self {
             VirtualField::Cut(cut) => cut_force(grid, cut, model, p, thickness_mm)?.force_n,
             VirtualField::Ramp(quadrature) => quadrature.force_n(grid, model, p, thickness_mm)?,
+        })
+    }
+
+    /// The nodes the field weighs over `grid`, for compiled equations.
+    pub fn weighted_nodes(&self, grid: &FieldGrid) -> Result<Vec<WeightedNode>, VfmError> {
+        Ok(match self {
+            VirtualField::Cut(cut) => cut_weights(grid, cut)?.0,
+            VirtualField::Ramp(quadrature) => quadrature.weighted_nodes(grid)?,
         })
     }
 }
@@ -88,13 +98,38 @@ pub enum VfmError {
     },
     #[error("the law is not defined at the starting parameters {start:?}")]
     UndefinedStart { start: Vec<f64> },
+    #[error("node (col {}, row {}): {}", .0.at.0, .0.at.1, .0.reason)]
+    Node(NodeFailure),
+    #[error("the law at the fitted parameters: {0}")]
+    Stress(#[from] NodeStressError),
 }
 
-/// Computed forces of every observation at `p` (N), `None` where the law is undefined.
-fn computed(model: &Model, obs: &[CutObservation], p: &[f64]) -> Result<Vec<f64>, VfmError> {
-    obs.iter()
-        .map(|o| o.cut.force_n(o.grid, model, p, o.thickness_mm))
-        .collect()
+/// The observations' equations, compiled once for every trial law of a fit (nodes of one
+/// field grid that several virtual fields weigh are evaluated once).
+pub fn compile(obs: &[CutObservation]) -> Result<Equations, VfmError> {
+    let mut frames: Vec<*const FieldGrid> = vec![];
+    let nodes = obs
+        .iter()
+        .map(|o| o.cut.weighted_nodes(o.grid))
+        .collect::<Result<Vec<_>, _>>()?;
+    let inputs: Vec<EquationInput> = obs
+        .iter()
+        .zip(&nodes)
+        .map(|(o, nodes)| {
+            let key: *const FieldGrid = o.grid;
+            let frame = frames.iter().position(|&g| g == key).unwrap_or_else(|| {
+                frames.push(key);
+                frames.len() - 1
+            });
+            EquationInput {
+                frame,
+                nodes,
+                thickness_mm: o.thickness_mm,
+                measured_n: o.force_n,
+            }
+        })
+        .collect();
+    Equations::compile(&inputs).map_err(VfmError::Node)
 }
 
 /// Condition number of `j` with its columns scaled to unit norm.
@@ -118,16 +153,19 @@ fn condition(j: &DMatrix<f64>) -> f64 {
 }
 
 /// Jacobian of the computed forces by central differences (relative step).
-fn jacobian(model: &Model, obs: &[CutObservation], p: &[f64]) -> Result<DMatrix<f64>, VfmError> {
-    let mut j = DMatrix::zeros(obs.len(), p.len());
+fn jacobian(model: &Model, equations: &Equations, p: &[f64]) -> Result<DMatrix<f64>, VfmError> {
+    let mut j = DMatrix::zeros(equations.len(), p.len());
     for k in 0..p.len() {
         let h = 1e-6 * p[k].abs().max(1e-3);
         let mut plus = p.to_vec();
         let mut minus = p.to_vec();
         plus[k] += h;
         minus[k] -= h;
-        let (fp, fm) = (computed(model, obs, &plus)?, computed(model, obs, &minus)?);
-        for i in 0..obs.len() {
+        let (fp, fm) = (
+            equations.forces_n(model, &plus)?,
+            equations.forces_n(model, &minus)?,
+        );
+        for i in 0..equations.len() {
             j[(i, k)] = (fp[i] - fm[i]) / (2.0 * h);
         }
     }
@@ -137,19 +175,35 @@ fn jacobian(model: &Model, obs: &[CutObservation], p: &[f64]) -> Result<DMatrix<
 /// Fits `model`'s parameters to the cut equations, starting from `start` (used only by the
 /// nonlinear fit).
 pub fn fit(model: &Model, obs: &[CutObservation], start: &[f64]) -> Result<VfmFit, VfmError> {
-    let n = start.len();
-    if obs.len() <= n {
+    if obs.len() <= start.len() {
         return Err(VfmError::TooFewEquations {
             equations: obs.len(),
+            params: start.len(),
+        });
+    }
+    fit_equations(model, &compile(obs)?, start)
+}
+
+/// Fits `model`'s parameters to compiled equations (see [`fit`]).
+pub fn fit_equations(
+    model: &Model,
+    equations: &Equations,
+    start: &[f64],
+) -> Result<VfmFit, VfmError> {
+    let n = start.len();
+    let m = equations.len();
+    if m <= n {
+        return Err(VfmError::TooFewEquations {
+            equations: m,
             params: n,
         });
     }
-    let measured = DVector::from_iterator(obs.len(), obs.iter().map(|o| o.force_n));
+    let measured = DVector::from_column_slice(equations.measured_n());
     let params = if model.linear_params().iter().all(|&l| l) {
-        let mut a = DMatrix::zeros(obs.len(), n);
+        let mut a = DMatrix::zeros(m, n);
         for k in 0..n {
             let unit: Vec<f64> = (0..n).map(|i| f64::from(u8::from(i == k))).collect();
-            let column = computed(model, obs, &unit)?;
+            let column = equations.forces_n(model, &unit)?;
             a.set_column(k, &DVector::from_vec(column));
         }
         linear_least_squares(&a, &measured)?
@@ -157,21 +211,24 @@ pub fn fit(model: &Model, obs: &[CutObservation], start: &[f64]) -> Result<VfmFi
             .copied()
             .collect()
     } else {
-        if computed(model, obs, start).is_err() {
+        if equations.forces_n(model, start).is_err() {
             return Err(VfmError::UndefinedStart {
                 start: start.to_vec(),
             });
         }
         let residuals = |p: &[f64]| {
-            let forces = computed(model, obs, p).ok()?;
+            let forces = equations.forces_n(model, p).ok()?;
             Some(DVector::from_iterator(
-                obs.len(),
-                forces.iter().zip(obs).map(|(f, o)| f - o.force_n),
+                m,
+                forces
+                    .iter()
+                    .zip(equations.measured_n())
+                    .map(|(f, o)| f - o),
             ))
         };
-        levenberg_marquardt(&residuals, start, obs.len())?.params
+        levenberg_marquardt(&residuals, start, m)?.params
     };
-    let j = jacobian(model, obs, &params)?;
+    let j = jacobian(model, equations, &params)?;
     let condition = condition(&j);
     if condition > MAX_CONDITION {
         return Err(VfmError::NotIdentifiable {
@@ -180,13 +237,13 @@ pub fn fit(model: &Model, obs: &[CutObservation], start: &[f64]) -> Result<VfmFi
             condition,
         });
     }
-    let forces = computed(model, obs, &params)?;
+    let forces = equations.forces_n(model, &params)?;
     let rss: f64 = forces
         .iter()
-        .zip(obs)
-        .map(|(f, o)| (f - o.force_n).powi(2))
+        .zip(equations.measured_n())
+        .map(|(f, o)| (f - o).powi(2))
         .sum();
-    let variance = rss / (obs.len() - n) as f64;
+    let variance = rss / (m - n) as f64;
     let sigma = match inverse_normal_matrix(&j) {
         Some(cov) => (0..n).map(|k| (cov[(k, k)] * variance).sqrt()).collect(),
         None => vec![f64::INFINITY; n],
@@ -194,8 +251,8 @@ pub fn fit(model: &Model, obs: &[CutObservation], start: &[f64]) -> Result<VfmFi
     Ok(VfmFit {
         params,
         sigma,
-        rms_n: (rss / obs.len() as f64).sqrt(),
-        equations: obs.len(),
+        rms_n: (rss / m as f64).sqrt(),
+        equations: m,
         condition,
     })
 }

@@ -5,8 +5,8 @@
 
 use super::parts::PreviousFrames;
 use super::{
-    compose_gradients, difference, median, median_ok_score, to_mat2, Correlator, Support,
-    EXTRAPOLATION_RINGS, OUTLIER_MAX_PX, OUTLIER_MIN_PX, OUTLIER_SCATTER,
+    compose_gradients, difference, median, median_ok_score, to_mat2, Correlator, OUTLIER_MAX_PX,
+    OUTLIER_MIN_PX, OUTLIER_SCATTER,
 };
 use crate::field::NodeStatus;
 use crate::strain::{gauge, node_strains_and_gradients, strains_from_gradients};
@@ -102,12 +102,8 @@ impl Correlator {
     fn refuse_inconsistent(&mut self) {
         for k in 0..self.mesh.len() {
             self.scratch.residuals[k] = if self.field.nodes[k].status == NodeStatus::Ok {
-                self.affine_fit(Some(k), EXTRAPOLATION_RINGS, Some(k), Support::Valid)
-                    .map_or(f64::NAN, |fit| {
-                        let (u, v) = self.extrapolate(k, fit);
-                        let node = &self.field.nodes[k];
-                        (node.u_px - u).hypot(node.v_px - v)
-                    })
+                self.increment_and_prediction(k)
+                    .map_or(f64::NAN, |((u, v), (pu, pv))| (u - pu).hypot(v - pv))
             } else {
                 f64::NAN
             };

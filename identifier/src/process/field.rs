@@ -1,7 +1,9 @@
 //! The field route in the identifier process: each field's nodes to the reference grid in mm
 //! (through the producer's `View::centred`, the one mapping of the camera's px to specimen mm),
-//! the grips' forces of the rig sample the frame names, the pure [`FieldRoute`] fed and refitted
-//! (at most every [`REFIT_INTERVAL`], and at the end), its report published beside the gauge route's.
+//! the grips' forces of the rig sample the frame names, the pure [`FieldRoute`] fed, and refitted
+//! on a thread of its own (at most every [`REFIT_INTERVAL`], and at the end) so that neither
+//! the gauge route nor the reception of fields ever waits for a fit; its report published
+//! beside the gauge route's.
 //!
 //! Restart: the field route journals nothing. A restarted identifier refits from the fields it
 //! receives after the restart (the frames before it are not re-sent): it says so on stderr and
@@ -9,19 +11,20 @@
 
 use super::ProcessError;
 use crate::field_layout::ArmLayout;
-use crate::field_route::{FieldFits, FieldRoute, FieldRouteConfig, FrameOutcome};
+use crate::field_route::{FieldFits, FieldRoute, FieldRouteConfig, FitJob, FrameOutcome};
 use crate::grip_forces::{ForceHistory, GripForces};
 use crate::models::Model;
 use crate::section_cut::FieldGrid;
 use membrane::specimens::cruciform::CruciformGeometry;
 use producer::View;
 use serde_json::{json, Value};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 use wire::identification::{RankedModel, ReportRoute, MAX_COEFFICIENTS, MAX_RANKED};
 use wire::{FieldHeader, FieldNode, IdentificationReport, NodeStatus, RigState};
 
-/// Shortest time between two fits of all frames (a fit of 12 frames takes seconds).
-pub const REFIT_INTERVAL: Duration = Duration::from_secs(5);
+/// Shortest time between the starts of two fits of all frames.
+pub const REFIT_INTERVAL: Duration = Duration::from_secs(2);
 
 /// What the field route needs of the run: the camera's view and the specimen filmed.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -43,7 +46,8 @@ pub struct FieldRouteSettings {
 
 impl FieldRouteSettings {
     pub const DEFAULT_LEVEL_INCREMENT: f64 = 0.0015;
-    pub const DEFAULT_MAX_FRAMES: usize = 12;
+    /// Frames kept (spread over the loading: `FieldRoute` thins them at the limit).
+    pub const DEFAULT_MAX_FRAMES: usize = 24;
 }
 
 fn default_level_increment() -> f64 {
@@ -80,8 +84,12 @@ pub(super) struct FieldShell {
     /// Why the route stopped (a view that crosses no arm), said once.
     error: Option<String>,
     fits: Option<FieldFits>,
+    /// Frames kept since the last fit started.
     dirty: bool,
     last_fit: Option<Instant>,
+    /// The fit running on its own thread (its result and duration, ns), and the last frame
+    /// it fits.
+    running: Option<RunningFit>,
     cost: Cost,
 }
 
@@ -111,6 +119,7 @@ impl FieldShell {
             fits: None,
             dirty: false,
             last_fit: None,
+            running: None,
             cost: Cost::default(),
         })
     }
@@ -186,21 +195,71 @@ impl FieldShell {
             .push(started.elapsed().as_nanos() as u64);
     }
 
-    /// Refits when new frames came and [`REFIT_INTERVAL`] has passed since the last fit (or `now`);
-    /// the report to publish, if a fit was made.
+    /// The report of a fit that has finished, if any; starts the next one when new frames
+    /// came and [`REFIT_INTERVAL`] has passed since the last start. With `now` (the end), waits
+    /// for the running fit and fits the frames kept since, here.
     pub fn refit(&mut self, now: bool) -> Option<IdentificationReport> {
-        let due = self.last_fit.is_none_or(|t| t.elapsed() >= REFIT_INTERVAL);
-        if !self.dirty || !(due || now) {
-            return None;
+        let mut report = None;
+        if self
+            .running
+            .as_ref()
+            .is_some_and(|(running, _)| now || running.is_finished())
+        {
+            report = self.take_running();
         }
-        let started = Instant::now();
-        let fits = self.route.fit()?;
-        self.cost.fit_ns.push(started.elapsed().as_nanos() as u64);
-        self.dirty = false;
-        self.last_fit = Some(Instant::now());
-        let report = report(&fits, self.route.frames().last().map(|f| f.frame_id));
+        if now {
+            if self.dirty {
+                if let Some(job) = self.route.fit_job() {
+                    self.dirty = false;
+                    report = Some(self.finished(run_timed(&job), job.last_frame_id));
+                }
+            }
+            return report;
+        }
+        let due = self.last_fit.is_none_or(|t| t.elapsed() >= REFIT_INTERVAL);
+        if self.running.is_none() && self.dirty && due {
+            if let Some(job) = self.route.fit_job() {
+                self.dirty = false;
+                self.last_fit = Some(Instant::now());
+                let frame_id = job.last_frame_id;
+                let spawned = std::thread::Builder::new()
+                    .name("field-fit".into())
+                    .spawn(move || run_timed(&job));
+                match spawned {
+                    Ok(handle) => self.running = Some((handle, frame_id)),
+                    // No thread to be had: fit here, once, rather than never.
+                    Err(e) => {
+                        eprintln!("identifier: field route: no thread for the fit ({e}): fitting in the loop");
+                        let job = self.route.fit_job()?;
+                        return Some(self.finished(run_timed(&job), job.last_frame_id));
+                    }
+                }
+            }
+        }
+        report
+    }
+
+    /// The running fit's report (None if its thread panicked, which is said).
+    fn take_running(&mut self) -> Option<IdentificationReport> {
+        let (handle, frame_id) = self.running.take()?;
+        match handle.join() {
+            Ok(result) => Some(self.finished(result, frame_id)),
+            Err(_) => {
+                eprintln!("identifier: field route: the fit's thread panicked");
+                None
+            }
+        }
+    }
+
+    fn finished(
+        &mut self,
+        (fits, ns): (FieldFits, u64),
+        frame_id: Option<u64>,
+    ) -> IdentificationReport {
+        self.cost.fit_ns.push(ns);
+        let report = report(&fits, frame_id);
         self.fits = Some(fits);
-        Some(report)
+        report
     }
 
     /// The route's part of `identification.json`.
@@ -209,6 +268,7 @@ impl FieldShell {
         json!({
             "error": self.error,
             "counters": self.route.counters,
+            "last_dropped": self.route.last_dropped,
             "frames": fits.map(|f| f.frames),
             "max_stretches": fits.map(|f| f.max_stretches),
             "fits": fits.map(|f| f.fits.iter().map(|fit| {
@@ -231,6 +291,16 @@ impl FieldShell {
             },
         })
     }
+}
+
+/// A fit on its own thread (its fits and duration, ns) and the last frame it fits.
+type RunningFit = (JoinHandle<(FieldFits, u64)>, Option<u64>);
+
+/// A fit and its duration, ns.
+fn run_timed(job: &FitJob) -> (FieldFits, u64) {
+    let started = Instant::now();
+    let fits = job.run();
+    (fits, started.elapsed().as_nanos() as u64)
 }
 
 /// The loading level of a field: the mean over its measured nodes of (F11 + F22)/2 − 1 (the
