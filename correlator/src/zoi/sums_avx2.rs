@@ -187,8 +187,6 @@ pub unsafe fn window_rows(
 #[cfg(test)]
 mod tests {
     use super::super::{spectrum_len, ZoiEngine, PAD};
-    pub use crate::simd_avx2::available;
-    use crate::simd_avx2::{load8, store8};
     use rustfft::num_complex::Complex32;
 
     /// The phase ramp gives the portable products g (px py) to rounding.
