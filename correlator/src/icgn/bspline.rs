@@ -159,8 +159,8 @@ fn filter_rows(rows: &mut [f32], n: usize) {
             // Causal start: Σ z^k s[k], the mirror boundary's sum truncated.
             let mut sum = line[0];
             let mut zk = z;
-            for k in 1..horizon(z).min(n) {
-                sum += zk * line[k];
+            for &value in &line[1..horizon(z).min(n)] {
+                sum += zk * value;
                 zk *= z;
             }
             line[0] = sum;
