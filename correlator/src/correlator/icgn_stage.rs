@@ -205,9 +205,8 @@ impl Correlator {
                 // IC-GN's own ZNCC of the whole subset (B-spline samples) through the warp of
                 // its last evaluation: an `ok` subset stopped because the update from that
                 // warp to the final one moves no subset point by more than
-                // `icgn::CONVERGED_PX / icgn::CONTRACTION` (0.02 px), so it is the subset's
-                // ZNCC through the final warp within what a 0.02 px move changes about the
-                // match (where the ZNCC is at its maximum). Below `min_zncc`, the check through the
+                // `icgn::CONVERGED_PX`, so it is the subset's ZNCC through the final warp
+                // within what a 0.001 px move changes. Below `min_zncc`, the check through the
                 // guess's gradient (smoother than a noisy subset's own, as the check of the
                 // other results falls back to).
                 score = outcome.zncc;

@@ -16,16 +16,9 @@
 //! subset's gradient terms are several times too short and the convergence is linear (ratio
 //! 0.85 to 0.9 per iteration at 9 px, even without noise; a third of the 9 px subsets then
 //! stopped at a 10-iteration cap); with them it takes 2 to 4 iterations. Offset and gain of the deformed image cancel in
-//! (g − g_m)/g_n. Each update is a small fraction of the previous one (at most [`CONTRACTION`]
-//! measured at 1 % noise), so the iterations stop when the moves still to come, estimated from
-//! that fraction after a first update and from the contraction measured between the last two
-//! updates after the others ([`remaining_px`]), move no point of the subset by more than
-//! [`CONVERGED_PX`]: the first update of a subset started within 0.02 px of its match is its
-//! last (two thirds of the subsets predicted from their previous frame at 1 %
-//! noise then cost one evaluation, where the test of the update itself against
-//! [`CONVERGED_PX`] took a second one that moved them by 0.0003 px at the median, 0.0017 px
-//! at most); at the cap the subset is `not_converged`. The ZNCC of the last samples, 1 − C/2
-//! with C the ZNSSD, is the result's score.
+//! (g − g_m)/g_n. The iterations stop when the update moves no point of the subset by more
+//! than [`CONVERGED_PX`]; at the cap the subset is `not_converged`. The ZNCC of the last
+//! samples, 1 − C/2 with C the ZNSSD, is the result's score.
 //!
 //! Nothing here allocates: the caller owns every buffer.
 
@@ -41,13 +34,8 @@ use bspline::Coefficients;
 use shape::{Order, Warp};
 use subset::{SubsetStats, PLANES};
 
-/// The iterations stop when the next update would move no point of the subset by more than
-/// this (px).
+/// The iterations stop when the update moves no point of the subset by more than this (px).
 pub const CONVERGED_PX: f64 = 1e-3;
-/// The largest ratio of an update's reach to the previous one's measured at 1 % noise: 0.05
-/// (median 0.016, 99th percentile 0.033 over 34,515 second updates of 33 px subsets predicted
-/// from the previous frame, `bench correlate --method icgn1 --zoi 33`, 2026-11-28).
-pub const CONTRACTION: f64 = 0.05;
 /// A subset whose samples' standard deviation is below this (counts) is `low_contrast`.
 const MIN_DEFORMED_STD: f64 = 0.5;
 
@@ -230,27 +218,7 @@ fn evaluate_portable(
     Some(sums)
 }
 
-/// How far (px, the reach of [`Warp::reach_px`]) the iterations after an update of `reach`
-/// would still move the subset: after a first update, at most [`CONTRACTION`] times it; after
-/// the others, the geometric tail of the contraction measured between the last two updates
-/// (a subset whose updates do not shrink, as on low-contrast noisy 13 px subsets that wander,
-/// has no tail: it stops only once an update itself is below [`CONVERGED_PX`]).
-fn remaining_px(reach: f64, previous_reach: Option<f64>) -> f64 {
-    match previous_reach {
-        None => CONTRACTION * reach,
-        Some(previous) => {
-            let ratio = reach / previous;
-            if ratio < 0.5 {
-                reach * ratio.max(CONTRACTION) / (1.0 - ratio)
-            } else {
-                reach
-            }
-        }
-    }
-}
-
-/// IC-GN from `guess` until the next update is predicted below [`CONVERGED_PX`] (see
-/// [`CONTRACTION`]) or `max_iterations`.
+/// IC-GN from `guess` until the update is below [`CONVERGED_PX`] or `max_iterations`.
 pub fn solve(
     subset: &Subset,
     order: Order,
@@ -269,7 +237,6 @@ pub fn solve(
         zncc: 0.0,
         status: NodeStatus::NotConverged,
     };
-    let mut previous_reach = None;
     for iteration in 1..=max_iterations {
         outcome.iterations = iteration;
         let Some(sums) = evaluate(subset, order, coefficients, &outcome.warp) else {
@@ -299,12 +266,10 @@ pub fn solve(
             return outcome;
         };
         outcome.warp = next;
-        let reach = delta.reach_px(radius_px);
-        if remaining_px(reach, previous_reach) < CONVERGED_PX {
+        if delta.reach_px(radius_px) < CONVERGED_PX {
             outcome.status = NodeStatus::Ok;
             return outcome;
         }
-        previous_reach = Some(reach);
         // A subset sent further than half its size from its guess has lost its match.
         let (du, dv) = (
             next.p[shape::U] - guess.p[shape::U],
@@ -328,21 +293,6 @@ mod tests {
     /// A deformed image of the analytic texture under a known affine map: IC-GN recovers the
     /// displacement and gradient at the subset centre from a guess 0.6 px away and no gradient,
     /// with either order, and is insensitive to the deformed image's offset and gain.
-    /// A first update is trusted to shrink by CONTRACTION; later ones by the contraction they
-    /// show, and not at all when they do not shrink.
-    #[test]
-    fn the_moves_to_come_follow_the_measured_contraction() {
-        assert_eq!(remaining_px(0.01, None), CONTRACTION * 0.01);
-        assert!(remaining_px(0.019, None) < CONVERGED_PX);
-        assert!(remaining_px(0.021, None) > CONVERGED_PX);
-        // Shrinking by 10: a tenth of the update, and the tail after it.
-        let tail = remaining_px(0.005, Some(0.05));
-        assert!((tail - 0.005 * 0.1 / 0.9).abs() < 1e-12, "{tail}");
-        // Wandering: the update itself.
-        assert_eq!(remaining_px(0.005, Some(0.006)), 0.005);
-        assert_eq!(remaining_px(0.005, Some(0.004)), 0.005);
-    }
-
     #[test]
     fn recovers_an_affine_motion_with_offset_and_gain() {
         let size = 96usize;
