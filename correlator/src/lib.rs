@@ -43,6 +43,8 @@ mod real_fft2d;
 pub mod region;
 pub mod settings;
 mod simd;
+#[cfg(target_arch = "x86_64")]
+mod simd_avx2;
 pub mod state;
 pub mod strain;
 pub mod timing;

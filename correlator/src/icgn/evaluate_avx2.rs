@@ -26,14 +26,16 @@
 use super::bspline::{Coefficients, MARGIN_HIGH, MARGIN_LOW, TAPS};
 use super::shape::{Order, Warp};
 use super::{Subset, Sums};
+pub use crate::simd_avx2::available;
+use crate::simd_avx2::{load8, store8};
 use std::arch::x86_64::{
     __m256, __m256d, _mm256_add_pd, _mm256_add_ps, _mm256_and_pd, _mm256_and_ps,
     _mm256_broadcast_ss, _mm256_castps256_ps128, _mm256_cmp_pd, _mm256_cmp_ps, _mm256_cvtepi32_pd,
     _mm256_cvtpd_ps, _mm256_cvtps_pd, _mm256_cvttpd_epi32, _mm256_extractf128_ps, _mm256_fmadd_pd,
     _mm256_fmadd_ps, _mm256_hadd_ps, _mm256_loadu_ps, _mm256_movemask_pd, _mm256_mul_pd,
     _mm256_mul_ps, _mm256_permute2f128_ps, _mm256_set1_pd, _mm256_set1_ps, _mm256_setr_ps,
-    _mm256_setzero_pd, _mm256_setzero_ps, _mm256_storeu_pd, _mm256_storeu_ps, _mm256_sub_pd,
-    _mm256_sub_ps, _mm_storeu_ps, _mm_storeu_si128, _CMP_GE_OQ, _CMP_LT_OQ,
+    _mm256_setzero_pd, _mm256_setzero_ps, _mm256_storeu_pd, _mm256_sub_pd, _mm256_sub_ps,
+    _mm_storeu_ps, _mm_storeu_si128, _CMP_GE_OQ, _CMP_LT_OQ,
 };
 
 /// 120 × the weights of the taps −2..=3 (lanes 0..=5; lanes 6 and 7 zero) as polynomials in
@@ -52,12 +54,6 @@ const SCALE: f32 = 1.0 / (120.0 * 120.0);
 pub const FLUSH_CHUNKS: usize = 8;
 /// Sums kept: Σ g', Σ g'², Σ f̂ g', then Σ J g' (6 or 12).
 const SUMS: usize = 15;
-
-/// Whether this CPU runs [`evaluate`].
-#[inline]
-pub fn available() -> bool {
-    is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
-}
 
 /// The sums of one evaluation, or None when a sample falls off the coefficients' fast path
 /// (the caller then runs the portable evaluation, which handles the border).
@@ -81,10 +77,7 @@ pub unsafe fn evaluate(
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 fn weights(t: __m256) -> __m256 {
-    let row = |p: usize| {
-        // SAFETY: reads the 32 bytes of a [f32; 8].
-        unsafe { _mm256_loadu_ps(POLY[p].as_ptr()) }
-    };
+    let row = |p: usize| load8(&POLY[p]);
     // Written out: an iterator adapter is not inlined into a target-feature function.
     let mut w = _mm256_fmadd_ps(row(5), t, row(4));
     w = _mm256_fmadd_ps(w, t, row(3));
@@ -108,15 +101,6 @@ fn lane_sums(v: &[__m256; 8]) -> __m256 {
         _mm256_permute2f128_ps(u0, u1, 0x20),
         _mm256_permute2f128_ps(u0, u1, 0x31),
     )
-}
-
-/// 8 f32 lanes from a slice of at least 8 values.
-#[target_feature(enable = "avx2,fma")]
-#[inline]
-fn load8(values: &[f32]) -> __m256 {
-    let values = &values[..8];
-    // SAFETY: reads the 8 values of `values`.
-    unsafe { _mm256_loadu_ps(values.as_ptr()) }
 }
 
 /// The two f64 halves of 8 f32 lanes.
@@ -261,8 +245,7 @@ fn run<const SECOND: bool>(subset: &Subset, c: &Coefficients, warp: &Warp) -> Op
         for l in 0..8 {
             let wx = weights(_mm256_broadcast_ss(&tx[l]));
             let mut wy = [0.0f32; 8];
-            // SAFETY: writes the 32 bytes of a local [f32; 8].
-            unsafe { _mm256_storeu_ps(wy.as_mut_ptr(), weights(_mm256_broadcast_ss(&ty[l]))) };
+            store8(weights(_mm256_broadcast_ss(&ty[l])), &mut wy);
             // The fast-path check above: 2 <= ix < w − 4 and 2 <= iy < h − 4.
             let start = (iy[l] as usize - MARGIN_LOW) * w + ix[l] as usize - MARGIN_LOW;
             debug_assert!(start + (TAPS - 1) * w + 8 <= data.len());

@@ -153,30 +153,11 @@ fn inverse_hessian_of<const COUNT: usize>(
     let nn = n * n;
     let (values, gx, gy) = (&values[..nn], &gx[..nn], &gy[..nn]);
     let count = COUNT;
-    let half = (n as f64 - 1.0) / 2.0;
-    let mut hessian = [0.0f64; 144];
-    let mut j_pixel = [0.0f64; 12];
-    for j in 0..n {
-        for i in 0..n {
-            let k = j * n + i;
-            steepest_descent(
-                order,
-                gx[k] as f64,
-                gy[k] as f64,
-                i as f64 - half,
-                j as f64 - half,
-                &mut j_pixel,
-            );
-            let f = values[k] as f64;
-            for a in 0..count {
-                stats.sum_j[a] += j_pixel[a];
-                stats.sum_jf[a] += j_pixel[a] * f;
-                for b in a..count {
-                    hessian[a * count + b] += j_pixel[a] * j_pixel[b];
-                }
-            }
-        }
-    }
+    let mut hessian = if order == Order::First {
+        super::first_order_sums::sums(n, [values, gx, gy], &mut stats.sum_j, &mut stats.sum_jf)
+    } else {
+        steepest_descent_sums::<COUNT>(spec, [values, gx, gy], stats)
+    };
     // The Gauss-Newton Hessian of the ZNSSD itself: the reference subset's mean and norm move
     // with Δp too, so its steepest-descent images are K = J − J̄ − f̂ (Σ J f̂) (centred, and
     // without their component along f̂), and Σ K Kᵀ = Σ J Jᵀ − (Σ J)(Σ J)ᵀ / n² − (Σ J f̂)(Σ J f̂)ᵀ.
@@ -195,6 +176,41 @@ fn inverse_hessian_of<const COUNT: usize>(
         }
     }
     invert::<COUNT>(&hessian)
+}
+
+/// Σ J Jᵀ (upper triangle, row-major COUNT x COUNT) of the planes, and Σ J, Σ J f̂ into
+/// `stats`, from the steepest-descent images pixel by pixel (any order).
+fn steepest_descent_sums<const COUNT: usize>(
+    spec: SubsetSpec,
+    [values, gx, gy]: [&[f32]; 3],
+    stats: &mut SubsetStats,
+) -> [f64; 144] {
+    let (n, order) = (spec.side_px, spec.order);
+    let half = (n as f64 - 1.0) / 2.0;
+    let mut hessian = [0.0f64; 144];
+    let mut j_pixel = [0.0f64; 12];
+    for j in 0..n {
+        for i in 0..n {
+            let k = j * n + i;
+            steepest_descent(
+                order,
+                gx[k] as f64,
+                gy[k] as f64,
+                i as f64 - half,
+                j as f64 - half,
+                &mut j_pixel,
+            );
+            let f = values[k] as f64;
+            for a in 0..COUNT {
+                stats.sum_j[a] += j_pixel[a];
+                stats.sum_jf[a] += j_pixel[a] * f;
+                for b in a..COUNT {
+                    hessian[a * COUNT + b] += j_pixel[a] * j_pixel[b];
+                }
+            }
+        }
+    }
+    hessian
 }
 
 /// [`central_gradient`] at every pixel of the n x n block from `top_left` into `gx` and `gy`
@@ -343,6 +359,56 @@ pub(crate) mod test_support {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The first order's row sums give the pixel-by-pixel sums within f32 rounding of the rows,
+    /// at odd and even sizes.
+    #[test]
+    fn first_order_row_sums_are_the_pixel_sums() {
+        for n in [9usize, 24, 33] {
+            let nn = n * n;
+            let plane = |a: f64, b: f64| -> Vec<f32> {
+                (0..nn)
+                    .map(|k| ((a * k as f64).sin() * 0.03 + b * (k % n) as f64 * 1e-3) as f32)
+                    .collect()
+            };
+            let (values, gx, gy) = (plane(0.71, 0.2), plane(1.37, -0.5), plane(0.29, 0.8));
+            let spec = SubsetSpec {
+                top_left_px: (0, 0),
+                side_px: n,
+                order: Order::First,
+            };
+            let mut pixelwise = SubsetStats::default();
+            let expected = steepest_descent_sums::<6>(spec, [&values, &gx, &gy], &mut pixelwise);
+            let mut rows = SubsetStats::default();
+            let found = super::super::first_order_sums::sums(
+                n,
+                [&values, &gx, &gy],
+                &mut rows.sum_j,
+                &mut rows.sum_jf,
+            );
+            let scale = expected.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for a in 0..6 {
+                for b in a..6 {
+                    let (e, f) = (expected[a * 6 + b], found[a * 6 + b]);
+                    assert!(
+                        (e - f).abs() <= 1e-5 * scale,
+                        "n {n} H[{a}][{b}]: {f} vs {e}"
+                    );
+                }
+                let sums = [
+                    (pixelwise.sum_j[a], rows.sum_j[a]),
+                    (pixelwise.sum_jf[a], rows.sum_jf[a]),
+                ];
+                for (e, f) in sums {
+                    assert!(
+                        (e - f).abs() <= 1e-5 * (e.abs() + 1e-3),
+                        "n {n} {a}: {f} vs {e}"
+                    );
+                }
+            }
+            assert!(scale > 0.0);
+        }
+    }
 
     /// The block gradient is the per-pixel one, bit for bit, inside and at the borders.
     #[test]

@@ -11,36 +11,14 @@
 //! multiple of 8. Only the 8-value loads and stores are unsafe, each on a slice of at least 8
 //! values, and the views of complex slices as their f32 pairs.
 
+pub use crate::simd_avx2::available;
+use crate::simd_avx2::{load8, store8};
 use rustfft::num_complex::Complex32;
 use std::arch::x86_64::{
-    __m256, _mm256_fmadd_ps, _mm256_fmaddsub_ps, _mm256_loadu_ps, _mm256_movehdup_ps,
-    _mm256_moveldup_ps, _mm256_mul_ps, _mm256_permute_ps, _mm256_set1_ps, _mm256_setr_ps,
-    _mm256_setzero_ps, _mm256_storeu_ps, _mm256_sub_ps,
+    __m256, _mm256_fmadd_ps, _mm256_fmaddsub_ps, _mm256_movehdup_ps, _mm256_moveldup_ps,
+    _mm256_mul_ps, _mm256_permute_ps, _mm256_set1_ps, _mm256_setr_ps, _mm256_setzero_ps,
+    _mm256_sub_ps,
 };
-
-/// Whether this CPU runs this module's functions.
-#[inline]
-pub fn available() -> bool {
-    is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
-}
-
-/// 8 lanes from the first 8 values of `values`.
-#[target_feature(enable = "avx2,fma")]
-#[inline]
-fn load8(values: &[f32]) -> __m256 {
-    let values = &values[..8];
-    // SAFETY: reads the 8 values of `values`.
-    unsafe { _mm256_loadu_ps(values.as_ptr()) }
-}
-
-/// Writes 8 lanes to the first 8 values of `out`.
-#[target_feature(enable = "avx2,fma")]
-#[inline]
-fn store8(v: __m256, out: &mut [f32]) {
-    let out = &mut out[..8];
-    // SAFETY: writes the 8 values of `out`.
-    unsafe { _mm256_storeu_ps(out.as_mut_ptr(), v) }
-}
 
 /// Four complex products a b, each complex number two lanes (re, im).
 #[target_feature(enable = "avx2,fma")]
