@@ -24,6 +24,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod columns;
 pub mod data;
 pub mod field_layout;
 pub mod field_route;
@@ -47,5 +48,6 @@ pub mod route;
 pub mod section_cut;
 pub mod stability;
 pub mod subsample;
+pub mod table;
 pub mod tapered_ramp;
 pub mod vfm;

@@ -1,14 +1,20 @@
 //! `dicstream identify`: offline identification of hyperelastic potentials from CSV load cases
 //! (`stretch,nominal_stress_mpa`) and general biaxial states (`--biaxial-general`:
 //! `lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa`, both stresses fitted at once),
-//! ranked by AIC; table, JSON, and optional PNG plots (of the canonical curves).
+//! ranked by AIC; table, JSON, and optional PNG plots (of the canonical curves). A file may be
+//! a test machine's export as it comes (title lines, a units row, `;` and decimal commas, a
+//! force and an extension with the specimen's section and gauge length: `identifier::table`,
+//! `identifier::columns`).
 //!
 //! Above `--max-fit-points` the fit runs on a load-path-preserving subsample, said on stderr and
 //! in the JSON. When stderr is a terminal, one progress line per model (model, start k/n,
 //! elapsed) is drawn there; never on stdout, which holds the JSON alone with `--json`.
 
 use anyhow::{bail, Context};
-use identifier::data::{read_biaxial_csv, read_curve_csv, BiaxialState, Curve, LoadCase};
+use identifier::columns::Specimen;
+use identifier::data::{
+    read_biaxial_csv, read_curve_csv, BiaxialState, Curve, LoadCase, ReadOptions,
+};
 use identifier::fit::{
     evaluate_data, fit_ranked_data, Fit, FitData, FitError, FitOptions, FitStage, ResidualKind,
 };
@@ -16,6 +22,7 @@ use identifier::models::{parse_model_list, Model};
 use identifier::report::fit_json;
 use identifier::route::{paper_route, RouteResult};
 use identifier::subsample::{subsample_data, Subsample, DEFAULT_MAX_FIT_POINTS};
+use identifier::table::TableOptions;
 use serde_json::{json, Value};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -63,6 +70,19 @@ pub struct IdentifyArgs {
     /// JSON; RMS and R² are still over every point).
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_FIT_POINTS as u64, value_parser = clap::value_parser!(u64).range(2..))]
     pub max_fit_points: u64,
+    /// Lines at the top of each data file skipped before its header (a machine export's title
+    /// lines; a line whose cell count differs from the header's that follows is skipped
+    /// anyway).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub skip_lines: usize,
+    /// Gauge length L0 (mm) of a load case's file that logs an extension (`Extension (mm)`)
+    /// instead of a stretch or a strain: λ = 1 + Δl / L0.
+    #[arg(long, value_name = "MM")]
+    pub gauge_length_mm: Option<f64>,
+    /// Reference (undeformed) section A0 (mm²) of a load case's file that logs a force
+    /// (`Load (kN)`) instead of a nominal stress: P = F / A0.
+    #[arg(long, value_name = "MM2")]
+    pub section_mm2: Option<f64>,
     /// Threads sharing the points of each fit evaluation; the results do not depend on it.
     /// Default 1: on a shared two-core machine more threads (spawned per evaluation) measured
     /// slower, not faster.
@@ -131,6 +151,23 @@ pub fn run_with(
 
 /// The load cases' curves and the general biaxial states the arguments name; at least one.
 fn read_data(args: &IdentifyArgs) -> anyhow::Result<(Vec<Curve>, Vec<BiaxialState>)> {
+    for (value, flag) in [
+        (args.gauge_length_mm, "--gauge-length-mm"),
+        (args.section_mm2, "--section-mm2"),
+    ] {
+        if value.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
+            bail!("{flag} must be a positive number");
+        }
+    }
+    let options = ReadOptions {
+        table: TableOptions {
+            skip_lines: args.skip_lines,
+        },
+        specimen: Specimen {
+            gauge_length_mm: args.gauge_length_mm,
+            section_mm2: args.section_mm2,
+        },
+    };
     let mut curves: Vec<Curve> = Vec::new();
     for (path, case) in [
         (&args.uniaxial, LoadCase::Uniaxial),
@@ -138,12 +175,14 @@ fn read_data(args: &IdentifyArgs) -> anyhow::Result<(Vec<Curve>, Vec<BiaxialStat
         (&args.pure_shear, LoadCase::PureShear),
     ] {
         if let Some(path) = path {
-            curves
-                .push(read_curve_csv(path, case).with_context(|| format!("reading {case} data"))?);
+            curves.push(
+                read_curve_csv(path, case, &options)
+                    .with_context(|| format!("reading {case} data"))?,
+            );
         }
     }
     let states: Vec<BiaxialState> = match &args.biaxial_general {
-        Some(path) => read_biaxial_csv(path).context("reading general biaxial data")?,
+        Some(path) => read_biaxial_csv(path, &options).context("reading general biaxial data")?,
         None => Vec::new(),
     };
     if curves.is_empty() && states.is_empty() {
@@ -428,6 +467,9 @@ mod tests {
                 json,
                 plot: None,
                 max_fit_points,
+                skip_lines: 0,
+                gauge_length_mm: None,
+                section_mm2: None,
                 threads: 2,
             }
         }
@@ -584,6 +626,9 @@ mod tests {
             json: true,
             plot: None,
             max_fit_points: DEFAULT_MAX_FIT_POINTS as u64,
+            skip_lines: 0,
+            gauge_length_mm: None,
+            section_mm2: None,
             threads: 1,
         }
     }
@@ -636,12 +681,12 @@ mod tests {
         for (text, needle) in [
             (
                 format!("{h}\n1.2,1.1,0.3,0.2\n1.3,1.1,NaN,0.2\n"),
-                "line 3: nominal_stress1_mpa NaN is not a finite number",
+                "line 3, column 3 `nominal_stress1_mpa`: `NaN` is not a finite number",
             ),
             (format!("{h}\n1.2,1.1,0.3\n"), "line 2: expected 4 cells"),
             (
                 "1.2,1.1,0.3,0.2\n1.3,1.2,0.4,0.3\n".to_string(),
-                "line 1: expected the header",
+                "line 1: expected a header",
             ),
             (
                 format!("{h}\n1.2,0,0.3,0.2\n1.3,1.2,0.4,0.3\n"),
