@@ -26,11 +26,14 @@
 
 pub mod columns;
 pub mod data;
+pub mod fe_cards;
 pub mod field_layout;
 pub mod field_route;
 pub mod field_stress;
 pub mod fit;
 pub mod gradient;
+pub mod identifiability;
+pub mod initial_modulus;
 pub mod journal;
 pub mod kinematics;
 /// The law lives in its own crate (`material`), shared with the rig; re-exported here.
@@ -43,6 +46,7 @@ pub mod plot;
 #[cfg(feature = "process")]
 pub mod process;
 pub mod report;
+pub mod residual_plot;
 pub mod residuals;
 pub mod route;
 pub mod section_cut;

@@ -9,17 +9,24 @@
 //! Above `--max-fit-points` the fit runs on a load-path-preserving subsample, said on stderr and
 //! in the JSON. When stderr is a terminal, one progress line per model (model, start k/n,
 //! elapsed) is drawn there; never on stdout, which holds the JSON alone with `--json`.
+//!
+//! The report gives each fit's initial shear modulus, its Abaqus and Ansys cards (in the JSON;
+//! as files with `--cards`), and says on stderr (and leaves unranked: `-`, `"rank": null`) a
+//! fit whose parameters the data do not identify (`identifier::identifiability`).
 
 use anyhow::{bail, Context};
 use identifier::columns::Specimen;
 use identifier::data::{
     read_biaxial_csv, read_curve_csv, BiaxialState, Curve, LoadCase, ReadOptions,
 };
+use identifier::fe_cards::write_cards;
 use identifier::fit::{
     evaluate_data, fit_ranked_data, Fit, FitData, FitError, FitOptions, FitStage, ResidualKind,
 };
+use identifier::initial_modulus::initial_shear_modulus_mpa;
 use identifier::models::{parse_model_list, Model};
 use identifier::report::fit_json;
+use identifier::residual_plot::write_residual_plot;
 use identifier::route::{paper_route, RouteResult};
 use identifier::subsample::{subsample_data, Subsample, DEFAULT_MAX_FIT_POINTS};
 use identifier::table::TableOptions;
@@ -62,9 +69,14 @@ pub struct IdentifyArgs {
     /// Print JSON instead of the ranked table.
     #[arg(long)]
     pub json: bool,
-    /// Write PNG plots (data and fitted curves, f(I1) and g(I2)) into this folder.
+    /// Write PNG plots (data and fitted curves, f(I1) and g(I2), the best fit's residuals)
+    /// into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// Write each fit's FE coefficient cards into this folder: `abaqus_<model>.inp`
+    /// (`*HYPERELASTIC`) and `ansys_<model>.mac` (`TB,HYPER`), for the models the codes have.
+    #[arg(long, value_name = "DIR")]
+    pub cards: Option<PathBuf>,
     /// Largest number of points fitted (all load cases together); above it the fit runs on a
     /// deterministic subsample keeping each curve's ends and shape (said on stderr and in the
     /// JSON; RMS and R² are still over every point).
@@ -114,6 +126,11 @@ pub fn run_with(
         states: &states,
     };
     let outcome = fit(&args, all, err, progress)?;
+    for fit in &outcome.fits {
+        if let Some(w) = fit.identifiability.warning() {
+            writeln!(err, "{}: {w}", fit.model)?;
+        }
+    }
     if args.json {
         write_json(out, &outcome)?;
     } else {
@@ -139,6 +156,18 @@ pub fn run_with(
         let written =
             identifier::plot::write_plots(dir, &curves, &outcome.fits, outcome.route.as_ref())
                 .with_context(|| format!("writing plots into {}", dir.display()))?;
+        for path in written {
+            writeln!(err, "wrote {}", path.display())?;
+        }
+        if let Some(best) = outcome.fits.first() {
+            let path = dir.join("residuals.png");
+            write_residual_plot(&path, all, best)
+                .with_context(|| format!("writing {}", path.display()))?;
+            writeln!(err, "wrote {}", path.display())?;
+        }
+    }
+    if let Some(dir) = &args.cards {
+        let written = write_cards(dir, &outcome.fits)?;
         for path in written {
             writeln!(err, "wrote {}", path.display())?;
         }
@@ -259,7 +288,22 @@ fn fit(
 
 /// `--json`: the fits, the failures, the paper's route and the subsample as one object.
 fn write_json(out: &mut dyn Write, outcome: &Outcome) -> anyhow::Result<()> {
-    let fits_json: Vec<Value> = outcome.fits.iter().map(fit_json).collect();
+    let mut rank = 0;
+    let fits_json: Vec<Value> = outcome
+        .fits
+        .iter()
+        .map(|fit| {
+            let mut value = fit_json(fit);
+            value["rank"] = match fit.identifiability.identifiable() {
+                true => {
+                    rank += 1;
+                    json!(rank)
+                }
+                false => Value::Null,
+            };
+            value
+        })
+        .collect();
     let failures_json: Vec<Value> = outcome
         .failures
         .iter()
@@ -377,8 +421,8 @@ fn print_table(
     }
     write!(
         out,
-        "{:>2} {:<22} {:>9} {:>9}",
-        "#", "model", "aic", "rms_mpa"
+        "{:>2} {:<22} {:>9} {:>9} {:>9}",
+        "#", "model", "aic", "rms_mpa", "mu0_mpa"
     )?;
     for c in &cases {
         write!(out, " {:>14}", format!("r2_{c}"))?;
@@ -387,14 +431,25 @@ fn print_table(
         out,
         "  stable_up_to (uniaxial/equibiaxial/pure_shear)  params ± std"
     )?;
-    for (rank, fit) in fits.iter().enumerate() {
+    let mut rank = 0;
+    for fit in fits {
+        let shown_rank = match fit.identifiability.identifiable() {
+            true => {
+                rank += 1;
+                rank.to_string()
+            }
+            false => "-".to_string(),
+        };
+        let mu0 = initial_shear_modulus_mpa(&fit.model, &fit.params)
+            .map_or("?".to_string(), |m| format!("{m:.4}"));
         write!(
             out,
-            "{:>2} {:<22} {:>9.1} {:>9.4}",
-            rank + 1,
+            "{:>2} {:<22} {:>9.1} {:>9.4} {:>9}",
+            shown_rank,
             fit.model.name(),
             fit.aic,
-            fit.rms_mpa
+            fit.rms_mpa,
+            mu0
         )?;
         for c in &fit.cases {
             write!(out, " {:>14.4}", c.r2)?;
@@ -421,7 +476,8 @@ fn print_table(
     }
     writeln!(
         out,
-        "(`!`: Drucker stability lost beyond that stretch; checked up to the largest data stretch)"
+        "(`!`: Drucker stability lost beyond that stretch; checked up to the largest data stretch; \
+         `-`: parameters not identifiable from these data, not ranked; mu0: initial shear modulus)"
     )
 }
 
@@ -466,6 +522,7 @@ mod tests {
                 residual: ResidualArg::Absolute,
                 json,
                 plot: None,
+                cards: None,
                 max_fit_points,
                 skip_lines: 0,
                 gauge_length_mm: None,
@@ -625,6 +682,7 @@ mod tests {
             residual: ResidualArg::Absolute,
             json: true,
             plot: None,
+            cards: None,
             max_fit_points: DEFAULT_MAX_FIT_POINTS as u64,
             skip_lines: 0,
             gauge_length_mm: None,
@@ -638,8 +696,25 @@ mod tests {
         let (_data, path) = general_csv("general");
         let (out, err) = run_captured(general_args(path.clone(), "ldr:2,2,mooney"), false);
         let value: Value = serde_json::from_str(&out).expect("stdout is one JSON document");
-        let best = &value["fits"][0];
+        let fits = value["fits"].as_array().unwrap();
+        let best = fits
+            .iter()
+            .min_by(|a, b| {
+                a["aic"]
+                    .as_f64()
+                    .unwrap()
+                    .total_cmp(&b["aic"].as_f64().unwrap())
+            })
+            .unwrap();
         assert_eq!(best["model"], "lambert-diani-rey:2,2", "{out}");
+        // Up to λ = 1.8 (I1 − 3 < 1.6) the quadratic term of ln f (true a2 = 1.4e-3) is not
+        // told from zero: the fit says so and is not ranked.
+        let warning = best["warning"].as_str().unwrap_or_default();
+        assert!(warning.contains("σ ≥ |value| for a2"), "{warning}");
+        assert!(
+            best["rank"].is_null()
+                && err.contains("lambert-diani-rey:2,2: parameters not identifiable")
+        );
         assert!(
             best["rms_by_case_mpa"]["biaxial_general"].is_number(),
             "{out}"
@@ -719,6 +794,54 @@ mod tests {
             run_with(missing, &mut out, &mut err, false).unwrap_err()
         );
         assert!(message.contains("cannot read the file"), "{message}");
+    }
+
+    #[test]
+    fn ogden3_on_uniaxial_data_alone_is_warned_and_not_ranked_and_cards_are_written() {
+        let data = Data::new("loose", 60);
+        let mut args = data.args(true, 1_000);
+        args.biaxial = None;
+        args.model = "ogden:3,mooney".into();
+        args.cards = Some(data.0.join("cards"));
+        let (out, err) = run_captured(args, false);
+        let value: Value = serde_json::from_str(&out).expect("stdout is one JSON document");
+        let fits = value["fits"].as_array().unwrap();
+        eprintln!("{err}");
+        let ogden = fits.iter().find(|f| f["model"] == "ogden:3").unwrap();
+        let mooney = fits.iter().find(|f| f["model"] == "mooney").unwrap();
+        assert_eq!(ogden["identifiable"], false, "{ogden}");
+        assert!(ogden["rank"].is_null());
+        assert!(ogden["warning"]
+            .as_str()
+            .unwrap()
+            .contains("not identifiable"));
+        assert_eq!(mooney["identifiable"], true, "{mooney}");
+        assert_eq!(mooney["rank"], 1);
+        assert_eq!(fits[0]["model"], "mooney", "the identifiable fit first");
+        assert!(
+            err.contains("ogden:3: parameters not identifiable from these data"),
+            "{err}"
+        );
+        // μ0 = 2 (C10 + C01) of the fitted Mooney law, near the true 0.44 MPa.
+        let mu0 = mooney["initial_shear_modulus_mpa"].as_f64().unwrap();
+        let (c10, c01) = (
+            mooney["params"]["C10"].as_f64().unwrap(),
+            mooney["params"]["C01"].as_f64().unwrap(),
+        );
+        assert!(
+            (mu0 - 2.0 * (c10 + c01)).abs() < 1e-12 && (mu0 - 0.44).abs() < 0.05,
+            "{mu0}"
+        );
+        let card = mooney["fe_cards"]["abaqus"].as_str().unwrap();
+        assert!(card.contains("*HYPERELASTIC, MOONEY-RIVLIN\n"), "{card}");
+        let written = std::fs::read_to_string(data.0.join("cards/abaqus_mooney.inp")).unwrap();
+        assert_eq!(written, card);
+        let ansys = std::fs::read_to_string(data.0.join("cards/ansys_ogden_3.mac")).unwrap();
+        assert!(
+            ansys.contains("! WARNING: parameters not identifiable"),
+            "{ansys}"
+        );
+        assert!(ansys.contains("TB,HYPER,1,,3,OGDEN"), "{ansys}");
     }
 
     #[test]
