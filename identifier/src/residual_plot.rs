@@ -1,6 +1,8 @@
 //! `residuals.png`: the best-ranked fit's residuals P_model − P_data (MPa) against the loaded
-//! stretch, one marker series per load case or the general biaxial states, and a zero line: a
-//! trend along the stretch says the model misses a feature of the data that the RMS hides.
+//! stretch, one coloured line per load case or the general biaxial states (points in stretch
+//! order; [`chart`] draws marker series all black, so cases would not be told apart), and a
+//! zero line: a trend along the stretch says the model misses a feature of the data that the
+//! RMS hides.
 
 use crate::fit::{Fit, FitData};
 use crate::plot::{chart, PlotError, Series};
@@ -11,7 +13,7 @@ pub fn write_residual_plot(path: &Path, data: FitData, fit: &Fit) -> Result<(), 
     let points = data.points();
     let mut series: Vec<Series> = Vec::new();
     for group in data.groups() {
-        let residuals: Vec<(f64, f64)> = points
+        let mut residuals: Vec<(f64, f64)> = points
             .iter()
             .filter(|p| p.0 == group)
             .filter_map(|(_, k, stretch, stress)| {
@@ -19,10 +21,11 @@ pub fn write_residual_plot(path: &Path, data: FitData, fit: &Fit) -> Result<(), 
                 Some((*stretch, model - stress))
             })
             .collect();
+        residuals.sort_by(|a, b| a.0.total_cmp(&b.0));
         series.push(Series {
             label: format!("{group} ({} points)", residuals.len()),
             points: residuals,
-            markers: true,
+            markers: false,
         });
     }
     let max_stretch = data.max_stretch();

@@ -803,7 +803,14 @@ mod tests {
         args.biaxial = None;
         args.model = "ogden:3,mooney".into();
         args.cards = Some(data.0.join("cards"));
+        args.plot = Some(data.0.join("plots"));
         let (out, err) = run_captured(args, false);
+        let residuals = data.0.join("plots/residuals.png");
+        assert!(
+            err.contains(&format!("wrote {}", residuals.display())),
+            "{err}"
+        );
+        assert!(image::open(&residuals).is_ok(), "residuals.png is a PNG");
         let value: Value = serde_json::from_str(&out).expect("stdout is one JSON document");
         let fits = value["fits"].as_array().unwrap();
         eprintln!("{err}");
