@@ -3,27 +3,9 @@
 //! kN and an extension in mm with the specimen's section and gauge length give the same fit
 //! as the identifier's own clean CSV; a bad cell is an error naming the file, line and column.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
-
-/// A scratch folder removed on drop.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(tag: &str) -> Scratch {
-        let dir =
-            std::env::temp_dir().join(format!("identify_machine_{tag}_{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+use testkit::Run;
 
 fn dicstream(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_dicstream"))
@@ -108,12 +90,13 @@ fn fits(args: &[&str]) -> Vec<(String, Vec<f64>)> {
 
 #[test]
 fn a_machine_export_gives_the_same_fit_as_the_clean_csv() {
-    let dir = Scratch::new("same");
-    let d = |name: &str| dir.0.join(name).display().to_string();
-    clean_csv(&dir.0.join("u.csv"), false);
-    clean_csv(&dir.0.join("b.csv"), true);
-    machine_csv(&dir.0.join("u_machine.csv"), false);
-    machine_csv(&dir.0.join("b_machine.csv"), true);
+    // The scratch folder, removed on drop.
+    let run = Run::new("identify_machine_same", env!("CARGO_BIN_EXE_dicstream"));
+    let d = |name: &str| run.dir.join(name).display().to_string();
+    clean_csv(&run.dir.join("u.csv"), false);
+    clean_csv(&run.dir.join("b.csv"), true);
+    machine_csv(&run.dir.join("u_machine.csv"), false);
+    machine_csv(&run.dir.join("b_machine.csv"), true);
     let models = "mooney,yeoh,ogden:2";
     let clean = fits(&[
         "identify",
@@ -154,8 +137,8 @@ fn a_machine_export_gives_the_same_fit_as_the_clean_csv() {
 
 #[test]
 fn a_bad_cell_or_a_missing_specimen_is_named() {
-    let dir = Scratch::new("bad");
-    let path = dir.0.join("u_machine.csv");
+    let run = Run::new("identify_machine_bad", env!("CARGO_BIN_EXE_dicstream"));
+    let path = run.dir.join("u_machine.csv");
     machine_csv(&path, false);
     let text = std::fs::read_to_string(&path).unwrap();
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();

@@ -145,13 +145,13 @@ fn stretch_from(table: &Table, specimen: Specimen) -> Result<Option<StretchFrom>
     })?;
     if let Some(c) = extension {
         let factor = named_unit::<LengthUnit>(table, c, "an extension")?.to_mm();
-        let Some(l0) = specimen.gauge_length_mm else {
-            return Err(table.error(format!(
-                "column {} `{}` is an extension: give the gauge length with --gauge-length-mm",
-                c + 1,
-                table.columns[c].name
-            )));
-        };
+        let l0 = given(
+            table,
+            c,
+            specimen.gauge_length_mm,
+            "an extension",
+            "the gauge length with --gauge-length-mm",
+        )?;
         return Ok(Some(StretchFrom::Extension(c, factor, l0)));
     }
     Ok(None)
@@ -167,19 +167,36 @@ fn stress_from(table: &Table, specimen: Specimen) -> Result<Option<StressFrom>, 
     }
     if let Some(c) = table.find(|n| n.contains("force") || n.contains("load"))? {
         let factor_n = named_unit::<ForceUnit>(table, c, "a force")?.to_n();
-        let Some(a0) = specimen.section_mm2 else {
-            return Err(table.error(format!(
-                "column {} `{}` is a force: give the reference section with --section-mm2",
-                c + 1,
-                table.columns[c].name
-            )));
-        };
+        let a0 = given(
+            table,
+            c,
+            specimen.section_mm2,
+            "a force",
+            "the reference section with --section-mm2",
+        )?;
         return Ok(Some(StressFrom {
             column: c,
             factor_mpa: factor_n / a0,
         }));
     }
     Ok(None)
+}
+
+/// The specimen's `value` column `c` needs, or an error saying what to give.
+fn given(
+    table: &Table,
+    c: usize,
+    value: Option<f64>,
+    what: &str,
+    give: &str,
+) -> Result<f64, DataError> {
+    value.ok_or_else(|| {
+        table.error(format!(
+            "column {} `{}` is {what}: give {give}",
+            c + 1,
+            table.columns[c].name
+        ))
+    })
 }
 
 /// The unit of a column: stated, or its name's last `_unit` when that is one of `known`.

@@ -127,6 +127,56 @@ fn polynomial_order(terms: &[((u32, u32), f64)], n: u32) -> Vec<f64> {
     out
 }
 
+/// A Rivlin polynomial as the codes name it.
+enum PolynomialForm {
+    NeoHookean {
+        c10: f64,
+    },
+    MooneyRivlin {
+        c10: f64,
+        c01: f64,
+    },
+    /// C10 … CN0 (Yeoh for N = 3).
+    Reduced(Vec<f64>),
+    /// Order N and C10, C01, C20, C11, C02, C30, …
+    Full(u32, Vec<f64>),
+}
+
+/// The codes' form of a model that is a Rivlin polynomial.
+fn polynomial_form(model: &Model, p: &[f64]) -> Option<PolynomialForm> {
+    let terms = polynomial_terms(model, p)?;
+    let n = terms.iter().map(|((i, j), _)| i + j).max()?;
+    let only = |set: &[(u32, u32)]| terms.iter().all(|(t, _)| set.contains(t));
+    let c = polynomial_order(&terms, n);
+    Some(if only(&[(1, 0)]) {
+        PolynomialForm::NeoHookean { c10: c[0] }
+    } else if only(&[(1, 0), (0, 1)]) {
+        PolynomialForm::MooneyRivlin {
+            c10: c[0],
+            c01: c[1],
+        }
+    } else if terms.iter().all(|((_, j), _)| *j == 0) {
+        PolynomialForm::Reduced(
+            (1..=n)
+                .map(|i| {
+                    terms
+                        .iter()
+                        .find(|(t, _)| *t == (i, 0))
+                        .map_or(0.0, |t| t.1)
+                })
+                .collect(),
+        )
+    } else {
+        PolynomialForm::Full(n, c)
+    })
+}
+
+/// `values` then `count` zeros (the incompressible D or d).
+fn with_zeros(mut values: Vec<f64>, count: usize) -> Vec<f64> {
+    values.extend(std::iter::repeat_n(0.0, count));
+    values
+}
+
 fn number(v: f64) -> String {
     format!("{v:.8e}")
 }
@@ -140,53 +190,34 @@ fn abaqus_lines(values: &[f64]) -> String {
 }
 
 fn abaqus(model: &Model, p: &[f64]) -> Option<String> {
-    if let Some(terms) = polynomial_terms(model, p) {
-        let n = terms.iter().map(|((i, j), _)| i + j).max()?;
-        let only = |set: &[(u32, u32)]| terms.iter().all(|(t, _)| set.contains(t));
-        let zeros = |k: u32| vec![0.0; k as usize];
-        return Some(if only(&[(1, 0)]) {
-            format!(
+    if let Some(form) = polynomial_form(model, p) {
+        return match form {
+            PolynomialForm::NeoHookean { c10 } => Some(format!(
                 "*HYPERELASTIC, NEO HOOKE\n{}",
-                abaqus_lines(&[terms[0].1, 0.0])
-            )
-        } else if only(&[(1, 0), (0, 1)]) {
-            let c = polynomial_order(&terms, 1);
-            format!(
+                abaqus_lines(&[c10, 0.0])
+            )),
+            PolynomialForm::MooneyRivlin { c10, c01 } => Some(format!(
                 "*HYPERELASTIC, MOONEY-RIVLIN\n{}",
-                abaqus_lines(&[c[0], c[1], 0.0])
-            )
-        } else if terms.iter().all(|((_, j), _)| *j == 0) {
-            let mut v: Vec<f64> = (1..=n)
-                .map(|i| {
-                    terms
-                        .iter()
-                        .find(|(t, _)| *t == (i, 0))
-                        .map_or(0.0, |t| t.1)
-                })
-                .collect();
-            v.extend(zeros(n));
-            format!(
-                "*HYPERELASTIC, REDUCED POLYNOMIAL, N={n}\n{}",
-                abaqus_lines(&v)
-            )
-        } else {
-            if n > 6 {
-                return None;
-            }
-            let mut v = polynomial_order(&terms, n);
-            v.extend(zeros(n));
-            format!("*HYPERELASTIC, POLYNOMIAL, N={n}\n{}", abaqus_lines(&v))
-        });
+                abaqus_lines(&[c10, c01, 0.0])
+            )),
+            PolynomialForm::Reduced(c) => Some(format!(
+                "*HYPERELASTIC, REDUCED POLYNOMIAL, N={}\n{}",
+                c.len(),
+                abaqus_lines(&with_zeros(c.clone(), c.len()))
+            )),
+            // Abaqus takes polynomials up to N = 6.
+            PolynomialForm::Full(n, _) if n > 6 => None,
+            PolynomialForm::Full(n, c) => Some(format!(
+                "*HYPERELASTIC, POLYNOMIAL, N={n}\n{}",
+                abaqus_lines(&with_zeros(c, n as usize))
+            )),
+        };
     }
     match model {
         Model::Ogden(n) => {
             let (mu, alpha) = p.split_at(*n);
-            let mut v: Vec<f64> = mu
-                .iter()
-                .zip(alpha)
-                .flat_map(|(m, a)| [m * a / 2.0, *a])
-                .collect();
-            v.extend(vec![0.0; *n]);
+            let v = mu.iter().zip(alpha).flat_map(|(m, a)| [m * a / 2.0, *a]);
+            let v = with_zeros(v.collect(), *n);
             Some(format!("*HYPERELASTIC, OGDEN, N={n}\n{}", abaqus_lines(&v)))
         }
         Model::ArrudaBoyce => Some(format!(
@@ -210,37 +241,30 @@ fn tbdata(values: &[f64]) -> String {
 }
 
 fn ansys(model: &Model, p: &[f64]) -> Option<String> {
-    if let Some(terms) = polynomial_terms(model, p) {
-        let n = terms.iter().map(|((i, j), _)| i + j).max()?;
-        let only = |set: &[(u32, u32)]| terms.iter().all(|(t, _)| set.contains(t));
-        let zeros = |k: u32| vec![0.0; k as usize];
-        return Some(if only(&[(1, 0)]) {
-            format!("TB,HYPER,1,,,NEO\n{}", tbdata(&[2.0 * terms[0].1, 0.0]))
-        } else if only(&[(1, 0), (0, 1)]) {
-            let c = polynomial_order(&terms, 1);
-            format!("TB,HYPER,1,,2,MOONEY\n{}", tbdata(&[c[0], c[1], 0.0]))
-        } else if terms.iter().all(|((_, j), _)| *j == 0) {
-            let mut v: Vec<f64> = (1..=n)
-                .map(|i| {
-                    terms
-                        .iter()
-                        .find(|(t, _)| *t == (i, 0))
-                        .map_or(0.0, |t| t.1)
-                })
-                .collect();
-            v.extend(zeros(n));
-            format!("TB,HYPER,1,,{n},YEOH\n{}", tbdata(&v))
-        } else {
-            let mut v = polynomial_order(&terms, n);
-            v.extend(zeros(n));
-            format!("TB,HYPER,1,,{n},POLY\n{}", tbdata(&v))
+    if let Some(form) = polynomial_form(model, p) {
+        return Some(match form {
+            PolynomialForm::NeoHookean { c10 } => {
+                format!("TB,HYPER,1,,,NEO\n{}", tbdata(&[2.0 * c10, 0.0]))
+            }
+            PolynomialForm::MooneyRivlin { c10, c01 } => {
+                format!("TB,HYPER,1,,2,MOONEY\n{}", tbdata(&[c10, c01, 0.0]))
+            }
+            PolynomialForm::Reduced(c) => format!(
+                "TB,HYPER,1,,{},YEOH\n{}",
+                c.len(),
+                tbdata(&with_zeros(c.clone(), c.len()))
+            ),
+            PolynomialForm::Full(n, c) => format!(
+                "TB,HYPER,1,,{n},POLY\n{}",
+                tbdata(&with_zeros(c, n as usize))
+            ),
         });
     }
     match model {
         Model::Ogden(n) => {
             let (mu, alpha) = p.split_at(*n);
-            let mut v: Vec<f64> = mu.iter().zip(alpha).flat_map(|(m, a)| [*m, *a]).collect();
-            v.extend(vec![0.0; *n]);
+            let v = mu.iter().zip(alpha).flat_map(|(m, a)| [*m, *a]);
+            let v = with_zeros(v.collect(), *n);
             Some(format!("TB,HYPER,1,,{n},OGDEN\n{}", tbdata(&v)))
         }
         Model::Gent => Some(format!("TB,HYPER,1,,,GENT\n{}", tbdata(&[p[0], p[1], 0.0]))),
