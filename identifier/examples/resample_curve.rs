@@ -30,7 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Err("POINTS must be at least 2".into());
     }
     // The load case only matters for the reader's checks, which are the same for all three.
-    let curve = read_curve_csv(Path::new(&args[0]), LoadCase::Uniaxial)?;
+    let curve = read_curve_csv(Path::new(&args[0]), LoadCase::Uniaxial, &Default::default())?;
     let (first, last) = (curve.stretch[0], curve.stretch[curve.len() - 1]);
     let mut text = String::from("stretch,nominal_stress_mpa\n");
     let mut segment = 0;

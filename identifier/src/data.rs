@@ -19,6 +19,8 @@
 //! residuals). The reader accepts it and drops it, counting it in
 //! [`Curve::reference_rows_dropped`]. Any stretch below 1.0 is an error (tension data only).
 
+use crate::columns::{biaxial_rows, curve_rows, Specimen};
+use crate::table::{Table, TableOptions};
 use std::fmt;
 use std::path::Path;
 
@@ -211,86 +213,60 @@ pub fn canonical_curves(states: &[BiaxialState], tolerance: f64) -> Vec<Curve> {
     curves
 }
 
-/// The header of a general biaxial CSV.
+/// The header of a general biaxial CSV as the identifier writes it.
 pub const BIAXIAL_HEADER: &str = "lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa";
 
-/// Reads a general biaxial CSV ([`BIAXIAL_HEADER`], then one state a row).
-pub fn read_biaxial_csv(path: &Path) -> Result<Vec<BiaxialState>, DataError> {
-    let source = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| DataError::new(&source, format!("cannot read the file: {e}")))?;
-    parse_biaxial_csv(&text, &source)
+/// How to read a data file: its title lines ([`TableOptions`]) and what it lacks of the
+/// specimen ([`Specimen`]: a gauge length for an extension, a section for a force).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReadOptions {
+    pub table: TableOptions,
+    pub specimen: Specimen,
 }
 
-/// Parses general biaxial CSV text: the header is required (its four names, in order); every
-/// row has four finite numbers, positive stretches; the undeformed state (λ1 = λ2 = 1) is
-/// dropped (it carries no information, as in [`Curve`]); at least
-/// [`MIN_POINTS_PER_CURVE`] states remain. Errors name the line (counted from 1).
-pub fn parse_biaxial_csv(text: &str, source_name: &str) -> Result<Vec<BiaxialState>, DataError> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty());
-    let Some((header_index, header)) = lines.next() else {
-        return Err(DataError::new(
-            source_name,
-            format!("empty file: expected a header `{BIAXIAL_HEADER}` then data rows"),
-        ));
-    };
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    if names != BIAXIAL_HEADER.split(',').collect::<Vec<_>>() {
-        return Err(DataError::new(
-            source_name,
-            format!(
-                "line {}: expected the header `{BIAXIAL_HEADER}`, found `{header}`",
-                header_index + 1
-            ),
-        ));
-    }
+/// Reads a general biaxial CSV ([`BIAXIAL_HEADER`], or a machine's export of those columns:
+/// [`crate::table`], [`crate::columns`]), one state a row.
+pub fn read_biaxial_csv(
+    path: &Path,
+    options: &ReadOptions,
+) -> Result<Vec<BiaxialState>, DataError> {
+    biaxial_states(&Table::read(path, options.table)?)
+}
+
+/// Parses general biaxial CSV text: the header names the four columns; every row has four
+/// finite numbers, positive stretches; the undeformed state (λ1 = λ2 = 1) is dropped (it
+/// carries no information, as in [`Curve`]); at least [`MIN_POINTS_PER_CURVE`] states
+/// remain. Errors name the line (counted from 1).
+pub fn parse_biaxial_csv(
+    text: &str,
+    source_name: &str,
+    options: &ReadOptions,
+) -> Result<Vec<BiaxialState>, DataError> {
+    biaxial_states(&Table::parse(text, source_name, options.table)?)
+}
+
+fn biaxial_states(table: &Table) -> Result<Vec<BiaxialState>, DataError> {
     let mut states = Vec::new();
-    for (index, line) in lines {
-        let line_no = index + 1;
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        if cells.len() != 4 {
-            return Err(DataError::new(
-                source_name,
-                format!(
-                    "line {line_no}: expected 4 cells `{BIAXIAL_HEADER}`, found {} in `{line}`",
-                    cells.len()
-                ),
-            ));
-        }
-        let mut values = [0.0; 4];
-        for (value, (cell, name)) in values.iter_mut().zip(cells.iter().zip(&names)) {
-            *value = cell.parse::<f64>().map_err(|_| {
-                DataError::new(
-                    source_name,
-                    format!("line {line_no}: {name} `{cell}` is not a number"),
-                )
-            })?;
-        }
+    for (line_no, [l1, l2, p1, p2]) in biaxial_rows(table, BIAXIAL_HEADER)? {
         let state = BiaxialState {
-            stretch1: values[0],
-            stretch2: values[1],
-            nominal_stress1_mpa: values[2],
-            nominal_stress2_mpa: values[3],
+            stretch1: l1,
+            stretch2: l2,
+            nominal_stress1_mpa: p1,
+            nominal_stress2_mpa: p2,
         };
         state
             .check()
-            .map_err(|m| DataError::new(source_name, format!("line {line_no}: {m}")))?;
+            .map_err(|m| table.error(format!("line {line_no}: {m}")))?;
         if state.stretch1 == 1.0 && state.stretch2 == 1.0 {
             continue;
         }
         states.push(state);
     }
     if states.len() < MIN_POINTS_PER_CURVE {
-        return Err(DataError::new(
-            source_name,
-            format!(
-                "too few states: {} deformed, expected at least {MIN_POINTS_PER_CURVE}",
-                states.len()
-            ),
-        ));
+        return Err(table.error(format!(
+            "too few states: {} deformed, expected at least {MIN_POINTS_PER_CURVE}",
+            states.len()
+        )));
     }
     Ok(states)
 }
@@ -400,7 +376,7 @@ pub struct DataError {
 }
 
 impl DataError {
-    fn new(source_name: &str, message: String) -> Self {
+    pub(crate) fn new(source_name: &str, message: String) -> Self {
         DataError {
             source_name: source_name.to_string(),
             message,
@@ -408,64 +384,37 @@ impl DataError {
     }
 }
 
-/// Reads a `stretch,nominal_stress_mpa` CSV (one header line, then two numeric columns).
-pub fn read_curve_csv(path: &Path, case: LoadCase) -> Result<Curve, DataError> {
-    let source = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| DataError::new(&source, format!("cannot read the file: {e}")))?;
-    parse_curve_csv(&text, &source, case)
+/// Reads a load case's CSV: `stretch,nominal_stress_mpa`, or a machine's export
+/// ([`crate::table`]: title lines, units row, `;` and decimal commas; [`crate::columns`]: which
+/// columns, in which units).
+pub fn read_curve_csv(
+    path: &Path,
+    case: LoadCase,
+    options: &ReadOptions,
+) -> Result<Curve, DataError> {
+    curve_of(&Table::read(path, options.table)?, case, options.specimen)
 }
 
-/// Parses CSV text; `source_name` is used in error messages.
-pub fn parse_curve_csv(text: &str, source_name: &str, case: LoadCase) -> Result<Curve, DataError> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty());
-    let Some((_, header)) = lines.next() else {
-        return Err(DataError::new(
-            source_name,
-            "empty file: expected a header `stretch,nominal_stress_mpa` then data rows".into(),
-        ));
-    };
-    let header_first = header.split(',').next().unwrap_or("").trim();
-    if header_first.parse::<f64>().is_ok() {
-        return Err(DataError::new(
-            source_name,
-            "line 1: expected a header `stretch,nominal_stress_mpa`, found numbers".into(),
-        ));
-    }
-    let mut rows = Vec::new();
-    for (index, line) in lines {
-        let line_no = index + 1;
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        if cells.len() != 2 {
-            return Err(DataError::new(source_name, format!(
-                "line {line_no}: expected 2 cells `stretch,nominal_stress_mpa`, found {} in `{line}`", cells.len()
-            )));
-        }
-        let parse = |cell: &str, what: &str| -> Result<f64, DataError> {
-            match cell.parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(DataError::new(
-                    source_name,
-                    format!("line {line_no}: {what} `{cell}` is not a finite number"),
-                )),
-            }
-        };
-        rows.push((
-            line_no,
-            parse(cells[0], "stretch")?,
-            parse(cells[1], "nominal stress")?,
-        ));
-    }
+/// Parses CSV text as [`read_curve_csv`]; `source_name` is used in error messages.
+pub fn parse_curve_csv(
+    text: &str,
+    source_name: &str,
+    case: LoadCase,
+    options: &ReadOptions,
+) -> Result<Curve, DataError> {
+    curve_of(
+        &Table::parse(text, source_name, options.table)?,
+        case,
+        options.specimen,
+    )
+}
+
+fn curve_of(table: &Table, case: LoadCase, specimen: Specimen) -> Result<Curve, DataError> {
+    let rows = curve_rows(table, specimen)?;
     if rows.is_empty() {
-        return Err(DataError::new(
-            source_name,
-            "no data rows after the header".into(),
-        ));
+        return Err(table.error("no data rows after the header".into()));
     }
-    build_curve(case, source_name, &rows, "line")
+    build_curve(case, &table.source, &rows, "line")
 }
 
 fn build_curve(
@@ -540,17 +489,19 @@ mod tests {
     #[test]
     fn biaxial_csv_reads_and_refuses_bad_rows_naming_the_line() {
         let good = format!("{BIAXIAL_HEADER}\n1,1,0,0\n1.2,1.1,0.3,0.2\n\n1.4,1.2,0.5,0.3\n");
-        let states = parse_biaxial_csv(&good, "g.csv").unwrap();
+        let states = parse_biaxial_csv(&good, "g.csv", &ReadOptions::default()).unwrap();
         assert_eq!(states.len(), 2, "the undeformed row is dropped");
         assert_eq!(states[1].nominal_stress2_mpa, 0.3);
         let bad = |text: &str, needle: &str| {
-            let e = parse_biaxial_csv(text, "b.csv").unwrap_err().to_string();
+            let e = parse_biaxial_csv(text, "b.csv", &ReadOptions::default())
+                .unwrap_err()
+                .to_string();
             assert!(e.starts_with("b.csv: ") && e.contains(needle), "{e}");
         };
         bad("", "empty file");
         bad(
             "1.2,1.1,0.3,0.2\n1.3,1.1,0.3,0.2\n",
-            "line 1: expected the header",
+            "line 1: expected a header",
         );
         bad(
             "lambda1,lambda2,p1,p2\n1.2,1.1,0.3,0.2\n",
@@ -559,19 +510,19 @@ mod tests {
         let h = BIAXIAL_HEADER;
         bad(
             &format!("{h}\n1.2,1.1,0.3,0.2\n1.3,1.1,0.4\n"),
-            "line 3: expected 4 cells",
+            "line 3: expected 4 cells as the header on line 1",
         );
         bad(
             &format!("{h}\n1.2,1.1,0.3,0.2\n1.3,x,0.4,0.1\n"),
-            "line 3: lambda2 `x` is not a number",
+            "line 3, column 2 `lambda2`: `x` is not a finite number",
         );
         bad(
             &format!("{h}\n1.2,1.1,NaN,0.2\n1.3,1.1,0.4,0.1\n"),
-            "line 2: nominal_stress1_mpa NaN is not a finite",
+            "line 2, column 3 `nominal_stress1_mpa`: `NaN` is not a finite",
         );
         bad(
             &format!("{h}\n1.2,1.1,0.3,inf\n1.3,1.1,0.4,0.1\n"),
-            "line 2: nominal_stress2_mpa inf is not a finite",
+            "line 2, column 4 `nominal_stress2_mpa`: `inf` is not a finite",
         );
         bad(
             &format!("{h}\n1.2,-1.1,0.3,0.2\n1.3,1.1,0.4,0.1\n"),

@@ -12,6 +12,7 @@
 
 use crate::data::{BiaxialState, Curve, DataGroup, LoadCase};
 use crate::gradient::Kinematics;
+use crate::identifiability::Identifiability;
 use crate::lsq::{self, LsqError};
 use crate::models::Model;
 use crate::residuals::PointSet;
@@ -97,6 +98,8 @@ pub struct Fit {
     pub stability: Vec<StabilityRange>,
     /// False if Levenberg-Marquardt hit its iteration cap.
     pub converged: bool,
+    /// Whether the data identify the parameters; a fit they do not is not ranked.
+    pub identifiability: Identifiability,
 }
 
 impl Fit {
@@ -260,7 +263,7 @@ impl<'a> FitData<'a> {
     }
 
     /// The groups present, in [`FitData::points`] order.
-    fn groups(&self) -> Vec<DataGroup> {
+    pub fn groups(&self) -> Vec<DataGroup> {
         let mut groups: Vec<DataGroup> = self
             .curves
             .iter()
@@ -503,6 +506,12 @@ fn fit_at(
             .collect(),
         None => vec![None; n],
     };
+    let identifiability = Identifiability::new(
+        &model.param_names(),
+        &params,
+        &stderr,
+        lsq::scaled_condition_number(&jac),
+    );
     let (rms_mpa, cases) = group_stats(model, &params, data);
     let max_stretch = data.max_stretch();
     let stability = LoadCase::ALL
@@ -520,6 +529,7 @@ fn fit_at(
         objective,
         stability,
         converged,
+        identifiability,
     })
 }
 
@@ -563,7 +573,8 @@ pub fn evaluate_data(model: &Model, params: &[f64], data: FitData) -> (f64, Vec<
     group_stats(model, params, &data)
 }
 
-/// Fits several models; successful fits sorted by AIC (best first), failures listed apart.
+/// Fits several models; successful fits sorted by AIC (best first), those whose parameters the
+/// data do not identify after them (unranked, [`crate::identifiability`]), failures apart.
 pub fn fit_ranked(
     models: &[Model],
     curves: &[Curve],
@@ -601,7 +612,10 @@ pub fn fit_ranked_data(
             Err(e) => failures.push((model.clone(), e)),
         }
     }
-    fits.sort_by(|a, b| a.aic.total_cmp(&b.aic));
+    fits.sort_by(|a, b| {
+        let loose = |f: &Fit| !f.identifiability.identifiable();
+        loose(a).cmp(&loose(b)).then(a.aic.total_cmp(&b.aic))
+    });
     (fits, failures)
 }
 

@@ -27,13 +27,17 @@
 
 #![forbid(unsafe_code)]
 
+pub mod columns;
 pub mod data;
+pub mod fe_cards;
 pub mod field_layout;
 pub mod field_route;
 pub mod field_stress;
 pub mod fit;
 pub mod gradient;
 pub mod grip_forces;
+pub mod identifiability;
+pub mod initial_modulus;
 pub mod journal;
 pub mod kinematics;
 /// The law lives in its own crate (`material`), shared with the rig; re-exported here.
@@ -46,11 +50,13 @@ pub mod plot;
 #[cfg(feature = "process")]
 pub mod process;
 pub mod report;
+pub mod residual_plot;
 pub mod residuals;
 pub mod route;
 pub mod section_cut;
 pub mod stability;
 pub mod subsample;
+pub mod table;
 pub mod tapered_ramp;
 pub mod vfm;
 pub mod virtual_work;

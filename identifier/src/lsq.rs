@@ -88,8 +88,9 @@ fn solve_by_svd(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>, LsqE
     ))
 }
 
-/// Covariance (JᵀJ)⁻¹ by SVD; `None` when JᵀJ is numerically singular.
-pub fn inverse_normal_matrix(jacobian: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+/// The Jacobian with each column scaled to unit norm (the parameters' units out of the way)
+/// and the scales; `None` when a column is zero or not finite.
+fn column_scaled(jacobian: &DMatrix<f64>) -> Option<(DMatrix<f64>, Vec<f64>)> {
     let n = jacobian.ncols();
     let scales: Vec<f64> = (0..n).map(|j| jacobian.column(j).norm()).collect();
     if scales.iter().any(|&s| s == 0.0 || !s.is_finite()) {
@@ -99,6 +100,29 @@ pub fn inverse_normal_matrix(jacobian: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     for (j, &s) in scales.iter().enumerate() {
         scaled.column_mut(j).scale_mut(1.0 / s);
     }
+    Some((scaled, scales))
+}
+
+/// Condition number (largest over smallest singular value) of the column-scaled Jacobian:
+/// how nearly the parameters' effects on the residuals are dependent, whatever their units;
+/// infinite when a parameter has no effect.
+pub fn scaled_condition_number(jacobian: &DMatrix<f64>) -> f64 {
+    let Some((scaled, _)) = column_scaled(jacobian) else {
+        return f64::INFINITY;
+    };
+    let values = scaled.singular_values();
+    let (max, min) = (values.max(), values.min());
+    if min > 0.0 {
+        max / min
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Covariance (JᵀJ)⁻¹ by SVD; `None` when JᵀJ is numerically singular.
+pub fn inverse_normal_matrix(jacobian: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+    let n = jacobian.ncols();
+    let (scaled, scales) = column_scaled(jacobian)?;
     let svd = scaled.svd(false, true);
     let s_max = svd.singular_values.max();
     if svd.singular_values.iter().any(|&s| s <= 1e-12 * s_max) {

@@ -1,7 +1,11 @@
 //! JSON form of fits: `{"model", "params", "stderr", "rms_mpa", "rms_by_case_mpa", "r2",
-//! "aic", "stable_up_to", "unstable_from", "converged"}`; non-finite numbers become null.
+//! "aic", "stable_up_to", "unstable_from", "converged", "initial_shear_modulus_mpa",
+//! "identifiable", "condition_number", "warning", "fe_cards": {"abaqus", "ansys"}}`;
+//! non-finite numbers become null.
 
+use crate::fe_cards::fe_cards;
 use crate::fit::Fit;
+use crate::initial_modulus::initial_shear_modulus_mpa;
 use serde_json::{json, Map, Value};
 
 fn finite(v: f64) -> Value {
@@ -26,6 +30,8 @@ pub fn fit_json(fit: &Fit) -> Value {
         r2.insert(c.case.name().into(), finite(c.r2));
         rms.insert(c.case.name().into(), finite(c.rms_mpa));
     }
+    let mu0 = initial_shear_modulus_mpa(&fit.model, &fit.params);
+    let cards = fe_cards(fit, mu0);
     let mut stable = Map::new();
     let mut unstable = Map::new();
     for s in &fit.stability {
@@ -46,5 +52,10 @@ pub fn fit_json(fit: &Fit) -> Value {
         "stable_up_to": stable,
         "unstable_from": unstable,
         "converged": fit.converged,
+        "initial_shear_modulus_mpa": mu0.map_or(Value::Null, finite),
+        "identifiable": fit.identifiability.identifiable(),
+        "condition_number": finite(fit.identifiability.condition_number),
+        "warning": fit.identifiability.warning(),
+        "fe_cards": {"abaqus": cards.abaqus, "ansys": cards.ansys},
     })
 }

@@ -6,7 +6,8 @@ use identifier::lsq::LsqError;
 use identifier::models::Model;
 
 fn parse(text: &str) -> Result<Curve, String> {
-    parse_curve_csv(text, "test.csv", LoadCase::Uniaxial).map_err(|e| e.to_string())
+    parse_curve_csv(text, "test.csv", LoadCase::Uniaxial, &Default::default())
+        .map_err(|e| e.to_string())
 }
 
 #[test]

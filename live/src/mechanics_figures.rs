@@ -38,7 +38,7 @@ fn column(names: &[&str], name: &str, what: &str) -> anyhow::Result<usize> {
         .ok_or_else(|| anyhow::anyhow!("{what} has no column {name}"))
 }
 
-/// Each actuator's force (kN, as `rig.csv` logs it) against time (s): one series per
+/// Each actuator's force (N, as `rig.csv` logs it) against time (s): one series per
 /// actuator that carried a load ([`IDLE_FRACTION`]).
 pub fn actuator_forces(rig_csv: &str) -> anyhow::Result<Vec<Series>> {
     let (names, lines) = header(rig_csv, "rig.csv")?;
@@ -46,7 +46,7 @@ pub fn actuator_forces(rig_csv: &str) -> anyhow::Result<Vec<Series>> {
     let time = column("t_s")?;
     let actuators = rig::ids::ActuatorId::ALL
         .iter()
-        .map(|id| Ok((id.name(), column(&format!("{}_force_kn", id.name()))?)))
+        .map(|id| Ok((id.name(), column(&format!("{}_force_n", id.name()))?)))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let mut series: Vec<Series> = actuators
         .iter()
@@ -62,8 +62,8 @@ pub fn actuator_forces(rig_csv: &str) -> anyhow::Result<Vec<Series>> {
         // A row cut by a kill (the log's last) lacks cells: it is left out.
         let Some(t_s) = number(time) else { continue };
         for (s, (_, k)) in series.iter_mut().zip(&actuators) {
-            if let Some(force_kn) = number(*k).filter(|f| f.is_finite()) {
-                s.points.push((t_s, force_kn));
+            if let Some(force_n) = number(*k).filter(|f| f.is_finite()) {
+                s.points.push((t_s, force_n));
             }
         }
     }
@@ -85,7 +85,7 @@ pub fn forces_png(rig_csv: &Path, path: &Path) -> anyhow::Result<bool> {
     if series.is_empty() {
         return Ok(false);
     }
-    chart(path, "actuator forces", "time (s)", "force (kN)", &series)?;
+    chart(path, "actuator forces", "time (s)", "force (N)", &series)?;
     Ok(true)
 }
 
@@ -193,7 +193,7 @@ mod tests {
     fn each_actuators_force_is_read_against_time_and_idle_ones_left_out() {
         let mut header = String::from("t_s,program");
         for id in rig::ids::ActuatorId::ALL {
-            header.push_str(&format!(",{}_force_kn", id.name()));
+            header.push_str(&format!(",{}_force_n", id.name()));
         }
         let row = |t: f64, x: f64| {
             let mut r = format!("{t},1");

@@ -10,13 +10,13 @@ pub fn csv_header() -> String {
     let mut h = String::from("t_s,program,hydraulics_on,limits_tripped");
     for id in ActuatorId::ALL {
         let n = id.name();
-        for field in ["position_mm", "command", "error", "force_kn", "valve"] {
+        for field in ["position_mm", "command", "error", "force_n", "valve"] {
             let _ = write!(h, ",{n}_{field}");
         }
     }
     for axis in Axis::ALL {
         let n = axis.name();
-        let _ = write!(h, ",{n}_centre_mm,{n}_elongation_mm,{n}_force_kn");
+        let _ = write!(h, ",{n}_centre_mm,{n}_elongation_mm,{n}_force_n");
     }
     h.push_str(",stretch_x,stretch_y,rotation_deg,centre_x_mm,centre_y_mm,broken");
     // Who drives the X and Y set-points: displacement (programs, campaigns), strain (the strain
@@ -55,14 +55,20 @@ pub fn write_csv_row_with(s: &RigSnapshot, control: &ControlColumns, out: &mut S
         let _ = write!(
             out,
             ",{:.6},{:.6},{:.6},{:.6},{:.6}",
-            a.position_mm, a.command, a.error, a.force_kn, a.valve
+            a.position_mm,
+            a.command,
+            a.error,
+            a.force_kn * 1e3,
+            a.valve
         );
     }
     for x in &s.axes {
         let _ = write!(
             out,
             ",{:.6},{:.6},{:.6}",
-            x.centre_mm, x.elongation_mm, x.force_kn
+            x.centre_mm,
+            x.elongation_mm,
+            x.force_kn * 1e3
         );
     }
     let k = &s.specimen;

@@ -1,21 +1,35 @@
 //! `dicstream identify`: offline identification of hyperelastic potentials from CSV load cases
 //! (`stretch,nominal_stress_mpa`) and general biaxial states (`--biaxial-general`:
 //! `lambda1,lambda2,nominal_stress1_mpa,nominal_stress2_mpa`, both stresses fitted at once),
-//! ranked by AIC; table, JSON, and optional PNG plots (of the canonical curves).
+//! ranked by AIC; table, JSON, and optional PNG plots (of the canonical curves). A file may be
+//! a test machine's export as it comes (title lines, a units row, `;` and decimal commas, a
+//! force and an extension with the specimen's section and gauge length: `identifier::table`,
+//! `identifier::columns`).
 //!
 //! Above `--max-fit-points` the fit runs on a load-path-preserving subsample, said on stderr and
 //! in the JSON. When stderr is a terminal, one progress line per model (model, start k/n,
 //! elapsed) is drawn there; never on stdout, which holds the JSON alone with `--json`.
+//!
+//! The report gives each fit's initial shear modulus, its Abaqus and Ansys cards (in the JSON;
+//! as files with `--cards`), and says on stderr (and leaves unranked: `-`, `"rank": null`) a
+//! fit whose parameters the data do not identify (`identifier::identifiability`).
 
 use anyhow::{bail, Context};
-use identifier::data::{read_biaxial_csv, read_curve_csv, BiaxialState, Curve, LoadCase};
+use identifier::columns::Specimen;
+use identifier::data::{
+    read_biaxial_csv, read_curve_csv, BiaxialState, Curve, LoadCase, ReadOptions,
+};
+use identifier::fe_cards::write_cards;
 use identifier::fit::{
     evaluate_data, fit_ranked_data, Fit, FitData, FitError, FitOptions, FitStage, ResidualKind,
 };
+use identifier::initial_modulus::initial_shear_modulus_mpa;
 use identifier::models::{parse_model_list, Model};
 use identifier::report::fit_json;
+use identifier::residual_plot::write_residual_plot;
 use identifier::route::{paper_route, RouteResult};
 use identifier::subsample::{subsample_data, Subsample, DEFAULT_MAX_FIT_POINTS};
+use identifier::table::TableOptions;
 use serde_json::{json, Value};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -55,14 +69,32 @@ pub struct IdentifyArgs {
     /// Print JSON instead of the ranked table.
     #[arg(long)]
     pub json: bool,
-    /// Write PNG plots (data and fitted curves, f(I1) and g(I2)) into this folder.
+    /// Write PNG plots (data and fitted curves, f(I1) and g(I2), the best fit's residuals)
+    /// into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// Write each fit's FE coefficient cards into this folder: `abaqus_<model>.inp`
+    /// (`*HYPERELASTIC`) and `ansys_<model>.mac` (`TB,HYPER`), for the models the codes have.
+    #[arg(long, value_name = "DIR")]
+    pub cards: Option<PathBuf>,
     /// Largest number of points fitted (all load cases together); above it the fit runs on a
     /// deterministic subsample keeping each curve's ends and shape (said on stderr and in the
     /// JSON; RMS and R² are still over every point).
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_FIT_POINTS as u64, value_parser = clap::value_parser!(u64).range(2..))]
     pub max_fit_points: u64,
+    /// Lines at the top of each data file skipped before its header (a machine export's title
+    /// lines; a line whose cell count differs from the header's that follows is skipped
+    /// anyway).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub skip_lines: usize,
+    /// Gauge length L0 (mm) of a load case's file that logs an extension (`Extension (mm)`)
+    /// instead of a stretch or a strain: λ = 1 + Δl / L0.
+    #[arg(long, value_name = "MM")]
+    pub gauge_length_mm: Option<f64>,
+    /// Reference (undeformed) section A0 (mm²) of a load case's file that logs a force
+    /// (`Load (kN)`) instead of a nominal stress: P = F / A0.
+    #[arg(long, value_name = "MM2")]
+    pub section_mm2: Option<f64>,
     /// Threads sharing the points of each fit evaluation; the results do not depend on it.
     /// Default 1: on a shared two-core machine more threads (spawned per evaluation) measured
     /// slower, not faster.
@@ -94,6 +126,11 @@ pub fn run_with(
         states: &states,
     };
     let outcome = fit(&args, all, err, progress)?;
+    for fit in &outcome.fits {
+        if let Some(w) = fit.identifiability.warning() {
+            writeln!(err, "{}: {w}", fit.model)?;
+        }
+    }
     if args.json {
         write_json(out, &outcome)?;
     } else {
@@ -122,6 +159,18 @@ pub fn run_with(
         for path in written {
             writeln!(err, "wrote {}", path.display())?;
         }
+        if let Some(best) = outcome.fits.first() {
+            let path = dir.join("residuals.png");
+            write_residual_plot(&path, all, best)
+                .with_context(|| format!("writing {}", path.display()))?;
+            writeln!(err, "wrote {}", path.display())?;
+        }
+    }
+    if let Some(dir) = &args.cards {
+        let written = write_cards(dir, &outcome.fits)?;
+        for path in written {
+            writeln!(err, "wrote {}", path.display())?;
+        }
     }
     if outcome.fits.is_empty() {
         bail!("no model could be fitted");
@@ -131,6 +180,23 @@ pub fn run_with(
 
 /// The load cases' curves and the general biaxial states the arguments name; at least one.
 fn read_data(args: &IdentifyArgs) -> anyhow::Result<(Vec<Curve>, Vec<BiaxialState>)> {
+    for (value, flag) in [
+        (args.gauge_length_mm, "--gauge-length-mm"),
+        (args.section_mm2, "--section-mm2"),
+    ] {
+        if value.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
+            bail!("{flag} must be a positive number");
+        }
+    }
+    let options = ReadOptions {
+        table: TableOptions {
+            skip_lines: args.skip_lines,
+        },
+        specimen: Specimen {
+            gauge_length_mm: args.gauge_length_mm,
+            section_mm2: args.section_mm2,
+        },
+    };
     let mut curves: Vec<Curve> = Vec::new();
     for (path, case) in [
         (&args.uniaxial, LoadCase::Uniaxial),
@@ -138,12 +204,14 @@ fn read_data(args: &IdentifyArgs) -> anyhow::Result<(Vec<Curve>, Vec<BiaxialStat
         (&args.pure_shear, LoadCase::PureShear),
     ] {
         if let Some(path) = path {
-            curves
-                .push(read_curve_csv(path, case).with_context(|| format!("reading {case} data"))?);
+            curves.push(
+                read_curve_csv(path, case, &options)
+                    .with_context(|| format!("reading {case} data"))?,
+            );
         }
     }
     let states: Vec<BiaxialState> = match &args.biaxial_general {
-        Some(path) => read_biaxial_csv(path).context("reading general biaxial data")?,
+        Some(path) => read_biaxial_csv(path, &options).context("reading general biaxial data")?,
         None => Vec::new(),
     };
     if curves.is_empty() && states.is_empty() {
@@ -220,7 +288,22 @@ fn fit(
 
 /// `--json`: the fits, the failures, the paper's route and the subsample as one object.
 fn write_json(out: &mut dyn Write, outcome: &Outcome) -> anyhow::Result<()> {
-    let fits_json: Vec<Value> = outcome.fits.iter().map(fit_json).collect();
+    let mut rank = 0;
+    let fits_json: Vec<Value> = outcome
+        .fits
+        .iter()
+        .map(|fit| {
+            let mut value = fit_json(fit);
+            value["rank"] = match fit.identifiability.identifiable() {
+                true => {
+                    rank += 1;
+                    json!(rank)
+                }
+                false => Value::Null,
+            };
+            value
+        })
+        .collect();
     let failures_json: Vec<Value> = outcome
         .failures
         .iter()
@@ -338,8 +421,8 @@ fn print_table(
     }
     write!(
         out,
-        "{:>2} {:<22} {:>9} {:>9}",
-        "#", "model", "aic", "rms_mpa"
+        "{:>2} {:<22} {:>9} {:>9} {:>9}",
+        "#", "model", "aic", "rms_mpa", "mu0_mpa"
     )?;
     for c in &cases {
         write!(out, " {:>14}", format!("r2_{c}"))?;
@@ -348,14 +431,25 @@ fn print_table(
         out,
         "  stable_up_to (uniaxial/equibiaxial/pure_shear)  params ± std"
     )?;
-    for (rank, fit) in fits.iter().enumerate() {
+    let mut rank = 0;
+    for fit in fits {
+        let shown_rank = match fit.identifiability.identifiable() {
+            true => {
+                rank += 1;
+                rank.to_string()
+            }
+            false => "-".to_string(),
+        };
+        let mu0 = initial_shear_modulus_mpa(&fit.model, &fit.params)
+            .map_or("?".to_string(), |m| format!("{m:.4}"));
         write!(
             out,
-            "{:>2} {:<22} {:>9.1} {:>9.4}",
-            rank + 1,
+            "{:>2} {:<22} {:>9.1} {:>9.4} {:>9}",
+            shown_rank,
             fit.model.name(),
             fit.aic,
-            fit.rms_mpa
+            fit.rms_mpa,
+            mu0
         )?;
         for c in &fit.cases {
             write!(out, " {:>14.4}", c.r2)?;
@@ -382,7 +476,8 @@ fn print_table(
     }
     writeln!(
         out,
-        "(`!`: Drucker stability lost beyond that stretch; checked up to the largest data stretch)"
+        "(`!`: Drucker stability lost beyond that stretch; checked up to the largest data stretch; \
+         `-`: parameters not identifiable from these data, not ranked; mu0: initial shear modulus)"
     )
 }
 
@@ -427,7 +522,11 @@ mod tests {
                 residual: ResidualArg::Absolute,
                 json,
                 plot: None,
+                cards: None,
                 max_fit_points,
+                skip_lines: 0,
+                gauge_length_mm: None,
+                section_mm2: None,
                 threads: 2,
             }
         }
@@ -583,7 +682,11 @@ mod tests {
             residual: ResidualArg::Absolute,
             json: true,
             plot: None,
+            cards: None,
             max_fit_points: DEFAULT_MAX_FIT_POINTS as u64,
+            skip_lines: 0,
+            gauge_length_mm: None,
+            section_mm2: None,
             threads: 1,
         }
     }
@@ -593,8 +696,25 @@ mod tests {
         let (_data, path) = general_csv("general");
         let (out, err) = run_captured(general_args(path.clone(), "ldr:2,2,mooney"), false);
         let value: Value = serde_json::from_str(&out).expect("stdout is one JSON document");
-        let best = &value["fits"][0];
+        let fits = value["fits"].as_array().unwrap();
+        let best = fits
+            .iter()
+            .min_by(|a, b| {
+                a["aic"]
+                    .as_f64()
+                    .unwrap()
+                    .total_cmp(&b["aic"].as_f64().unwrap())
+            })
+            .unwrap();
         assert_eq!(best["model"], "lambert-diani-rey:2,2", "{out}");
+        // Up to λ = 1.8 (I1 − 3 < 1.6) the quadratic term of ln f (true a2 = 1.4e-3) is not
+        // told from zero: the fit says so and is not ranked.
+        let warning = best["warning"].as_str().unwrap_or_default();
+        assert!(warning.contains("σ ≥ |value| for a2"), "{warning}");
+        assert!(
+            best["rank"].is_null()
+                && err.contains("lambert-diani-rey:2,2: parameters not identifiable")
+        );
         assert!(
             best["rms_by_case_mpa"]["biaxial_general"].is_number(),
             "{out}"
@@ -636,12 +756,12 @@ mod tests {
         for (text, needle) in [
             (
                 format!("{h}\n1.2,1.1,0.3,0.2\n1.3,1.1,NaN,0.2\n"),
-                "line 3: nominal_stress1_mpa NaN is not a finite number",
+                "line 3, column 3 `nominal_stress1_mpa`: `NaN` is not a finite number",
             ),
             (format!("{h}\n1.2,1.1,0.3\n"), "line 2: expected 4 cells"),
             (
                 "1.2,1.1,0.3,0.2\n1.3,1.2,0.4,0.3\n".to_string(),
-                "line 1: expected the header",
+                "line 1: expected a header",
             ),
             (
                 format!("{h}\n1.2,0,0.3,0.2\n1.3,1.2,0.4,0.3\n"),
@@ -674,6 +794,61 @@ mod tests {
             run_with(missing, &mut out, &mut err, false).unwrap_err()
         );
         assert!(message.contains("cannot read the file"), "{message}");
+    }
+
+    #[test]
+    fn ogden3_on_uniaxial_data_alone_is_warned_and_not_ranked_and_cards_are_written() {
+        let data = Data::new("loose", 60);
+        let mut args = data.args(true, 1_000);
+        args.biaxial = None;
+        args.model = "ogden:3,mooney".into();
+        args.cards = Some(data.0.join("cards"));
+        args.plot = Some(data.0.join("plots"));
+        let (out, err) = run_captured(args, false);
+        let residuals = data.0.join("plots/residuals.png");
+        assert!(
+            err.contains(&format!("wrote {}", residuals.display())),
+            "{err}"
+        );
+        assert!(image::open(&residuals).is_ok(), "residuals.png is a PNG");
+        let value: Value = serde_json::from_str(&out).expect("stdout is one JSON document");
+        let fits = value["fits"].as_array().unwrap();
+        eprintln!("{err}");
+        let ogden = fits.iter().find(|f| f["model"] == "ogden:3").unwrap();
+        let mooney = fits.iter().find(|f| f["model"] == "mooney").unwrap();
+        assert_eq!(ogden["identifiable"], false, "{ogden}");
+        assert!(ogden["rank"].is_null());
+        assert!(ogden["warning"]
+            .as_str()
+            .unwrap()
+            .contains("not identifiable"));
+        assert_eq!(mooney["identifiable"], true, "{mooney}");
+        assert_eq!(mooney["rank"], 1);
+        assert_eq!(fits[0]["model"], "mooney", "the identifiable fit first");
+        assert!(
+            err.contains("ogden:3: parameters not identifiable from these data"),
+            "{err}"
+        );
+        // μ0 = 2 (C10 + C01) of the fitted Mooney law, near the true 0.44 MPa.
+        let mu0 = mooney["initial_shear_modulus_mpa"].as_f64().unwrap();
+        let (c10, c01) = (
+            mooney["params"]["C10"].as_f64().unwrap(),
+            mooney["params"]["C01"].as_f64().unwrap(),
+        );
+        assert!(
+            (mu0 - 2.0 * (c10 + c01)).abs() < 1e-12 && (mu0 - 0.44).abs() < 0.05,
+            "{mu0}"
+        );
+        let card = mooney["fe_cards"]["abaqus"].as_str().unwrap();
+        assert!(card.contains("*HYPERELASTIC, MOONEY-RIVLIN\n"), "{card}");
+        let written = std::fs::read_to_string(data.0.join("cards/abaqus_mooney.inp")).unwrap();
+        assert_eq!(written, card);
+        let ansys = std::fs::read_to_string(data.0.join("cards/ansys_ogden_3.mac")).unwrap();
+        assert!(
+            ansys.contains("! WARNING: parameters not identifiable"),
+            "{ansys}"
+        );
+        assert!(ansys.contains("TB,HYPER,1,,3,OGDEN"), "{ansys}");
     }
 
     #[test]

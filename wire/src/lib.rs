@@ -13,6 +13,7 @@
 //! origin at the centre of the top-left pixel; u, v are Lagrangian displacements in pixels.
 
 pub mod clock;
+pub mod delimited;
 pub mod descriptors;
 pub mod exit;
 pub mod field;
@@ -38,6 +39,7 @@ pub mod specimen;
 pub mod stats;
 pub mod text;
 pub mod toml_hint;
+pub mod units;
 
 pub use clock::monotonic_ns;
 pub use field::{FieldHeader, FieldNode, GaugeStrain, GradientSource, NodeStatus, StrainMeasure};

@@ -14,7 +14,9 @@ pub fn treloar() -> Option<Vec<Curve>> {
     Some(
         files
             .iter()
-            .map(|(f, c)| read_curve_csv(&dir.join(f), *c).expect("Treloar CSV reads"))
+            .map(|(f, c)| {
+                read_curve_csv(&dir.join(f), *c, &Default::default()).expect("Treloar CSV reads")
+            })
             .collect(),
     )
 }

@@ -3,6 +3,7 @@
 //! the units; every value is converted to s, N and mm.
 
 use super::malformed::{excerpt, RowError};
+use wire::delimited::{parse_decimal, split_unit};
 
 use wire::names::Named;
 
@@ -42,63 +43,7 @@ pub enum CsvError {
     Spec(String),
 }
 
-/// Seconds, milliseconds or minutes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TimeUnit {
-    S,
-    Ms,
-    Min,
-}
-
-/// Newtons or kilonewtons.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ForceUnit {
-    Newton,
-    KiloNewton,
-}
-
-/// Millimetres, micrometres or metres.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LengthUnit {
-    Mm,
-    Um,
-    M,
-}
-
-wire::named!(TimeUnit, "time unit", { S => "s" | "sec", Ms => "ms", Min => "min" });
-
-impl TimeUnit {
-    pub fn to_s(self) -> f64 {
-        match self {
-            TimeUnit::S => 1.0,
-            TimeUnit::Ms => 1e-3,
-            TimeUnit::Min => 60.0,
-        }
-    }
-}
-
-wire::named!(ForceUnit, "force unit", { Newton => "N", KiloNewton => "kN" | "KN" });
-
-impl ForceUnit {
-    pub fn to_n(self) -> f64 {
-        match self {
-            ForceUnit::Newton => 1.0,
-            ForceUnit::KiloNewton => 1e3,
-        }
-    }
-}
-
-wire::named!(LengthUnit, "displacement unit", { Mm => "mm", Um => "um" | "µm", M => "m" });
-
-impl LengthUnit {
-    pub fn to_mm(self) -> f64 {
-        match self {
-            LengthUnit::Mm => 1.0,
-            LengthUnit::Um => 1e-3,
-            LengthUnit::M => 1e3,
-        }
-    }
-}
+pub use wire::units::{ForceUnit, LengthUnit, TimeUnit};
 
 /// One configured column: the name as in the header, without its unit.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -172,23 +117,6 @@ pub struct Layout {
     displacement: [Option<(usize, f64)>; 3],
     /// (cell index, configured name) of every followed column.
     names: Vec<(usize, String)>,
-}
-
-/// A header cell as (name, unit): `Fx (kN)`, `Fx [kN]` or `Fx` (quotes are the record
-/// reader's).
-fn split_unit(cell: &str) -> (String, Option<String>) {
-    let cell = cell.trim();
-    for (open, close) in [('(', ')'), ('[', ']')] {
-        if let Some(stripped) = cell.strip_suffix(close) {
-            if let Some(at) = stripped.rfind(open) {
-                return (
-                    stripped[..at].trim().to_string(),
-                    Some(stripped[at + 1..].trim().to_string()),
-                );
-            }
-        }
-    }
-    (cell.to_string(), None)
 }
 
 /// The unit factor of a column: from the header, the configuration, both (must agree).
@@ -307,9 +235,9 @@ impl Layout {
         }
         let value = |(at, f): (usize, f64)| -> Result<f64, RowError> {
             let cell = cells[at].as_ref();
-            match cell.trim().replace(',', ".").parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(v * f),
-                _ => Err(RowError::NotANumber {
+            match parse_decimal(cell) {
+                Some(v) => Ok(v * f),
+                None => Err(RowError::NotANumber {
                     column: self.name_of(at).to_string(),
                     cell: excerpt(cell.as_bytes()),
                 }),
@@ -369,13 +297,6 @@ mod tests {
     fn layout(header: &str, spec: &CsvColumns) -> Result<Layout, CsvError> {
         let mut reader = RecordReader::new(spec.delimiter);
         Layout::from_header(&reader.split(header.as_bytes()).unwrap(), header, spec)
-    }
-
-    #[test]
-    fn header_cells_give_name_and_unit() {
-        assert_eq!(split_unit(" Fx (kN) "), ("Fx".into(), Some("kN".into())));
-        assert_eq!(split_unit("Time [s]"), ("Time".into(), Some("s".into())));
-        assert_eq!(split_unit("Fx"), ("Fx".into(), None));
     }
 
     #[test]

@@ -12,7 +12,10 @@
 pub mod clock;
 pub mod columns;
 pub mod counts_file;
-pub mod delimiter;
+/// The delimiter a user names, shared with the identifier's data files (`wire::delimited`).
+pub mod delimiter {
+    pub use wire::delimited::Delimiter;
+}
 pub mod lines;
 pub mod malformed;
 #[cfg(feature = "process")]
