@@ -41,20 +41,27 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
     );
     assert!(field["error"].is_null(), "{field}");
     let counters = &field["counters"];
-    // The route keeps its first 12 loading frames (`DEFAULT_MAX_FRAMES`).
-    assert!(field["frames"].as_u64().unwrap() >= 5, "{field}");
+    // The frames kept stay spread over the loading (thinned at `DEFAULT_MAX_FRAMES`).
+    assert!(field["frames"].as_u64().unwrap() >= 10, "{field}");
     assert!(!field["fits"].as_array().unwrap().is_empty(), "{field}");
     assert_eq!(counters["without_forces"], 0, "{field}");
     assert_eq!(counters["without_gradients"], 0, "{field}");
-    // The states reached by the frames kept: beyond the noise, in both directions.
+    // Every virtual field of every kept frame holds: the nodes the correlator loses along
+    // the specimen's edge are borrowed from, the fillets' nodes are not refused as outliers.
+    let kept_now = counters["kept"].as_u64().unwrap() - counters["thinned"].as_u64().unwrap();
+    let dropped = counters["virtual_fields_dropped"].as_u64().unwrap();
+    assert!(dropped * 10 <= kept_now, "{field}");
+    // The states reached by the frames kept: the arms' near-uniaxial states to λ 1.4, the
+    // centre's equibiaxial ones.
     let reach = field["max_stretches"].as_array().unwrap();
-    assert!(reach[0].as_f64().unwrap() > 1.05, "{field}");
-    assert!(reach[1].as_f64().unwrap() > 1.01, "{field}");
-    // Measured, not yet within issue 25's 2 % (when written: 9 % equibiaxial up to 1.027,
-    // several hundred % uniaxial and pure shear up to 1.11, the kept frames' range being too
-    // small to tell the cubic terms apart): the errors are reported, finite.
+    assert!(reach[0].as_f64().unwrap() > 1.3, "{field}");
+    assert!(reach[1].as_f64().unwrap() > 1.05, "{field}");
+    // The best law's nominal stresses against the truth over the stretches reached. Issue
+    // 25's target is 2 %; measured when written, two runs: uniaxial 0.9-1.4 %, equibiaxial
+    // 1.5-1.9 %, pure shear 1.7-2.2 % (camera noise moves them from run to run). Asserted
+    // with that spread's margin.
     for case in ["uniaxial", "equibiaxial", "pure_shear"] {
         let error = field[case]["max_relative_error"].as_f64().unwrap();
-        assert!(error.is_finite(), "{case}: {field}");
+        assert!(error < 0.035, "{case}: {field}");
     }
 }
