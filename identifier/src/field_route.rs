@@ -12,6 +12,10 @@
 //! sample, one where a grip pulls nothing (a strip's test, not the cruciform's), a virtual field
 //! with a hole or a node whose gradient is inverted (dropped for that frame, counted).
 //!
+//! A test's frames form a sequence (`set_sequence`, the frames' `sequence_id`): the loading
+//! level of a new test is measured from its own start, and the frames of every cruciform test
+//! are fitted together (more states).
+//!
 //! Each kept frame's equations are compiled when it is kept (`virtual_work::Equations`); a fit
 //! ([`FieldRoute::fit_job`]) owns their concatenation and may run on another thread.
 
@@ -48,6 +52,8 @@ pub struct FieldFrame {
     pub fields: Vec<(RampQuadrature, usize)>,
     /// Its loading level when kept.
     pub level: f64,
+    /// The frame sequence (one test) it belongs to.
+    pub sequence: u32,
     /// Its fields' equations, compiled.
     pub equations: Equations,
 }
@@ -112,6 +118,8 @@ pub struct FieldRoute {
     pub counters: FieldCounters,
     /// Why the last virtual field dropped was (its frame and the reason).
     pub last_dropped: Option<String>,
+    /// The frame sequence (one test) of the frames offered now.
+    sequence: u32,
 }
 
 impl FieldRoute {
@@ -123,6 +131,7 @@ impl FieldRoute {
             frames: vec![],
             counters: FieldCounters::default(),
             last_dropped: None,
+            sequence: 0,
         }
     }
 
@@ -171,9 +180,11 @@ impl FieldRoute {
         let Some(forces_n) = forces_n else {
             return Ok(FrameOutcome::WithoutForces);
         };
-        // Every arm of a cruciform under test pulls; a grip at rest is another specimen's
-        // test (the uniaxial strip's), whose field this layout does not describe.
-        if forces_n.iter().any(|&f| f <= 0.0) {
+        // Every arm of a cruciform under test pulls; a grip at rest (its force within
+        // `REST_FRACTION` of the largest grip force: noise) is another specimen's test (the
+        // uniaxial strip's), whose field this layout does not describe.
+        let largest = forces_n.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
+        if forces_n.iter().any(|&f| f <= REST_FRACTION * largest) {
             return Ok(FrameOutcome::GripsUnloaded);
         }
         if self.frames.len() >= self.config.max_frames.max(2) {
@@ -216,14 +227,28 @@ impl FieldRoute {
             forces_n,
             fields,
             level,
+            sequence: self.sequence,
             equations,
         });
         Ok(FrameOutcome::Kept)
     }
 
-    /// Grown by the increment since the last kept frame (from rest for the first).
+    /// The frames offered from now on belong to frame sequence `sequence` (a test; a new
+    /// one starts from rest: its loading is measured from its own first frame).
+    pub fn set_sequence(&mut self, sequence: u32) {
+        self.sequence = sequence;
+    }
+
+    /// Grown by the increment since the last kept frame of its sequence (from rest for the
+    /// first).
     fn is_new_level(&self, level: f64) -> bool {
-        level >= self.frames.last().map_or(0.0, |last| last.level) + self.increment
+        let last = self
+            .frames
+            .iter()
+            .rev()
+            .find(|f| f.sequence == self.sequence)
+            .map_or(0.0, |last| last.level);
+        level >= last + self.increment
     }
 
     /// Drops every other kept frame (the first stays) and doubles the level increment.
@@ -294,6 +319,9 @@ impl FieldRoute {
         range
     }
 }
+
+/// A grip whose force is at most this fraction of the largest grip force is at rest.
+pub const REST_FRACTION: f64 = 0.02;
 
 /// A fit of all kept frames: the equations and the models.
 #[derive(Clone, Debug)]
@@ -484,6 +512,34 @@ mod tests {
         // A cut and a central ramp per arm.
         assert_eq!(route.frames()[0].fields.len(), 8);
         assert!(route.fit().is_none(), "one frame is not a test");
+    }
+
+    /// A strip's test (two grips at rest, but for noise) is not kept; the next test (a new
+    /// sequence) is measured from its own start, not from the strip's level.
+    #[test]
+    fn a_new_test_starts_from_rest_and_grips_at_rest_are_told() {
+        let mut route = FieldRoute::new(config());
+        let g = |s: f64| Some(grid([[s, 0.0], [0.0, s]]));
+        let strip = Some([500.0, 480.0, 3.0, 1.0]);
+        assert_eq!(
+            route.push(1, g(1.3), strip, 0.3, &everywhere),
+            Ok(FrameOutcome::GripsUnloaded)
+        );
+        let forces = Some([100.0; 4]);
+        assert_eq!(
+            route.push(2, g(1.3), forces, 0.3, &everywhere),
+            Ok(FrameOutcome::Kept)
+        );
+        assert_eq!(
+            route.push(3, g(1.05), forces, 0.05, &everywhere),
+            Ok(FrameOutcome::NotLoading)
+        );
+        route.set_sequence(1);
+        assert_eq!(
+            route.push(4, g(1.05), forces, 0.05, &everywhere),
+            Ok(FrameOutcome::Kept)
+        );
+        assert_eq!(route.frames()[1].sequence, 1);
     }
 
     /// A long loading at the frame limit keeps its frames spread from the first to the

@@ -179,6 +179,7 @@ impl FieldShell {
         let level = grid.as_ref().map_or(0.0, mean_stretching);
         let (mesh, elements) = (&self.mesh, &self.elements);
         let material = |x: [f64; 2]| elements.locate(mesh, x).is_some();
+        self.route.set_sequence(header.sequence_id);
         match self
             .route
             .push(header.frame_id, grid, forces, level, &material)
