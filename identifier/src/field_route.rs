@@ -293,6 +293,7 @@ impl FieldRoute {
             frames: self.frames.len(),
             max_stretches: self.max_stretches(),
             last_frame_id: self.frames.last().map(|f| f.frame_id),
+            warm_starts: vec![],
         })
     }
 
@@ -332,6 +333,10 @@ pub struct FitJob {
     pub max_stretches: [f64; 2],
     /// The last kept frame.
     pub last_frame_id: Option<u64>,
+    /// Nonlinear models' starts from an earlier fit (a refit on line starts where the last
+    /// fit ended: a few iterations instead of a descent from the Mooney-Rivlin fit); a model
+    /// whose warm start fails is fitted again from the cold start.
+    pub warm_starts: Vec<(Model, Vec<f64>)>,
 }
 
 impl FitJob {
@@ -346,8 +351,16 @@ impl FitJob {
         };
         let mooney = fit_equations(&Model::Mooney, equations, &[0.0, 0.0]);
         for model in &self.models {
+            let warm = self
+                .warm_starts
+                .iter()
+                .find(|(m, _)| m == model)
+                .filter(|_| !model.linear_params().iter().all(|&l| l))
+                .and_then(|(_, start)| fit_equations(model, equations, start).ok());
             let result = if *model == Model::Mooney {
                 mooney.clone()
+            } else if let Some(fit) = warm {
+                Ok(fit)
             } else {
                 match start_for(model, mooney.as_ref().ok()) {
                     Some(start) => fit_equations(model, equations, &start),

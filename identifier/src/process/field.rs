@@ -219,7 +219,13 @@ impl FieldShell {
         }
         let due = self.last_fit.is_none_or(|t| t.elapsed() >= REFIT_INTERVAL);
         if self.running.is_none() && self.dirty && due {
-            if let Some(job) = self.route.fit_job() {
+            if let Some(mut job) = self.route.fit_job() {
+                job.warm_starts = self.fits.as_ref().map_or(vec![], |fits| {
+                    fits.fits
+                        .iter()
+                        .map(|f| (f.model.clone(), f.fit.params.clone()))
+                        .collect()
+                });
                 self.dirty = false;
                 self.last_fit = Some(Instant::now());
                 let frame_id = job.last_frame_id;
