@@ -108,6 +108,19 @@ pub fn start_run(run: &mut Run, name: &str, config: &Path, out: &Path, extra: &[
 #[allow(unused_imports)]
 pub use testkit::signal;
 
+/// Waits for the `run` child that [`start_run`] started and reads its `summary.json` from
+/// `out`: the run must have completed, passed (0) or with doubtful results (2: on a
+/// heterogeneous field the gauge route's acceptance fails, frames lost to a fault); with the
+/// run's stdout.
+pub fn completed_summary(run: &mut Run, out: &Path) -> (serde_json::Value, String) {
+    let (status, stdout, stderr) = run.child("run").wait();
+    assert!(
+        matches!(status.code(), Some(0 | 2)),
+        "{status:?}\n{stdout}\n{stderr}"
+    );
+    (summary(out), stdout)
+}
+
 pub fn summary(folder: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(folder.join("summary.json")).expect("summary.json");
     serde_json::from_str(&text).expect("summary.json is JSON")
