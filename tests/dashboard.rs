@@ -226,6 +226,7 @@ fn write_config(dir: &std::path::Path) -> PathBuf {
              [camera]\nwidth_px = 256\nheight_px = 256\nfps = 10.0\n\
              [correlator]\nthreads = 1\n\
              [rig]\npublish_hz = 100.0\nlog_hz = 20.0\n\
+             [specimen]\nmodel = \"homogeneous\"\n\
              [[rig.tests]]\nkind = \"uniaxial\"\nstretch = 1.5\nrate_per_s = 0.01\n",
             dir.join("results").display()
         ),

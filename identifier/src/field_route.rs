@@ -20,6 +20,7 @@
 //! ([`FieldRoute::fit_job`]) owns their concatenation and may run on another thread.
 
 use crate::field_layout::{place_fields, ArmLayout, LayoutError, PlacedField};
+use crate::identifiability::Identifiability;
 use crate::models::Model;
 use crate::section_cut::FieldGrid;
 use crate::tapered_ramp::RampQuadrature;
@@ -95,6 +96,16 @@ pub struct FieldFit {
     pub fit: VfmFit,
     /// m ln(RSS/m) + 2 k over the m force equations (as the gauge route's).
     pub aic: f64,
+    /// Whether the equations tell its parameters apart, by the gauge route's rule
+    /// ([`crate::identifiability`]): a fit that fails is listed after the others, unranked.
+    pub identifiability: Identifiability,
+}
+
+impl FieldFit {
+    /// Whether it takes part in the AIC ranking.
+    pub fn ranked(&self) -> bool {
+        self.identifiability.identifiable()
+    }
 }
 
 /// The fits of all models (best AIC first) and the models refused, with why.
@@ -378,16 +389,26 @@ impl FitJob {
                     let (m, k) = (fit.equations as f64, fit.params.len() as f64);
                     let rss = fit.rms_n.powi(2) * m;
                     let aic = m * (rss.max(f64::MIN_POSITIVE) / m).ln() + 2.0 * k;
+                    let sigma: Vec<Option<f64>> = fit.sigma.iter().map(|&s| Some(s)).collect();
+                    let identifiability = Identifiability::new(
+                        &model.param_names(),
+                        &fit.params,
+                        &sigma,
+                        fit.condition,
+                    );
                     out.fits.push(FieldFit {
                         model: model.clone(),
                         fit,
                         aic,
+                        identifiability,
                     });
                 }
                 Err(e) => out.refused.push((model.name(), refusal(&e))),
             }
         }
-        out.fits.sort_by(|a, b| a.aic.total_cmp(&b.aic));
+        // The identifiable fits by AIC, then the others (as the gauge route ranks).
+        out.fits
+            .sort_by(|a, b| b.ranked().cmp(&a.ranked()).then(a.aic.total_cmp(&b.aic)));
         out
     }
 }

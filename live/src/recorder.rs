@@ -8,7 +8,6 @@ use crate::origin_frames::OriginFrames;
 use crate::results::ResultsDir;
 use crate::truth::NodeErrors;
 use producer::specimen_states::SpecimenStates;
-use producer::View;
 use wire::files::{write_atomic, FileError, RowFile};
 use wire::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, RigState};
 
@@ -24,9 +23,9 @@ pub struct RecorderSettings {
     /// The camera's frames carry the ground truth (simulated): `frames.csv` has the truth
     /// columns. A real camera's has none: the columns are absent.
     pub truth: bool,
-    /// The simulated camera's scale (mm per px): how it films a finite-element specimen,
-    /// whose field is the truth node by node.
-    pub mm_per_px: f64,
+    /// How the simulated camera frames a finite-element specimen, whose field is the truth
+    /// node by node.
+    pub framing: producer::Framing,
 }
 
 pub struct Recorder {
@@ -145,8 +144,13 @@ impl Recorder {
         let Some([width, height]) = self.frame_size_px else {
             return Some(None);
         };
-        let view = View::centred(self.settings.mm_per_px, width, height);
-        let field = |id, grip_mm: &[f64; 4]| self.specimen.field(id, grip_mm, view).ok();
+        let framing = &self.settings.framing;
+        let field = |id, grip_mm: &[f64; 4]| {
+            let framed = self
+                .specimen
+                .framed_field(id, grip_mm, framing, [width, height]);
+            framed.ok()
+        };
         Some(
             field(origin_id, &origin.specimen_grip_mm)
                 .zip(field(current_id, &current.specimen_grip_mm)),

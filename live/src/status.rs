@@ -161,7 +161,10 @@ mod tests {
             fields_every: 10,
             vtk: false,
             truth: true,
-            mm_per_px: 0.015,
+            framing: producer::Framing {
+                mm_per_px: 0.25,
+                strip_mm_per_px: 0.12,
+            },
         };
         let mut recorder = Recorder::new(&results, settings, 0).unwrap();
         let mut rig = RigState {

@@ -77,6 +77,28 @@ impl View {
     }
 }
 
+/// How the simulated camera frames the specimen mounted, its centre at the image's centre:
+/// `mm_per_px` on a cruciform (and the homogeneous sheet), `strip_mm_per_px` on a specimen
+/// held by two grips (the uniaxial or plane-strain strip), for which a lab re-frames the
+/// camera: a strip 20 mm wide would cross a cruciform's view in a few ZOIs.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Framing {
+    pub mm_per_px: f64,
+    pub strip_mm_per_px: f64,
+}
+
+impl Framing {
+    /// The view of a specimen held by `grips` grips in a `width_px` × `height_px` image.
+    pub fn view(&self, grips: usize, width_px: u32, height_px: u32) -> View {
+        let mm_per_px = match grips {
+            2 => self.strip_mm_per_px,
+            _ => self.mm_per_px,
+        };
+        View::centred(mm_per_px, width_px, height_px)
+    }
+}
+
 /// The reference mesh and its element grid, built once per specimen and shared by every state.
 #[derive(Debug)]
 pub struct ReferenceMesh {

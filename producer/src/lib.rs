@@ -35,7 +35,7 @@ mod watch;
 
 pub use camera::{CameraModel, BIT_DEPTHS};
 pub use error::ProducerError;
-pub use field_motion::{FieldMotion, ReferenceMesh, View, BACKDROP};
+pub use field_motion::{FieldMotion, Framing, ReferenceMesh, View, BACKDROP};
 pub use image_io::{decode_into, read_image, read_shape, Image16, ImageShape};
 pub use image_out::{write_atomic, write_frame, ImageFormatOut};
 pub use motion::{Affine, Bulge, Chirp, Motion};
@@ -46,7 +46,7 @@ pub use replay::{list_images, Replay, IMAGE_EXTENSIONS};
 pub use rig_follow::{
     BeyondEnvelope, NextMotion, RigCamera, RigEnvelope, RigFollowConfig, RigFollower,
     RigKinematics, RigMotion, DEFAULT_MAX_OFFSET_MM, DEFAULT_MAX_ROTATION_DEG, DEFAULT_MAX_STRETCH,
-    DEFAULT_MM_PER_PX, RIG_SCENARIO_ID,
+    DEFAULT_MM_PER_PX, DEFAULT_STRIP_MM_PER_PX, RIG_SCENARIO_ID,
 };
 pub use scenario::{Scenario, ScenarioKind, SCENARIO_NAMES};
 pub use simulated::{

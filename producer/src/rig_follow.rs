@@ -19,7 +19,7 @@
 //! reason, and the shell skips and counts the frame instead of clamping.
 
 use crate::error::ProducerError;
-use crate::field_motion::{FieldMotion, View};
+use crate::field_motion::{FieldMotion, Framing};
 use crate::motion::{mul_mat, rotation, Affine, Motion};
 use crate::simulated::{motion_reach_px, SimulatedCamera, SimulatedConfig};
 use crate::source::{FrameDims, FrameInfo, FrameSource, Truth};
@@ -29,7 +29,10 @@ use wire::RigState;
 /// `FrameHeader::scenario_id` of rig-driven frames (beyond the [`crate::ScenarioKind`] ids).
 pub const RIG_SCENARIO_ID: u32 = 100;
 /// Default image scale, mm per px (a 1024 px camera sees 15 mm of the specimen).
-pub const DEFAULT_MM_PER_PX: f64 = 0.015;
+pub const DEFAULT_MM_PER_PX: f64 = 0.25;
+/// Image scale on a strip (a specimen held by two grips), mm per px: the 100 mm strip and
+/// its clamps across a 1024 px image, 20 mm = 167 px across.
+pub const DEFAULT_STRIP_MM_PER_PX: f64 = 0.12;
 /// Default largest stretch of the envelope, both axes.
 pub const DEFAULT_MAX_STRETCH: f64 = 3.0;
 /// Default largest specimen rotation of the envelope, degrees.
@@ -183,6 +186,8 @@ pub enum BeyondEnvelope {
 pub struct RigFollowConfig {
     /// Image scale, mm per px (> 0).
     pub mm_per_px: f64,
+    /// Image scale when a finite-element strip is mounted (two grips), mm per px (> 0).
+    pub strip_mm_per_px: f64,
     /// The admissible states.
     pub envelope: RigEnvelope,
 }
@@ -191,6 +196,7 @@ impl Default for RigFollowConfig {
     fn default() -> Self {
         RigFollowConfig {
             mm_per_px: DEFAULT_MM_PER_PX,
+            strip_mm_per_px: DEFAULT_STRIP_MM_PER_PX,
             envelope: RigEnvelope::default(),
         }
     }
@@ -287,12 +293,17 @@ pub struct RigFollower {
 impl RigFollower {
     /// A follower for `width` x `height` frames.
     pub fn new(config: RigFollowConfig, width: u32, height: u32) -> Result<Self, ProducerError> {
-        if !(config.mm_per_px.is_finite() && config.mm_per_px > 0.0) {
-            return Err(ProducerError::InvalidParameter {
-                name: "mm-per-px".to_owned(),
-                value: config.mm_per_px.to_string(),
-                expected: "a positive image scale in mm per px".to_owned(),
-            });
+        for (name, scale) in [
+            ("mm-per-px", config.mm_per_px),
+            ("strip-mm-per-px", config.strip_mm_per_px),
+        ] {
+            if !(scale.is_finite() && scale > 0.0) {
+                return Err(ProducerError::InvalidParameter {
+                    name: name.to_owned(),
+                    value: scale.to_string(),
+                    expected: "a positive image scale in mm per px".to_owned(),
+                });
+            }
         }
         config.envelope.validate()?;
         Ok(RigFollower {
@@ -519,10 +530,14 @@ impl RigCamera {
         &self.specimen
     }
 
-    /// How the camera sees the specimen: its centre at the image centre, the follower's scale.
-    pub fn view(&self) -> View {
-        let dims = self.camera.dims();
-        View::centred(self.follower.config().mm_per_px, dims.width, dims.height)
+    /// How the camera frames the specimen mounted: its centre at the image centre, the
+    /// follower's scale for its shape.
+    pub fn framing(&self) -> Framing {
+        let c = self.follower.config();
+        Framing {
+            mm_per_px: c.mm_per_px,
+            strip_mm_per_px: c.strip_mm_per_px,
+        }
     }
 
     /// What the next frame would show; for a finite-element specimen, its field is prepared
@@ -536,7 +551,12 @@ impl RigCamera {
         let Some((solve_id, grip_mm)) = motion.truth.specimen else {
             return next;
         };
-        let reason = match self.specimen.field(solve_id, &grip_mm, self.view()) {
+        let dims = self.camera.dims();
+        let size_px = [dims.width, dims.height];
+        let framed = self
+            .specimen
+            .framed_field(solve_id, &grip_mm, &self.framing(), size_px);
+        let reason = match framed {
             Ok(field) => {
                 self.field = Some(field);
                 return next;
@@ -587,8 +607,13 @@ impl RigCamera {
 mod tests {
     use super::*;
 
+    /// A follower at 0.015 mm/px (an offset of 0.15 mm is 10 px).
     fn follower(width: u32, height: u32) -> RigFollower {
-        RigFollower::new(RigFollowConfig::default(), width, height).unwrap()
+        let config = RigFollowConfig {
+            mm_per_px: 0.015,
+            ..RigFollowConfig::default()
+        };
+        RigFollower::new(config, width, height).unwrap()
     }
 
     fn kin(sx: f64, sy: f64, rot_deg: f64, offset_mm: [f64; 2]) -> RigKinematics {

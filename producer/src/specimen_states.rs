@@ -5,7 +5,7 @@
 //! samples; no IPC): the camera and the run's recorder share it.
 
 use crate::error::ProducerError;
-use crate::field_motion::{FieldMotion, ReferenceMesh, View};
+use crate::field_motion::{FieldMotion, Framing, ReferenceMesh, View};
 use membrane::{GripLinearField, Mesh};
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -127,6 +127,20 @@ impl SpecimenStates {
             solve.field.at(grip_mm),
             view,
         )?)
+    }
+
+    /// The field of solve `id` at `grip_mm` as the camera frames its specimen (by the number
+    /// of grips holding it) in a `size_px` image.
+    pub fn framed_field(
+        &self,
+        id: u64,
+        grip_mm: &[f64],
+        framing: &Framing,
+        size_px: [u32; 2],
+    ) -> Result<FieldMotion, StateError> {
+        let solve = self.solve(id).ok_or(StateError::Unknown(id))?;
+        let view = framing.view(solve.field.grip_mm.len(), size_px[0], size_px[1]);
+        self.field(id, grip_mm, view)
     }
 }
 

@@ -28,10 +28,8 @@ pub const LIMIT_RATE_MM_S: u32 = 6;
 pub const TEST_UNIAXIAL: f64 = 1.0;
 pub const TEST_EQUIBIAXIAL: f64 = 2.0;
 
-/// `RigState::load_case`.
-pub const LOAD_CASE_NONE: u32 = 0;
-pub const LOAD_CASE_UNIAXIAL: u32 = 1;
-pub const LOAD_CASE_EQUIBIAXIAL: u32 = 2;
+/// `RigState::load_case` (defined in `wire`).
+pub use wire::rig::{LOAD_CASE_EQUIBIAXIAL, LOAD_CASE_NONE, LOAD_CASE_UNIAXIAL};
 
 pub fn actuator_mode(control: AxisControl, mode: Option<ControlMode>) -> u32 {
     match (control, mode) {

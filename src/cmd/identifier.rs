@@ -40,7 +40,7 @@ pub struct IdentifierArgs {
     pub route: IdentifierRoutes,
     /// The field route's camera view: the image's scale (mm per px), its centre on the
     /// specimen's (the default cruciform's; other geometries through `--settings`).
-    #[arg(long, default_value_t = 0.16)]
+    #[arg(long, default_value_t = producer::DEFAULT_MM_PER_PX)]
     pub mm_per_px: f64,
     #[arg(long, default_value_t = 1024)]
     pub width_px: u32,

@@ -16,6 +16,7 @@ use producer::stream::{
 use producer::{
     FrameSource, Replay, RigCamera, RigEnvelope, RigFollowConfig, SimulatedConfig,
     DEFAULT_MAX_OFFSET_MM, DEFAULT_MAX_ROTATION_DEG, DEFAULT_MAX_STRETCH, DEFAULT_MM_PER_PX,
+    DEFAULT_STRIP_MM_PER_PX,
 };
 
 /// Options of `dicstream producer`.
@@ -63,6 +64,10 @@ pub struct ProducerArgs {
     /// With --follow-rig: image scale, mm per px
     #[arg(long, default_value_t = DEFAULT_MM_PER_PX, requires = "follow_rig")]
     pub mm_per_px: f64,
+    /// With --follow-rig: image scale when the rig mounts a finite-element strip (two grips),
+    /// mm per px
+    #[arg(long, default_value_t = DEFAULT_STRIP_MM_PER_PX, requires = "follow_rig")]
+    pub strip_mm_per_px: f64,
     /// With --follow-rig: largest stretch the camera can show, both axes (the pattern also
     /// covers the lateral contraction max^-1/2); rig states beyond are skipped and counted
     #[arg(long, default_value_t = DEFAULT_MAX_STRETCH, requires = "follow_rig")]
@@ -161,6 +166,7 @@ fn settings_of(args: &ProducerArgs) -> anyhow::Result<ProducerSettings> {
             camera: args.sim.config()?,
             follow: RigFollowConfig {
                 mm_per_px: args.mm_per_px,
+                strip_mm_per_px: args.strip_mm_per_px,
                 envelope: RigEnvelope {
                     max_stretch: args.max_stretch,
                     max_rotation_rad: args.max_rotation_deg.to_radians(),

@@ -95,14 +95,22 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
             None => println!("run: mean displacement error against the ground truth {error:.4} px"),
         }
     }
+    // On a structure the law from the whole field decides; the gauge's is said, not judged.
+    let gauge = match report.field_acceptance_decides {
+        true => "gauge route (force / section, no stress on a structure: not the verdict): ",
+        false => "",
+    };
     match &report.acceptance {
         Some(a) => println!(
-            "run: identified a = {:?}, b = {:?}\nrun: {}",
+            "run: identified a = {:?}, b = {:?}\nrun: {gauge}{}",
             a.a,
             a.b,
             a.verdict_line()
         ),
-        None => println!("run: nothing identified"),
+        None => println!("run: nothing identified by the gauge route"),
+    }
+    if let Some(field) = &report.field_acceptance {
+        println!("run: {}", field.verdict_line());
     }
     println!("run: results in {}", report.results.display());
     if report.leftover_shm_files > 0 {

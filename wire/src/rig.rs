@@ -4,6 +4,11 @@
 #[cfg(feature = "ipc")]
 use iceoryx2::prelude::ZeroCopySend;
 
+/// [`RigState::load_case`] codes.
+pub const LOAD_CASE_NONE: u32 = 0;
+pub const LOAD_CASE_UNIAXIAL: u32 = 1;
+pub const LOAD_CASE_EQUIBIAXIAL: u32 = 2;
+
 /// Actuators in this order everywhere: X+, X−, Y+, Y−, Z+, Z−.
 pub const ACTUATOR_NAMES: [&str; 6] = ["X+", "X-", "Y+", "Y-", "Z+", "Z-"];
 /// Axes in this order everywhere: X, Y, Z.
@@ -60,7 +65,8 @@ pub struct RigState {
     /// Current specimen cross-sections normal to X and Y (mm²), for Cauchy stress = force / area.
     pub specimen_section_x_mm2: f64,
     pub specimen_section_y_mm2: f64,
-    /// Load case code of the running test (rig crate: none, uniaxial, equibiaxial).
+    /// Load case code of the running test: [`LOAD_CASE_NONE`], [`LOAD_CASE_UNIAXIAL`] (on a
+    /// structure: the uniaxial strip is mounted) or [`LOAD_CASE_EQUIBIAXIAL`] (the cruciform).
     pub load_case: u32,
     /// 1 when the hydraulics are on.
     pub hydraulics_on: u32,

@@ -74,8 +74,12 @@ pub struct CameraSection {
     pub height_px: u32,
     pub fps: f64,
     pub bit_depth: u8,
-    /// Scale of the image of the specimen (mm per px).
+    /// Scale of the image of the specimen (mm per px): of a cruciform or the homogeneous
+    /// sheet.
     pub mm_per_px: f64,
+    /// Scale of the image of a finite-element strip (the uniaxial tests' specimen on a
+    /// structure: the camera is re-framed on it), mm per px.
+    pub strip_mm_per_px: f64,
     pub speckle_size_px: f64,
     pub seed: u64,
     /// Rendering threads of the simulated camera.
@@ -248,9 +252,9 @@ pub struct SpecimenSection {
     pub law_f: Vec<f64>,
     /// ln g(I2) = Σ b_i (I2 − 3)^i (eq. 25), g in MPa.
     pub law_g: Vec<f64>,
-    /// The rig's specimen: `homogeneous` (the analytic sheet, the default: the run's
-    /// acceptance divides forces by sections, right only for a homogeneous field) or
-    /// `structure` (the finite-element cruciform and strip of `[specimen.geometry]`).
+    /// The rig's specimen: `structure` (the default: the finite-element cruciform and strip of
+    /// `[specimen.geometry]`, the law judged from the whole field) or `homogeneous` (the
+    /// analytic sheet, the law judged from the gauge's forces over sections).
     pub model: rig::SpecimenModel,
     /// The specimen as a structure (`[specimen.geometry]`): its shape and the geometry of each
     /// shape, meshed by `membrane` (`dicstream specimen` solves it).
@@ -266,6 +270,16 @@ pub struct IdentifierSection {
     /// The identification routes: `gauge`, `field` (the whole field of the cruciform, by the
     /// virtual fields method), `both`, or `auto` (both on a structure, the gauge otherwise).
     pub route: wire::identification::IdentifierRoutes,
+}
+
+impl CameraSection {
+    /// How the simulated camera frames the specimen mounted.
+    pub fn framing(&self) -> producer::Framing {
+        producer::Framing {
+            mm_per_px: self.mm_per_px,
+            strip_mm_per_px: self.strip_mm_per_px,
+        }
+    }
 }
 
 impl RunConfig {
@@ -300,7 +314,8 @@ impl Default for CameraSection {
             height_px: 1024,
             fps: 10.0,
             bit_depth: 8,
-            mm_per_px: 0.015,
+            mm_per_px: producer::DEFAULT_MM_PER_PX,
+            strip_mm_per_px: producer::DEFAULT_STRIP_MM_PER_PX,
             speckle_size_px: 4.0,
             seed: 1,
             threads: 1,
@@ -365,7 +380,7 @@ impl Default for SpecimenSection {
         SpecimenSection {
             law_f: law.f.coefficients().to_vec(),
             law_g: law.g.coefficients().to_vec(),
-            model: rig::SpecimenModel::default(),
+            model: rig::SpecimenModel::Structure,
             geometry: membrane::SpecimenChoice::default(),
         }
     }

@@ -75,11 +75,13 @@ impl RunConfig {
                 producer::BIT_DEPTHS
             );
         }
-        if !(c.mm_per_px.is_finite() && c.mm_per_px > 0.0) {
-            bail!(
-                "[camera] mm_per_px = {}: expected a positive scale",
-                c.mm_per_px
-            );
+        for (key, scale) in [
+            ("mm_per_px", c.mm_per_px),
+            ("strip_mm_per_px", c.strip_mm_per_px),
+        ] {
+            if !(scale.is_finite() && scale > 0.0) {
+                bail!("[camera] {key} = {scale}: expected a positive scale");
+            }
         }
         producer::SpeckleParams {
             size_px: c.speckle_size_px,

@@ -143,6 +143,7 @@ pub fn producer_settings(
             camera: simulated_camera(c),
             follow: producer::RigFollowConfig {
                 mm_per_px: c.mm_per_px,
+                strip_mm_per_px: c.strip_mm_per_px,
                 envelope: producer::RigEnvelope {
                     // The rig overshoots a level by a little: the camera covers a margin
                     // beyond it.

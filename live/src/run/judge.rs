@@ -13,6 +13,10 @@ pub(super) struct Judged {
     pub(super) acceptance: Option<Acceptance>,
     /// The field route's, from the identifier's `identification.json`.
     pub(super) field: Option<crate::field_acceptance::FieldAcceptance>,
+    /// The field route's acceptance decides the run, not the gauge's: the specimen is a
+    /// structure (its gauge's force / section is no stress) and the field route ran with a
+    /// ground truth.
+    pub(super) field_decides: bool,
     pub(super) skipped: Option<String>,
 }
 
@@ -37,18 +41,19 @@ pub(super) fn judge(
         .last_report
         .filter(|_| has_truth)
         .map(|report| accept_report(config, recorder, &report));
-    let field = config
+    let field_runs = config
         .identifier_routes()
         .runs(wire::identification::ReportRoute::Field)
-        .then_some(())
-        .filter(|_| has_truth)
-        .and_then(|_| {
-            let truth = config.law().ok()?;
-            crate::field_acceptance::judge_field(&truth, identification_json)
-        });
+        && has_truth;
+    let field_decides = field_runs && config.specimen.model == rig::SpecimenModel::Structure;
+    let field = field_runs.then_some(()).and_then(|_| {
+        let truth = config.law().ok()?;
+        crate::field_acceptance::judge_field(&truth, identification_json)
+    });
     Judged {
         acceptance,
         field,
+        field_decides,
         skipped,
     }
 }

@@ -69,7 +69,7 @@ impl<'a> Run<'a> {
             fields_every: config.run.fields_every,
             vtk: config.run.vtk,
             truth: config.camera.source.has_truth(),
-            mm_per_px: config.camera.mm_per_px,
+            framing: config.camera.framing(),
         };
         let recorder = Recorder::new(&prepared.results, settings, t0_ns)?;
         start::write_running(

@@ -81,11 +81,14 @@ pub struct RunReport {
     /// Node by node against the ground truth (simulated cameras): what the truth was and the
     /// nodes' error percentiles.
     pub truth: Option<TruthReport>,
+    /// The gauge route's law against the truth: the run's verdict on the homogeneous sheet;
+    /// on a structure informative only (its gauge's force / section is no stress there).
     pub acceptance: Option<Acceptance>,
     /// The field route's law against the truth (`[identifier] route` field or both, with a
-    /// ground truth): informative, it does not decide the ending.
+    /// ground truth): the run's verdict on a structure (`field_acceptance_decides`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub field_acceptance: Option<crate::field_acceptance::FieldAcceptance>,
+    pub field_acceptance_decides: bool,
     /// Why there is no acceptance although a law was identified: a real camera or machine
     /// has no ground truth to compare with.
     pub acceptance_skipped: Option<String>,

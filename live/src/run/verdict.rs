@@ -3,6 +3,7 @@
 
 use super::{exit_code, Ending};
 use crate::acceptance::Acceptance;
+use crate::field_acceptance::FieldAcceptance;
 
 /// What the end of a run knows that decides its verdict.
 pub(super) struct Facts<'a> {
@@ -12,6 +13,9 @@ pub(super) struct Facts<'a> {
     pub(super) acceptance: Option<&'a Acceptance>,
     /// The acceptance was skipped (no ground truth): its absence is no doubt.
     pub(super) acceptance_skipped: bool,
+    /// On a structure, the field route's acceptance (inner None: the route gave none), which
+    /// decides in place of the gauge's; None on the homogeneous sheet.
+    pub(super) field_acceptance: Option<Option<&'a FieldAcceptance>>,
     pub(super) frames_lost_to_faults: u64,
     /// The termination signal that interrupted the run.
     pub(super) signal: Option<i32>,
@@ -60,18 +64,9 @@ pub(super) fn verdict(facts: Facts) -> Verdict {
 /// What makes a completed run's results doubtful, if anything.
 fn doubts(facts: &Facts) -> Option<String> {
     let mut doubts = Vec::new();
-    match facts.acceptance {
-        None if facts.acceptance_skipped => {}
-        None => doubts.push("nothing was identified".to_string()),
-        Some(a) if a.tested_nothing() => doubts.push(format!(
-            "the acceptance tested nothing ({})",
-            a.why_nothing_tested()
-        )),
-        Some(a) if !a.passed => doubts.push(format!(
-            "the identified law did not pass the acceptance (tolerance {:.0} %)",
-            100.0 * a.tolerance
-        )),
-        Some(_) => {}
+    match facts.field_acceptance {
+        Some(field) => doubts.extend(field_doubt(field)),
+        None => doubts.extend(gauge_doubt(facts)),
     }
     if facts.frames_lost_to_faults > 0 {
         doubts.push(format!(
@@ -81,6 +76,40 @@ fn doubts(facts: &Facts) -> Option<String> {
         ));
     }
     (!doubts.is_empty()).then(|| doubts.join("; "))
+}
+
+/// The doubt the law from the whole field leaves on a structure, if any.
+fn field_doubt(field: Option<&FieldAcceptance>) -> Option<String> {
+    match field {
+        None => Some("the field route identified nothing".to_string()),
+        Some(f) if f.model.is_none() => Some(format!(
+            "the field route identified nothing ({})",
+            f.error.as_deref().unwrap_or("no fit")
+        )),
+        Some(f) if !f.passed => Some(format!(
+            "the law identified from the whole field did not pass the acceptance (tolerance \
+             {:.0} %)",
+            100.0 * f.tolerance
+        )),
+        Some(_) => None,
+    }
+}
+
+/// The doubt the gauge route's law leaves, if any.
+fn gauge_doubt(facts: &Facts) -> Option<String> {
+    match facts.acceptance {
+        None if facts.acceptance_skipped => None,
+        None => Some("nothing was identified".to_string()),
+        Some(a) if a.tested_nothing() => Some(format!(
+            "the acceptance tested nothing ({})",
+            a.why_nothing_tested()
+        )),
+        Some(a) if !a.passed => Some(format!(
+            "the identified law did not pass the acceptance (tolerance {:.0} %)",
+            100.0 * a.tolerance
+        )),
+        Some(_) => None,
+    }
 }
 
 /// A run whose results could not all be written (a full disk) failed: the files are named
@@ -102,6 +131,8 @@ fn unwritten(verdict: Verdict, notes: &[String]) -> Verdict {
 mod tests {
     use super::*;
     use crate::acceptance::{accept, accept_path, true_law};
+    use crate::field_acceptance::compare;
+    use identifier::law::InvariantLaw;
 
     /// A run that ended as `ending`, with nothing else known.
     fn facts(ending: Ending) -> Facts<'static> {
@@ -110,6 +141,7 @@ mod tests {
             failure: None,
             acceptance: None,
             acceptance_skipped: false,
+            field_acceptance: None,
             frames_lost_to_faults: 0,
             signal: None,
             faults: &[],
@@ -147,6 +179,56 @@ mod tests {
         let (failure, code) = completed(Some(&bad), false);
         assert_eq!(code, exit_code::DOUBTFUL);
         assert!(failure.unwrap().contains("did not pass the acceptance"));
+    }
+
+    #[test]
+    fn on_a_structure_the_law_from_the_whole_field_decides() {
+        let (truth, a, b) = true_law();
+        let law = InvariantLaw::smactane();
+        // The gauge's force / section fails on a structure: not the verdict there.
+        let mut a_off = a.clone();
+        a_off[0] += 0.3f64.ln_1p();
+        let gauge = accept(&truth, &a_off, &b, Some(3.0), Some(1.1));
+        assert!(!gauge.passed);
+        let route = |a0: f64| {
+            serde_json::json!({
+                "frames": 12,
+                "max_stretches": [1.7, 1.13],
+                "fits": [{"model": "lambert-diani-rey:2,2",
+                          "params": {"a0": a0, "a1": -2.52e-2, "a2": 1.40e-3,
+                                     "b0": -1.02, "b1": -3.92e-3, "b2": -5.30e-4}}],
+            })
+        };
+        let on_structure = |field: Option<&FieldAcceptance>| {
+            let v = verdict(Facts {
+                acceptance: Some(&gauge),
+                field_acceptance: Some(field),
+                ..facts(Ending::Completed)
+            });
+            (v.failure, v.exit_code)
+        };
+        let good = compare(&law, &route(-1.27));
+        assert_eq!(on_structure(Some(&good)), (None, exit_code::PASSED));
+        let off = compare(&law, &route(-1.27 + 0.1f64.ln_1p()));
+        let (failure, code) = on_structure(Some(&off));
+        assert_eq!(code, exit_code::DOUBTFUL);
+        assert_eq!(
+            failure.as_deref(),
+            Some("the law identified from the whole field did not pass the acceptance (tolerance 3 %)")
+        );
+        let nothing = compare(
+            &law,
+            &serde_json::json!({"error": "crosses no arm", "fits": null}),
+        );
+        let (failure, code) = on_structure(Some(&nothing));
+        assert_eq!(code, exit_code::DOUBTFUL);
+        assert_eq!(
+            failure.as_deref(),
+            Some("the field route identified nothing (crosses no arm)")
+        );
+        assert_eq!(on_structure(None).1, exit_code::DOUBTFUL);
+        // On the homogeneous sheet the gauge's acceptance decides.
+        assert_eq!(completed(Some(&gauge), false).1, exit_code::DOUBTFUL);
     }
 
     #[test]
