@@ -466,9 +466,8 @@ mod tests {
     #[test]
     fn a_field_file_gives_its_grid_and_each_ok_nodes_f() {
         let dir = scratch("grid");
-        let mut text = String::from(
-            "x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy\n",
-        );
+        let mut text =
+            String::from("x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy\n");
         for (k, (x, y)) in [(10, 20), (14, 20), (10, 24), (14, 24)].iter().enumerate() {
             let status = if k == 2 { "low_contrast" } else { "ok" };
             text += &format!("{x},{y},0,0,0,0,0,1,3,{status},0.1,0.02,-0.01,0.05\n");
@@ -514,15 +513,21 @@ mod tests {
             frame_forces(&frames, &source, &field(10)).unwrap(),
             (1, [2.5, 5.0, 7.5, 10.0])
         );
-        let e = frame_forces(&frames, &source, &field(20)).unwrap_err().to_string();
+        let e = frame_forces(&frames, &source, &field(20))
+            .unwrap_err()
+            .to_string();
         assert!(
             e.contains("frames.csv: line 3: frame 20: rig time 1.5 s is outside")
                 && e.contains("rig.csv (0 to 1 s)"),
             "{e}"
         );
-        let e = frame_forces(&frames, &source, &field(30)).unwrap_err().to_string();
+        let e = frame_forces(&frames, &source, &field(30))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("line 4: frame 30: no rig time"), "{e}");
-        let e = frame_forces(&frames, &source, &field(40)).unwrap_err().to_string();
+        let e = frame_forces(&frames, &source, &field(40))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("field_40.csv: frame 40 has no row in"), "{e}");
         // Forces from frames.csv: an older one without the grip columns has none here.
         let e = frame_forces(&frames, &ForceSource::Frames, &field(10))

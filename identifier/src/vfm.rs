@@ -15,8 +15,9 @@ use crate::tapered_ramp::{RampError, RampQuadrature};
 use crate::virtual_work::{EquationInput, Equations, NodeFailure, WeightedNode};
 use nalgebra::{DMatrix, DVector};
 
-/// Condition number of the scaled Jacobian beyond which the parameters are not told apart.
-pub const MAX_CONDITION: f64 = 1e8;
+/// Condition number of the scaled Jacobian beyond which the parameters are not told apart:
+/// the gauge route's limit ([`crate::identifiability::MAX_CONDITION_NUMBER`]), one definition.
+pub const MAX_CONDITION: f64 = crate::identifiability::MAX_CONDITION_NUMBER;
 
 /// A virtual field whose work balances one arm's grip force.
 #[derive(Clone, Copy, Debug)]
@@ -224,6 +225,16 @@ pub fn fit_equations(
             let unit: Vec<f64> = (0..n).map(|i| f64::from(u8::from(i == k))).collect();
             let column = equations.forces_n(model, &unit)?;
             a.set_column(k, &DVector::from_vec(column));
+        }
+        // States that cannot separate the parameters: refused with the design's condition
+        // number (infinite when a column is a combination of the others), not solved.
+        let design = condition(&a);
+        if design.is_nan() || design > MAX_CONDITION {
+            return Err(VfmError::NotIdentifiable {
+                model: model.name(),
+                params: n,
+                condition: design,
+            });
         }
         linear_least_squares(&a, &measured)?
             .iter()

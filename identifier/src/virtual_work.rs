@@ -128,7 +128,9 @@ impl Equations {
                     *computed.entry(key).or_insert_with(|| kinematics_of(node))
                 };
                 match k {
-                    Ok((stretches, k)) => resolved.push(((!node.filled).then_some(key), stretches, k)),
+                    Ok((stretches, k)) => {
+                        resolved.push(((!node.filled).then_some(key), stretches, k))
+                    }
                     Err(e) => {
                         failure = Some(e);
                         break;

@@ -542,6 +542,8 @@ mod tests {
                 gauge_length_mm: None,
                 section_mm2: None,
                 threads: 2,
+                fields: None,
+                forces: None,
             }
         }
     }

@@ -76,7 +76,10 @@ pub fn run(
         print_table(out, &saved, &identifiability)?;
     }
     if saved.fits.fits.is_empty() {
-        bail!("no model could be fitted to the fields of {}", dir.display());
+        bail!(
+            "no model could be fitted to the fields of {}",
+            dir.display()
+        );
     }
     Ok(())
 }
@@ -119,7 +122,11 @@ fn saved_json(
 ) -> Value {
     let mut value = identifier::process::fits_json(&saved.fits);
     if let Some(fits) = value["fits"].as_array_mut() {
-        for ((fit, id), rank) in fits.iter_mut().zip(identifiability).zip(ranks(identifiability)) {
+        for ((fit, id), rank) in fits
+            .iter_mut()
+            .zip(identifiability)
+            .zip(ranks(identifiability))
+        {
             fit["rank"] = json!(rank);
             fit["warning"] = json!(id.warning());
         }
@@ -160,7 +167,12 @@ fn print_table(
         "{:>2} {:<22} {:>9} {:>9} {:>9} {:>10}  params ± std",
         "#", "model", "aic", "rms_n", "equations", "condition"
     )?;
-    for ((fit, rank), _) in fits.fits.iter().zip(ranks(identifiability)).zip(identifiability) {
+    for ((fit, rank), _) in fits
+        .fits
+        .iter()
+        .zip(ranks(identifiability))
+        .zip(identifiability)
+    {
         let params: Vec<String> = fit
             .model
             .param_names()
@@ -186,4 +198,197 @@ fn print_table(
         "(virtual fields method: each equation a virtual field's internal work against its grip's \
          force, N; `-`: parameters not identifiable from these fields, not ranked)"
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+    use identifier::data::LoadCase;
+    use identifier::models::Model;
+    use std::path::PathBuf;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: IdentifyArgs,
+    }
+
+    /// A results folder of homogeneous equibiaxial fields (512 px square images, a 31 x 31
+    /// mesh 16 px apart) whose grips pull what an arm of the default cruciform (100 mm wide, 2
+    /// mm thick) carries under a Mooney law; removed on drop.
+    struct RunDir(PathBuf);
+
+    impl Drop for RunDir {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    const HEADER: &str = "x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy";
+
+    fn run_dir(tag: &str, mm_per_px: f64, stretches: &[f64]) -> RunDir {
+        let dir =
+            std::env::temp_dir().join(format!("identify_fields_{tag}_{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("fields")).unwrap();
+        std::fs::write(
+            dir.join("config.toml"),
+            format!("[camera]\nwidth_px = 512\nheight_px = 512\nmm_per_px = {mm_per_px}\n[identifier]\nmodels = \"mooney\"\n"),
+        )
+        .unwrap();
+        let mut frames = String::from(
+            "frame_id,t_sim_s,sequence_id,force_x+_n,force_x-_n,force_y+_n,force_y-_n\n",
+        );
+        for (k, &l) in stretches.iter().enumerate() {
+            let frame = 10 * (k + 1);
+            let force = 100.0
+                * 2.0
+                * Model::Mooney
+                    .nominal_stress_mpa(&[0.3, 0.05], LoadCase::Equibiaxial, l)
+                    .unwrap();
+            frames += &format!("{frame},{},0,{force},{force},{force},{force}\n", k as f64);
+            let mut field = format!("{HEADER}\n");
+            for row in 0..31 {
+                for col in 0..31 {
+                    let (x, y) = (16 + 16 * col, 16 + 16 * row);
+                    let g = l - 1.0;
+                    field += &format!("{x},{y},0,0,0,0,0,1,3,ok,{g},0,0,{g}\n");
+                }
+            }
+            std::fs::write(dir.join(format!("fields/field_{frame:06}.csv")), field).unwrap();
+        }
+        std::fs::write(dir.join("frames.csv"), frames).unwrap();
+        RunDir(dir)
+    }
+
+    /// `identify --fields DIR extra...`: its stdout, stderr and result.
+    fn identify(dir: &Path, extra: &[&str]) -> (String, String, anyhow::Result<()>) {
+        let mut argv = vec!["identify".to_string(), "--fields".into()];
+        argv.push(dir.display().to_string());
+        argv.extend(extra.iter().map(|s| s.to_string()));
+        let cli = Cli::try_parse_from(argv).unwrap();
+        let (mut out, mut err) = (vec![], vec![]);
+        let result = super::super::identify::run_with(cli.args, &mut out, &mut err, false);
+        (
+            String::from_utf8(out).unwrap(),
+            String::from_utf8(err).unwrap(),
+            result,
+        )
+    }
+
+    fn error_of(result: anyhow::Result<()>) -> String {
+        format!("{:#}", result.unwrap_err())
+    }
+
+    /// The JSON alone on stdout (the notes on stderr), every frame used, each fit's rank and
+    /// warning in agreement; the table says the frames. (A homogeneous field is no cruciform's
+    /// equilibrium: its central ramps do not balance the grips' forces, so the law is not
+    /// asserted here; tests/field_route.rs fits a run's finite-element fields.)
+    #[test]
+    fn json_alone_on_stdout_and_the_table_says_the_frames() {
+        let run = run_dir("json", 0.36, &[1.05, 1.1, 1.15, 1.2, 1.25]);
+        let (out, err, result) = identify(&run.0, &["--json"]);
+        result.unwrap();
+        let value: Value = serde_json::from_str(&out).expect("stdout is JSON alone");
+        assert_eq!(value["frames"], 5, "{value}");
+        assert_eq!(value["fields_read"], 5);
+        assert_eq!(value["counters"]["kept"], 5);
+        assert_eq!(value["source"]["per_grip_forces"], true);
+        assert_eq!(value["max_stretches"], json!([1.25, 1.25]));
+        let fit = &value["fits"][0];
+        assert_eq!(fit["model"], "mooney", "the run's models: {value}");
+        assert_eq!(fit["rank"].is_null(), !fit["warning"].is_null(), "{value}");
+        if let Some(warning) = fit["warning"].as_str() {
+            assert!(err.contains(&format!("mooney: {warning}")), "{err}");
+        }
+        let (table, _, result) = identify(&run.0, &[]);
+        result.unwrap();
+        assert!(
+            table.contains("5 frames fitted of 5 field files"),
+            "{table}"
+        );
+        assert!(table.contains(" mooney "), "{table}");
+    }
+
+    #[test]
+    fn a_field_without_gradients_is_named() {
+        let run = run_dir("no_gradients", 0.36, &[1.05, 1.1, 1.15]);
+        let path = run.0.join("fields/field_000020.csv");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let old: String = text
+            .lines()
+            .map(|l| l.split(',').take(10).collect::<Vec<_>>().join(",") + "\n")
+            .collect();
+        std::fs::write(&path, old).unwrap();
+        let e = error_of(identify(&run.0, &["--json"]).2);
+        assert!(
+            e.contains("field_000020.csv: line 1: no displacement gradient columns (du_dx, du_dy, dv_dx, dv_dy missing)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn forces_without_a_matching_frame_or_time_are_named() {
+        let run = run_dir("no_forces", 0.36, &[1.05, 1.1, 1.15]);
+        // frames.csv without frame 30's row.
+        let frames = run.0.join("frames.csv");
+        let text = std::fs::read_to_string(&frames).unwrap();
+        let cut: String = text
+            .lines()
+            .filter(|l| !l.starts_with("30,"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        std::fs::write(&frames, &cut).unwrap();
+        let e = error_of(identify(&run.0, &[]).2);
+        assert!(
+            e.contains("field_000030.csv: frame 30 has no row in"),
+            "{e}"
+        );
+        // The rig's log by time: frame 20 (rig time 1 s) after the log's end.
+        std::fs::write(&frames, text).unwrap();
+        let rig = run.0.join("rig.csv");
+        std::fs::write(
+            &rig,
+            "t_s,X+_force_n,X-_force_n,Y+_force_n,Y-_force_n\n0,1,1,1,1\n0.5,2,2,2,2\n",
+        )
+        .unwrap();
+        let e = error_of(identify(&run.0, &["--forces", rig.to_str().unwrap()]).2);
+        assert!(
+            e.contains("frames.csv: line 3: frame 20: rig time 1 s is outside")
+                && e.contains("(0 to 0.5 s): no forces to pair with it"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_view_that_crosses_no_arm_is_named() {
+        // 512 px at 0.05 mm/px: ±12.8 mm, inside the central square.
+        let run = run_dir("no_arm", 0.05, &[1.05, 1.1, 1.15]);
+        let e = error_of(identify(&run.0, &[]).2);
+        assert!(
+            e.contains("field_000010.csv: the field of view") && e.contains("crosses no arm"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn too_few_distinct_states_are_refused_with_the_condition_number() {
+        // One loading state thrice: one frame kept.
+        let run = run_dir("one_state", 0.36, &[1.1, 1.1, 1.1]);
+        let e = error_of(identify(&run.0, &[]).2);
+        assert!(
+            e.contains("1 frame(s) kept of 3 field file(s), 3 needed for a fit (not loading: 2")
+                && e.contains("too few distinct states"),
+            "{e}"
+        );
+        // Equibiaxial states alone, close together: more parameters than they separate.
+        let run = run_dir("close_states", 0.36, &[1.002, 1.004, 1.006, 1.008]);
+        let (out, err, result) = identify(&run.0, &["--model", "mooney,rivlin:10,01,11,20,02"]);
+        result.unwrap();
+        assert!(
+            err.contains("not fitted: rivlin:10,01,11,20,02: the states the field reached do not separate the 5 parameters of rivlin:10,01,11,20,02: condition number"),
+            "{err}"
+        );
+        assert!(!out.contains("rivlin"), "not ranked: {out}");
+    }
 }

@@ -11,8 +11,8 @@
 
 use super::ProcessError;
 use crate::field_layout::{ArmLayout, LayoutError};
-use crate::field_stress::Mat2;
 use crate::field_route::{FieldFits, FieldRoute, FieldRouteConfig, FitJob, FrameOutcome};
+use crate::field_stress::Mat2;
 use crate::grip_forces::{ForceHistory, GripForces};
 use crate::models::Model;
 use crate::section_cut::FieldGrid;
@@ -91,7 +91,10 @@ impl FieldFeed {
     /// Kept frames before the first fit.
     pub const MIN_FRAMES_TO_FIT: usize = 3;
 
-    pub fn new(settings: &FieldRouteSettings, models: &[Model]) -> Result<Self, membrane::GeometryError> {
+    pub fn new(
+        settings: &FieldRouteSettings,
+        models: &[Model],
+    ) -> Result<Self, membrane::GeometryError> {
         let specimen = settings.cruciform.mesh()?;
         let elements = membrane::ElementGrid::new(&specimen.mesh);
         let c = &settings.cruciform;
@@ -327,7 +330,10 @@ impl FieldShell {
                 "correlator_per_field": ms(&self.cost.correlate_ns),
             },
         });
-        let fitted = fits.map_or(json!({"frames": null, "max_stretches": null, "fits": null, "refused": null}), fits_json);
+        let fitted = fits.map_or(
+            json!({"frames": null, "max_stretches": null, "fits": null, "refused": null}),
+            fits_json,
+        );
         if let (Some(out), Value::Object(fitted)) = (out.as_object_mut(), fitted) {
             out.extend(fitted);
         }
