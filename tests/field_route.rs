@@ -107,6 +107,7 @@ fn offline_agrees_with_the_live_fit(out: &Path) {
         ("pure_shear", offline_law.pure_shear),
     ] {
         let c = c.unwrap_or_else(|| panic!("{case}: {offline}"));
+        println!("offline best law against the truth, {case}: {c:?}");
         assert!(c.max_relative_error < 0.035, "{case}: {c:?}\n{offline}");
     }
     // The live fit: the live route's best model, as fitted offline, against its live fit,
@@ -150,5 +151,8 @@ fn offline_agrees_with_the_live_fit(out: &Path) {
 }
 
 /// Largest relative difference in nominal stress between the offline and the live fit of one
-/// model (see the test's measurement).
+/// model. The two fit different frames of one test (the saved fields are every 2nd frame, kept
+/// and thinned by their own loading levels; the live route saw every frame), each with its
+/// camera noise: measured when written, one run, 0.3 % in all three cases (the live fits of
+/// two runs differ by up to 1 % against the truth, above); asserted at the 2 %.
 const AGREEMENT: f64 = 0.02;

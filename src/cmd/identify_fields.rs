@@ -276,8 +276,12 @@ mod tests {
         )
     }
 
-    fn error_of(result: anyhow::Result<()>) -> String {
-        format!("{:#}", result.unwrap_err())
+    /// `identify --fields DIR extra...` fails with an error holding every one of `wants`.
+    fn refused(dir: &Path, extra: &[&str], wants: &[&str]) {
+        let e = format!("{:#}", identify(dir, extra).2.unwrap_err());
+        for want in wants {
+            assert!(e.contains(want), "{want:?} not in: {e}");
+        }
     }
 
     /// The JSON alone on stdout (the notes on stderr), every frame used, each fit's rank and
@@ -320,10 +324,10 @@ mod tests {
             .map(|l| l.split(',').take(10).collect::<Vec<_>>().join(",") + "\n")
             .collect();
         std::fs::write(&path, old).unwrap();
-        let e = error_of(identify(&run.0, &["--json"]).2);
-        assert!(
-            e.contains("field_000020.csv: line 1: no displacement gradient columns (du_dx, du_dy, dv_dx, dv_dy missing)"),
-            "{e}"
+        refused(
+            &run.0,
+            &["--json"],
+            &["field_000020.csv: line 1: no displacement gradient columns (du_dx, du_dy, dv_dx, dv_dy missing)"],
         );
     }
 
@@ -339,11 +343,7 @@ mod tests {
             .map(|l| format!("{l}\n"))
             .collect();
         std::fs::write(&frames, &cut).unwrap();
-        let e = error_of(identify(&run.0, &[]).2);
-        assert!(
-            e.contains("field_000030.csv: frame 30 has no row in"),
-            "{e}"
-        );
+        refused(&run.0, &[], &["field_000030.csv: frame 30 has no row in"]);
         // The rig's log by time: frame 20 (rig time 1 s) after the log's end.
         std::fs::write(&frames, text).unwrap();
         let rig = run.0.join("rig.csv");
@@ -352,11 +352,13 @@ mod tests {
             "t_s,X+_force_n,X-_force_n,Y+_force_n,Y-_force_n\n0,1,1,1,1\n0.5,2,2,2,2\n",
         )
         .unwrap();
-        let e = error_of(identify(&run.0, &["--forces", rig.to_str().unwrap()]).2);
-        assert!(
-            e.contains("frames.csv: line 3: frame 20: rig time 1 s is outside")
-                && e.contains("(0 to 0.5 s): no forces to pair with it"),
-            "{e}"
+        refused(
+            &run.0,
+            &["--forces", rig.to_str().unwrap()],
+            &[
+                "frames.csv: line 3: frame 20: rig time 1 s is outside",
+                "(0 to 0.5 s): no forces to pair with it",
+            ],
         );
     }
 
@@ -364,10 +366,10 @@ mod tests {
     fn a_view_that_crosses_no_arm_is_named() {
         // 512 px at 0.05 mm/px: ±12.8 mm, inside the central square.
         let run = run_dir("no_arm", 0.05, &[1.05, 1.1, 1.15]);
-        let e = error_of(identify(&run.0, &[]).2);
-        assert!(
-            e.contains("field_000010.csv: the field of view") && e.contains("crosses no arm"),
-            "{e}"
+        refused(
+            &run.0,
+            &[],
+            &["field_000010.csv: the field of view", "crosses no arm"],
         );
     }
 
@@ -375,11 +377,13 @@ mod tests {
     fn too_few_distinct_states_are_refused_with_the_condition_number() {
         // One loading state thrice: one frame kept.
         let run = run_dir("one_state", 0.36, &[1.1, 1.1, 1.1]);
-        let e = error_of(identify(&run.0, &[]).2);
-        assert!(
-            e.contains("1 frame(s) kept of 3 field file(s), 3 needed for a fit (not loading: 2")
-                && e.contains("too few distinct states"),
-            "{e}"
+        refused(
+            &run.0,
+            &[],
+            &[
+                "1 frame(s) kept of 3 field file(s), 3 needed for a fit (not loading: 2",
+                "too few distinct states",
+            ],
         );
         // Equibiaxial states alone, close together: more parameters than they separate.
         let run = run_dir("close_states", 0.36, &[1.002, 1.004, 1.006, 1.008]);
