@@ -54,13 +54,14 @@ pub const COLUMNS: [&str; 47] = [
     "latency_seen_ms",
     "correlate_ms",
     "frames_dropped",
-    // Appended (a reader of the columns above is unaffected): the frame sequence (one test)
-    // and each grip's own force, X+, X-, Y+, Y- (the field route's external virtual work).
-    "sequence_id",
+    // Appended (a reader of the columns above is unaffected): each grip's own force, X+, X-,
+    // Y+, Y- (the field route's external virtual work), and the frame sequence (one test),
+    // last: a row always ends with a number.
     "force_x+_n",
     "force_x-_n",
     "force_y+_n",
     "force_y-_n",
+    "sequence_id",
 ];
 
 /// The columns that compare with the ground truth: absent (not empty, not zero) from the
@@ -386,12 +387,8 @@ impl FrameRow {
         }
         let _ = write!(
             out,
-            "{:.3},{:.3},{:.3},{},{}",
-            self.latency_field_ms,
-            self.latency_seen_ms,
-            self.correlate_ms,
-            self.frames_dropped,
-            self.sequence_id
+            "{:.3},{:.3},{:.3},{}",
+            self.latency_field_ms, self.latency_seen_ms, self.correlate_ms, self.frames_dropped
         );
         match self.grip_forces_n {
             Some(forces) => forces.iter().for_each(|f| {
@@ -399,7 +396,7 @@ impl FrameRow {
             }),
             None => out.push_str(",,,,"),
         }
-        out.push('\n');
+        let _ = writeln!(out, ",{}", self.sequence_id);
     }
 }
 
