@@ -276,6 +276,15 @@ mod tests {
         )
     }
 
+    /// Rewrites the file at `path` line by line (None: the line left out); returns its text
+    /// before.
+    fn edit_lines(path: &Path, edit: impl Fn(&str) -> Option<String>) -> String {
+        let text = std::fs::read_to_string(path).unwrap();
+        let edited: String = text.lines().filter_map(edit).map(|l| l + "\n").collect();
+        std::fs::write(path, edited).unwrap();
+        text
+    }
+
     /// `identify --fields DIR extra...` fails with an error holding every one of `wants`.
     fn refused(dir: &Path, extra: &[&str], wants: &[&str]) {
         let e = format!("{:#}", identify(dir, extra).2.unwrap_err());
@@ -317,13 +326,10 @@ mod tests {
     #[test]
     fn a_field_without_gradients_is_named() {
         let run = run_dir("no_gradients", 0.36, &[1.05, 1.1, 1.15]);
-        let path = run.0.join("fields/field_000020.csv");
-        let text = std::fs::read_to_string(&path).unwrap();
-        let old: String = text
-            .lines()
-            .map(|l| l.split(',').take(10).collect::<Vec<_>>().join(",") + "\n")
-            .collect();
-        std::fs::write(&path, old).unwrap();
+        // The first ten columns only, as fields were written before the gradients.
+        edit_lines(&run.0.join("fields/field_000020.csv"), |l| {
+            Some(l.split(',').take(10).collect::<Vec<_>>().join(","))
+        });
         refused(
             &run.0,
             &["--json"],
@@ -336,13 +342,7 @@ mod tests {
         let run = run_dir("no_forces", 0.36, &[1.05, 1.1, 1.15]);
         // frames.csv without frame 30's row.
         let frames = run.0.join("frames.csv");
-        let text = std::fs::read_to_string(&frames).unwrap();
-        let cut: String = text
-            .lines()
-            .filter(|l| !l.starts_with("30,"))
-            .map(|l| format!("{l}\n"))
-            .collect();
-        std::fs::write(&frames, &cut).unwrap();
+        let text = edit_lines(&frames, |l| (!l.starts_with("30,")).then(|| l.to_string()));
         refused(&run.0, &[], &["field_000030.csv: frame 30 has no row in"]);
         // The rig's log by time: frame 20 (rig time 1 s) after the log's end.
         std::fs::write(&frames, text).unwrap();
