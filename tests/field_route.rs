@@ -1,12 +1,19 @@
 //! The field route in the live bench (issue 25 deliverable 3): `dicstream run` on the
 //! finite-element cruciform filmed wide enough to cross its arms, one equibiaxial test, the
 //! identifier running both routes; the field route's law against the true one in
-//! `summary.json`, the gauge route's beside it.
+//! `summary.json`, the gauge route's beside it. Then the same run's saved fields identified
+//! offline (`dicstream identify --fields`, issue 25 deliverable 4) against the live fit and
+//! the truth.
 
 mod common;
 
 use common::bench_run::{completed_summary, config, start_run};
 use common::Run;
+use identifier::data::LoadCase;
+use identifier::models::Model;
+use live::field_acceptance::judge_route;
+use serde_json::Value;
+use std::path::Path;
 
 /// One equibiaxial test to a grip stretch of 1.5.
 const EQUIBIAXIAL: &str =
@@ -19,7 +26,9 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
     // 32 x 32 mesh of 5.8 mm steps).
     let extra =
         format!("{EQUIBIAXIAL}[specimen]\nmodel = \"structure\"\n[identifier]\nroute = \"both\"\n");
-    let config = config(&run, "", &extra);
+    // A field file every 2nd frame (10 by default): the offline fit's frames as many as the
+    // live route keeps.
+    let config = config(&run, "fields_every = 2", &extra);
     let text = std::fs::read_to_string(&config).unwrap().replace(
         "width_px = 256\nheight_px = 256\n",
         "width_px = 512\nheight_px = 512\nmm_per_px = 0.36\n",
@@ -28,6 +37,7 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
     let out = run.dir.join("out");
     start_run(&mut run, "run", &config, &out, &["--no-dashboard"]);
     let (summary, _) = completed_summary(&mut run, &out);
+    offline_agrees_with_the_live_fit(&out);
     let field = &summary["field_acceptance"];
     println!(
         "field route: {}\ngauge route: {}",
@@ -60,3 +70,89 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
         assert!(error < 0.035, "{case}: {field}");
     }
 }
+
+/// `dicstream identify --fields` on the run's results: the JSON alone on stdout, the live
+/// route's best model fitted offline within `AGREEMENT` of its live fit, the offline best law
+/// within the live test's margin of the truth.
+fn offline_agrees_with_the_live_fit(out: &Path) {
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_dicstream"))
+        .args(["identify", "--fields"])
+        .arg(out)
+        .arg("--json")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    let offline: Value = serde_json::from_slice(&output.stdout).expect("stdout is JSON alone");
+    let live_json: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("identification.json")).unwrap())
+            .unwrap();
+    let live_route = &live_json["field_route"];
+    println!(
+        "offline: frames {} of {} files, counters {}, fits {}\nstderr: {stderr}",
+        offline["frames"], offline["fields_read"], offline["counters"], offline["fits"]
+    );
+    assert_eq!(offline["source"]["per_grip_forces"], true, "{offline}");
+    assert!(offline["frames"].as_u64().unwrap() >= 6, "{offline}");
+    let config = live::RunConfig::read(Some(&out.join("config.toml"))).unwrap();
+    let truth = config.law().unwrap();
+    let (offline_law, live_law) = (
+        judge_route(&truth, &offline),
+        judge_route(&truth, live_route),
+    );
+    // The truth: the live test's margin (see above).
+    for (case, c) in [
+        ("uniaxial", offline_law.uniaxial),
+        ("equibiaxial", offline_law.equibiaxial),
+        ("pure_shear", offline_law.pure_shear),
+    ] {
+        let c = c.unwrap_or_else(|| panic!("{case}: {offline}"));
+        println!("offline best law against the truth, {case}: {c:?}");
+        assert!(c.max_relative_error < 0.035, "{case}: {c:?}\n{offline}");
+    }
+    // The live fit: the live route's best model, as fitted offline, against its live fit,
+    // nominal stress over the stretches both reached.
+    let best = live_law.model.clone().unwrap();
+    let fit_of = |route: &Value| -> Value {
+        let fits = route["fits"].as_array().unwrap();
+        let fit = fits.iter().find(|f| f["model"] == best.as_str());
+        fit.unwrap_or_else(|| panic!("{best} not fitted: {route}"))
+            .clone()
+    };
+    let law = |fit: &Value| -> Vec<f64> {
+        let model = Model::parse(&best).unwrap();
+        let names = model.param_names();
+        names
+            .iter()
+            .map(|n| fit["params"][n].as_f64().unwrap())
+            .collect()
+    };
+    let model = Model::parse(&best).unwrap();
+    let (live_p, offline_p) = (law(&fit_of(live_route)), law(&fit_of(&offline)));
+    let reached = |route: &Value, k: usize| route["max_stretches"][k].as_f64().unwrap();
+    for case in [
+        LoadCase::Uniaxial,
+        LoadCase::Equibiaxial,
+        LoadCase::PureShear,
+    ] {
+        let k = usize::from(case == LoadCase::Equibiaxial);
+        let max = reached(live_route, k).min(reached(&offline, k));
+        let worst = (1..=100)
+            .map(|i| {
+                let l = 1.0 + (max - 1.0) * i as f64 / 100.0;
+                let a = model.nominal_stress_mpa(&live_p, case, l).unwrap();
+                let b = model.nominal_stress_mpa(&offline_p, case, l).unwrap();
+                ((b - a) / a).abs()
+            })
+            .fold(0.0, f64::max);
+        println!("{best} {case}: offline against live {worst:.4} up to {max:.3}");
+        assert!(worst < AGREEMENT, "{case}: {worst}\n{offline}");
+    }
+}
+
+/// Largest relative difference in nominal stress between the offline and the live fit of one
+/// model. The two fit different frames of one test (the saved fields are every 2nd frame, kept
+/// and thinned by their own loading levels; the live route saw every frame), each with its
+/// camera noise: measured when written, one run, 0.3 % in all three cases (the live fits of
+/// two runs differ by up to 1 % against the truth, above); asserted at the issue's 2 %.
+const AGREEMENT: f64 = 0.02;

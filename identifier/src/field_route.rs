@@ -24,7 +24,7 @@ use crate::identifiability::Identifiability;
 use crate::models::Model;
 use crate::section_cut::FieldGrid;
 use crate::tapered_ramp::RampQuadrature;
-use crate::vfm::{compile, fit_equations, CutObservation, VfmError, VfmFit, VirtualField};
+use crate::vfm::{compile_each, fit_equations, CutObservation, VfmError, VfmFit, VirtualField};
 use crate::virtual_work::Equations;
 
 /// Settings of the field route.
@@ -208,30 +208,35 @@ impl FieldRoute {
             self.placed = Some(place_fields(&self.config.layout, &grid)?);
         }
         let placed = self.placed.as_deref().unwrap_or_default();
-        let mut fields = vec![];
+        let (mut fields, mut dropped) = (vec![], vec![]);
         for p in placed
             .iter()
             .filter(|p| p.is_cut || self.config.central_ramps)
         {
-            // A node whose gradient has no stress (inverted) drops the field too.
-            let field = p
-                .ramp
-                .quadrature(&grid, material)
-                .map_err(VfmError::from)
-                .and_then(|q| compile(&[self.observation(&grid, &q, forces_n[p.grip])]).map(|_| q));
-            match field {
+            match p.ramp.quadrature(&grid, material) {
                 Ok(q) => fields.push((q, p.grip)),
-                Err(e) => {
-                    self.counters.virtual_fields_dropped += 1;
-                    self.last_dropped = Some(format!("frame {frame_id}: {e}"));
-                }
+                Err(e) => dropped.push(VfmError::from(e)),
             }
         }
+        // Compiled once: a virtual field holding a node without stress (inverted) is dropped
+        // with its reason, the others keep their equations.
         let observations: Vec<_> = fields
             .iter()
             .map(|(q, grip)| self.observation(&grid, q, forces_n[*grip]))
             .collect();
-        let equations = compile(&observations).unwrap_or_default();
+        let (equations, failures) = compile_each(&observations);
+        let mut kept = Vec::with_capacity(fields.len());
+        for (field, failure) in fields.into_iter().zip(failures) {
+            match failure {
+                None => kept.push(field),
+                Some(e) => dropped.push(e),
+            }
+        }
+        let fields = kept;
+        for why in dropped {
+            self.counters.virtual_fields_dropped += 1;
+            self.last_dropped = Some(format!("frame {frame_id}: {why}"));
+        }
         self.frames.push(FieldFrame {
             frame_id,
             grid,
@@ -598,6 +603,55 @@ mod tests {
             levels.len() as u64
         );
         assert!(route.counters.thinned > 0);
+    }
+
+    /// A node whose gradient is inverted drops the virtual fields that weigh it, and only
+    /// those: each counted, the reason kept, the frame's other fields compiled.
+    #[test]
+    fn an_inverted_node_drops_only_the_fields_holding_it() {
+        let config = config();
+        let good = grid([[1.1, 0.0], [0.0, 1.1]]);
+        let placed = place_fields(&config.layout, &good).unwrap();
+        let holds = |p: &PlacedField, at: (usize, usize)| {
+            let q = p.ramp.quadrature(&good, &everywhere).unwrap();
+            q.weighted_nodes(&good).unwrap().iter().any(|n| n.at == at)
+        };
+        // A node of the x+ arm's cut that some, not all, virtual fields weigh.
+        let cut = placed.iter().find(|p| p.is_cut && p.grip == 0).unwrap();
+        let q = cut.ramp.quadrature(&good, &everywhere).unwrap();
+        let at = q
+            .weighted_nodes(&good)
+            .unwrap()
+            .iter()
+            .map(|n| n.at)
+            .find(|&at| placed.iter().filter(|p| holds(p, at)).count() < placed.len())
+            .unwrap();
+        let holding: Vec<bool> = placed.iter().map(|p| holds(p, at)).collect();
+        let mut bad = good.clone();
+        bad.gradients[at.1 * bad.cols + at.0] = Some([[1.0, 2.0], [1.0, 2.0]]);
+        let mut route = FieldRoute::new(config);
+        assert_eq!(
+            route.push(1, Some(bad), Some([10.0; 4]), 0.1, &everywhere),
+            Ok(FrameOutcome::Kept)
+        );
+        let dropped = holding.iter().filter(|&&h| h).count();
+        assert!(dropped >= 1);
+        assert_eq!(route.counters.virtual_fields_dropped, dropped as u64);
+        let frame = &route.frames()[0];
+        let kept: Vec<_> = frame.fields.iter().map(|(q, g)| (*q.field(), *g)).collect();
+        let expected: Vec<_> = placed
+            .iter()
+            .zip(&holding)
+            .filter(|(_, &h)| !h)
+            .map(|(p, _)| (p.ramp, p.grip))
+            .collect();
+        assert_eq!(kept, expected);
+        assert_eq!(frame.equations.len(), expected.len());
+        let why = route.last_dropped.as_deref().unwrap();
+        assert!(
+            why.contains(&format!("node (col {}, row {})", at.0, at.1)) && why.contains("det F"),
+            "{why}"
+        );
     }
 
     /// Homogeneous biaxial frames whose grip forces are what the cuts carry under the true law

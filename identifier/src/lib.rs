@@ -18,6 +18,8 @@
 //! - [`field_layout`]: where the cuts and ramps go, from the cruciform and the view.
 //! - [`grip_forces`]: the grips' forces of recent rig samples, by id or by time.
 //! - [`field_route`]: the frames of a test kept for the field route, fitted together.
+//! - [`saved_fields`]: a run's saved fields, frames and rig log read for the field route
+//!   offline (`identify --fields`).
 //! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
 //! - [`plot`]: PNG plots of the data, fits, f(I1) and g(I2) (plotters, bitmap backend).
 //! - [`online`]: pairing strains with rig forces, accumulating the load path, refitting (no IPC).
@@ -53,6 +55,7 @@ pub mod report;
 pub mod residual_plot;
 pub mod residuals;
 pub mod route;
+pub mod saved_fields;
 pub mod section_cut;
 pub mod stability;
 pub mod subsample;

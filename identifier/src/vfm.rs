@@ -15,8 +15,9 @@ use crate::tapered_ramp::{RampError, RampQuadrature};
 use crate::virtual_work::{EquationInput, Equations, NodeFailure, WeightedNode};
 use nalgebra::{DMatrix, DVector};
 
-/// Condition number of the scaled Jacobian beyond which the parameters are not told apart.
-pub const MAX_CONDITION: f64 = 1e8;
+/// Condition number of the scaled Jacobian beyond which the parameters are not told apart:
+/// the gauge route's limit ([`crate::identifiability::MAX_CONDITION_NUMBER`]), one definition.
+pub const MAX_CONDITION: f64 = crate::identifiability::MAX_CONDITION_NUMBER;
 
 /// A virtual field whose work balances one arm's grip force.
 #[derive(Clone, Copy, Debug)]
@@ -107,14 +108,24 @@ pub enum VfmError {
 /// The observations' equations, compiled once for every trial law of a fit (nodes of one
 /// field grid that several virtual fields weigh are evaluated once).
 pub fn compile(obs: &[CutObservation]) -> Result<Equations, VfmError> {
+    let (equations, failures) = compile_each(obs);
+    match failures.into_iter().flatten().next() {
+        Some(failure) => Err(failure),
+        None => Ok(equations),
+    }
+}
+
+/// [`compile`], leaving out each observation that has no equation (a hole in its virtual
+/// field, a node without kinematics), its error given in its place (`None`: compiled). Each
+/// node's kinematics are computed once.
+pub fn compile_each(obs: &[CutObservation]) -> (Equations, Vec<Option<VfmError>>) {
     let mut frames: Vec<*const FieldGrid> = vec![];
-    let nodes = obs
-        .iter()
-        .map(|o| o.cut.weighted_nodes(o.grid))
-        .collect::<Result<Vec<_>, _>>()?;
+    let nodes: Vec<Result<Vec<WeightedNode>, VfmError>> =
+        obs.iter().map(|o| o.cut.weighted_nodes(o.grid)).collect();
     let inputs: Vec<EquationInput> = obs
         .iter()
         .zip(&nodes)
+        .filter_map(|(o, nodes)| Some((o, nodes.as_ref().ok()?)))
         .map(|(o, nodes)| {
             let key: *const FieldGrid = o.grid;
             let frame = frames.iter().position(|&g| g == key).unwrap_or_else(|| {
@@ -129,7 +140,16 @@ pub fn compile(obs: &[CutObservation]) -> Result<Equations, VfmError> {
             }
         })
         .collect();
-    Equations::compile(&inputs).map_err(VfmError::Node)
+    let (equations, mut compiled) = Equations::compile_each(&inputs);
+    compiled.reverse();
+    let failures = nodes
+        .into_iter()
+        .map(|n| match n {
+            Err(e) => Some(e),
+            Ok(_) => compiled.pop().flatten().map(VfmError::Node),
+        })
+        .collect();
+    (equations, failures)
 }
 
 /// Condition number of `j` with its columns scaled to unit norm.
@@ -205,6 +225,16 @@ pub fn fit_equations(
             let unit: Vec<f64> = (0..n).map(|i| f64::from(u8::from(i == k))).collect();
             let column = equations.forces_n(model, &unit)?;
             a.set_column(k, &DVector::from_vec(column));
+        }
+        // States that cannot separate the parameters: refused with the design's condition
+        // number (infinite when a column is a combination of the others), not solved.
+        let design = condition(&a);
+        if design.is_nan() || design > MAX_CONDITION {
+            return Err(VfmError::NotIdentifiable {
+                model: model.name(),
+                params: n,
+                condition: design,
+            });
         }
         linear_least_squares(&a, &measured)?
             .iter()

@@ -86,43 +86,74 @@ impl Equations {
     /// Compiles `inputs`; a node whose kinematics are not defined (not finite, inverted) is an
     /// error naming it.
     pub fn compile(inputs: &[EquationInput]) -> Result<Self, NodeFailure> {
+        let (equations, failures) = Self::compile_each(inputs);
+        match failures.into_iter().flatten().next() {
+            Some(failure) => Err(failure),
+            None => Ok(equations),
+        }
+    }
+
+    /// Compiles every input whose nodes all have kinematics, each node's once (a node that
+    /// several inputs of its frame weigh, valid or not, is computed once); an input holding a
+    /// node that has none is left out, its failure given in its place (`None`: compiled).
+    pub fn compile_each(inputs: &[EquationInput]) -> (Self, Vec<Option<NodeFailure>>) {
         let mut out = Equations {
             row_start: vec![0],
             ..Self::default()
         };
-        // (frame, node) → (distinct node, its K1 and K2).
-        let mut seen: HashMap<NodeKey, (u32, [Mat2; 2])> = HashMap::new();
+        // (frame, node) → its kinematics ((λ1, λ2), K1, K2) or why it has none.
+        type Kinematics = Result<([f64; 2], [Mat2; 2]), NodeFailure>;
+        let kinematics_of = |node: &WeightedNode| -> Kinematics {
+            let k = node_kinematics(&node.gradient).map_err(|reason| NodeFailure {
+                at: node.at,
+                reason,
+            })?;
+            let [l1, l2, _] = k.stretches;
+            Ok(([l1, l2], k.nominal_per_cauchy))
+        };
+        let mut computed: HashMap<NodeKey, Kinematics> = HashMap::new();
+        // (frame, node) → its distinct node, once an equation uses it.
+        let mut index: HashMap<NodeKey, u32> = HashMap::new();
+        let mut failures = Vec::with_capacity(inputs.len());
+        let mut resolved: Vec<(Option<NodeKey>, [f64; 2], [Mat2; 2])> = vec![];
         for input in inputs {
+            resolved.clear();
+            let mut failure = None;
             for node in input.nodes {
                 let key = (input.frame, node.at);
-                let known = if node.filled {
-                    None
+                // A filled value is not the node's own: computed for its equation alone.
+                let k = if node.filled {
+                    kinematics_of(node)
                 } else {
-                    seen.get(&key).copied()
+                    *computed.entry(key).or_insert_with(|| kinematics_of(node))
                 };
-                let (index, k) = match known {
-                    Some(found) => found,
-                    None => {
-                        let kinematics =
-                            node_kinematics(&node.gradient).map_err(|reason| NodeFailure {
-                                at: node.at,
-                                reason,
-                            })?;
-                        let [l1, l2, _] = kinematics.stretches;
-                        out.stretches.push([l1, l2]);
-                        let entry = (
-                            (out.stretches.len() - 1) as u32,
-                            kinematics.nominal_per_cauchy,
-                        );
-                        if !node.filled {
-                            seen.insert(key, entry);
-                        }
-                        entry
+                match k {
+                    Ok((stretches, k)) => {
+                        resolved.push(((!node.filled).then_some(key), stretches, k))
                     }
-                };
+                    Err(e) => {
+                        failure = Some(e);
+                        break;
+                    }
+                }
+            }
+            if failure.is_some() {
+                failures.push(failure);
+                continue;
+            }
+            for (node, &(key, stretches, k)) in input.nodes.iter().zip(&resolved) {
+                let known = key.and_then(|key| index.get(&key).copied());
+                let distinct = known.unwrap_or_else(|| {
+                    out.stretches.push(stretches);
+                    let new = (out.stretches.len() - 1) as u32;
+                    if let Some(key) = key {
+                        index.insert(key, new);
+                    }
+                    new
+                });
                 let h = input.thickness_mm;
                 out.terms.push((
-                    index,
+                    distinct,
                     [
                         h * contract(&k[0], &node.weight_mm2),
                         h * contract(&k[1], &node.weight_mm2),
@@ -131,8 +162,9 @@ impl Equations {
             }
             out.row_start.push(out.terms.len());
             out.measured_n.push(input.measured_n);
+            failures.push(None);
         }
-        Ok(out)
+        (out, failures)
     }
 
     /// Appends `other`'s equations (their nodes stay theirs).

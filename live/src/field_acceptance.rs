@@ -49,7 +49,7 @@ pub struct FieldAcceptance {
 pub fn judge_field(truth: &InvariantLaw, identification_json: &Path) -> Option<FieldAcceptance> {
     let text = std::fs::read_to_string(identification_json).ok()?;
     let json: Value = serde_json::from_str(&text).ok()?;
-    Some(compare(truth, json.get("field_route")?))
+    Some(judge_route(truth, json.get("field_route")?))
 }
 
 /// The model and parameters of one fit of the route's JSON.
@@ -103,9 +103,10 @@ impl FieldAcceptance {
     }
 }
 
-/// The acceptance of the route's JSON (`identification.json`'s `field_route`).
-pub(crate) fn compare(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
-    // The first ranked fit: one whose parameters the equations identify.
+/// The acceptance of a field route's JSON (`identification.json`'s `field_route`, or
+/// `identify --fields --json`'s): its best fit by AIC among those whose parameters the
+/// equations identify, against `truth`.
+pub fn judge_route(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
     let best = route["fits"]
         .as_array()
         .and_then(|f| f.iter().find(|fit| fit["identifiable"] != false))
@@ -176,18 +177,18 @@ mod tests {
                                      "b0": -1.02, "b1": -3.92e-3, "b2": -5.30e-4}}],
             })
         };
-        let exact = compare(&truth, &route(-1.27));
+        let exact = judge_route(&truth, &route(-1.27));
         assert!(exact.passed, "{exact:?}");
         assert_eq!(exact.model.as_deref(), Some("lambert-diani-rey:2,2"));
         assert_eq!(exact.uniaxial.unwrap().max_stretch, 1.5);
         assert_eq!(exact.equibiaxial.unwrap().max_stretch, 1.3);
         assert!(exact.pure_shear.unwrap().max_relative_error < 1e-12);
         // f 10 % stiffer: measured, not passed.
-        let off = compare(&truth, &route(-1.27 + 0.1_f64.ln_1p()));
+        let off = judge_route(&truth, &route(-1.27 + 0.1_f64.ln_1p()));
         assert!(!off.passed);
         assert!(off.uniaxial.unwrap().max_relative_error > 0.03, "{off:?}");
         // A route that fitted nothing is compared on nothing and not passed.
-        let none = compare(&truth, &json!({"error": "crosses no arm", "fits": null}));
+        let none = judge_route(&truth, &json!({"error": "crosses no arm", "fits": null}));
         assert!(!none.passed && none.uniaxial.is_none());
         assert_eq!(none.error.as_deref(), Some("crosses no arm"));
     }

@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 use wire::{FieldHeader, FieldNode, GroundTruth, RigState, StrainMeasure};
 
 /// Column names, in order.
-pub const COLUMNS: [&str; 42] = [
+pub const COLUMNS: [&str; 47] = [
     "frame_id",
     "reference_frame_id",
     "rig_sample_id",
@@ -54,6 +54,14 @@ pub const COLUMNS: [&str; 42] = [
     "latency_seen_ms",
     "correlate_ms",
     "frames_dropped",
+    // Appended (a reader of the columns above is unaffected): each grip's own force, X+, X-,
+    // Y+, Y- (the field route's external virtual work), and the frame sequence (one test),
+    // last: a row always ends with a number.
+    "force_x+_n",
+    "force_x-_n",
+    "force_y+_n",
+    "force_y-_n",
+    "sequence_id",
 ];
 
 /// The columns that compare with the ground truth: absent (not empty, not zero) from the
@@ -195,6 +203,10 @@ pub struct FrameRow {
     pub latency_seen_ms: f64,
     pub correlate_ms: f64,
     pub frames_dropped: u64,
+    /// The frame sequence (one test) of the frame.
+    pub sequence_id: u32,
+    /// Each grip's force at the frame's rig sample, N, actuators X+, X-, Y+, Y-.
+    pub grip_forces_n: Option<[f64; 4]>,
 }
 
 /// The forces (N) along x and y: the mean of each axis's two actuator forces (kN).
@@ -322,6 +334,8 @@ impl FrameRow {
             latency_seen_ms: ms(seen_ns.saturating_sub(header.t_capture_ns)),
             correlate_ms: ms(header.correlate_ns),
             frames_dropped: header.frames_dropped,
+            sequence_id: header.sequence_id,
+            grip_forces_n: rig.map(|s| std::array::from_fn(|i| 1e3 * s.actuators[i].force_kn)),
         }
     }
 
@@ -371,11 +385,18 @@ impl FrameRow {
             pair(out, self.displacement_error_px);
             pair(out, self.log_strain_error);
         }
-        let _ = writeln!(
+        let _ = write!(
             out,
             "{:.3},{:.3},{:.3},{}",
             self.latency_field_ms, self.latency_seen_ms, self.correlate_ms, self.frames_dropped
         );
+        match self.grip_forces_n {
+            Some(forces) => forces.iter().for_each(|f| {
+                let _ = write!(out, ",{f:.6}");
+            }),
+            None => out.push_str(",,,,"),
+        }
+        let _ = writeln!(out, ",{}", self.sequence_id);
     }
 }
 
@@ -396,6 +417,7 @@ mod tests {
         let mut header = FieldHeader {
             frame_id: 12,
             rig_sample_id: 40,
+            sequence_id: 3,
             t_capture_ns: 2_000_000_000,
             t_published_ns: 2_050_000_000,
             has_truth: 1,
@@ -453,6 +475,10 @@ mod tests {
         };
         assert_eq!(cell(&line, "target_log_exx"), "");
         assert_eq!(cell(&line, "target_log_eyy"), "");
+        // Each grip's own force and the frame's test, for the field route offline.
+        assert_eq!(cell(&line, "force_x+_n"), "100.000000");
+        assert_eq!(cell(&line, "force_y-_n"), "0.000000");
+        assert_eq!(cell(&line, "sequence_id"), "3");
         // Under strain control (or held), the rig sample's target fills both cells.
         rig.control_mode = wire::RigControl::Held as u32;
         rig.target_log_exx = 0.405_465_1;

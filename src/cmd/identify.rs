@@ -60,9 +60,20 @@ pub struct IdentifyArgs {
     /// both stresses are fitted, with the other files if given.
     #[arg(long = "biaxial-general", value_name = "F.csv")]
     pub biaxial_general: Option<PathBuf>,
-    /// Models: NAME[,NAME...] (e.g. mooney,ogden:3,rivlin:10,01,11) or `all`.
-    #[arg(long, default_value = "all")]
-    pub model: String,
+    /// Models: NAME[,NAME...] (e.g. mooney,ogden:3,rivlin:10,01,11) or `all` (the default;
+    /// with `--fields`, the run's `[identifier] models`).
+    #[arg(long)]
+    pub model: Option<String>,
+    /// A run's results folder: fit its saved fields (`fields/field_<frame>.csv` with each
+    /// node's gradient) against the grips' forces (`frames.csv`) by the virtual fields method,
+    /// the live field route's own code, with the run's camera view and cruciform
+    /// (`config.toml`).
+    #[arg(long, value_name = "DIR")]
+    pub fields: Option<PathBuf>,
+    /// With `--fields`: the grips' forces from this rig log (`t_s`, `X+_force_n` ...
+    /// `Y-_force_n`), at each frame's rig time, instead of `frames.csv`'s.
+    #[arg(long, value_name = "rig.csv", requires = "fields")]
+    pub forces: Option<PathBuf>,
     /// Residual measure of the fit.
     #[arg(long, value_enum, default_value = "absolute")]
     pub residual: ResidualArg,
@@ -120,6 +131,9 @@ pub fn run_with(
     err: &mut dyn Write,
     progress: bool,
 ) -> anyhow::Result<()> {
+    if let Some(dir) = &args.fields {
+        return super::identify_fields::run(&args, dir, out, err);
+    }
     let (curves, states) = read_data(&args)?;
     let all = FitData {
         curves: &curves,
@@ -239,7 +253,7 @@ fn fit(
     err: &mut dyn Write,
     progress: bool,
 ) -> anyhow::Result<Outcome> {
-    let models = parse_model_list(&args.model)?;
+    let models = parse_model_list(args.model.as_deref().unwrap_or("all"))?;
     let options = FitOptions {
         residual: match args.residual {
             ResidualArg::Absolute => ResidualKind::Absolute,
@@ -518,7 +532,7 @@ mod tests {
                 biaxial: Some(self.0.join("b.csv")),
                 pure_shear: None,
                 biaxial_general: None,
-                model: "mooney,ogden:2".into(),
+                model: Some("mooney,ogden:2".into()),
                 residual: ResidualArg::Absolute,
                 json,
                 plot: None,
@@ -528,6 +542,8 @@ mod tests {
                 gauge_length_mm: None,
                 section_mm2: None,
                 threads: 2,
+                fields: None,
+                forces: None,
             }
         }
     }
@@ -678,7 +694,7 @@ mod tests {
             biaxial: None,
             pure_shear: None,
             biaxial_general: Some(path),
-            model: model.into(),
+            model: Some(model.into()),
             residual: ResidualArg::Absolute,
             json: true,
             plot: None,
@@ -688,6 +704,8 @@ mod tests {
             gauge_length_mm: None,
             section_mm2: None,
             threads: 1,
+            fields: None,
+            forces: None,
         }
     }
 
@@ -801,7 +819,7 @@ mod tests {
         let data = Data::new("loose", 60);
         let mut args = data.args(true, 1_000);
         args.biaxial = None;
-        args.model = "ogden:3,mooney".into();
+        args.model = Some("ogden:3,mooney".into());
         args.cards = Some(data.0.join("cards"));
         args.plot = Some(data.0.join("plots"));
         let (out, err) = run_captured(args, false);

@@ -7,6 +7,7 @@ pub mod correlate;
 pub mod correlator;
 pub mod identifier;
 pub mod identify;
+pub mod identify_fields;
 pub mod log_rows;
 pub mod monitor;
 pub mod named_arg;

@@ -10,8 +10,9 @@
 //! its `identification.json` counts only what it saw.
 
 use super::ProcessError;
-use crate::field_layout::ArmLayout;
+use crate::field_layout::{ArmLayout, LayoutError};
 use crate::field_route::{FieldFits, FieldRoute, FieldRouteConfig, FitJob, FrameOutcome};
+use crate::field_stress::Mat2;
 use crate::grip_forces::{ForceHistory, GripForces};
 use crate::models::Model;
 use crate::section_cut::FieldGrid;
@@ -75,12 +76,88 @@ fn ms(ns: &[u64]) -> Value {
     json!({"count": ns.len(), "mean": mean, "max": max})
 }
 
-pub(super) struct FieldShell {
-    route: FieldRoute,
-    history: ForceHistory,
+/// The field route fed with frames as the camera saw them: node px mapped to specimen mm
+/// through the camera's view, the specimen's outline, each frame's loading level. The one
+/// feed of the route, live (the identifier process) and offline (`identify --fields`:
+/// `crate::saved_fields`).
+pub struct FieldFeed {
+    pub route: FieldRoute,
     view: View,
     mesh: membrane::Mesh,
     elements: membrane::ElementGrid,
+}
+
+impl FieldFeed {
+    /// Kept frames before the first fit.
+    pub const MIN_FRAMES_TO_FIT: usize = 3;
+
+    pub fn new(
+        settings: &FieldRouteSettings,
+        models: &[Model],
+    ) -> Result<Self, membrane::GeometryError> {
+        let specimen = settings.cruciform.mesh()?;
+        let elements = membrane::ElementGrid::new(&specimen.mesh);
+        let c = &settings.cruciform;
+        Ok(Self {
+            route: FieldRoute::new(FieldRouteConfig {
+                layout: ArmLayout {
+                    arm_width_mm: c.arm_width_mm,
+                    fillet_radius_mm: c.fillet_radius_mm,
+                },
+                thickness_mm: c.thickness_mm,
+                models: models.to_vec(),
+                min_level_increment: settings.min_level_increment,
+                max_frames: settings.max_frames,
+                min_frames_to_fit: Self::MIN_FRAMES_TO_FIT,
+                central_ramps: true,
+            }),
+            view: View::centred(settings.mm_per_px, settings.width_px, settings.height_px),
+            mesh: specimen.mesh,
+            elements,
+        })
+    }
+
+    /// A grid of `cols` x `rows` nodes `step_px` apart from `first_px` (the first node, in its
+    /// origin image) in specimen mm, each node's F (None: not measured).
+    pub fn grid(
+        &self,
+        first_px: [f64; 2],
+        step_px: f64,
+        (cols, rows): (usize, usize),
+        gradients: Vec<Option<Mat2>>,
+    ) -> FieldGrid {
+        let origin = self.view.to_mm(first_px);
+        let next = self.view.to_mm([first_px[0] + step_px, first_px[1]]);
+        FieldGrid {
+            cols,
+            rows,
+            x0_mm: origin[0],
+            y0_mm: origin[1],
+            step_mm: next[0] - origin[0],
+            gradients,
+        }
+    }
+
+    /// Offers frame `frame_id` of test `sequence` to the route (its loading level the mean
+    /// stretching of its measured nodes, its material the specimen's outline).
+    pub fn offer(
+        &mut self,
+        frame_id: u64,
+        sequence: u32,
+        grid: Option<FieldGrid>,
+        forces_n: Option<[f64; 4]>,
+    ) -> Result<FrameOutcome, LayoutError> {
+        let level = grid.as_ref().map_or(0.0, mean_stretching);
+        let (mesh, elements) = (&self.mesh, &self.elements);
+        let material = |x: [f64; 2]| elements.locate(mesh, x).is_some();
+        self.route.set_sequence(sequence);
+        self.route.push(frame_id, grid, forces_n, level, &material)
+    }
+}
+
+pub(super) struct FieldShell {
+    feed: FieldFeed,
+    history: ForceHistory,
     /// Why the route stopped (a view that crosses no arm), said once.
     error: Option<String>,
     fits: Option<FieldFits>,
@@ -95,26 +172,9 @@ pub(super) struct FieldShell {
 
 impl FieldShell {
     pub fn new(settings: &FieldRouteSettings, models: &[Model]) -> Result<Self, ProcessError> {
-        let specimen = settings.cruciform.mesh()?;
-        let elements = membrane::ElementGrid::new(&specimen.mesh);
-        let c = &settings.cruciform;
         Ok(Self {
-            route: FieldRoute::new(FieldRouteConfig {
-                layout: ArmLayout {
-                    arm_width_mm: c.arm_width_mm,
-                    fillet_radius_mm: c.fillet_radius_mm,
-                },
-                thickness_mm: c.thickness_mm,
-                models: models.to_vec(),
-                min_level_increment: settings.min_level_increment,
-                max_frames: settings.max_frames,
-                min_frames_to_fit: 3,
-                central_ramps: true,
-            }),
+            feed: FieldFeed::new(settings, models)?,
             history: ForceHistory::default(),
-            view: View::centred(settings.mm_per_px, settings.width_px, settings.height_px),
-            mesh: specimen.mesh,
-            elements,
             error: None,
             fits: None,
             dirty: false,
@@ -147,10 +207,6 @@ impl FieldShell {
             return None;
         }
         let first = [f64::from(nodes[0].x_px), f64::from(nodes[0].y_px)];
-        let origin = self.view.to_mm(first);
-        let next = self
-            .view
-            .to_mm([first[0] + f64::from(header.step_px), first[1]]);
         let gradients = nodes
             .iter()
             .map(|n| {
@@ -162,14 +218,10 @@ impl FieldShell {
                 })
             })
             .collect();
-        Some(FieldGrid {
-            cols,
-            rows,
-            x0_mm: origin[0],
-            y0_mm: origin[1],
-            step_mm: next[0] - origin[0],
-            gradients,
-        })
+        Some(
+            self.feed
+                .grid(first, f64::from(header.step_px), (cols, rows), gradients),
+        )
     }
 
     pub fn on_field(&mut self, header: &FieldHeader, nodes: &[FieldNode]) {
@@ -181,13 +233,9 @@ impl FieldShell {
         let grid = self.grid(header, nodes);
         let sample = (header.rig_sample_id != wire::NO_RIG_SAMPLE).then_some(header.rig_sample_id);
         let forces = self.history.find(sample, header.t_capture_ns);
-        let level = grid.as_ref().map_or(0.0, mean_stretching);
-        let (mesh, elements) = (&self.mesh, &self.elements);
-        let material = |x: [f64; 2]| elements.locate(mesh, x).is_some();
-        self.route.set_sequence(header.sequence_id);
         match self
-            .route
-            .push(header.frame_id, grid, forces, level, &material)
+            .feed
+            .offer(header.frame_id, header.sequence_id, grid, forces)
         {
             Ok(FrameOutcome::Kept) => self.dirty = true,
             Ok(_) => {}
@@ -215,7 +263,7 @@ impl FieldShell {
         }
         if now {
             if self.dirty {
-                if let Some(job) = self.route.fit_job() {
+                if let Some(job) = self.feed.route.fit_job() {
                     self.dirty = false;
                     report = Some(self.finished(run_timed(&job), job.last_frame_id));
                 }
@@ -224,7 +272,7 @@ impl FieldShell {
         }
         let due = self.last_fit.is_none_or(|t| t.elapsed() >= REFIT_INTERVAL);
         if self.running.is_none() && self.dirty && due {
-            if let Some(mut job) = self.route.fit_job() {
+            if let Some(mut job) = self.feed.route.fit_job() {
                 job.warm_starts = self.fits.as_ref().map_or(vec![], |fits| {
                     fits.fits
                         .iter()
@@ -242,7 +290,7 @@ impl FieldShell {
                     // No thread to be had: fit here, once, rather than never.
                     Err(e) => {
                         eprintln!("identifier: field route: no thread for the fit ({e}): fitting in the loop");
-                        let job = self.route.fit_job()?;
+                        let job = self.feed.route.fit_job()?;
                         return Some(self.finished(run_timed(&job), job.last_frame_id));
                     }
                 }
@@ -277,34 +325,50 @@ impl FieldShell {
     /// The route's part of `identification.json`.
     pub fn json(&self) -> Value {
         let fits = self.fits.as_ref();
-        json!({
+        let mut out = json!({
             "error": self.error,
-            "counters": self.route.counters,
-            "last_dropped": self.route.last_dropped,
-            "frames": fits.map(|f| f.frames),
-            "max_stretches": fits.map(|f| f.max_stretches),
-            "fits": fits.map(|f| f.fits.iter().map(|fit| {
-                let names = fit.model.param_names();
-                json!({
-                    "model": fit.model.name(),
-                    "params": names.iter().cloned().zip(fit.fit.params.iter().map(|v| json!(v))).collect::<serde_json::Map<String, Value>>(),
-                    "sigma": names.iter().cloned().zip(fit.fit.sigma.iter().map(|s| json!(s.is_finite().then_some(*s)))).collect::<serde_json::Map<String, Value>>(),
-                    "rms_n": fit.fit.rms_n,
-                    "equations": fit.fit.equations,
-                    "condition": fit.fit.condition,
-                    "aic": fit.aic,
-                    "identifiable": fit.ranked(),
-                    "warning": fit.identifiability.warning(),
-                })
-            }).collect::<Vec<_>>()),
-            "refused": fits.map(|f| f.refused.iter().map(|(m, why)| json!({"model": m, "why": why})).collect::<Vec<_>>()),
+            "counters": self.feed.route.counters,
+            "last_dropped": self.feed.route.last_dropped,
             "cost_ms": {
                 "prepare_per_field": ms(&self.cost.prepare_ns),
                 "fit_all_frames": ms(&self.cost.fit_ns),
                 "correlator_per_field": ms(&self.cost.correlate_ns),
             },
-        })
+        });
+        let fitted = fits.map_or(
+            json!({"frames": null, "max_stretches": null, "fits": null, "refused": null}),
+            fits_json,
+        );
+        if let (Some(out), Value::Object(fitted)) = (out.as_object_mut(), fitted) {
+            out.extend(fitted);
+        }
+        out
     }
+}
+
+/// The fits' part of the field route's JSON: frames, the stretches reached, each fit
+/// (parameters, σ, RMS force, equations, condition number, AIC; best first) and the models
+/// refused with why. `identification.json`'s `field_route` and `identify --fields --json`.
+pub fn fits_json(fits: &FieldFits) -> Value {
+    json!({
+        "frames": fits.frames,
+        "max_stretches": fits.max_stretches,
+        "fits": fits.fits.iter().map(|fit| {
+            let names = fit.model.param_names();
+            json!({
+                "model": fit.model.name(),
+                "params": names.iter().cloned().zip(fit.fit.params.iter().map(|v| json!(v))).collect::<serde_json::Map<String, Value>>(),
+                "sigma": names.iter().cloned().zip(fit.fit.sigma.iter().map(|s| json!(s.is_finite().then_some(*s)))).collect::<serde_json::Map<String, Value>>(),
+                "rms_n": fit.fit.rms_n,
+                "equations": fit.fit.equations,
+                "condition": fit.fit.condition,
+                "aic": fit.aic,
+                "identifiable": fit.ranked(),
+                "warning": fit.identifiability.warning(),
+            })
+        }).collect::<Vec<_>>(),
+        "refused": fits.refused.iter().map(|(m, why)| json!({"model": m, "why": why})).collect::<Vec<_>>(),
+    })
 }
 
 /// A fit on its own thread (its fits and duration, ns) and the last frame it fits.

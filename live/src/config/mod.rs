@@ -428,6 +428,20 @@ impl RunConfig {
         toml::to_string_pretty(self).expect("the run configuration serialises")
     }
 
+    /// The field route's settings of this run: the camera's view and the cruciform filmed
+    /// (the identifier's, and `identify --fields` on the run's results).
+    pub fn field_route_settings(&self) -> identifier::process::FieldRouteSettings {
+        use identifier::process::FieldRouteSettings;
+        FieldRouteSettings {
+            mm_per_px: self.camera.mm_per_px,
+            width_px: self.camera.width_px,
+            height_px: self.camera.height_px,
+            cruciform: self.specimen.geometry.cruciform,
+            min_level_increment: FieldRouteSettings::DEFAULT_LEVEL_INCREMENT,
+            max_frames: FieldRouteSettings::DEFAULT_MAX_FRAMES,
+        }
+    }
+
     /// Largest stretch any test reaches: the camera's pattern must cover it.
     pub fn max_stretch(&self) -> f64 {
         self.rig.tests.iter().map(|t| t.stretch).fold(1.0, f64::max)

@@ -239,15 +239,7 @@ pub fn identifier_settings(
         field: config
             .identifier_routes()
             .runs(wire::identification::ReportRoute::Field)
-            .then_some(identifier::process::FieldRouteSettings {
-                mm_per_px: config.camera.mm_per_px,
-                width_px: config.camera.width_px,
-                height_px: config.camera.height_px,
-                cruciform: config.specimen.geometry.cruciform,
-                min_level_increment:
-                    identifier::process::FieldRouteSettings::DEFAULT_LEVEL_INCREMENT,
-                max_frames: identifier::process::FieldRouteSettings::DEFAULT_MAX_FRAMES,
-            }),
+            .then(|| config.field_route_settings()),
     }
 }
 

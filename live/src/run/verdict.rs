@@ -131,7 +131,7 @@ fn unwritten(verdict: Verdict, notes: &[String]) -> Verdict {
 mod tests {
     use super::*;
     use crate::acceptance::{accept, accept_path, true_law};
-    use crate::field_acceptance::compare;
+    use crate::field_acceptance::judge_route as compare;
     use identifier::law::InvariantLaw;
 
     /// A run that ended as `ending`, with nothing else known.
