@@ -17,6 +17,7 @@ pub const SHORT_CAMPAIGN: &str =
 pub fn config(run: &Run, run_keys: &str, extra: &str) -> PathBuf {
     // The tests of faults, files and viewers run on the analytic sheet, light and judged by
     // its gauge; the structure's own tests (structure_run.rs, field_route.rs) name theirs.
+    // Last: `extra` may start with keys of `[rig]`.
     let specimen = match extra.contains("[specimen]") {
         true => "",
         false => "[specimen]\nmodel = \"homogeneous\"\n",
@@ -25,7 +26,7 @@ pub fn config(run: &Run, run_keys: &str, extra: &str) -> PathBuf {
         "[run]\nresults_dir = \"{}\"\nstatus_interval_s = 0.5\n{run_keys}\n\
          [camera]\nwidth_px = 256\nheight_px = 256\nfps = 10.0\n\
          [correlator]\nthreads = 1\n\
-         [rig]\npublish_hz = 100.0\nlog_hz = 20.0\n{specimen}{extra}",
+         [rig]\npublish_hz = 100.0\nlog_hz = 20.0\n{extra}\n{specimen}",
         run.dir.join("results").display()
     );
     let path = run.dir.join("bench.toml");
