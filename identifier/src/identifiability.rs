@@ -16,8 +16,11 @@ pub struct Identifiability {
     /// Condition number of the column-scaled Jacobian at the fitted parameters (∞ when a
     /// parameter has no effect).
     pub condition_number: f64,
-    /// The parameters whose σ is not below |value| (or unknown: JᵀJ singular).
+    /// The parameters whose σ (times `sigmas`) is not below |value| (or unknown: JᵀJ
+    /// singular).
     pub loose_params: Vec<String>,
+    /// Standard deviations |value| must exceed (1 for the gauge route).
+    pub sigmas: f64,
 }
 
 impl Identifiability {
@@ -28,15 +31,29 @@ impl Identifiability {
         stderr: &[Option<f64>],
         condition_number: f64,
     ) -> Identifiability {
+        Self::with_sigmas(names, values, stderr, condition_number, 1.0)
+    }
+
+    /// As [`Identifiability::new`], a parameter identified only when `sigmas` standard
+    /// deviations stay below its magnitude (the field route asks for 2: see
+    /// `field_route::SIGMAS_PER_VALUE`).
+    pub fn with_sigmas(
+        names: &[String],
+        values: &[f64],
+        stderr: &[Option<f64>],
+        condition_number: f64,
+        sigmas: f64,
+    ) -> Identifiability {
         let loose_params = names
             .iter()
             .zip(values.iter().zip(stderr))
-            .filter(|(_, (v, s))| s.is_none_or(|s| s.is_nan() || s >= v.abs()))
+            .filter(|(_, (v, s))| s.is_none_or(|s| s.is_nan() || sigmas * s >= v.abs()))
             .map(|(n, _)| n.clone())
             .collect();
         Identifiability {
             condition_number,
             loose_params,
+            sigmas,
         }
     }
 
@@ -51,7 +68,14 @@ impl Identifiability {
         }
         let mut why = Vec::new();
         if !self.loose_params.is_empty() {
-            why.push(format!("σ ≥ |value| for {}", self.loose_params.join(", ")));
+            let sigma = match self.sigmas {
+                1.0 => "σ".to_string(),
+                k => format!("{k}σ"),
+            };
+            why.push(format!(
+                "{sigma} ≥ |value| for {}",
+                self.loose_params.join(", ")
+            ));
         }
         if self.condition_number.is_nan() || self.condition_number > MAX_CONDITION_NUMBER {
             why.push(format!(
