@@ -36,7 +36,7 @@ fn the_default_run_films_the_cruciform_and_its_field_decides() {
     assert_eq!(truth["fields_without_truth"], 0, "{truth}");
     let p99 = truth["node_error_p99_px"].as_f64().unwrap();
     // The cruciform's fillets are the steepest part of the field (about 0.11 px at p99 on
-    // the default campaign, 0.055 px on the homogeneous sheet): a bound well above that,
+    // the default campaign, 0.046 px on the homogeneous sheet): a bound well above that,
     // far below a node lost to a false match (several px).
     assert!(p99 < 0.2, "node error p99 {p99} px\n{truth}");
     // The field route decides: its law, compared over the stretches the field reached.
