@@ -20,6 +20,17 @@ pub struct GripForces {
     pub forces_n: [f64; 4],
 }
 
+/// The grips' forces on the specimen at a rig sample of test kind `load_case`: a uniaxial test
+/// pulls the strip, held by the x grips alone, so the y actuators hold no specimen and what
+/// they read is their own noise, not a force on it: 0 N (the route then leaves the frame out:
+/// grips at rest, another specimen than the cruciform). The live route and `identify
+/// --fields` both take their forces through it.
+pub fn on_specimen(load_case: u32, forces_n: [f64; 4]) -> [f64; 4] {
+    let strip = load_case == wire::rig::LOAD_CASE_UNIAXIAL;
+    let holds = |i: usize| !strip || crate::field_layout::GRIPS[i].starts_with('x');
+    std::array::from_fn(|i| if holds(i) { forces_n[i] } else { 0.0 })
+}
+
 /// The last [`HISTORY`] samples, in arrival order.
 #[derive(Debug, Default)]
 pub struct ForceHistory {

@@ -256,6 +256,8 @@ pub struct FrameInfo {
     pub line: usize,
     /// The frame's test (0 in a `frames.csv` written before the column was).
     pub sequence: u32,
+    /// The test's kind at the frame's rig sample (`RigState::load_case`; 0 when unknown).
+    pub load_case: u32,
     /// The rig's simulated time at the frame's sample, s (None: no rig sample).
     pub t_rig_s: Option<f64>,
     /// Each grip's force, N, X+, X-, Y+, Y- (None: empty cells, no rig sample).
@@ -281,6 +283,7 @@ pub fn read_frames(path: &Path) -> Result<Frames, DataError> {
     let id = column(&table, "frame_id", "each row's frame")?;
     let find = |name: &str| table.find(|c| c == name);
     let sequence = find("sequence_id")?;
+    let load_case = find("load_case")?;
     let t_sim = find("t_sim_s")?;
     let grips = GRIP_COLUMNS
         .iter()
@@ -317,6 +320,7 @@ pub fn read_frames(path: &Path) -> Result<Frames, DataError> {
             FrameInfo {
                 line: row.line,
                 sequence: optional(sequence)?.map_or(0, |s| s as u32),
+                load_case: optional(load_case)?.map_or(0, |c| c as u32),
                 t_rig_s: optional(t_sim)?,
                 forces_n: forces,
             },
@@ -444,7 +448,10 @@ pub fn frame_forces(
             })?
         }
     };
-    Ok((info.sequence, forces))
+    Ok((
+        info.sequence,
+        crate::grip_forces::on_specimen(info.load_case, forces),
+    ))
 }
 
 #[cfg(test)]

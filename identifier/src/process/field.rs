@@ -186,15 +186,13 @@ impl FieldShell {
 
     pub fn on_rig(&mut self, state: &RigState) {
         let a = &state.actuators;
-        // A uniaxial test pulls the strip, held by the x grips alone: the y actuators hold no
-        // specimen, and what they read is their own noise, not a force on it (the route then
-        // leaves the frame out: grips at rest, another specimen than the cruciform).
-        let strip = state.load_case == wire::rig::LOAD_CASE_UNIAXIAL;
-        let holds = |i: usize| !strip || crate::field_layout::GRIPS[i].starts_with('x');
         self.history.push(GripForces {
             sample_id: state.sample_id,
             t_ns: state.t_published_ns,
-            forces_n: std::array::from_fn(|i| if holds(i) { 1e3 * a[i].force_kn } else { 0.0 }),
+            forces_n: crate::grip_forces::on_specimen(
+                state.load_case,
+                std::array::from_fn(|i| 1e3 * a[i].force_kn),
+            ),
         });
     }
 
