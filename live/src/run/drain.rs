@@ -48,7 +48,8 @@ impl Run<'_> {
             self.subscriptions.drain(&mut self.recorder)?;
         }
         self.supervisor.stop(Role::Identifier, self.stop_timeout());
-        self.subscriptions.drain(&mut self.recorder)?;
+        self.subscriptions
+            .drain_all(&mut self.recorder, super::stop::FINAL_DRAIN_ROUNDS)?;
         Ok(true)
     }
 }

@@ -10,6 +10,10 @@ use crate::recorder::Recorder;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
+/// Drains after the children stopped: the queues hold what they published last, a few rounds
+/// of [`crate::subscriptions::Subscriptions::drain`] at most.
+pub(super) const FINAL_DRAIN_ROUNDS: usize = 16;
+
 /// Stops in the order data flows: the source first, each consumer after.
 const STOP_ORDER: [Role; 4] = [
     Role::Rig,
@@ -62,7 +66,7 @@ impl<'a> Run<'a> {
             eprintln!("run: stopped {} ({how})", role.name());
         }
         // Samples published while stopping (last fields, last report).
-        let _ = subscriptions.drain(&mut recorder);
+        let _ = subscriptions.drain_all(&mut recorder, FINAL_DRAIN_ROUNDS);
         drop(subscriptions);
         drop(node);
         let signal = wire::signals::requested();
