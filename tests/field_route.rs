@@ -45,6 +45,9 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
         serde_json::to_string_pretty(&summary["acceptance"]).unwrap()
     );
     assert!(field["error"].is_null(), "{field}");
+    // The identified law drawn against the true one.
+    let figure = std::fs::metadata(out.join("field_route_law.png")).map(|m| m.len());
+    assert!(figure.as_ref().is_ok_and(|&bytes| bytes > 1000), "{figure:?}");
     let counters = &field["counters"];
     // The frames kept stay spread over the loading (thinned at `DEFAULT_MAX_FRAMES`).
     assert!(field["frames"].as_u64().unwrap() >= 10, "{field}");

@@ -70,6 +70,19 @@ pub fn chart(
     y_desc: &str,
     series: &[Series],
 ) -> Result<(), PlotError> {
+    chart_paired(path, title, x_desc, y_desc, series, false)
+}
+
+/// [`chart`], where with `paired` a series of markers takes the colour of the line just
+/// before it (a model's points against its reference curve) instead of black (data).
+pub fn chart_paired(
+    path: &Path,
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[Series],
+    paired: bool,
+) -> Result<(), PlotError> {
     let err = |e: &dyn std::fmt::Display| PlotError(format!("{}: {e}", path.display()));
     let Some((x0, x1, y0, y1)) = bounds(series) else {
         return Err(PlotError(format!("{}: nothing to plot", path.display())));
@@ -109,10 +122,10 @@ pub fn chart(
             .map_err(|e| err(&e))?;
         }
         for (k, s) in series.iter().enumerate() {
-            let color = if s.markers {
-                BLACK
-            } else {
-                PALETTE[k % PALETTE.len()]
+            let color = match (s.markers, paired) {
+                (true, true) if k > 0 => PALETTE[(k - 1) % PALETTE.len()],
+                (true, _) => BLACK,
+                (false, _) => PALETTE[k % PALETTE.len()],
             };
             let pts: Vec<(f64, f64)> = s
                 .points
@@ -130,9 +143,15 @@ pub fn chart(
                     .map_err(|e| err(&e))?
             };
             if text {
-                drawn.label(s.label.clone()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
-                });
+                let labelled = drawn.label(s.label.clone());
+                // The legend shows what the series draws: a marker or a line.
+                if s.markers {
+                    labelled.legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
+                } else {
+                    labelled.legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+                    });
+                }
             }
         }
         if text {

@@ -13,6 +13,7 @@ pub mod children;
 pub mod config;
 pub mod dashboard_view;
 pub mod field_acceptance;
+pub mod field_route_figure;
 pub mod figures;
 pub mod frames;
 pub mod latency;

@@ -1,0 +1,164 @@
+//! `field_route_law.png`: the law the field route identified against the specimen's true one,
+//! in uniaxial, equibiaxial and pure-shear nominal stress over the stretches the field reached
+//! (issue 25, deliverable 3's curves): the figure of what [`crate::field_acceptance`] judges,
+//! so a user sees where along each curve the identified law departs from the truth.
+
+use crate::field_acceptance::FieldAcceptance;
+use identifier::data::LoadCase;
+use identifier::law::InvariantLaw;
+use identifier::models::Model;
+use identifier::plot::{chart_paired, Series};
+use std::path::Path;
+
+/// Stretches per true curve (a line).
+const LINE_SAMPLES: usize = 100;
+/// Stretches per identified curve (markers, sparse enough to see the line under them).
+const MARKER_SAMPLES: usize = 20;
+
+/// The three canonical cases, each with the true law's nominal stress (MPa) at a stretch.
+type TrueCurve = fn(&InvariantLaw, f64) -> f64;
+const CASES: [(&str, LoadCase, TrueCurve); 3] = [
+    (
+        "uniaxial",
+        LoadCase::Uniaxial,
+        InvariantLaw::uniaxial_nominal_stress_mpa,
+    ),
+    (
+        "equibiaxial",
+        LoadCase::Equibiaxial,
+        InvariantLaw::equibiaxial_nominal_stress_mpa,
+    ),
+    (
+        "pure shear",
+        LoadCase::PureShear,
+        InvariantLaw::pure_shear_nominal_stress_mpa,
+    ),
+];
+
+/// Stretches 1..=max in `samples` steps.
+fn stretches(max: f64, samples: usize) -> impl Iterator<Item = f64> {
+    (0..=samples).map(move |k| 1.0 + (max - 1.0) * k as f64 / samples as f64)
+}
+
+/// The figure's series: per case the field reached, the true law (line) and the identified
+/// one (markers, in the line's colour); empty when the route identified no law or reached no stretch.
+pub fn series(truth: &InvariantLaw, acceptance: &FieldAcceptance) -> Vec<Series> {
+    let (Some(name), Some([major, minor])) = (&acceptance.model, acceptance.max_stretches) else {
+        return Vec::new();
+    };
+    let Ok(model) = Model::parse(name) else {
+        return Vec::new();
+    };
+    let p = &acceptance.params;
+    let mut out = Vec::new();
+    for (case_name, case, true_curve) in CASES {
+        // As the acceptance compares them: equibiaxial up to the minor stretch reached.
+        let max = if case == LoadCase::Equibiaxial {
+            minor
+        } else {
+            major
+        };
+        if max <= 1.005 {
+            continue;
+        }
+        out.push(Series {
+            label: format!("{case_name}: true law"),
+            points: stretches(max, LINE_SAMPLES)
+                .map(|l| (l, true_curve(truth, l)))
+                .collect(),
+            markers: false,
+        });
+        out.push(Series {
+            label: format!("{case_name}: field route ({name})"),
+            points: stretches(max, MARKER_SAMPLES)
+                .filter_map(|l| Some((l, model.nominal_stress_mpa(p, case, l)?)))
+                .filter(|(_, s)| s.is_finite())
+                .collect(),
+            markers: true,
+        });
+    }
+    out
+}
+
+/// Writes `field_route_law.png`; false (no file) when the route identified no law.
+pub fn field_route_law_png(
+    path: &Path,
+    truth: &InvariantLaw,
+    acceptance: &FieldAcceptance,
+) -> anyhow::Result<bool> {
+    let series = series(truth, acceptance);
+    if series.is_empty() {
+        return Ok(false);
+    }
+    let frames = acceptance.frames.unwrap_or(0);
+    chart_paired(
+        path,
+        &format!("field route's law against the true one ({frames} frames)"),
+        "stretch λ",
+        "nominal stress (MPa)",
+        &series,
+        true,
+    )?;
+    Ok(true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field_acceptance::judge_route;
+    use serde_json::json;
+
+    fn acceptance(max_stretches: [f64; 2]) -> FieldAcceptance {
+        judge_route(
+            &InvariantLaw::smactane(),
+            &json!({
+                "frames": 12,
+                "max_stretches": max_stretches,
+                "fits": [{"model": "mooney", "params": {"C10": 0.3, "C01": 0.05}}],
+            }),
+        )
+    }
+
+    #[test]
+    fn each_case_reached_has_its_true_line_and_the_identified_markers() {
+        let truth = InvariantLaw::smactane();
+        let series = series(&truth, &acceptance([1.6, 1.3]));
+        let labels: Vec<&str> = series.iter().map(|s| s.label.as_str()).collect();
+        assert_eq!(
+            labels,
+            [
+                "uniaxial: true law",
+                "uniaxial: field route (mooney)",
+                "equibiaxial: true law",
+                "equibiaxial: field route (mooney)",
+                "pure shear: true law",
+                "pure shear: field route (mooney)",
+            ]
+        );
+        // Each over the stretches the acceptance compares: equibiaxial to the minor one.
+        let last_x = |s: &Series| s.points.last().unwrap().0;
+        assert!((last_x(&series[0]) - 1.6).abs() < 1e-12);
+        assert!((last_x(&series[3]) - 1.3).abs() < 1e-12);
+        assert!(series[1].markers && !series[0].markers);
+        // The true line is the law's: at λ 1.6 in uniaxial tension.
+        let (l, s) = *series[0].points.last().unwrap();
+        assert!((s - truth.uniaxial_nominal_stress_mpa(l)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_png_is_written_and_nothing_identified_writes_none() {
+        let dir = std::env::temp_dir().join(format!("field_route_law_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let png = dir.join("field_route_law.png");
+        let truth = InvariantLaw::smactane();
+        assert!(field_route_law_png(&png, &truth, &acceptance([1.6, 1.3])).unwrap());
+        assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+        std::fs::remove_file(&png).unwrap();
+        let nothing = judge_route(&truth, &json!({"error": "crosses no arm", "fits": null}));
+        assert!(!field_route_law_png(&png, &truth, &nothing).unwrap());
+        assert!(!png.exists());
+        // At rest: no stretch reached, no figure.
+        assert!(!field_route_law_png(&png, &truth, &acceptance([1.0, 1.0])).unwrap());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
