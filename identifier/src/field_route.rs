@@ -19,7 +19,7 @@
 //! Each kept frame's equations are compiled when it is kept (`virtual_work::Equations`); a fit
 //! ([`FieldRoute::fit_job`]) owns their concatenation and may run on another thread.
 
-use crate::field_layout::{place_fields, ArmLayout, LayoutError, PlacedField};
+use crate::field_layout::{place_fields, ArmLayout, LayoutError, PlacedField, GRIPS};
 use crate::identifiability::Identifiability;
 use crate::models::Model;
 use crate::section_cut::FieldGrid;
@@ -342,6 +342,51 @@ impl FieldRoute {
             }
         }
         range
+    }
+}
+
+/// One kept frame's force balance on one grip: the grip's measured force, and the force its
+/// virtual fields compute from the field under a law (their mean; each balances that grip's
+/// force alone).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct GripBalance {
+    pub frame_id: u64,
+    pub grip: &'static str,
+    pub measured_n: f64,
+    pub computed_n: f64,
+    /// The grip's virtual fields that held in the frame.
+    pub fields: usize,
+}
+
+impl FieldRoute {
+    /// The kept frames' force balance per grip under `model` at `params` (paper section 4.c:
+    /// the forces computed from the whole field against the measured loads); a frame where
+    /// the law is not defined at some node's stretches is left out.
+    pub fn force_balance(&self, model: &Model, params: &[f64]) -> Vec<GripBalance> {
+        let mut out = Vec::new();
+        for frame in &self.frames {
+            let Ok(forces_n) = frame.equations.forces_n(model, params) else {
+                continue;
+            };
+            for (grip, name) in GRIPS.iter().enumerate() {
+                let (sum, fields) = frame
+                    .fields
+                    .iter()
+                    .zip(&forces_n)
+                    .filter(|((_, g), _)| *g == grip)
+                    .fold((0.0, 0usize), |(s, n), (_, f)| (s + f, n + 1));
+                if fields > 0 {
+                    out.push(GripBalance {
+                        frame_id: frame.frame_id,
+                        grip: name,
+                        measured_n: frame.forces_n[grip],
+                        computed_n: sum / fields as f64,
+                        fields,
+                    });
+                }
+            }
+        }
+        out
     }
 }
 
@@ -701,5 +746,19 @@ mod tests {
         assert_eq!(fits.frames, 3);
         assert!((fits.max_stretches[0] - 1.4).abs() < 1e-12);
         assert!((fits.max_stretches[1] - 1.2).abs() < 1e-12);
+        // Under the truth every grip's fields balance its force; under a stiffer law they
+        // compute more than was measured.
+        let balance = route.force_balance(&model, &truth);
+        assert_eq!(balance.len(), 3 * 4, "{balance:?}");
+        for b in &balance {
+            assert!(
+                (b.computed_n - b.measured_n).abs() < 1e-9 * b.measured_n,
+                "{b:?}"
+            );
+            assert!(b.fields >= 1);
+        }
+        assert_eq!((balance[0].frame_id, balance[0].grip), (0, "x+"));
+        let stiffer = route.force_balance(&model, &[0.33, 0.055]);
+        assert!(stiffer.iter().all(|b| b.computed_n > 1.05 * b.measured_n));
     }
 }

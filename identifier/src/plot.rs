@@ -121,12 +121,16 @@ pub fn chart_paired(
             ))
             .map_err(|e| err(&e))?;
         }
+        // Paired: the lines take the palette in turn and each line's markers its colour.
+        let mut lines = 0;
         for (k, s) in series.iter().enumerate() {
             let color = match (s.markers, paired) {
-                (true, true) if k > 0 => PALETTE[(k - 1) % PALETTE.len()],
+                (true, true) if lines > 0 => PALETTE[(lines - 1) % PALETTE.len()],
                 (true, _) => BLACK,
-                (false, _) => PALETTE[k % PALETTE.len()],
+                (false, true) => PALETTE[lines % PALETTE.len()],
+                (false, false) => PALETTE[k % PALETTE.len()],
             };
+            lines += usize::from(!s.markers);
             let pts: Vec<(f64, f64)> = s
                 .points
                 .iter()

@@ -17,7 +17,7 @@ use wire::{
 mod field;
 mod shell;
 
-pub use field::{fits_json, FieldFeed, FieldRouteSettings};
+pub use field::{fits_json, force_balance, FieldFeed, FieldRouteSettings};
 use wire::identification::IdentifierRoutes;
 
 /// Settings of the process: what `dicstream run` writes for its identifier (`--settings`),

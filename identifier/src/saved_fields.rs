@@ -66,6 +66,8 @@ pub struct SavedFit {
     pub fields_read: usize,
     /// The forces were each grip's (false: an older `frames.csv`'s axis means).
     pub per_grip: bool,
+    /// The kept frames' force balance per grip under the first ranked fit.
+    pub force_balance: Vec<crate::field_route::GripBalance>,
 }
 
 /// Fits the saved fields of results folder `dir` with the live route's feed: each field file
@@ -115,6 +117,7 @@ pub fn fit_saved(
         });
     };
     Ok(SavedFit {
+        force_balance: crate::process::force_balance(route, &fits),
         fits,
         counters: c,
         last_dropped: route.last_dropped.clone(),

@@ -39,6 +39,9 @@ pub struct FieldAcceptance {
     pub cost_ms: Value,
     pub fits: Value,
     pub refused: Value,
+    /// Each kept frame's grip forces, measured and computed from the field under the first
+    /// ranked fit (`frame_id, grip, measured_n, computed_n, fields`), as the identifier wrote it.
+    pub force_balance: Value,
     /// Why the route gave nothing (a view that crosses no arm...).
     pub error: Option<String>,
     pub tolerance: f64,
@@ -154,6 +157,7 @@ pub fn judge_route(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
         cost_ms: route["cost_ms"].clone(),
         fits: route["fits"].clone(),
         refused: route["refused"].clone(),
+        force_balance: route["force_balance"].clone(),
         error: route["error"].as_str().map(str::to_string),
         tolerance: FIELD_TOLERANCE,
         passed: within(uniaxial) && within(equibiaxial) && within(pure_shear),

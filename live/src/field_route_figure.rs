@@ -1,13 +1,16 @@
-//! `field_route_law.png`: the law the field route identified against the specimen's true one,
-//! in uniaxial, equibiaxial and pure-shear nominal stress over the stretches the field reached
-//! (issue 25, deliverable 3's curves): the figure of what [`crate::field_acceptance`] judges,
-//! so a user sees where along each curve the identified law departs from the truth.
+//! The field route's figures (issue 25, deliverable 3): `field_route_law.png`, the law it
+//! identified against the specimen's true one in uniaxial, equibiaxial and pure-shear nominal
+//! stress over the stretches the field reached (what [`crate::field_acceptance`] judges, so a
+//! user sees where along each curve it departs), and `force_balance.png`, each grip's measured
+//! force against the force its virtual fields compute from the field under that law, over the
+//! test's time (paper section 4.c).
 
 use crate::field_acceptance::FieldAcceptance;
 use identifier::data::LoadCase;
 use identifier::law::InvariantLaw;
 use identifier::models::Model;
 use identifier::plot::{chart_paired, Series};
+use serde_json::Value;
 use std::path::Path;
 
 /// Stretches per true curve (a line).
@@ -102,6 +105,86 @@ pub fn field_route_law_png(
     Ok(true)
 }
 
+/// Each frame's capture time (s since the run started) from `frames.csv`'s text.
+fn capture_times_s(frames_csv: &str) -> anyhow::Result<std::collections::HashMap<u64, f64>> {
+    let mut lines = frames_csv.lines();
+    let names: Vec<&str> = lines
+        .next()
+        .ok_or_else(|| anyhow::anyhow!("frames.csv is empty"))?
+        .split(',')
+        .collect();
+    let at = |name: &str| {
+        names
+            .iter()
+            .position(|n| *n == name)
+            .ok_or_else(|| anyhow::anyhow!("frames.csv has no column {name}"))
+    };
+    let (id, t) = (at("frame_id")?, at("t_capture_s")?);
+    Ok(lines
+        .filter_map(|line| {
+            let cells: Vec<&str> = line.split(',').collect();
+            Some((cells.get(id)?.parse().ok()?, cells.get(t)?.parse().ok()?))
+        })
+        .collect())
+}
+
+/// The series of `force_balance.png` (kN against s): per grip, its measured force (line) and
+/// the computed one (markers), from the route's `force_balance` and `frames.csv`'s text.
+pub fn force_balance_series(balance: &Value, frames_csv: &str) -> anyhow::Result<Vec<Series>> {
+    let times = capture_times_s(frames_csv)?;
+    let mut out = Vec::new();
+    for grip in identifier::field_layout::GRIPS {
+        let rows: Vec<(f64, f64, f64)> = balance
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter(|row| row["grip"] == grip)
+            .filter_map(|row| {
+                let t = *times.get(&row["frame_id"].as_u64()?)?;
+                Some((t, row["measured_n"].as_f64()?, row["computed_n"].as_f64()?))
+            })
+            .collect();
+        if rows.is_empty() {
+            continue;
+        }
+        let series = |label: String, pick: fn(&(f64, f64, f64)) -> f64, markers| Series {
+            label,
+            points: rows.iter().map(|r| (r.0, 1e-3 * pick(r))).collect(),
+            markers,
+        };
+        out.push(series(format!("{grip}: measured"), |r| r.1, false));
+        out.push(series(format!("{grip}: from the field"), |r| r.2, true));
+    }
+    Ok(out)
+}
+
+/// Writes `force_balance.png`; false (no file) when the route balanced no frame.
+pub fn force_balance_png(
+    path: &Path,
+    acceptance: &FieldAcceptance,
+    frames_csv: &Path,
+) -> anyhow::Result<bool> {
+    if acceptance.model.is_none() {
+        return Ok(false);
+    }
+    let text = std::fs::read_to_string(frames_csv)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", frames_csv.display()))?;
+    let series = force_balance_series(&acceptance.force_balance, &text)?;
+    if series.is_empty() {
+        return Ok(false);
+    }
+    let model = acceptance.model.as_deref().unwrap_or_default();
+    chart_paired(
+        path,
+        &format!("grip forces: measured, and from the field under {model}"),
+        "time (s)",
+        "force (kN)",
+        &series,
+        true,
+    )?;
+    Ok(true)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -160,5 +243,35 @@ mod tests {
         // At rest: no stretch reached, no figure.
         assert!(!field_route_law_png(&png, &truth, &acceptance([1.0, 1.0])).unwrap());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_force_balance_is_each_grips_measured_line_and_computed_markers_over_time() {
+        let balance = json!([
+            {"frame_id": 10, "grip": "x+", "measured_n": 100.0, "computed_n": 98.0, "fields": 2},
+            {"frame_id": 10, "grip": "y+", "measured_n": 90.0, "computed_n": 91.0, "fields": 2},
+            {"frame_id": 20, "grip": "x+", "measured_n": 200.0, "computed_n": 203.0, "fields": 2},
+            {"frame_id": 99, "grip": "x+", "measured_n": 1.0, "computed_n": 1.0, "fields": 2},
+        ]);
+        let frames_csv = "frame_id,reference_frame_id,t_capture_s\n10,0,1.5\n20,0,2.5\n";
+        let series = force_balance_series(&balance, frames_csv).unwrap();
+        let labels: Vec<&str> = series.iter().map(|s| s.label.as_str()).collect();
+        assert_eq!(
+            labels,
+            [
+                "x+: measured",
+                "x+: from the field",
+                "y+: measured",
+                "y+: from the field"
+            ]
+        );
+        // kN against the frames' capture times; a frame frames.csv does not hold is left out.
+        assert_eq!(series[0].points, vec![(1.5, 0.1), (2.5, 0.2)]);
+        assert_eq!(series[1].points, vec![(1.5, 0.098), (2.5, 0.203)]);
+        assert!(series[1].markers && !series[0].markers);
+        let error = force_balance_series(&balance, "frame_id,x\n")
+            .err()
+            .unwrap();
+        assert_eq!(error.to_string(), "frames.csv has no column t_capture_s");
     }
 }

@@ -127,6 +127,7 @@ fn saved_json(
     value["fields_read"] = json!(saved.fields_read);
     value["counters"] = json!(saved.counters);
     value["last_dropped"] = json!(saved.last_dropped);
+    value["force_balance"] = json!(saved.force_balance);
     value
 }
 

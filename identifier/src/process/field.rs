@@ -11,7 +11,9 @@
 
 use super::ProcessError;
 use crate::field_layout::{ArmLayout, LayoutError};
-use crate::field_route::{FieldFits, FieldRoute, FieldRouteConfig, FitJob, FrameOutcome};
+use crate::field_route::{
+    FieldFits, FieldRoute, FieldRouteConfig, FitJob, FrameOutcome, GripBalance,
+};
 use crate::field_stress::Mat2;
 use crate::grip_forces::{ForceHistory, GripForces};
 use crate::models::Model;
@@ -340,6 +342,7 @@ impl FieldShell {
         if let (Some(out), Value::Object(fitted)) = (out.as_object_mut(), fitted) {
             out.extend(fitted);
         }
+        out["force_balance"] = json!(fits.map_or(vec![], |f| force_balance(&self.feed.route, f)));
         out
     }
 }
@@ -367,6 +370,17 @@ pub fn fits_json(fits: &FieldFits) -> Value {
         }).collect::<Vec<_>>(),
         "refused": fits.refused.iter().map(|(m, why)| json!({"model": m, "why": why})).collect::<Vec<_>>(),
     })
+}
+
+/// The kept frames' force balance per grip under the first ranked fit (none when no fit is
+/// identifiable): `identification.json`'s `field_route.force_balance`.
+pub fn force_balance(route: &FieldRoute, fits: &FieldFits) -> Vec<GripBalance> {
+    fits.fits
+        .iter()
+        .find(|fit| fit.ranked())
+        .map_or(vec![], |best| {
+            route.force_balance(&best.model, &best.fit.params)
+        })
 }
 
 /// A fit on its own thread (its fits and duration, ns) and the last frame it fits.

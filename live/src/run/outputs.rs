@@ -1,7 +1,7 @@
 //! The files a run writes at its end from what it recorded: the latency histograms (also
 //! rewritten during the run), `latency.png`, the identification figures, `strain_map.png`,
 //! `forces.png` and `stretch_states.png`; once the field route is judged,
-//! `field_route_law.png`.
+//! `field_route_law.png` and `force_balance.png`.
 //! A file that cannot be written is a note, never the end of the others.
 
 use super::StrainMapInfo;
@@ -89,8 +89,9 @@ pub(super) fn write(config: &RunConfig, results: &ResultsDir, recorder: &Recorde
     Outputs { strain_map, notes }
 }
 
-/// `field_route_law.png` when the field route identified a law and the run has its truth
-/// (`field`: the route's acceptance); a note saying why it could not be written, if so.
+/// `field_route_law.png` and `force_balance.png` when the field route identified a law and
+/// the run has its truth (`field`: the route's acceptance); a note saying why one could not
+/// be written, if so.
 pub(super) fn field_route_law(
     config: &RunConfig,
     results: &ResultsDir,
@@ -98,9 +99,17 @@ pub(super) fn field_route_law(
 ) -> Option<String> {
     let (field, truth) = (field?, config.law().ok()?);
     let path = results.path("field_route_law.png");
-    crate::field_route_figure::field_route_law_png(&path, &truth, field)
+    let law = crate::field_route_figure::field_route_law_png(&path, &truth, field)
         .err()
-        .map(|e| format!("field_route_law.png: {e:#}"))
+        .map(|e| format!("field_route_law.png: {e:#}"));
+    let path = results.path("force_balance.png");
+    let balance = crate::field_route_figure::force_balance_png(&path, field, &results.frames_csv())
+        .err()
+        .map(|e| format!("force_balance.png: {e:#}"));
+    match (law, balance) {
+        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+        (a, b) => a.or(b),
+    }
 }
 
 /// The most strained field of the last test over the image its mesh is defined in (its origin
