@@ -67,6 +67,39 @@ fn law_of(fit: &Value) -> Option<(Model, Vec<f64>)> {
     Some((model, p))
 }
 
+/// The true law's nominal stress (MPa) at a stretch, in one case.
+pub(crate) type TrueCurve = fn(&InvariantLaw, f64) -> f64;
+
+/// The cases the field route's law is judged (and drawn) on, with the true law's curve.
+pub(crate) const CASES: [(&str, LoadCase, TrueCurve); 3] = [
+    (
+        "uniaxial",
+        LoadCase::Uniaxial,
+        InvariantLaw::uniaxial_nominal_stress_mpa,
+    ),
+    (
+        "equibiaxial",
+        LoadCase::Equibiaxial,
+        InvariantLaw::equibiaxial_nominal_stress_mpa,
+    ),
+    (
+        "pure shear",
+        LoadCase::PureShear,
+        InvariantLaw::pure_shear_nominal_stress_mpa,
+    ),
+];
+
+/// How far the field reached `case`, given the nodes' largest major and minor principal
+/// stretches: uniaxial and pure shear to the major one, equibiaxial to the minor one; None
+/// when not reached (at most 1.005).
+pub(crate) fn reach(case: LoadCase, [major, minor]: [f64; 2]) -> Option<f64> {
+    let max = match case {
+        LoadCase::Equibiaxial => minor,
+        _ => major,
+    };
+    (max > 1.005).then_some(max)
+}
+
 /// Worst |identified − true| / true over (1, max].
 fn worst(
     truth: impl Fn(f64) -> f64,
@@ -117,32 +150,15 @@ pub fn judge_route(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
     let max_stretches = route["max_stretches"]
         .as_array()
         .and_then(|m| Some([m.first()?.as_f64()?, m.get(1)?.as_f64()?]));
-    let (mut uniaxial, mut equibiaxial, mut pure_shear) = (None, None, None);
-    if let (Some((model, p)), Some([major, minor])) = (&best, max_stretches) {
-        let reached = |l: f64| (l > 1.005).then_some(l);
-        let case = |c: LoadCase| move |l: f64| model.nominal_stress_mpa(p, c, l);
-        uniaxial = reached(major).map(|m| {
-            worst(
-                |l| truth.uniaxial_nominal_stress_mpa(l),
-                case(LoadCase::Uniaxial),
-                m,
-            )
-        });
-        equibiaxial = reached(minor).map(|m| {
-            worst(
-                |l| truth.equibiaxial_nominal_stress_mpa(l),
-                case(LoadCase::Equibiaxial),
-                m,
-            )
-        });
-        pure_shear = reached(major).map(|m| {
-            worst(
-                |l| truth.pure_shear_nominal_stress_mpa(l),
-                case(LoadCase::PureShear),
-                m,
-            )
-        });
-    }
+    let [uniaxial, equibiaxial, pure_shear] = CASES.map(|(_, case, true_curve)| {
+        let (model, p) = best.as_ref()?;
+        let max = reach(case, max_stretches?)?;
+        Some(worst(
+            |l| true_curve(truth, l),
+            |l| model.nominal_stress_mpa(p, case, l),
+            max,
+        ))
+    });
     let within =
         |c: Option<CaseComparison>| c.is_some_and(|c| c.max_relative_error <= FIELD_TOLERANCE);
     FieldAcceptance {

@@ -5,8 +5,7 @@
 //! force against the force its virtual fields compute from the field under that law, over the
 //! test's time (paper section 4.c).
 
-use crate::field_acceptance::FieldAcceptance;
-use identifier::data::LoadCase;
+use crate::field_acceptance::{reach, FieldAcceptance, CASES};
 use identifier::law::InvariantLaw;
 use identifier::models::Model;
 use identifier::plot::{chart_paired, Series};
@@ -18,26 +17,6 @@ const LINE_SAMPLES: usize = 100;
 /// Stretches per identified curve (markers, sparse enough to see the line under them).
 const MARKER_SAMPLES: usize = 20;
 
-/// The three canonical cases, each with the true law's nominal stress (MPa) at a stretch.
-type TrueCurve = fn(&InvariantLaw, f64) -> f64;
-const CASES: [(&str, LoadCase, TrueCurve); 3] = [
-    (
-        "uniaxial",
-        LoadCase::Uniaxial,
-        InvariantLaw::uniaxial_nominal_stress_mpa,
-    ),
-    (
-        "equibiaxial",
-        LoadCase::Equibiaxial,
-        InvariantLaw::equibiaxial_nominal_stress_mpa,
-    ),
-    (
-        "pure shear",
-        LoadCase::PureShear,
-        InvariantLaw::pure_shear_nominal_stress_mpa,
-    ),
-];
-
 /// Stretches 1..=max in `samples` steps.
 fn stretches(max: f64, samples: usize) -> impl Iterator<Item = f64> {
     (0..=samples).map(move |k| 1.0 + (max - 1.0) * k as f64 / samples as f64)
@@ -46,7 +25,7 @@ fn stretches(max: f64, samples: usize) -> impl Iterator<Item = f64> {
 /// The figure's series: per case the field reached, the true law (line) and the identified
 /// one (markers, in the line's colour); empty when the route identified no law or reached no stretch.
 pub fn series(truth: &InvariantLaw, acceptance: &FieldAcceptance) -> Vec<Series> {
-    let (Some(name), Some([major, minor])) = (&acceptance.model, acceptance.max_stretches) else {
+    let (Some(name), Some(reached)) = (&acceptance.model, acceptance.max_stretches) else {
         return Vec::new();
     };
     let Ok(model) = Model::parse(name) else {
@@ -56,14 +35,9 @@ pub fn series(truth: &InvariantLaw, acceptance: &FieldAcceptance) -> Vec<Series>
     let mut out = Vec::new();
     for (case_name, case, true_curve) in CASES {
         // As the acceptance compares them: equibiaxial up to the minor stretch reached.
-        let max = if case == LoadCase::Equibiaxial {
-            minor
-        } else {
-            major
-        };
-        if max <= 1.005 {
+        let Some(max) = reach(case, reached) else {
             continue;
-        }
+        };
         out.push(Series {
             label: format!("{case_name}: true law"),
             points: stretches(max, LINE_SAMPLES)
@@ -107,19 +81,12 @@ pub fn field_route_law_png(
 
 /// Each frame's capture time (s since the run started) from `frames.csv`'s text.
 fn capture_times_s(frames_csv: &str) -> anyhow::Result<std::collections::HashMap<u64, f64>> {
-    let mut lines = frames_csv.lines();
-    let names: Vec<&str> = lines
-        .next()
-        .ok_or_else(|| anyhow::anyhow!("frames.csv is empty"))?
-        .split(',')
-        .collect();
-    let at = |name: &str| {
-        names
-            .iter()
-            .position(|n| *n == name)
-            .ok_or_else(|| anyhow::anyhow!("frames.csv has no column {name}"))
-    };
-    let (id, t) = (at("frame_id")?, at("t_capture_s")?);
+    use crate::mechanics_figures::{column, header};
+    let (names, lines) = header(frames_csv, "frames.csv")?;
+    let (id, t) = (
+        column(&names, "frame_id", "frames.csv")?,
+        column(&names, "t_capture_s", "frames.csv")?,
+    );
     Ok(lines
         .filter_map(|line| {
             let cells: Vec<&str> = line.split(',').collect();

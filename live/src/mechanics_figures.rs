@@ -18,9 +18,9 @@ const PATH_SAMPLES: usize = 60;
 const IDLE_FRACTION: f64 = 0.1;
 
 /// The CSV `text`'s header (`what` names the file in errors) and its data lines.
-type Columns<'a> = (Vec<&'a str>, std::str::Lines<'a>);
+pub(crate) type Columns<'a> = (Vec<&'a str>, std::str::Lines<'a>);
 
-fn header<'a>(text: &'a str, what: &str) -> anyhow::Result<Columns<'a>> {
+pub(crate) fn header<'a>(text: &'a str, what: &str) -> anyhow::Result<Columns<'a>> {
     let mut lines = text.lines();
     let names = lines
         .next()
@@ -31,7 +31,7 @@ fn header<'a>(text: &'a str, what: &str) -> anyhow::Result<Columns<'a>> {
 }
 
 /// The index of column `name` of `names`, or an error naming it and the file.
-fn column(names: &[&str], name: &str, what: &str) -> anyhow::Result<usize> {
+pub(crate) fn column(names: &[&str], name: &str, what: &str) -> anyhow::Result<usize> {
     names
         .iter()
         .position(|h| *h == name)

@@ -44,9 +44,7 @@ impl Stopped<'_> {
         let recorder = &self.recorder;
         let mut outputs = outputs::write(config, results, recorder);
         let judged = super::judge::judge(config, recorder, &results.identification_json());
-        if let Some(note) = outputs::field_route_law(config, results, judged.field.as_ref()) {
-            outputs.notes.push(note);
-        }
+        outputs::field_route_figures(config, results, judged.field.as_ref(), &mut outputs.notes);
         let displacement_error_mean_px = read_back::mean_displacement_error(&results.frames_csv());
         let machine_csv = read_back::machine_csv_counts(config, results);
         let wall_s = self.started.elapsed().as_secs_f64();

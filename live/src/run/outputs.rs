@@ -90,25 +90,28 @@ pub(super) fn write(config: &RunConfig, results: &ResultsDir, recorder: &Recorde
 }
 
 /// `field_route_law.png` and `force_balance.png` when the field route identified a law and
-/// the run has its truth (`field`: the route's acceptance); a note saying why one could not
-/// be written, if so.
-pub(super) fn field_route_law(
+/// the run has its truth (`field`: the route's acceptance); what could not be written goes to
+/// `notes`, each with why.
+pub(super) fn field_route_figures(
     config: &RunConfig,
     results: &ResultsDir,
     field: Option<&crate::field_acceptance::FieldAcceptance>,
-) -> Option<String> {
-    let (field, truth) = (field?, config.law().ok()?);
-    let path = results.path("field_route_law.png");
-    let law = crate::field_route_figure::field_route_law_png(&path, &truth, field)
-        .err()
-        .map(|e| format!("field_route_law.png: {e:#}"));
-    let path = results.path("force_balance.png");
-    let balance = crate::field_route_figure::force_balance_png(&path, field, &results.frames_csv())
-        .err()
-        .map(|e| format!("force_balance.png: {e:#}"));
-    match (law, balance) {
-        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
-        (a, b) => a.or(b),
+    notes: &mut Vec<String>,
+) {
+    let (Some(field), Ok(truth)) = (field, config.law()) else {
+        return;
+    };
+    use crate::field_route_figure::{field_route_law_png, force_balance_png};
+    let law = field_route_law_png(&results.path("field_route_law.png"), &truth, field);
+    let balance = force_balance_png(
+        &results.path("force_balance.png"),
+        field,
+        &results.frames_csv(),
+    );
+    for (name, result) in [("field_route_law.png", law), ("force_balance.png", balance)] {
+        if let Err(e) = result {
+            notes.push(format!("{name}: {e:#}"));
+        }
     }
 }
 
