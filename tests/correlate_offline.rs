@@ -579,3 +579,90 @@ fn bad_regions_are_refused_naming_the_setting() {
         assert!(!out.exists(), "{args:?} wrote {}", out.display());
     }
 }
+
+/// `--gauge` and `--control-gauge` (issue 28 d2): a strain gauge reads the stretch, an
+/// extensometer its elongation, the control gauge is the summary's `gauge`, a gauge where no
+/// node is says why, and bad gauges are refused naming the option.
+#[test]
+fn gauges_read_the_stretch_where_they_are_placed() {
+    let dir = TempDir::new("gauges");
+    let (lx, ly) = (1.02, 0.99);
+    let reference = dir.0.join("ref.png");
+    let deformed = dir.0.join("def.png");
+    write_png(&reference, &render(W, H, &translation(0.0, 0.0).0, 1), W, H);
+    let stretched = common::camera::affine([[lx, 0.0], [0.0, ly]], [0.0, 0.0], [96.0, 80.0]).0;
+    write_png(&deformed, &render(W, H, &stretched, 2), W, H);
+    let out = dir.0.join("out");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "correlate",
+            path(&reference),
+            path(&deformed),
+            "--zoi",
+            "32",
+            "--step",
+            "8",
+            "--out",
+            path(&out),
+        ];
+        args.extend_from_slice(extra);
+        dicstream(&args)
+    };
+    let output = run(&[
+        "--gauge",
+        "mid=rect:64,48,64,64",
+        "--gauge",
+        "arm=extensometer:40,80 150,80",
+        "--gauge",
+        "corner=rect:0,0,10,10",
+        "--control-gauge",
+        "mid",
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(stderr.contains("gauge mid (strain, "), "{stderr}");
+    assert!(stderr.contains("gauge arm (extensometer): elongation"), "{stderr}");
+    assert!(
+        stderr.contains("gauge corner (strain): no reading: 0 valid nodes inside the gauge"),
+        "{stderr}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let frame = &summary["frames"][0];
+    let gauges = frame["gauges"].as_array().unwrap();
+    let mid = &gauges[0];
+    assert_eq!(mid["name"], "mid");
+    let exx = mid["strain"]["log"]["exx"].as_f64().unwrap();
+    let eyy = mid["strain"]["log"]["eyy"].as_f64().unwrap();
+    eprintln!("mid: log exx {exx:.6} eyy {eyy:.6} over {} nodes", mid["nodes"]);
+    assert!((exx - lx.ln()).abs() < 1e-3 && (eyy - ly.ln()).abs() < 1e-3);
+    // The control gauge is the summary's gauge.
+    assert_eq!(frame["gauge"], mid["strain"]);
+    let arm = &gauges[1];
+    let elongation = arm["elongation_px"].as_f64().unwrap();
+    eprintln!("arm: elongation {elongation:.4} px (truth {:.4})", (lx - 1.0) * 110.0);
+    assert!((elongation - (lx - 1.0) * 110.0).abs() < 0.05);
+    assert!((arm["nominal_strain"].as_f64().unwrap() - (lx - 1.0)).abs() < 5e-4);
+    assert_eq!(gauges[2]["nodes"], 0);
+    assert!(gauges[2]["no_reading"].as_str().unwrap().contains("0 valid nodes"));
+    // The default control gauge, the mesh's central half, reads the same homogeneous stretch.
+    let output = run(&[]);
+    assert!(output.status.success());
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let centre = summary["frames"][0]["gauge"]["log"]["exx"].as_f64().unwrap();
+    assert!((centre - lx.ln()).abs() < 1e-3, "{centre}");
+    for (args, expected) in [
+        (
+            ["--gauge", "arm=extensometer:40,80 500,80"],
+            "point 500,80 is outside the 192x160 px image",
+        ),
+        (["--gauge", "arm=extensometer:40,80"], "two points"),
+        (["--control-gauge", "nosuch"], "control gauge nosuch is not one of the gauges"),
+    ] {
+        let output = run(&args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{args:?}");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
+}

@@ -238,6 +238,11 @@ impl Correlator {
     ) -> Result<Self, SettingsError> {
         settings.validate()?;
         let region = settings.resolve_region(width_px, height_px)?;
+        for gauge in &settings.gauges {
+            gauge
+                .check_inside(width_px, height_px)
+                .map_err(SettingsError::Gauge)?;
+        }
         let mesh = Mesh::of_region(&region, settings.zoi_px, settings.step_px);
         if mesh.measured() == 0 {
             return Err(SettingsError::RegionSmallerThanZoi {
@@ -262,6 +267,7 @@ impl Correlator {
             ny: mesh.ny,
             nodes: vec![Node::default(); nodes],
             gradients: vec![[[0.0; 2]; 2]; nodes],
+            gauges: Vec::with_capacity(settings.gauges.len()),
             ..Field::default()
         };
         for (k, node) in field.nodes.iter_mut().enumerate() {

@@ -1,4 +1,4 @@
-//! The result of one correlation: nodes of the mesh and gauge strains.
+//! The result of one correlation: nodes of the mesh and gauge readings.
 
 use crate::settings::StrainMeasure;
 
@@ -12,7 +12,7 @@ pub struct Strain2 {
     pub exy: f64,
 }
 
-/// Average strain over the ROI in the four measures (CORRELI-GAUGE, see `strain::gauge`).
+/// A gauge's mean strain in the four measures (CORRELI-GAUGE over its region, `gauges.rs`).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct GaugeStrains {
     pub small: Strain2,
@@ -60,7 +60,13 @@ pub struct Field {
     pub nx: usize,
     pub ny: usize,
     pub nodes: Vec<Node>,
+    /// The control gauge's strains (`settings.control_gauge`: the mesh's central region by
+    /// default; NaN when it has no reading, `gauges::NoReading`).
     pub gauge: GaugeStrains,
+    /// The valid nodes the control gauge read.
+    pub gauge_nodes: usize,
+    /// The user's gauges' readings, in the order of `settings.gauges`.
+    pub gauges: Vec<crate::gauges::GaugeReading>,
     /// Nodes with status Ok.
     pub valid: usize,
     /// Mean u, v over valid nodes (px; 0 when none).
@@ -79,7 +85,7 @@ pub struct Field {
     /// frame the mesh was defined in, the one its strains come from: IC-GN's own shape function
     /// (composed with the gradient at the current reference's base) for the IC-GN methods, the
     /// least-squares gradient of the neighbouring nodes for `correli`; zero where the node is
-    /// not `ok`. The gauge is always the least-squares fit over all valid nodes.
+    /// not `ok`. A gauge is always the least-squares fit over its valid nodes' displacements.
     pub gradients: Vec<[[f64; 2]; 2]>,
 }
 

@@ -28,6 +28,7 @@
 mod correlator;
 mod fft2d;
 pub mod field;
+pub mod gauges;
 mod global;
 mod icgn;
 mod image;
@@ -54,6 +55,7 @@ mod zoi;
 
 pub use correlator::{Correlator, ORIGIN_PASS_FRAMES};
 pub use field::{Field, GaugeStrains, Node, NodeStatus, Strain2};
+pub use gauges::{ControlGauge, Gauge, GaugeReading, GaugeShape, GaugeValue};
 pub use region::{Polygon, Region, RoiChoice};
 pub use settings::{
     CorrelatorSettings, GuessMode, Method, ReferenceMode, Roi, SettingsError, StrainMeasure,

@@ -95,6 +95,25 @@ pub struct Polygon {
     pub vertices_px: Vec<(f64, f64)>,
 }
 
+impl Polygon {
+    /// Whether the point is inside (even-odd rule, the one [`Region`]'s pixels follow; a point
+    /// exactly on a left or top edge is inside, on a right or bottom edge outside).
+    pub fn contains(&self, (x, y): (f64, f64)) -> bool {
+        let v = &self.vertices_px;
+        let mut inside = false;
+        for i in 0..v.len() {
+            let (a, b) = (v[i], v[(i + 1) % v.len()]);
+            if (a.1 <= y && y < b.1) || (b.1 <= y && y < a.1) {
+                let crossing = a.0 + (y - a.1) * (b.0 - a.0) / (b.1 - a.1);
+                if crossing <= x {
+                    inside = !inside;
+                }
+            }
+        }
+        inside
+    }
+}
+
 /// As `--polygon` and `polygons` take it: `x,y x,y x,y ...`.
 impl fmt::Display for Polygon {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -1,5 +1,6 @@
 //! User settings of the correlator and their validation.
 
+use crate::gauges::{ControlGauge, Gauge, GaugeShape};
 use crate::region::{Region, ResolvedRegion};
 use thiserror::Error;
 
@@ -212,6 +213,13 @@ pub struct CorrelatorSettings {
     /// displacement gradient (it reports the motion of a point off its centre, weighted by
     /// where its speckles are; see `zoi::GradientSensitivity`). Off = CORRELI-GD as published.
     pub gradient_correction: bool,
+    /// The user's strain gauges and extensometers (`gauges.rs`), read on every field.
+    #[serde(default)]
+    pub gauges: Vec<Gauge>,
+    /// The gauge the field's header carries, the one strain control closes its loop on: the
+    /// mesh's central region by default.
+    #[serde(default)]
+    pub control_gauge: ControlGauge,
 }
 
 impl Default for CorrelatorSettings {
@@ -230,6 +238,8 @@ impl Default for CorrelatorSettings {
             min_relative_score: 0.7,
             min_zncc: DEFAULT_MIN_ZNCC,
             gradient_correction: true,
+            gauges: Vec::new(),
+            control_gauge: ControlGauge::Centre,
         }
     }
 }
@@ -325,6 +335,8 @@ pub enum SettingsError {
         "auto reference thresholds invalid: expected 0 < deformation <= 8 px and 0 <= score < 1"
     )]
     AutoThresholds,
+    #[error("{0} (--gauge, [correlator] gauges)")]
+    Gauge(String),
 }
 
 /// Nearest power of two (ties go up), for the error message.
@@ -399,6 +411,40 @@ impl CorrelatorSettings {
             let score_ok = (0.0..1.0).contains(&min_mean_score);
             if !deformation_ok || !score_ok {
                 return Err(SettingsError::AutoThresholds);
+            }
+        }
+        self.validate_gauges()
+    }
+
+    /// Gauge names unique, and the control gauge the mesh's centre, all nodes or one of the
+    /// strain gauges.
+    fn validate_gauges(&self) -> Result<(), SettingsError> {
+        for (i, g) in self.gauges.iter().enumerate() {
+            if self.gauges[..i].iter().any(|o| o.name == g.name) {
+                return Err(SettingsError::Gauge(format!(
+                    "two gauges are named {}: each needs its own name",
+                    g.name
+                )));
+            }
+        }
+        if let ControlGauge::Named(name) = &self.control_gauge {
+            match self.gauges.iter().find(|g| &g.name == name) {
+                Some(Gauge {
+                    shape: GaugeShape::Region(_),
+                    ..
+                }) => {}
+                Some(_) => {
+                    return Err(SettingsError::Gauge(format!(
+                        "the control gauge {name} is an extensometer: the field's header carries a strain gauge's strains (centre, all, or a rect or polygon gauge)"
+                    )))
+                }
+                None => {
+                    let names: Vec<&str> = self.gauges.iter().map(|g| g.name.as_str()).collect();
+                    return Err(SettingsError::Gauge(format!(
+                        "the control gauge {name} is not one of the gauges ({}): name one, or centre, or all",
+                        if names.is_empty() { "none is placed".to_owned() } else { names.join(", ") }
+                    )));
+                }
             }
         }
         Ok(())

@@ -8,7 +8,7 @@
 //! nodes, which equals the ROI average of the gradient for an affine field and weighs every node
 //! equally otherwise; the four measures are then computed from that one F.
 
-use crate::field::{GaugeStrains, Node, NodeStatus, Strain2};
+use crate::field::{Node, NodeStatus, Strain2};
 use crate::settings::StrainMeasure;
 use nalgebra::{Matrix2, Matrix3, SymmetricEigen, Vector3};
 
@@ -204,34 +204,6 @@ pub fn strains_from_gradients(
         let gradient = (node.status == NodeStatus::Ok)
             .then(|| Matrix2::new(g[0][0], g[0][1], g[1][0], g[1][1]));
         set_strain(node, gradient, measure);
-    }
-}
-
-/// Gauge strains: one affine least-squares fit over all valid nodes, then the four measures.
-pub fn gauge(nodes: &[Node]) -> GaugeStrains {
-    let mut sums = AffineSums::default();
-    let (mut cx, mut cy, mut count) = (0.0, 0.0, 0.0);
-    for node in nodes.iter().filter(|n| n.status == NodeStatus::Ok) {
-        cx += node.x_px;
-        cy += node.y_px;
-        count += 1.0;
-    }
-    if count == 0.0 {
-        return GaugeStrains::default();
-    }
-    let (cx, cy) = (cx / count, cy / count);
-    for node in nodes.iter().filter(|n| n.status == NodeStatus::Ok) {
-        sums.add(node.x_px - cx, node.y_px - cy, node.u_px, node.v_px);
-    }
-    let Some(grad) = sums.gradient() else {
-        return GaugeStrains::default();
-    };
-    let get = |m| strain_from_gradient(&grad, m).unwrap_or_default();
-    GaugeStrains {
-        small: get(StrainMeasure::Small),
-        green: get(StrainMeasure::Green),
-        nominal: get(StrainMeasure::Nominal),
-        log: get(StrainMeasure::Log),
     }
 }
 

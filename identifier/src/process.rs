@@ -112,6 +112,10 @@ fn field_sample(header: &FieldHeader) -> Option<FieldSample> {
         return None;
     }
     let gauge = header.gauge_of(StrainMeasure::Log);
+    // A control gauge without a reading (NaN) gives no state.
+    if !(gauge.exx.is_finite() && gauge.eyy.is_finite()) {
+        return None;
+    }
     Some(FieldSample {
         frame_id: header.frame_id,
         // A frame without a rig sample (a real camera's) is paired by time.

@@ -232,13 +232,15 @@ fn cauchy_mpa(rig: &RigState, force_n: [f64; 2]) -> [f64; 2] {
 
 /// What a field is compared with: the homogeneous motion of its origin frame (the field's own
 /// header holds the current one), or the finite-element fields of its origin frame and of its
-/// own frame (the specimen as a structure).
+/// own frame (the specimen as a structure), with the control gauge whose nodes the gauge's
+/// truth is the mean over.
 #[derive(Clone, Copy)]
 pub enum OriginTruth<'a> {
     Motion(&'a GroundTruth),
     Field {
         origin: &'a FieldMotion,
         current: &'a FieldMotion,
+        control: &'a correlator::gauges::ControlRegion<'a>,
     },
 }
 
@@ -263,11 +265,16 @@ fn truth_errors(
                 .map(strain_error);
             (displacement_error_px, log_strain_error)
         }
-        OriginTruth::Field { origin, current } => {
-            match truth::field_errors(nodes, current, origin, each) {
+        OriginTruth::Field {
+            origin,
+            current,
+            control,
+        } => {
+            let in_gauge = |n: &FieldNode| control.contains(correlator::gauges::GaugeNode::position_px(n));
+            match truth::field_errors(nodes, current, origin, in_gauge, each) {
                 Some(e) => (
                     Some([e.mean_px, e.max_px]),
-                    truth::log_strain(&e.mean_gradient).map(strain_error),
+                    e.mean_gradient.and_then(|g| truth::log_strain(&g)).map(strain_error),
                 ),
                 None => (None, None),
             }

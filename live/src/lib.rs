@@ -16,6 +16,7 @@ pub mod field_acceptance;
 pub mod field_route_figure;
 pub mod figures;
 pub mod frames;
+pub mod gauge_columns;
 pub mod latency;
 pub mod leftovers;
 pub mod liveness;

@@ -26,6 +26,10 @@ pub struct RecorderSettings {
     /// How the simulated camera frames a finite-element specimen, whose field is the truth
     /// node by node.
     pub framing: producer::Framing,
+    /// The user's gauges (`frames.csv`'s last columns) and the control gauge the fields'
+    /// header carries (its truth is taken over the same nodes).
+    pub gauges: Vec<correlator::Gauge>,
+    pub control_gauge: correlator::ControlGauge,
 }
 
 pub struct Recorder {
@@ -90,7 +94,8 @@ impl Recorder {
         Ok(Recorder {
             frames_csv: RowFile::create(
                 &results.frames_csv(),
-                &crate::frames::csv_header_for(settings.truth),
+                &(crate::frames::csv_header_for(settings.truth)
+                    + &crate::gauge_columns::header(&settings.gauges)),
             )?,
             results: results.clone(),
             settings,
@@ -226,9 +231,19 @@ impl Recorder {
             self.specimen.pin(id);
         }
         let fields = origin.and_then(|o| self.specimen_fields(header, &o));
+        // The header's gauge is the control gauge: its truth is taken over the same nodes.
+        let control = correlator::gauges::ControlRegion::of(
+            &self.settings.control_gauge,
+            &self.settings.gauges,
+            nodes,
+        );
         let origin_truth = match (&origin, &fields) {
             (Some(o), None) => Some(OriginTruth::Motion(o)),
-            (_, Some(Some((origin, current)))) => Some(OriginTruth::Field { origin, current }),
+            (_, Some(Some((origin, current)))) => Some(OriginTruth::Field {
+                origin,
+                current,
+                control: &control,
+            }),
             _ => None,
         };
         let row = FrameRow::new(
@@ -254,6 +269,11 @@ impl Recorder {
         }
         self.row.clear();
         row.write_csv_for(&mut self.row, self.settings.truth);
+        // The gauges' cells go before the line's end.
+        self.row.pop();
+        let step_px = f64::from(header.step_px);
+        crate::gauge_columns::write_cells(&self.settings.gauges, nodes, step_px, &mut self.row);
+        self.row.push('\n');
         let line = std::mem::take(&mut self.row);
         let result = self.frames_csv.append(&line);
         self.row = line;

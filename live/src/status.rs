@@ -165,6 +165,8 @@ mod tests {
                 mm_per_px: 0.25,
                 strip_mm_per_px: 0.12,
             },
+            gauges: Vec::new(),
+            control_gauge: correlator::ControlGauge::default(),
         };
         let mut recorder = Recorder::new(&results, settings, 0).unwrap();
         let mut rig = RigState {

@@ -96,15 +96,18 @@ impl ErrorSum {
 /// field (the specimen as a structure), node by node: the node at x0 in the origin frame's
 /// image is the material point X = φ_o⁻¹(x0), which the current frame shows at φ_k(X). A node
 /// on no material (the room behind the specimen) has no truth and is not counted. Also the
-/// log strain of the valid nodes' mean relative gradient F_k F_o⁻¹ (the gauge's truth).
+/// mean relative gradient F_k F_o⁻¹ of the valid nodes `in_gauge` selects (the control
+/// gauge's truth).
 pub fn field_errors(
     nodes: &[FieldNode],
     current: &FieldMotion,
     origin: &FieldMotion,
+    in_gauge: impl Fn(&FieldNode) -> bool,
     mut each: impl FnMut(f64),
 ) -> Option<FieldErrors> {
     let mut errors = ErrorSum::default();
     let mut gradient_sum = Matrix2::zeros();
+    let mut gauge_nodes = 0usize;
     for node in nodes {
         if node.status != NodeStatus::Ok as u32 {
             continue;
@@ -124,14 +127,17 @@ pub fn field_errors(
         each(errors.add(node, truth));
         let f_k = Matrix2::new(f_k[0][0], f_k[0][1], f_k[1][0], f_k[1][1]);
         let f_o = Matrix2::new(f_o[0][0], f_o[0][1], f_o[1][0], f_o[1][1]);
-        gradient_sum += f_k * f_o.try_inverse()?;
+        if in_gauge(node) {
+            gradient_sum += f_k * f_o.try_inverse()?;
+            gauge_nodes += 1;
+        }
     }
     let (mean_px, max_px, count) = errors.mean_max_count()?;
     Some(FieldErrors {
         mean_px,
         max_px,
         nodes: count,
-        mean_gradient: gradient_sum / count as f64,
+        mean_gradient: (gauge_nodes > 0).then(|| gradient_sum / gauge_nodes as f64),
     })
 }
 
@@ -142,8 +148,9 @@ pub struct FieldErrors {
     pub max_px: f64,
     /// Valid nodes on material, compared.
     pub nodes: usize,
-    /// Their mean relative gradient F_k F_o⁻¹ (image to image).
-    pub mean_gradient: Matrix2<f64>,
+    /// The mean relative gradient F_k F_o⁻¹ (image to image) of those in the gauge; None
+    /// when none is.
+    pub mean_gradient: Option<Matrix2<f64>>,
 }
 
 /// Every node's displacement error of a run (px), for its percentiles.

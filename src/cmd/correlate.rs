@@ -7,10 +7,11 @@
 //! written atomically (temporary sibling, then rename). Images are read by `producer::read_image`.
 
 use super::named_arg::named;
+use super::gauge_report::{reading_line, readings_json, strains_json};
 use anyhow::{anyhow, bail, Context, Result};
 use correlator::settings::{Method, ReferenceKind};
 use correlator::{
-    Correlator, CorrelatorSettings, Field, GaugeStrains, GuessMode, Polygon, ReferenceMode, Region,
+    ControlGauge, Correlator, CorrelatorSettings, Field, Gauge, GuessMode, Polygon, ReferenceMode, Region,
     RoiChoice, StrainMeasure,
 };
 use std::io::IsTerminal;
@@ -53,6 +54,17 @@ pub struct CorrelationArgs {
     /// A mask image the size of the images (PNG, TIFF or BMP): non-zero pixels are measured.
     #[arg(long)]
     pub mask: Option<PathBuf>,
+    /// A virtual strain gauge or extensometer placed in the reference image (px), read on
+    /// every frame: NAME=rect:X,Y,W,H, NAME=polygon:x,y x,y x,y ... (the mean strain of the
+    /// valid nodes inside) or NAME=extensometer:x,y x,y (the two points followed, their
+    /// elongation); repeat for several.
+    #[arg(long = "gauge", value_name = "NAME=KIND:POINTS")]
+    pub gauges: Vec<Gauge>,
+    /// The gauge whose strains are the field's `gauge` (a live field's header; what strain
+    /// control closes its loop on): centre (the mesh's central half), all (every valid node)
+    /// or the name of a --gauge rect or polygon.
+    #[arg(long, default_value_t = defaults().control_gauge)]
+    pub control_gauge: ControlGauge,
     /// Strain measure of the node strains (the gauge is given in all four).
     #[arg(long, value_parser = named::<StrainMeasure>(), default_value_t = defaults().strain)]
     pub strain: StrainMeasure,
@@ -97,6 +109,8 @@ impl CorrelationArgs {
             gradient_correction: self.gradient_correction,
             threads: self.threads,
             max_iterations: self.max_iterations,
+            gauges: self.gauges.clone(),
+            control_gauge: self.control_gauge.clone(),
             ..CorrelatorSettings::default()
         }
     }
@@ -178,7 +192,13 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
         valid.push(field.valid);
         warn_if_few_valid(path, field, progress.as_ref());
         write_field_files(&args, &reference, field, index)?;
-        frames.push(frame_json(index, path, field, elapsed_ms));
+        frames.push(frame_json(
+            index,
+            path,
+            field,
+            &args.correlation.gauges,
+            elapsed_ms,
+        ));
         let summary = serde_json::json!({ "frames": frames, "settings": settings_value });
         write(
             &args.out.join("summary.json"),
@@ -193,6 +213,10 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
         bar.finish();
     }
     eprintln!("{}", summary_line(&correlator, &valid));
+    let settings = correlator.settings();
+    for (gauge, reading) in settings.gauges.iter().zip(&correlator.field().gauges) {
+        eprintln!("{}", reading_line(gauge, reading));
+    }
     if frames_with_valid_nodes == 0 {
         return Err(nothing_measured(&args));
     }
@@ -305,7 +329,13 @@ fn write_field_files(
 }
 
 /// Frame `index`'s entry of `summary.json`.
-fn frame_json(index: usize, path: &Path, field: &Field, elapsed_ms: f64) -> serde_json::Value {
+fn frame_json(
+    index: usize,
+    path: &Path,
+    field: &Field,
+    gauges: &[Gauge],
+    elapsed_ms: f64,
+) -> serde_json::Value {
     serde_json::json!({
         "index": index,
         "file": path.display().to_string(),
@@ -314,7 +344,9 @@ fn frame_json(index: usize, path: &Path, field: &Field, elapsed_ms: f64) -> serd
         "valid": field.valid,
         "u_mean": field.u_mean_px,
         "v_mean": field.v_mean_px,
-        "gauge": gauge_json(&field.gauge),
+        "gauge": strains_json(&field.gauge),
+        "gauge_nodes": field.gauge_nodes,
+        "gauges": readings_json(gauges, field),
         "elapsed_ms": elapsed_ms,
         "reference_updated": field.reference_updated,
         "statuses": status_json(field),
@@ -347,12 +379,6 @@ fn status_json(field: &Field) -> serde_json::Value {
         .map(|&s| (s.name().to_owned(), field.count(s).into()))
         .collect::<serde_json::Map<_, _>>()
         .into()
-}
-
-fn gauge_json(g: &GaugeStrains) -> serde_json::Value {
-    let one =
-        |s: correlator::Strain2| serde_json::json!({ "exx": s.exx, "eyy": s.eyy, "exy": s.exy });
-    serde_json::json!({ "small": one(g.small), "green": one(g.green), "nominal": one(g.nominal), "log": one(g.log) })
 }
 
 fn settings_json(args: &CorrelateArgs, correlator: &Correlator) -> serde_json::Value {

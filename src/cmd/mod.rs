@@ -5,6 +5,7 @@ pub mod bench_pipeline;
 pub mod cameras;
 pub mod correlate;
 pub mod correlator;
+pub mod gauge_report;
 pub mod identifier;
 pub mod identify;
 pub mod identify_fields;

@@ -1,6 +1,6 @@
 //! The assembly of a frame's field: results (against the current reference, at the ZOI
 //! centres) to total displacements at the followed nodes, the relative score and consistency
-//! checks, the nodes returned to view measured against the origin, strains and gauge, and what
+//! checks, the nodes returned to view measured against the origin, strains and gauges, and what
 //! the next frame's guesses need.
 
 use super::parts::PreviousFrames;
@@ -9,7 +9,8 @@ use super::{
     OUTLIER_MIN_PX, OUTLIER_SCATTER,
 };
 use crate::field::NodeStatus;
-use crate::strain::{gauge, node_strains_and_gradients, strains_from_gradients};
+use crate::gauges::{read, read_control};
+use crate::strain::{node_strains_and_gradients, strains_from_gradients};
 use crate::zoi::Image;
 
 impl Correlator {
@@ -155,7 +156,7 @@ impl Correlator {
     }
 
     /// Node gradients (IC-GN's own composed with the base's, or the neighbours' fit), node
-    /// strains and the gauge.
+    /// strains, the control gauge and the user's gauges.
     fn strains(&mut self) {
         if self.settings.method.is_icgn() {
             for k in 0..self.mesh.len() {
@@ -182,7 +183,14 @@ impl Correlator {
                 &mut self.field.gradients,
             );
         }
-        self.field.gauge = gauge(&self.field.nodes);
+        let step_px = self.settings.step_px as f64;
+        let nodes = &self.field.nodes;
+        let control = read_control(&self.settings.control_gauge, &self.settings.gauges, nodes);
+        self.field.gauge = control.strains_or_nan();
+        self.field.gauge_nodes = control.nodes;
+        self.field.gauges.clear();
+        let readings = (self.settings.gauges.iter()).map(|g| read(&g.shape, nodes, step_px));
+        self.field.gauges.extend(readings);
     }
 
     /// What the next frame's guesses need: the never-lost nodes, the last two fields, IC-GN's

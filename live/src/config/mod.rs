@@ -179,6 +179,10 @@ pub struct CorrelatorSection {
     pub min_zncc: f64,
     /// First-order correction of the rigid ZOI's bias under a displacement gradient.
     pub gradient_correction: bool,
+    /// Virtual strain gauges and extensometers, read on every field into `frames.csv`.
+    pub gauges: Vec<correlator::Gauge>,
+    /// The gauge the fields' header carries (strain control, the identifier's gauge route).
+    pub control_gauge: correlator::ControlGauge,
     /// `[correlator.region]`: where the correlator measures (the rectangle, polygons, a mask).
     pub region: correlator::Region,
 }
@@ -350,6 +354,8 @@ impl Default for CorrelatorSection {
             guess: d.guess,
             min_zncc: d.min_zncc,
             gradient_correction: d.gradient_correction,
+            gauges: d.gauges,
+            control_gauge: d.control_gauge,
             region: d.region,
         }
     }

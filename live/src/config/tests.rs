@@ -33,7 +33,7 @@ fn strain_controlled_tests_are_checked_and_the_default_is_unchanged() {
     // Displacement control stays the default, and its config file does not change.
     let d = RunConfig::default();
     assert!(d.strain_test().unwrap().is_none());
-    assert!(!d.to_toml().contains("control"), "{}", d.to_toml());
+    assert!(!d.to_toml().contains("\ncontrol ="), "{}", d.to_toml());
     let strain = |body: &str| {
         RunConfig::from_toml(&format!("[[rig.tests]]\n{body}"), "t.toml")
             .and_then(|config| config.validate())
@@ -267,4 +267,51 @@ fn the_region_is_read_checked_and_passed_on() {
         .unwrap()
         .is_absolute());
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `[correlator] gauges` and `control_gauge`: read typed, passed to the correlator and the
+/// recorder, bad ones refused naming the key and the gauge.
+#[test]
+fn gauges_are_read_checked_and_passed_on() {
+    let config = RunConfig::from_toml(
+        "[correlator]\ngauges = [\"mid=rect:400,400,224,224\", \"arm=extensometer:100,512 300,512\"]\ncontrol_gauge = \"mid\"\n",
+        "t.toml",
+    )
+    .unwrap();
+    config.validate().unwrap();
+    let settings = config.correlator_settings().unwrap();
+    assert_eq!(settings.gauges.len(), 2);
+    assert_eq!(settings.gauges[1].kind(), "extensometer");
+    assert_eq!(
+        settings.control_gauge,
+        correlator::ControlGauge::Named("mid".into())
+    );
+    let round = RunConfig::from_toml(&config.to_toml(), "round").unwrap();
+    assert_eq!(round, config);
+    assert_eq!(
+        RunConfig::default().correlator_settings().unwrap().control_gauge,
+        correlator::ControlGauge::Centre
+    );
+    let refuse = |toml: &str, expected: &str| {
+        let checked = RunConfig::from_toml(toml, "t.toml").and_then(|config| config.validate());
+        let error = format!("{:#}", checked.unwrap_err());
+        assert!(error.contains(expected), "{toml}: {error}");
+    };
+    refuse("[correlator]\ngauges = [\"mid=rect:1,2,3\"]\n", "X,Y,W,H");
+    refuse(
+        "[correlator]\ngauges = [\"far=rect:1000,1000,100,100\"]\n",
+        "outside the 1024x1024 px image",
+    );
+    refuse(
+        "[correlator]\ngauges = [\"a=rect:1,1,50,50\", \"a=rect:60,60,50,50\"]\n",
+        "two gauges are named a",
+    );
+    refuse(
+        "[correlator]\ncontrol_gauge = \"nosuch\"\n",
+        "control gauge nosuch is not one of the gauges (none is placed)",
+    );
+    refuse(
+        "[correlator]\ngauges = [\"e=extensometer:1,1 50,50\"]\ncontrol_gauge = \"e\"\n",
+        "is an extensometer",
+    );
 }

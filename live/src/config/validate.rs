@@ -198,6 +198,8 @@ impl RunConfig {
             guess: c.guess,
             min_zncc: c.min_zncc,
             gradient_correction: c.gradient_correction,
+            gauges: c.gauges.clone(),
+            control_gauge: c.control_gauge.clone(),
             region: correlator::Region {
                 // The correlator process reads the mask: from wherever it runs.
                 mask: c
@@ -214,6 +216,11 @@ impl RunConfig {
         settings
             .validate()
             .map_err(|e| anyhow!("[correlator] {e}"))?;
+        for gauge in &settings.gauges {
+            gauge
+                .check_inside(self.camera.width_px as usize, self.camera.height_px as usize)
+                .map_err(|e| anyhow!("[correlator] gauges: {e}"))?;
+        }
         settings
             .resolve_region(
                 self.camera.width_px as usize,

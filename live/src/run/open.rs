@@ -70,6 +70,8 @@ impl<'a> Run<'a> {
             vtk: config.run.vtk,
             truth: config.camera.source.has_truth(),
             framing: config.camera.framing(),
+            gauges: config.correlator.gauges.clone(),
+            control_gauge: config.correlator.control_gauge.clone(),
         };
         let recorder = Recorder::new(&prepared.results, settings, t0_ns)?;
         start::write_running(

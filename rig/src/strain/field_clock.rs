@@ -73,8 +73,10 @@ impl FieldClock {
 
 impl FieldClock {
     /// The strain loop's measurement of a field: its gauge log strains (ln λx, ln λy) and valid
-    /// nodes, captured at its rig time. None for a field of another layout version or one the
-    /// clock cannot place (older than the kept samples, another run's).
+    /// nodes, captured at its rig time. None for a field of another layout version, one the
+    /// clock cannot place (older than the kept samples, another run's) or one whose control
+    /// gauge has no reading (NaN: too few valid nodes in it); the loop holds on those as on a
+    /// stale field.
     pub fn measurement(&self, header: &wire::FieldHeader) -> Option<GaugeMeasurement> {
         if header.layout_version != wire::LAYOUT_VERSION {
             return None;
@@ -84,6 +86,9 @@ impl FieldClock {
             id => self.of_sample(id)?,
         };
         let gauge = header.gauge_of(wire::StrainMeasure::Log);
+        if !(gauge.exx.is_finite() && gauge.eyy.is_finite()) {
+            return None;
+        }
         Some(GaugeMeasurement {
             t_capture_s,
             log_strain: [gauge.exx, gauge.eyy],
@@ -121,6 +126,11 @@ mod tests {
         assert_eq!(clock.measurement(&header), None);
         header.rig_sample_id = 5;
         header.layout_version += 1;
+        assert_eq!(clock.measurement(&header), None);
+        // A control gauge without a reading is no measurement: the loop holds.
+        header.layout_version -= 1;
+        assert!(clock.measurement(&header).is_some());
+        header.gauge[wire::StrainMeasure::Log as usize].eyy = f64::NAN;
         assert_eq!(clock.measurement(&header), None);
     }
 
