@@ -621,7 +621,10 @@ fn gauges_read_the_stretch_where_they_are_placed() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");
     assert!(stderr.contains("gauge mid (strain, "), "{stderr}");
-    assert!(stderr.contains("gauge arm (extensometer): elongation"), "{stderr}");
+    assert!(
+        stderr.contains("gauge arm (extensometer): elongation"),
+        "{stderr}"
+    );
     assert!(
         stderr.contains("gauge corner (strain): no reading: 0 valid nodes inside the gauge"),
         "{stderr}"
@@ -634,23 +637,34 @@ fn gauges_read_the_stretch_where_they_are_placed() {
     assert_eq!(mid["name"], "mid");
     let exx = mid["strain"]["log"]["exx"].as_f64().unwrap();
     let eyy = mid["strain"]["log"]["eyy"].as_f64().unwrap();
-    eprintln!("mid: log exx {exx:.6} eyy {eyy:.6} over {} nodes", mid["nodes"]);
+    eprintln!(
+        "mid: log exx {exx:.6} eyy {eyy:.6} over {} nodes",
+        mid["nodes"]
+    );
     assert!((exx - lx.ln()).abs() < 1e-3 && (eyy - ly.ln()).abs() < 1e-3);
     // The control gauge is the summary's gauge.
     assert_eq!(frame["gauge"], mid["strain"]);
     let arm = &gauges[1];
     let elongation = arm["elongation_px"].as_f64().unwrap();
-    eprintln!("arm: elongation {elongation:.4} px (truth {:.4})", (lx - 1.0) * 110.0);
+    eprintln!(
+        "arm: elongation {elongation:.4} px (truth {:.4})",
+        (lx - 1.0) * 110.0
+    );
     assert!((elongation - (lx - 1.0) * 110.0).abs() < 0.05);
     assert!((arm["nominal_strain"].as_f64().unwrap() - (lx - 1.0)).abs() < 5e-4);
     assert_eq!(gauges[2]["nodes"], 0);
-    assert!(gauges[2]["no_reading"].as_str().unwrap().contains("0 valid nodes"));
+    assert!(gauges[2]["no_reading"]
+        .as_str()
+        .unwrap()
+        .contains("0 valid nodes"));
     // The default control gauge, the mesh's central half, reads the same homogeneous stretch.
     let output = run(&[]);
     assert!(output.status.success());
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    let centre = summary["frames"][0]["gauge"]["log"]["exx"].as_f64().unwrap();
+    let centre = summary["frames"][0]["gauge"]["log"]["exx"]
+        .as_f64()
+        .unwrap();
     assert!((centre - lx.ln()).abs() < 1e-3, "{centre}");
     for (args, expected) in [
         (
@@ -658,7 +672,10 @@ fn gauges_read_the_stretch_where_they_are_placed() {
             "point 500,80 is outside the 192x160 px image",
         ),
         (["--gauge", "arm=extensometer:40,80"], "two points"),
-        (["--control-gauge", "nosuch"], "control gauge nosuch is not one of the gauges"),
+        (
+            ["--control-gauge", "nosuch"],
+            "control gauge nosuch is not one of the gauges",
+        ),
     ] {
         let output = run(&args);
         let stderr = String::from_utf8_lossy(&output.stderr);

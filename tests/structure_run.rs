@@ -28,6 +28,12 @@ fn structure_config(run: &Run, run_keys: &str) -> std::path::PathBuf {
 fn a_run_on_the_structure_compares_every_node_with_the_filmed_field() {
     let mut run = Run::new("run_structure");
     let config = structure_config(&run, "");
+    // Two of the user's gauges (issue 28 d2): their columns in frames.csv.
+    let text = std::fs::read_to_string(&config).unwrap().replace(
+        "[correlator]\n",
+        "[correlator]\ngauges = [\"mid=rect:96,96,64,64\", \"span=extensometer:64,128 192,128\"]\n",
+    );
+    std::fs::write(&config, text).unwrap();
     let out = run.dir.join("out");
     start_run(&mut run, "run", &config, &out, &["--no-dashboard"]);
     // The acceptance divides forces by the gauge's sections, wrong on a heterogeneous field
@@ -57,6 +63,38 @@ fn a_run_on_the_structure_compares_every_node_with_the_filmed_field() {
         assert!(error < 0.05, "{row:?}");
     }
     assert!(stdout.contains("(finite-element field)"), "{stdout}");
+    // The gauges' columns, before sequence_id. At the centre of the specimen the field is
+    // near homogeneous at this scale: the central strain gauge reads what the control gauge
+    // (the mesh's central half) reads, and the extensometer across it the same stretch.
+    let column = |name: &str| {
+        columns
+            .iter()
+            .position(|c| *c == name)
+            .unwrap_or_else(|| panic!("no column {name}: {columns:?}"))
+    };
+    assert_eq!(columns.last(), Some(&"sequence_id"));
+    let (control, mid, mid_nodes, span) = (
+        column("log_exx"),
+        column("gauge_mid_log_exx"),
+        column("gauge_mid_nodes"),
+        column("ext_span_nominal_strain"),
+    );
+    column("ext_span_elongation_px");
+    let last = rows.last().unwrap();
+    let value = |k: usize| -> f64 { last[k].parse().unwrap_or_else(|_| panic!("{last:?}")) };
+    eprintln!(
+        "last row: control log exx {:.5}, mid {:.5} over {} nodes, span nominal {:.5}",
+        value(control),
+        value(mid),
+        last[mid_nodes],
+        value(span)
+    );
+    assert!(value(mid_nodes) > 10.0, "{last:?}");
+    assert!((value(mid) - value(control)).abs() < 0.01, "{last:?}");
+    assert!(
+        (value(span) - value(control).exp_m1()).abs() < 0.02,
+        "{last:?}"
+    );
 }
 
 /// kill -9 of the rig while it publishes the structure's solves: the restarted rig resumes

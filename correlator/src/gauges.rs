@@ -279,10 +279,7 @@ mod tests {
     fn the_control_gauge_is_centre_all_or_a_name() {
         assert_eq!("centre".parse(), Ok(ControlGauge::Centre));
         assert_eq!("all".parse(), Ok(ControlGauge::All));
-        assert_eq!(
-            "mid".parse(),
-            Ok(ControlGauge::Named("mid".to_owned()))
-        );
+        assert_eq!("mid".parse(), Ok(ControlGauge::Named("mid".to_owned())));
         assert!("no good".parse::<ControlGauge>().is_err());
         assert_eq!(ControlGauge::default().to_string(), "centre");
     }

@@ -79,12 +79,21 @@ pub fn csv_header() -> String {
 
 /// The header with the truth columns, or without them (a camera without ground truth).
 pub fn csv_header_for(truth: bool) -> String {
-    COLUMNS
+    csv_header_with(truth, "")
+}
+
+/// The header with or without the truth columns, and the user's gauges' columns (each
+/// preceded by a comma, `gauge_columns::header`) before the last, `sequence_id`.
+pub fn csv_header_with(truth: bool, gauge_columns: &str) -> String {
+    let mut header = COLUMNS
         .iter()
         .filter(|c| truth || !TRUTH_COLUMNS.contains(c))
         .copied()
         .collect::<Vec<_>>()
-        .join(",")
+        .join(",");
+    let last = header.rfind(',').expect("several columns");
+    header.insert_str(last, gauge_columns);
+    header
 }
 
 /// Recent rig samples by id, bounded: fields name the sample their frame was taken at.
@@ -270,11 +279,14 @@ fn truth_errors(
             current,
             control,
         } => {
-            let in_gauge = |n: &FieldNode| control.contains(correlator::gauges::GaugeNode::position_px(n));
+            let in_gauge =
+                |n: &FieldNode| control.contains(correlator::gauges::GaugeNode::position_px(n));
             match truth::field_errors(nodes, current, origin, in_gauge, each) {
                 Some(e) => (
                     Some([e.mean_px, e.max_px]),
-                    e.mean_gradient.and_then(|g| truth::log_strain(&g)).map(strain_error),
+                    e.mean_gradient
+                        .and_then(|g| truth::log_strain(&g))
+                        .map(strain_error),
                 ),
                 None => (None, None),
             }
@@ -353,6 +365,12 @@ impl FrameRow {
 
     /// Appends the CSV line, with or without the truth columns ([`csv_header_for`]).
     pub fn write_csv_for(&self, out: &mut String, truth: bool) {
+        self.write_csv_with(out, truth, "")
+    }
+
+    /// Appends the CSV line with or without the truth columns and with the gauges' cells
+    /// (each preceded by a comma) before the last, as [`csv_header_with`] orders them.
+    pub fn write_csv_with(&self, out: &mut String, truth: bool, gauge_cells: &str) {
         fn opt<T: std::fmt::Display>(out: &mut String, v: Option<T>) {
             if let Some(v) = v {
                 let _ = write!(out, "{v}");
@@ -403,6 +421,7 @@ impl FrameRow {
             }),
             None => out.push_str(",,,,"),
         }
+        out.push_str(gauge_cells);
         let _ = writeln!(out, ",{}", self.sequence_id);
     }
 }
@@ -559,6 +578,16 @@ mod tests {
         let row = FrameRow::new(&field, &[], None, None, &mut NodeErrors::default(), 0, 0);
         let mut line = String::new();
         row.write_csv_for(&mut line, false);
+        assert_eq!(
+            line.trim_end().split(',').count(),
+            header.split(',').count()
+        );
+        // The gauges' columns and cells go before sequence_id, which stays last.
+        let header = csv_header_with(true, ",gauge_a_log_exx,ext_b_elongation_px");
+        assert!(header.ends_with(",gauge_a_log_exx,ext_b_elongation_px,sequence_id"));
+        line.clear();
+        row.write_csv_with(&mut line, true, ",,");
+        assert!(line.ends_with(",,,0\n"), "{line}");
         assert_eq!(
             line.trim_end().split(',').count(),
             header.split(',').count()

@@ -1,4 +1,5 @@
-//! The user's gauges in `frames.csv`: their columns, after the fixed ones, and each field's
+//! The user's gauges in `frames.csv`: their columns, before the last (`sequence_id`: a row
+//! always ends with a number), and each field's
 //! cells (empty where a gauge has no reading on that field). A strain gauge writes its mean
 //! log strains and the valid nodes it read; an extensometer its elongation (px) and nominal
 //! strain. Read from the field's nodes with the correlator's own gauge code, so the numbers
@@ -68,7 +69,11 @@ mod tests {
             x_px: x,
             y_px: y,
             u_px: u,
-            status: if ok { 0 } else { wire::NodeStatus::LowZncc as u32 },
+            status: if ok {
+                0
+            } else {
+                wire::NodeStatus::LowZncc as u32
+            },
             ..FieldNode::default()
         }
     }

@@ -77,6 +77,8 @@ pub struct Recorder {
     /// Largest measured stretch per load case code (1 uniaxial, 2 equibiaxial).
     pub max_stretch: [f64; 3],
     row: String,
+    /// The user's gauges' cells of the row being written.
+    gauge_cells: String,
     text: String,
     /// The VTK fields written so far, as one time series (`fields/fields.vtk.series`).
     vtk_series: crate::vtk_series::VtkSeries,
@@ -94,8 +96,10 @@ impl Recorder {
         Ok(Recorder {
             frames_csv: RowFile::create(
                 &results.frames_csv(),
-                &(crate::frames::csv_header_for(settings.truth)
-                    + &crate::gauge_columns::header(&settings.gauges)),
+                &crate::frames::csv_header_with(
+                    settings.truth,
+                    &crate::gauge_columns::header(&settings.gauges),
+                ),
             )?,
             results: results.clone(),
             settings,
@@ -126,6 +130,7 @@ impl Recorder {
             peak_field: None,
             max_stretch: [1.0; 3],
             row: String::with_capacity(1024),
+            gauge_cells: String::new(),
             text: String::new(),
             write_error: None,
         })
@@ -268,12 +273,11 @@ impl Recorder {
             }
         }
         self.row.clear();
-        row.write_csv_for(&mut self.row, self.settings.truth);
-        // The gauges' cells go before the line's end.
-        self.row.pop();
+        self.gauge_cells.clear();
         let step_px = f64::from(header.step_px);
-        crate::gauge_columns::write_cells(&self.settings.gauges, nodes, step_px, &mut self.row);
-        self.row.push('\n');
+        let gauges = &self.settings.gauges;
+        crate::gauge_columns::write_cells(gauges, nodes, step_px, &mut self.gauge_cells);
+        row.write_csv_with(&mut self.row, self.settings.truth, &self.gauge_cells);
         let line = std::mem::take(&mut self.row);
         let result = self.frames_csv.append(&line);
         self.row = line;

@@ -6,13 +6,13 @@
 //! structured grid and colour maps of |u| and exx over the reference image. Every file is
 //! written atomically (temporary sibling, then rename). Images are read by `producer::read_image`.
 
-use super::named_arg::named;
 use super::gauge_report::{reading_line, readings_json, strains_json};
+use super::named_arg::named;
 use anyhow::{anyhow, bail, Context, Result};
 use correlator::settings::{Method, ReferenceKind};
 use correlator::{
-    ControlGauge, Correlator, CorrelatorSettings, Field, Gauge, GuessMode, Polygon, ReferenceMode, Region,
-    RoiChoice, StrainMeasure,
+    ControlGauge, Correlator, CorrelatorSettings, Field, Gauge, GuessMode, Polygon, ReferenceMode,
+    Region, RoiChoice, StrainMeasure,
 };
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};

@@ -190,7 +190,9 @@ pub struct FieldHeader {
     pub truth: crate::frame::GroundTruth,
     pub u_mean_px: f64,
     pub v_mean_px: f64,
-    /// Gauge (ROI average) strains in the order of [`StrainMeasure::ALL`].
+    /// The control gauge's strains (the correlator's `control_gauge`: by default the mesh's
+    /// central half) in the order of [`StrainMeasure::ALL`]; NaN when it has no reading (fewer
+    /// than 3 valid nodes in it, not on one line): a consumer holds rather than read a 0.
     pub gauge: [GaugeStrain; 4],
     /// The frame's `sequence_id`.
     pub sequence_id: u32,

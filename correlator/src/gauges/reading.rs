@@ -207,11 +207,21 @@ pub fn read<N: GaugeNode>(shape: &GaugeShape, nodes: &[N], step_px: f64) -> Gaug
             };
             let a = match follow(*a_px, 'A') {
                 Ok(a) => a,
-                Err(e) => return GaugeReading { nodes: 0, value: Err(e) },
+                Err(e) => {
+                    return GaugeReading {
+                        nodes: 0,
+                        value: Err(e),
+                    }
+                }
             };
             let b = match follow(*b_px, 'B') {
                 Ok(b) => b,
-                Err(e) => return GaugeReading { nodes: a.1, value: Err(e) },
+                Err(e) => {
+                    return GaugeReading {
+                        nodes: a.1,
+                        value: Err(e),
+                    }
+                }
             };
             let length = |p: (f64, f64), q: (f64, f64)| (q.0 - p.0).hypot(q.1 - p.1);
             GaugeReading {
@@ -253,7 +263,10 @@ impl ControlRegion<'_> {
             ControlGauge::All => ControlRegion::All,
             ControlGauge::Centre => {
                 let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
-                for node in nodes.iter().filter(|n| n.status() != NodeStatus::OutsideRegion) {
+                for node in nodes
+                    .iter()
+                    .filter(|n| n.status() != NodeStatus::OutsideRegion)
+                {
                     let (x, y) = node.position_px();
                     (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
                 }
@@ -345,7 +358,10 @@ mod tests {
         }
         // rect 150..210 x 150..190, its right and bottom edges outside (the region's rule):
         // 6 x 4 nodes.
-        assert_eq!(read(&gauge("g=rect:150,150,60,40").shape, &nodes, 10.0).nodes, 24);
+        assert_eq!(
+            read(&gauge("g=rect:150,150,60,40").shape, &nodes, 10.0).nodes,
+            24
+        );
         // An extensometer between points off the nodes: exact for an affine motion.
         let e = read(&gauge("e=extensometer:123,157 281,157").shape, &nodes, 10.0);
         let value = e.value.unwrap();

@@ -289,7 +289,10 @@ fn gauges_are_read_checked_and_passed_on() {
     let round = RunConfig::from_toml(&config.to_toml(), "round").unwrap();
     assert_eq!(round, config);
     assert_eq!(
-        RunConfig::default().correlator_settings().unwrap().control_gauge,
+        RunConfig::default()
+            .correlator_settings()
+            .unwrap()
+            .control_gauge,
         correlator::ControlGauge::Centre
     );
     let refuse = |toml: &str, expected: &str| {

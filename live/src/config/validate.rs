@@ -218,7 +218,10 @@ impl RunConfig {
             .map_err(|e| anyhow!("[correlator] {e}"))?;
         for gauge in &settings.gauges {
             gauge
-                .check_inside(self.camera.width_px as usize, self.camera.height_px as usize)
+                .check_inside(
+                    self.camera.width_px as usize,
+                    self.camera.height_px as usize,
+                )
                 .map_err(|e| anyhow!("[correlator] gauges: {e}"))?;
         }
         settings
