@@ -80,15 +80,22 @@ fn a_run_on_the_structure_compares_every_node_with_the_filmed_field() {
         column("ext_span_nominal_strain"),
     );
     column("ext_span_elongation_px");
-    let last = rows.last().unwrap();
-    let value = |k: usize| -> f64 { last[k].parse().unwrap_or_else(|_| panic!("{last:?}")) };
+    // The most stretched row (the campaign ends unloaded).
+    let cell = |row: &Vec<String>, k: usize| -> f64 { row[k].parse().unwrap_or(f64::NAN) };
+    let last = rows
+        .iter()
+        .filter(|r| cell(r, mid).is_finite() && cell(r, span).is_finite())
+        .max_by(|a, b| cell(a, control).total_cmp(&cell(b, control)))
+        .unwrap();
+    let value = |k: usize| cell(last, k);
     eprintln!(
-        "last row: control log exx {:.5}, mid {:.5} over {} nodes, span nominal {:.5}",
+        "most stretched row: control log exx {:.5}, mid {:.5} over {} nodes, span nominal {:.5}",
         value(control),
         value(mid),
         last[mid_nodes],
         value(span)
     );
+    assert!(value(control) > 0.05, "{last:?}");
     assert!(value(mid_nodes) > 10.0, "{last:?}");
     assert!((value(mid) - value(control)).abs() < 0.01, "{last:?}");
     assert!(
