@@ -457,15 +457,18 @@ fn new_panels_have_data_pause_and_export(browser: &Browser) {
             .as_str()
             .and_then(|t| t.trim_end_matches(" s").parse::<f64>().ok())
     };
-    let first = until("the test's time, forces and field states on the page", || {
-        let p = read_page(browser);
-        (seconds(&p).is_some()
-            && p["force_time_points"].as_u64() > Some(0)
-            && p["force_grip_points"].as_u64() > Some(0)
-            && p["state_points"].as_u64() > Some(0)
-            && p["gauge_clock"] == "test")
-        .then_some(p)
-    });
+    let first = until(
+        "the test's time, forces and field states on the page",
+        || {
+            let p = read_page(browser);
+            (seconds(&p).is_some()
+                && p["force_time_points"].as_u64() > Some(0)
+                && p["force_grip_points"].as_u64() > Some(0)
+                && p["state_points"].as_u64() > Some(0)
+                && p["gauge_clock"] == "test")
+                .then_some(p)
+        },
+    );
     until("the test's time advancing", || {
         (seconds(&read_page(browser)) > seconds(&first)).then_some(())
     });
@@ -479,7 +482,10 @@ fn new_panels_have_data_pause_and_export(browser: &Browser) {
         let p = read_page(browser);
         (p["snapshots"].as_u64() > paused["snapshots"].as_u64().map(|n| n + 1)).then_some(p)
     });
-    assert_eq!(later["charts"], paused["charts"], "paused charts are not redrawn");
+    assert_eq!(
+        later["charts"], paused["charts"],
+        "paused charts are not redrawn"
+    );
     browser.eval("document.getElementById('pause').click(); return null;");
     until("charts drawn again after resuming", || {
         (read_page(browser)["charts"].as_u64() > paused["charts"].as_u64()).then_some(())
@@ -494,10 +500,16 @@ fn new_panels_have_data_pause_and_export(browser: &Browser) {
                   pngs: Object.keys(png).length };",
     );
     for kind in ["csv", "png", "json"] {
-        assert!(exported["sizes"][kind].as_u64() > Some(100), "{kind}: {exported}");
+        assert!(
+            exported["sizes"][kind].as_u64() > Some(100),
+            "{kind}: {exported}"
+        );
     }
     let csv = exported["csv"].as_str().unwrap();
-    assert!(csv.starts_with("chart,series,x_name,y_name,x,y\n"), "{csv:.200}");
+    assert!(
+        csv.starts_with("chart,series,x_name,y_name,x,y\n"),
+        "{csv:.200}"
+    );
     assert!(
         csv.contains("force-time-chart,X+,test time (s),force (kN),")
             && csv.contains("states-chart,nodes,"),

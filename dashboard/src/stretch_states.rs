@@ -33,7 +33,9 @@ pub fn node_stretches(n: &FieldNode, measure: StrainMeasure) -> Option<[f64; 2]>
             ];
             identifier::field_stress::principal_stretches(&f)
         }
-        _ => stretch(mean + radius).zip(stretch(mean - radius)).map(|(a, b)| [a, b]),
+        _ => stretch(mean + radius)
+            .zip(stretch(mean - radius))
+            .map(|(a, b)| [a, b]),
     }?;
     stretches
         .iter()
@@ -48,7 +50,9 @@ pub fn json(nodes: &[FieldNode], measure: StrainMeasure) -> Value {
         .filter_map(|n| node_stretches(n, measure))
         .collect();
     let shown = states.len().min(MAX_POINTS);
-    let kept: Vec<[f64; 2]> = (0..shown).map(|i| states[i * states.len() / shown]).collect();
+    let kept: Vec<[f64; 2]> = (0..shown)
+        .map(|i| states[i * states.len() / shown])
+        .collect();
     json!({
         "l1": kept.iter().map(|s| significant(s[0], 5)).collect::<Vec<_>>(),
         "l2": kept.iter().map(|s| significant(s[1], 5)).collect::<Vec<_>>(),
@@ -76,11 +80,19 @@ mod tests {
         // Uniaxial λ = 1.3 rotated by 30°: ln λ along (cos, sin), −ln λ / 2 across.
         let (a, b, t) = (1.3f64.ln(), -0.5 * 1.3f64.ln(), 30f64.to_radians());
         let (c, s) = (t.cos(), t.sin());
-        let n = node(a * c * c + b * s * s, a * s * s + b * c * c, (a - b) * c * s);
+        let n = node(
+            a * c * c + b * s * s,
+            a * s * s + b * c * c,
+            (a - b) * c * s,
+        );
         let [l1, l2] = node_stretches(&n, StrainMeasure::Log).unwrap();
         assert!((l1 - 1.3).abs() < 1e-6 && (l2 - 1.3f64.powf(-0.5)).abs() < 1e-6);
         // Green-Lagrange (λ² − 1)/2 and nominal λ − 1 give the same stretches.
-        let g = node(0.5 * (1.2f64.powi(2) - 1.0), 0.5 * (1.1f64.powi(2) - 1.0), 0.0);
+        let g = node(
+            0.5 * (1.2f64.powi(2) - 1.0),
+            0.5 * (1.1f64.powi(2) - 1.0),
+            0.0,
+        );
         let [l1, l2] = node_stretches(&g, StrainMeasure::Green).unwrap();
         assert!((l1 - 1.2).abs() < 1e-6 && (l2 - 1.1).abs() < 1e-6);
         let [l1, l2] = node_stretches(&node(0.1, 0.2, 0.0), StrainMeasure::Nominal).unwrap();
@@ -98,9 +110,7 @@ mod tests {
 
     #[test]
     fn a_large_field_is_subsampled_evenly_to_the_cap() {
-        let nodes: Vec<FieldNode> = (0..5000)
-            .map(|i| node(1e-4 * i as f64, 0.0, 0.0))
-            .collect();
+        let nodes: Vec<FieldNode> = (0..5000).map(|i| node(1e-4 * i as f64, 0.0, 0.0)).collect();
         let j = json(&nodes, StrainMeasure::Log);
         assert_eq!(j["valid"], 5000);
         assert_eq!(j["shown"], MAX_POINTS);

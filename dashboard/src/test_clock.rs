@@ -27,7 +27,12 @@ impl TestClock {
 
     /// The test time (s) of a frame taken at `t_capture_ns` under rig sample `rig_sample_id`.
     pub fn test_time_s(&self, rig_sample_id: u64, t_capture_ns: u64) -> Option<f64> {
-        if let Some(&(_, t)) = self.recent.iter().rev().find(|(id, _)| *id == rig_sample_id) {
+        if let Some(&(_, t)) = self
+            .recent
+            .iter()
+            .rev()
+            .find(|(id, _)| *id == rig_sample_id)
+        {
             return Some(t);
         }
         let (published_ns, t_sim_s) = self.newest?;
@@ -45,11 +50,17 @@ mod tests {
         let mut clock = TestClock::default();
         assert_eq!(clock.test_time_s(3, 5), None);
         for id in 0..10u64 {
-            clock.on_rig(id, 100.0 + id as f64 * 0.01, 1_000_000_000 + id * 10_000_000);
+            clock.on_rig(
+                id,
+                100.0 + id as f64 * 0.01,
+                1_000_000_000 + id * 10_000_000,
+            );
         }
         assert!((clock.test_time_s(4, 0).unwrap() - 100.04).abs() < 1e-12);
         // Unknown sample (a frame from no rig): the newest sample, 0.5 s later.
-        let t = clock.test_time_s(wire::NO_RIG_SAMPLE, 1_590_000_000).unwrap();
+        let t = clock
+            .test_time_s(wire::NO_RIG_SAMPLE, 1_590_000_000)
+            .unwrap();
         assert!((t - 100.59).abs() < 1e-9, "{t}");
     }
 }
