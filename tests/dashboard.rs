@@ -472,8 +472,11 @@ fn new_panels_have_data_pause_and_export(browser: &Browser) {
     until("the test's time advancing", || {
         (seconds(&read_page(browser)) > seconds(&first)).then_some(())
     });
+    // x pulls (which others count as loaded is the 10 % rule's, unit-tested in `wire::rig`: at
+    // this test's small forces, about 50 N, the other load cells' noise passes it).
     let loaded = browser.eval("return dash.last.forces.actuators.map((a) => a.name).join(',');");
-    assert_eq!(loaded, "X+,X-", "the uniaxial test loads x only");
+    let loaded = loaded.as_str().unwrap_or_default();
+    assert!(loaded.starts_with("X+,X-"), "{loaded}");
 
     // Paused: snapshots go on, the charts do not move; resumed, they do.
     browser.eval("document.getElementById('pause').click(); return null;");
@@ -511,8 +514,8 @@ fn new_panels_have_data_pause_and_export(browser: &Browser) {
         "{csv:.200}"
     );
     assert!(
-        csv.contains("force-time-chart,X+,test time (s),force (kN),")
-            && csv.contains("states-chart,nodes,"),
+        csv.contains("\"force-time-chart\",\"X+\",\"test time (s)\",\"force (kN)\",")
+            && csv.contains("\"states-chart\",\"nodes\","),
         "{csv:.400}"
     );
     assert_eq!(exported["png"], true, "{exported:.300}");
