@@ -450,7 +450,8 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
 
 /// The test's time in the header advances; the force charts (the uniaxial test loads x: X+
 /// and X−) and the (λ1, λ2) states have points; pause freezes the charts while snapshots go
-/// on; each export button produces content, read back through the page's `dash` hooks.
+/// on; each export button produces content, read back through the page's `dash` hooks; a
+/// zoomed x range is drawn and a double click resets it.
 fn new_panels_have_data_pause_and_export(browser: &Browser) {
     let seconds = |p: &Value| {
         p["test_time"]
@@ -521,4 +522,17 @@ fn new_panels_have_data_pause_and_export(browser: &Browser) {
     assert_eq!(exported["png"], true, "{exported:.300}");
     assert_eq!(exported["pngs"], 8);
     assert!(exported["json"].is_string());
+
+    // Zoom: an x range drawn as asked; a double click resets the whole range.
+    let zoomed = browser.eval(
+        "const t = dash.last.forces.t_sim_s, a = t[0], b = t[t.length - 1]; \
+         const lo = a + 0.25 * (b - a), hi = a + 0.5 * (b - a); \
+         dash.zoomTo('force-time-chart', [lo, hi]); \
+         const f = dash.charts['force-time-chart'].frame; \
+         const ok = f.x0 === lo && f.x1 === hi; \
+         document.getElementById('force-time-chart').dispatchEvent(new MouseEvent('dblclick')); \
+         const g = dash.charts['force-time-chart'].frame; \
+         return ok && !dash.zoom['force-time-chart'] && g.x0 <= a && g.x1 >= hi;",
+    );
+    assert_eq!(zoomed, true);
 }

@@ -6,7 +6,7 @@
 // Counters the browser tests read: they must grow while the instance runs.
 // `points`: the points each chart drew (by canvas id); `charts`: what each chart drew last (the
 // CSV export); `exported`: the size of what each export button produced last.
-const dash = { snapshots: 0, imagesDrawn: 0, chartsDrawn: 0, last: null, points: {}, charts: {}, exported: {}, paused: false };
+const dash = { snapshots: 0, imagesDrawn: 0, chartsDrawn: 0, last: null, points: {}, charts: {}, exported: {}, paused: false, zoom: {} };
 window.dash = dash;
 
 const $ = (id) => document.getElementById(id);
@@ -43,9 +43,11 @@ function tickLabel(v, span) {
 }
 
 // series: [{x: [], y: [], color, label, dots}]
-// opts: {xlabel, ylabel (with units), yZero, empty}. Paused, a chart already drawn stays.
-function lineChart(canvas, series, opts) {
-  if (dash.paused && dash.charts[canvas.id]) return;
+// opts: {xlabel, ylabel (with units), yZero, empty}. Paused, a chart already drawn stays
+// (`redraw`: a zoom's change draws it anyway). Zoomed (`dash.zoom[id]`: an x range), the y
+// range fits the points inside it.
+function lineChart(canvas, series, opts, redraw) {
+  if (dash.paused && dash.charts[canvas.id] && !redraw) return;
   dash.charts[canvas.id] = { series, opts };
   const ctx = canvas.getContext('2d');
   const W = canvas.width, H = canvas.height, L = 70, R = 10, T = 10, B = 30;
@@ -66,9 +68,16 @@ function lineChart(canvas, series, opts) {
   }
   if (xs.length === 0) { ctx.fillText(opts.empty || 'no data yet', L + 10, H / 2); return; }
   let x0 = Math.min(...xs), x1 = Math.max(...xs), y0 = Math.min(...ys), y1 = Math.max(...ys);
+  const z = dash.zoom[canvas.id];
+  if (z) {
+    [x0, x1] = z;
+    const inside = ys.filter((_, i) => xs[i] >= x0 && xs[i] <= x1);
+    if (inside.length) { y0 = Math.min(...inside); y1 = Math.max(...inside); }
+  }
   if (opts.yZero) { y0 = Math.min(y0, 0); y1 = Math.max(y1, 0); }
   if (x1 === x0) { x1 = x0 + 1; }
   if (y1 === y0) { y1 = y0 + (Math.abs(y0) || 1) * 0.1; y0 -= (Math.abs(y0) || 1) * 0.1; }
+  dash.charts[canvas.id].frame = { left: L, right: W - R, x0, x1 };
   const px = (x) => L + (x - x0) / (x1 - x0) * (W - L - R);
   const py = (y) => H - B - (y - y0) / (y1 - y0) * (H - T - B);
   ctx.strokeStyle = '#e4e7eb'; ctx.lineWidth = 1;
@@ -494,6 +503,34 @@ $('pause').addEventListener('click', () => {
   $('pause').className = dash.paused ? 'on' : '';
   if (!dash.paused && dash.last) update(dash.last);
 });
+
+// ---- zoom: drag across a line chart selects its x range, a double click resets it ----
+function zoomTo(id, range) {
+  if (range) dash.zoom[id] = range; else delete dash.zoom[id];
+  const c = dash.charts[id];
+  if (c) lineChart($(id), c.series, c.opts, true);
+}
+dash.zoomTo = zoomTo;
+for (const id of CHART_IDS.filter((c) => c !== 'latency-chart')) {
+  const canvas = $(id);
+  canvas.title = 'drag across to zoom on x; double-click to reset';
+  const dataX = (e) => {
+    const f = dash.charts[id] && dash.charts[id].frame;
+    if (!f) return null;
+    const x = e.offsetX * canvas.width / canvas.clientWidth;
+    return f.x0 + (x - f.left) / (f.right - f.left) * (f.x1 - f.x0);
+  };
+  let from = null;
+  canvas.addEventListener('mousedown', (e) => { from = dataX(e); });
+  canvas.addEventListener('mouseup', (e) => {
+    const to = dataX(e), f = dash.charts[id] && dash.charts[id].frame;
+    if (from !== null && to !== null && f && Math.abs(to - from) > 0.02 * (f.x1 - f.x0)) {
+      zoomTo(id, [Math.min(from, to), Math.max(from, to)]);
+    }
+    from = null;
+  });
+  canvas.addEventListener('dblclick', () => zoomTo(id, null));
+}
 
 for (const id of ['component', 'map-measure', 'range-mode', 'range-min', 'range-max', 'show-mesh', 'show-map']) {
   $(id).addEventListener('change', drawSpecimen);
