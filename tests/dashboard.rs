@@ -261,6 +261,11 @@ const READ_PAGE: &str = "
         mode: text('mode'),
         rig_control: text('rig-control'),
         rig_strain: text('rig-strain'),
+        test_time: text('test-time'),
+        force_time_points: window.dash ? (dash.points['force-time-chart'] || 0) : 0,
+        force_grip_points: window.dash ? (dash.points['force-grip-chart'] || 0) : 0,
+        state_points: window.dash ? (dash.statePoints || 0) : 0,
+        gauge_clock: window.dash && dash.last ? dash.last.gauge.clock : null,
     };";
 
 fn read_page(browser: &Browser) -> Value {
@@ -377,6 +382,7 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
         (p["rig_control"] == "displacement").then_some(p)
     });
     assert!(read_page(&browser)["rig_strain"].is_null());
+    new_panels_have_data_pause_and_export(&browser);
     until("the process table", || {
         (read_page(&browser)["correlator_restarts"] == "0").then_some(())
     });
@@ -440,4 +446,93 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
     until("the page saying the run ended", || {
         (read_page(&browser)["conn"] == "run ended").then_some(())
     });
+}
+
+/// The test's time in the header advances; the force charts (the uniaxial test loads x: X+
+/// and X−) and the (λ1, λ2) states have points; pause freezes the charts while snapshots go
+/// on; each export button produces content, read back through the page's `dash` hooks; a
+/// zoomed x range is drawn and a double click resets it.
+fn new_panels_have_data_pause_and_export(browser: &Browser) {
+    let seconds = |p: &Value| {
+        p["test_time"]
+            .as_str()
+            .and_then(|t| t.trim_end_matches(" s").parse::<f64>().ok())
+    };
+    let first = until(
+        "the test's time, forces and field states on the page",
+        || {
+            let p = read_page(browser);
+            (seconds(&p).is_some()
+                && p["force_time_points"].as_u64() > Some(0)
+                && p["force_grip_points"].as_u64() > Some(0)
+                && p["state_points"].as_u64() > Some(0)
+                && p["gauge_clock"] == "test")
+                .then_some(p)
+        },
+    );
+    until("the test's time advancing", || {
+        (seconds(&read_page(browser)) > seconds(&first)).then_some(())
+    });
+    // x pulls (which others count as loaded is the 10 % rule's, unit-tested in `wire::rig`: at
+    // this test's small forces, about 50 N, the other load cells' noise passes it).
+    let loaded = browser.eval("return dash.last.forces.actuators.map((a) => a.name).join(',');");
+    let loaded = loaded.as_str().unwrap_or_default();
+    assert!(loaded.starts_with("X+,X-"), "{loaded}");
+
+    // Paused: snapshots go on, the charts do not move; resumed, they do.
+    browser.eval("document.getElementById('pause').click(); return null;");
+    let paused = read_page(browser);
+    let later = until("snapshots while paused", || {
+        let p = read_page(browser);
+        (p["snapshots"].as_u64() > paused["snapshots"].as_u64().map(|n| n + 1)).then_some(p)
+    });
+    assert_eq!(
+        later["charts"], paused["charts"],
+        "paused charts are not redrawn"
+    );
+    browser.eval("document.getElementById('pause').click(); return null;");
+    until("charts drawn again after resuming", || {
+        (read_page(browser)["charts"].as_u64() > paused["charts"].as_u64()).then_some(())
+    });
+
+    // Export: each button's content, and the hooks' content itself.
+    let exported = browser.eval(
+        "for (const id of ['export-csv', 'export-png', 'export-json']) document.getElementById(id).click(); \
+         const png = dash.exportPng(); \
+         return { sizes: dash.exported, csv: dash.exportCsv(), json: JSON.parse(dash.exportJson()).instance, \
+                  png: Object.values(png).every((u) => u.startsWith('data:image/png;base64,') && u.length > 1000), \
+                  pngs: Object.keys(png).length };",
+    );
+    for kind in ["csv", "png", "json"] {
+        assert!(
+            exported["sizes"][kind].as_u64() > Some(100),
+            "{kind}: {exported}"
+        );
+    }
+    let csv = exported["csv"].as_str().unwrap();
+    assert!(
+        csv.starts_with("chart,series,x_name,y_name,x,y\n"),
+        "{csv:.200}"
+    );
+    assert!(
+        csv.contains("\"force-time-chart\",\"X+\",\"test time (s)\",\"force (kN)\",")
+            && csv.contains("\"states-chart\",\"nodes\","),
+        "{csv:.400}"
+    );
+    assert_eq!(exported["png"], true, "{exported:.300}");
+    assert_eq!(exported["pngs"], 8);
+    assert!(exported["json"].is_string());
+
+    // Zoom: an x range drawn as asked; a double click resets the whole range.
+    let zoomed = browser.eval(
+        "const t = dash.last.forces.t_sim_s, a = t[0], b = t[t.length - 1]; \
+         const lo = a + 0.25 * (b - a), hi = a + 0.5 * (b - a); \
+         dash.zoomTo('force-time-chart', [lo, hi]); \
+         const f = dash.charts['force-time-chart'].frame; \
+         const ok = f.x0 === lo && f.x1 === hi; \
+         document.getElementById('force-time-chart').dispatchEvent(new MouseEvent('dblclick')); \
+         const g = dash.charts['force-time-chart'].frame; \
+         return ok && !dash.zoom['force-time-chart'] && g.x0 <= a && g.x1 >= hi;",
+    );
+    assert_eq!(zoomed, true);
 }

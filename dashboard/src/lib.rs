@@ -5,6 +5,8 @@
 //!
 //! - [`state`] (pure): what is kept of the four services and the snapshot sent to viewers;
 //!   [`image`] the capped thumbnail, [`series`] and [`latency`] the bounded histories;
+//!   [`test_clock`] the test's time of a field, [`forces`] each loaded actuator's force,
+//!   [`stretch_states`] the field's (λ1, λ2) states;
 //! - [`hub`]: the latest snapshot and image, shared with the viewers' threads;
 //! - [`server`]: read-only HTTP on std with server-sent events, assets compiled in, a
 //!   deadline on every read and write so no viewer holds another or the stop;
@@ -15,6 +17,7 @@
 pub mod address;
 mod error;
 pub mod feed;
+pub mod forces;
 pub mod hub;
 pub mod image;
 pub mod latency;
@@ -22,6 +25,8 @@ pub mod series;
 pub mod server;
 mod slots;
 pub mod state;
+pub mod stretch_states;
+pub mod test_clock;
 
 pub use error::DashboardError;
 pub use state::{Mode, Settings};

@@ -4,9 +4,11 @@
 //! thumbnail encoded at most every `image_every_ns`. A snapshot is one JSON object of bounded
 //! size (the field is sent decimated to at most `max_nodes_side`² nodes).
 
+use crate::forces::ForceHistory;
 use crate::image::{downsample, encode_png};
 use crate::latency::LatencyStats;
 use crate::series::{significant, Decimated, Rate};
+use crate::test_clock::TestClock;
 use material::InvariantFn;
 use serde_json::{json, Value};
 use wire::stats::IdGaps;
@@ -60,6 +62,14 @@ pub const MODE_NAMES: [&str; 4] = [
 ];
 const LOAD_CASES: [&str; 3] = ["none", "uniaxial", "equibiaxial"];
 
+/// What the gauge history's time is: the test's (the rig's `t_sim_s`) or, without a rig,
+/// the time since the dashboard started.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum GaugeClock {
+    Test,
+    Dashboard,
+}
+
 /// The thumbnail last encoded, as described to viewers (the PNG itself is served apart).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImageInfo {
@@ -88,8 +98,14 @@ pub struct LiveState {
     nodes: Vec<FieldNode>,
     latency_field: LatencyStats,
     latency_identification: LatencyStats,
-    /// t (s since the dashboard started), then exx, eyy, exy for each of the 4 measures.
+    /// t (s: the test's time, or since the dashboard started without a rig: `gauge_clock`),
+    /// then exx, eyy, exy for each of the 4 measures.
     gauge: Decimated<13>,
+    gauge_clock: GaugeClock,
+    /// The rig samples' test time, for the fields.
+    clock: TestClock,
+    /// Each loaded actuator's force against test time and grip displacement.
+    forces: ForceHistory,
     rig_seen: u64,
     rig_ids: IdGaps,
     rig_rate: Rate,
@@ -123,6 +139,9 @@ impl LiveState {
             latency_field: LatencyStats::default(),
             latency_identification: LatencyStats::default(),
             gauge: Decimated::new(n),
+            gauge_clock: GaugeClock::Dashboard,
+            clock: TestClock::default(),
+            forces: ForceHistory::new(n),
             rig_seen: 0,
             rig_ids: IdGaps::default(),
             rig_rate: Rate::new(RATE_WINDOW_NS),
@@ -190,7 +209,21 @@ impl LiveState {
         self.field_ids.observe(header.frame_id);
         self.latency_field
             .record_ns(header.t_capture_ns, header.t_published_ns);
-        let t_s = header.t_capture_ns.saturating_sub(self.t0_ns) as f64 / 1e9;
+        let (clock, t_s) = match self
+            .clock
+            .test_time_s(header.rig_sample_id, header.t_capture_ns)
+        {
+            Some(t_s) => (GaugeClock::Test, t_s),
+            None => (
+                GaugeClock::Dashboard,
+                header.t_capture_ns.saturating_sub(self.t0_ns) as f64 / 1e9,
+            ),
+        };
+        // One clock per chart: the first rig sample restarts the history on the test's.
+        if clock != self.gauge_clock {
+            self.gauge.clear();
+            self.gauge_clock = clock;
+        }
         let mut row = [t_s; 13];
         for (m, g) in header.gauge.iter().enumerate() {
             row[1 + 3 * m] = g.exx;
@@ -208,6 +241,9 @@ impl LiveState {
     pub fn on_rig(&mut self, state: &RigState) {
         self.rig_seen += 1;
         self.rig_ids.observe(state.sample_id);
+        self.clock
+            .on_rig(state.sample_id, state.t_sim_s, state.t_published_ns);
+        self.forces.push(state);
         let force_kn = |axis: usize| {
             0.5 * (state.actuators[2 * axis].force_kn + state.actuators[2 * axis + 1].force_kn)
         };
@@ -253,6 +289,7 @@ impl LiveState {
             "instance": self.settings.instance,
             "mode": match self.settings.mode { Mode::Run => "run", Mode::Monitor => "monitor" },
             "t_s": now_ns.saturating_sub(self.t0_ns) as f64 / 1e9,
+            "test_time_s": self.last_rig.map(|r| r.t_sim_s),
             "viewers": viewers,
             "frames": self.frames_json(),
             "image": self.image.map(|i| json!({
@@ -274,6 +311,8 @@ impl LiveState {
             },
             "gauge": self.gauge_json(),
             "rig": self.rig_json(),
+            "forces": self.forces.json(),
+            "stretch_states": self.stretch_states_json(),
             "identification": self.identification_json(),
             "processes": processes,
         })
@@ -357,7 +396,22 @@ impl LiveState {
                 }),
             );
         }
-        json!({"t_s": self.gauge.column(0), "measures": measures})
+        let clock = match self.gauge_clock {
+            GaugeClock::Test => "test",
+            GaugeClock::Dashboard => "dashboard",
+        };
+        json!({"t_s": self.gauge.column(0), "clock": clock, "measures": measures})
+    }
+
+    /// The latest field's node states in the (λ1, λ2) plane (null before a field).
+    fn stretch_states_json(&self) -> Value {
+        let Some(h) = &self.last_field else {
+            return Value::Null;
+        };
+        let measure = wire::StrainMeasure::from_code(h.strain_measure).unwrap_or_default();
+        let mut states = crate::stretch_states::json(&self.nodes, measure);
+        states["frame_id"] = json!(h.frame_id);
+        states
     }
 
     fn rig_json(&self) -> Value {
@@ -612,6 +666,41 @@ mod tests {
             "{}",
             snap.to_string().len()
         );
+    }
+
+    #[test]
+    fn fields_are_charted_on_the_tests_time_with_forces_and_stretch_states() {
+        let mut s = LiveState::new(Settings::new("t", Mode::Run), 0);
+        // Before any rig sample: the dashboard's clock (1 s after it started).
+        let (mut h, nodes) = field(1, 4, 4);
+        h.strain_measure = wire::StrainMeasure::Log as u32;
+        s.on_field(&h, &nodes);
+        let snap = s.snapshot(2_000_000_000, 1, &Value::Null);
+        assert_eq!(snap["gauge"]["clock"], "dashboard");
+        assert_eq!(snap["gauge"]["t_s"][0], 1.0);
+        assert_eq!(snap["test_time_s"], Value::Null);
+        let mut rig = RigState {
+            sample_id: 7,
+            t_sim_s: 42.5,
+            ..RigState::default()
+        };
+        rig.actuators[0].force_kn = 1.0;
+        rig.actuators[1].force_kn = 1.0;
+        s.on_rig(&rig);
+        h.rig_sample_id = 7;
+        s.on_field(&h, &nodes);
+        let snap = s.snapshot(3_000_000_000, 1, &Value::Null);
+        assert_eq!(snap["test_time_s"], 42.5);
+        // The history restarted on the test's clock.
+        assert_eq!(snap["gauge"]["clock"], "test");
+        assert_eq!(snap["gauge"]["t_s"], json!([42.5]));
+        assert_eq!(snap["forces"]["actuators"].as_array().unwrap().len(), 2);
+        assert_eq!(snap["forces"]["t_sim_s"], json!([42.5]));
+        // 15 of the 16 nodes are ok (exx 0.01 log: λ1 = e^0.01, λ2 = 1).
+        let states = &snap["stretch_states"];
+        assert_eq!(states["valid"], 15);
+        assert!((states["l1"][0].as_f64().unwrap() - 0.01f64.exp()).abs() < 1e-4);
+        assert_eq!(states["l2"][0], 1.0);
     }
 
     #[test]

@@ -13,10 +13,6 @@ const MIN_MAX_STRETCH: f64 = 1.1;
 /// Points per canonical path drawn.
 const PATH_SAMPLES: usize = 60;
 
-/// An actuator whose force never reaches this fraction of the largest one's peak only shows
-/// its load cell's noise (the Z pair of a planar test): left out.
-const IDLE_FRACTION: f64 = 0.1;
-
 /// The CSV `text`'s header (`what` names the file in errors) and its data lines.
 pub(crate) type Columns<'a> = (Vec<&'a str>, std::str::Lines<'a>);
 
@@ -39,7 +35,7 @@ pub(crate) fn column(names: &[&str], name: &str, what: &str) -> anyhow::Result<u
 }
 
 /// Each actuator's force (N, as `rig.csv` logs it) against time (s): one series per
-/// actuator that carried a load ([`IDLE_FRACTION`]).
+/// actuator that carried a load (`wire::rig::loaded_actuators`).
 pub fn actuator_forces(rig_csv: &str) -> anyhow::Result<Vec<Series>> {
     let (names, lines) = header(rig_csv, "rig.csv")?;
     let column = |name: &str| column(&names, name, "rig.csv");
@@ -68,8 +64,9 @@ pub fn actuator_forces(rig_csv: &str) -> anyhow::Result<Vec<Series>> {
         }
     }
     let peak = |s: &Series| s.points.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
-    let largest = series.iter().map(peak).fold(0.0, f64::max);
-    series.retain(|s| largest > 0.0 && peak(s) >= IDLE_FRACTION * largest);
+    let peaks: Vec<f64> = series.iter().map(peak).collect();
+    let mut loaded = wire::rig::loaded_actuators(&peaks).into_iter();
+    series.retain(|_| loaded.next().unwrap_or(false));
     Ok(series)
 }
 

@@ -14,6 +14,21 @@ pub const ACTUATOR_NAMES: [&str; 6] = ["X+", "X-", "Y+", "Y-", "Z+", "Z-"];
 /// Axes in this order everywhere: X, Y, Z.
 pub const AXIS_NAMES: [&str; 3] = ["X", "Y", "Z"];
 
+/// An actuator is "loaded" when its |force| ever exceeded this fraction of the largest
+/// actuator's peak |force|; below, it only shows its load cell's noise (the y pair of a uniaxial
+/// test, the Z pair of a planar one). One rule for the run's figures and the dashboard.
+pub const LOADED_FORCE_FRACTION: f64 = 0.1;
+
+/// Which of the actuators whose peak |force| is `peaks_abs` (any unit) carried a load
+/// ([`LOADED_FORCE_FRACTION`] of the largest peak); none before any force.
+pub fn loaded_actuators(peaks_abs: &[f64]) -> Vec<bool> {
+    let largest = peaks_abs.iter().copied().fold(0.0, f64::max);
+    peaks_abs
+        .iter()
+        .map(|p| largest > 0.0 && *p >= LOADED_FORCE_FRACTION * largest)
+        .collect()
+}
+
 /// One servo-hydraulic actuator at one instant.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -334,5 +349,19 @@ mod tests {
         state.control_mode = 77;
         assert_eq!(state.control(), RigControl::Displacement);
         assert_eq!(state.strain_target(), None);
+    }
+}
+
+#[cfg(test)]
+mod loaded_tests {
+    use super::*;
+
+    #[test]
+    fn an_actuator_is_loaded_above_a_tenth_of_the_largest_peak() {
+        assert_eq!(
+            loaded_actuators(&[2.0, 1.9, 0.21, 0.19, 0.0, 0.0]),
+            [true, true, true, false, false, false]
+        );
+        assert!(loaded_actuators(&[0.0; 6]).iter().all(|l| !l));
     }
 }

@@ -4,7 +4,9 @@
 'use strict';
 
 // Counters the browser tests read: they must grow while the instance runs.
-const dash = { snapshots: 0, imagesDrawn: 0, chartsDrawn: 0, last: null };
+// `points`: the points each chart drew (by canvas id); `charts`: what each chart drew last (the
+// CSV export); `exported`: the size of what each export button produced last.
+const dash = { snapshots: 0, imagesDrawn: 0, chartsDrawn: 0, last: null, points: {}, charts: {}, exported: {}, paused: false, zoom: {} };
 window.dash = dash;
 
 const $ = (id) => document.getElementById(id);
@@ -41,9 +43,14 @@ function tickLabel(v, span) {
 }
 
 // series: [{x: [], y: [], color, label, dots}]
-function lineChart(canvas, series, opts) {
+// opts: {xlabel, ylabel (with units), yZero, empty}. Paused, a chart already drawn stays
+// (`redraw`: a zoom's change draws it anyway). Zoomed (`dash.zoom[id]`: an x range), the y
+// range fits the points inside it.
+function lineChart(canvas, series, opts, redraw) {
+  if (dash.paused && dash.charts[canvas.id] && !redraw) return;
+  dash.charts[canvas.id] = { series, opts };
   const ctx = canvas.getContext('2d');
-  const W = canvas.width, H = canvas.height, L = 58, R = 10, T = 10, B = 30;
+  const W = canvas.width, H = canvas.height, L = 70, R = 10, T = 10, B = 30;
   ctx.clearRect(0, 0, W, H);
   ctx.font = '11px system-ui, sans-serif';
   let xs = [], ys = [];
@@ -54,24 +61,36 @@ function lineChart(canvas, series, opts) {
     }
   }
   ctx.fillStyle = '#52606d';
+  dash.points[canvas.id] = xs.length;
+  if (opts.ylabel) {
+    ctx.save(); ctx.translate(11, (H - B + T) / 2); ctx.rotate(-Math.PI / 2);
+    ctx.textAlign = 'center'; ctx.fillText(opts.ylabel, 0, 0); ctx.restore();
+  }
   if (xs.length === 0) { ctx.fillText(opts.empty || 'no data yet', L + 10, H / 2); return; }
   let x0 = Math.min(...xs), x1 = Math.max(...xs), y0 = Math.min(...ys), y1 = Math.max(...ys);
+  const z = dash.zoom[canvas.id];
+  if (z) {
+    [x0, x1] = z;
+    const inside = ys.filter((_, i) => xs[i] >= x0 && xs[i] <= x1);
+    if (inside.length) { y0 = Math.min(...inside); y1 = Math.max(...inside); }
+  }
   if (opts.yZero) { y0 = Math.min(y0, 0); y1 = Math.max(y1, 0); }
   if (x1 === x0) { x1 = x0 + 1; }
   if (y1 === y0) { y1 = y0 + (Math.abs(y0) || 1) * 0.1; y0 -= (Math.abs(y0) || 1) * 0.1; }
+  dash.charts[canvas.id].frame = { left: L, right: W - R, x0, x1 };
   const px = (x) => L + (x - x0) / (x1 - x0) * (W - L - R);
   const py = (y) => H - B - (y - y0) / (y1 - y0) * (H - T - B);
   ctx.strokeStyle = '#e4e7eb'; ctx.lineWidth = 1;
   for (const t of niceTicks(y0, y1, 5)) {
     ctx.beginPath(); ctx.moveTo(L, py(t)); ctx.lineTo(W - R, py(t)); ctx.stroke();
-    ctx.fillText(tickLabel(t, y1 - y0), 2, py(t) + 4);
+    ctx.fillText(tickLabel(t, y1 - y0), 16, py(t) + 4);
   }
   for (const t of niceTicks(x0, x1, 6)) {
     ctx.beginPath(); ctx.moveTo(px(t), T); ctx.lineTo(px(t), H - B); ctx.stroke();
     ctx.fillText(tickLabel(t, x1 - x0), px(t) - 10, H - B + 13);
   }
   ctx.strokeStyle = '#52606d'; ctx.strokeRect(L, T, W - L - R, H - T - B);
-  ctx.fillText(opts.xlabel || '', W / 2 - 30, H - 3);
+  ctx.textAlign = 'center'; ctx.fillText(opts.xlabel || '', (L + W - R) / 2, H - 3); ctx.textAlign = 'start';
   let lx = L + 8;
   ctx.save();
   ctx.beginPath(); ctx.rect(L, T, W - L - R, H - T - B); ctx.clip();
@@ -99,6 +118,8 @@ function lineChart(canvas, series, opts) {
 }
 
 function barChart(canvas, groups, edges) {
+  if (dash.paused && dash.points[canvas.id] !== undefined) return;
+  dash.points[canvas.id] = groups.filter((g) => g.bins).length;
   const ctx = canvas.getContext('2d');
   const W = canvas.width, H = canvas.height, L = 40, B = 30, T = 18;
   ctx.clearRect(0, 0, W, H);
@@ -238,6 +259,7 @@ function update(s) {
   setText('mode', s.mode === 'run' ? 'dicstream run' : 'dicstream monitor');
   setText('viewers', s.viewers);
   setText('uptime', `${fmt(s.t_s, 0)} s`);
+  setText('test-time', s.test_time_s === null || s.test_time_s === undefined ? '-' : `${fmt(s.test_time_s, 1)} s`);
 
   // Image and field.
   if (s.image && s.image.version !== imgVersion) {
@@ -259,8 +281,10 @@ function update(s) {
 
   // Gauge strains.
   const m = s.gauge.measures[$('measure').value];
+  const clock = s.gauge.clock === 'test' ? 'test time (s)' : 'time since the dashboard started (s)';
   lineChart($('gauge-chart'), ['exx', 'eyy', 'exy'].map((k, i) => ({ x: s.gauge.t_s, y: m[k], color: SERIES_COLORS[i], label: k })),
-    { xlabel: 'time (s)', yZero: true, empty: 'no field yet' });
+    { xlabel: clock, ylabel: `${$('measure').value} strain (-)`, yZero: true, empty: 'no field yet' });
+  setText('gauge-clock', s.gauge.clock === 'test' ? "the test's time (the rig's)" : 'the time since the dashboard started (no rig seen)');
   setText('gauge-points', s.gauge.t_s.length);
 
   // Stress-stretch.
@@ -270,10 +294,12 @@ function update(s) {
     series.push({ x: c.stretch, y: c.nominal_mpa, color: SERIES_COLORS[i], label: k, dots: true });
     if (c.fit) series.push({ x: c.fit.stretch, y: c.fit.nominal_mpa, color: SERIES_COLORS[i + 3], label: `fit ${k}`, noBounds: c.stretch.length > 0 });
   });
-  lineChart($('stress-chart'), series, { xlabel: 'stretch λ', yZero: true, empty: 'no test data yet' });
+  lineChart($('stress-chart'), series, { xlabel: 'stretch λ (-)', ylabel: 'nominal stress (MPa)', yZero: true, empty: 'no test data yet' });
 
   drawInvariantFunctions(id);
   updateRig(s.rig);
+  updateForces(s.forces);
+  updateStates(s.stretch_states);
   updatePipeline(s);
   updateProcesses(s.processes, s.mode);
   updateIdentification(id);
@@ -302,7 +328,7 @@ function drawInvariantFunctions(id) {
     .forEach(([p, label, color]) => {
       if (p && p.invariant.length) series.push({ x: p.invariant, y: p.value_mpa, color, label, dots: true });
     });
-  lineChart($('fg-chart'), series, { xlabel: 'invariant I1 or I2', yZero: true, empty: 'no coefficient identified yet' });
+  lineChart($('fg-chart'), series, { xlabel: 'invariant I1 or I2 (-)', ylabel: 'f, g (MPa)', yZero: true, empty: 'no coefficient identified yet' });
 }
 
 // Strain control: target against the newest field's gauge log strains, per axis.
@@ -331,7 +357,34 @@ function updateRig(r) {
   lineChart($('rig-chart'), [
     { x: h.t_sim_s, y: h.stretch_x, color: SERIES_COLORS[0], label: 'λx' },
     { x: h.t_sim_s, y: h.stretch_y, color: SERIES_COLORS[1], label: 'λy' },
-  ], { xlabel: 'simulated time (s)' });
+  ], { xlabel: 'test time (s)', ylabel: 'stretch (-)' });
+}
+
+// Each loaded actuator's force against the test's time and against its grip's displacement.
+function updateForces(f) {
+  const a = f ? f.actuators : [];
+  setText('forces-info', a.length ? `loaded: ${a.map((x) => x.name).join(', ')}; ${f.t_sim_s.length} points` : 'no load yet');
+  lineChart($('force-time-chart'), a.map((x, i) => ({ x: f.t_sim_s, y: x.force_kn, color: SERIES_COLORS[i % 5], label: x.name })),
+    { xlabel: 'test time (s)', ylabel: 'force (kN)', yZero: true, empty: 'no loaded actuator yet' });
+  lineChart($('force-grip-chart'), a.map((x, i) => ({ x: x.grip_mm, y: x.force_kn, color: SERIES_COLORS[i % 5], label: x.name })),
+    { xlabel: 'grip displacement (mm)', ylabel: 'force (kN)', yZero: true, empty: 'no loaded actuator yet' });
+}
+
+// The latest field's node states in the (λ1, λ2) plane and the canonical paths (paper Fig. 5).
+function updateStates(st) {
+  if (dash.paused && dash.charts['states-chart']) return;
+  dash.statePoints = st ? st.shown : 0;
+  setText('states-info', st ? `field of frame ${st.frame_id}: ${st.shown} of ${st.valid} valid nodes` : 'no field yet');
+  const series = [];
+  if (st && st.shown > 0) {
+    series.push({ x: st.l1, y: st.l2, color: SERIES_COLORS[1], label: 'nodes', dots: true });
+    const top = Math.max(1.1, ...st.l1), x = [];
+    for (let k = 0; k <= 40; k++) x.push(1 + (top - 1) * k / 40);
+    series.push({ x, y: x.map((l) => 1 / Math.sqrt(l)), color: SERIES_COLORS[0], label: 'uniaxial' });
+    series.push({ x, y: x, color: SERIES_COLORS[2], label: 'equibiaxial' });
+    series.push({ x, y: x.map(() => 1), color: SERIES_COLORS[4], label: 'pure shear' });
+  }
+  lineChart($('states-chart'), series, { xlabel: 'λ1 (larger principal stretch, -)', ylabel: 'λ2 (-)', empty: 'no field yet' });
 }
 
 function updatePipeline(s) {
@@ -402,6 +455,83 @@ function connect() {
     $('conn').className = finished ? 'good' : 'warn';
   });
 }
+// ---- pause and export ----
+const CHART_IDS = ['gauge-chart', 'stress-chart', 'rig-chart', 'force-time-chart', 'force-grip-chart', 'states-chart', 'fg-chart', 'latency-chart'];
+const csvCell = (v) => (v === null || v === undefined) ? '' : (typeof v === 'number' ? String(v) : `"${String(v).replace(/"/g, '""')}"`);
+// The line charts' series as drawn: one row per point (chart, series, axis labels with units).
+function chartsCsv() {
+  const rows = ['chart,series,x_name,y_name,x,y'];
+  for (const [id, c] of Object.entries(dash.charts)) {
+    for (const s of c.series) {
+      for (let i = 0; i < s.x.length; i++) {
+        rows.push([id, s.label || '', c.opts.xlabel || '', c.opts.ylabel || '', s.x[i], s.y[i]].map(csvCell).join(','));
+      }
+    }
+  }
+  return rows.join('\n') + '\n';
+}
+function chartsPng() {
+  const out = {};
+  for (const id of CHART_IDS) out[id] = $(id).toDataURL('image/png');
+  return out;
+}
+function snapshotJson() { return JSON.stringify(dash.last, null, 1); }
+dash.exportCsv = chartsCsv; dash.exportPng = chartsPng; dash.exportJson = snapshotJson;
+
+function download(name, url) {
+  const a = document.createElement('a');
+  a.href = url; a.download = name; document.body.appendChild(a); a.click(); a.remove();
+}
+const stamp = () => `${dash.last ? dash.last.instance : 'dicstream'}_${new Date().toISOString().replace(/[:.]/g, '-')}`;
+const blobUrl = (text, type) => URL.createObjectURL(new Blob([text], { type }));
+$('export-csv').addEventListener('click', () => {
+  const text = chartsCsv(); dash.exported.csv = text.length;
+  download(`${stamp()}_charts.csv`, blobUrl(text, 'text/csv'));
+});
+$('export-json').addEventListener('click', () => {
+  const text = snapshotJson(); dash.exported.json = text.length;
+  download(`${stamp()}_snapshot.json`, blobUrl(text, 'application/json'));
+});
+$('export-png').addEventListener('click', () => {
+  const pngs = chartsPng();
+  dash.exported.png = Object.values(pngs).reduce((n, u) => n + u.length, 0);
+  for (const [id, url] of Object.entries(pngs)) download(`${stamp()}_${id}.png`, url);
+});
+$('pause').addEventListener('click', () => {
+  dash.paused = !dash.paused;
+  $('pause').textContent = dash.paused ? 'resume' : 'pause';
+  $('pause').className = dash.paused ? 'on' : '';
+  if (!dash.paused && dash.last) update(dash.last);
+});
+
+// ---- zoom: drag across a line chart selects its x range, a double click resets it ----
+function zoomTo(id, range) {
+  if (range) dash.zoom[id] = range; else delete dash.zoom[id];
+  const c = dash.charts[id];
+  if (c) lineChart($(id), c.series, c.opts, true);
+}
+dash.zoomTo = zoomTo;
+for (const id of CHART_IDS.filter((c) => c !== 'latency-chart')) {
+  const canvas = $(id);
+  canvas.title = 'drag across to zoom on x; double-click to reset';
+  const dataX = (e) => {
+    const f = dash.charts[id] && dash.charts[id].frame;
+    if (!f) return null;
+    const x = e.offsetX * canvas.width / canvas.clientWidth;
+    return f.x0 + (x - f.left) / (f.right - f.left) * (f.x1 - f.x0);
+  };
+  let from = null;
+  canvas.addEventListener('mousedown', (e) => { from = dataX(e); });
+  canvas.addEventListener('mouseup', (e) => {
+    const to = dataX(e), f = dash.charts[id] && dash.charts[id].frame;
+    if (from !== null && to !== null && f && Math.abs(to - from) > 0.02 * (f.x1 - f.x0)) {
+      zoomTo(id, [Math.min(from, to), Math.max(from, to)]);
+    }
+    from = null;
+  });
+  canvas.addEventListener('dblclick', () => zoomTo(id, null));
+}
+
 for (const id of ['component', 'map-measure', 'range-mode', 'range-min', 'range-max', 'show-mesh', 'show-map']) {
   $(id).addEventListener('change', drawSpecimen);
 }
