@@ -1,5 +1,5 @@
 //! The field route's law against the specimen's true one (issue 25's target): the law the
-//! field route ranked first by AIC among the fits whose parameters it identifies
+//! field route ranked first by BIC among the fits whose parameters it identifies
 //! (`identification.json`'s `field_route`, any family of the catalogue) against
 //! `[specimen]`'s, in uniaxial, equibiaxial and pure-shear nominal stress over the states the
 //! field reached: uniaxial and pure shear up to the largest major principal stretch of the
@@ -25,7 +25,7 @@ const SAMPLES: usize = 200;
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FieldAcceptance {
-    /// The model compared (the field route's best by AIC) and its parameters, in the order of
+    /// The model compared (the field route's best by BIC) and its parameters, in the order of
     /// its parameter names.
     pub model: Option<String>,
     pub params: Vec<f64>,
@@ -140,7 +140,7 @@ impl FieldAcceptance {
 }
 
 /// The acceptance of a field route's JSON (`identification.json`'s `field_route`, or
-/// `identify --fields --json`'s): its best fit by AIC among those whose parameters the
+/// `identify --fields --json`'s): its best fit by BIC among those whose parameters the
 /// equations identify, against `truth`.
 pub fn judge_route(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
     let best = route["fits"]

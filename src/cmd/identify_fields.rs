@@ -88,7 +88,7 @@ pub fn run(
     Ok(())
 }
 
-/// The ranks shown: identifiable fits in AIC order, None for the others.
+/// The ranks shown: identifiable fits in BIC order, None for the others.
 fn ranks(identifiability: &[Identifiability]) -> Vec<Option<usize>> {
     let mut rank = 0;
     identifiability
@@ -153,8 +153,8 @@ fn print_table(
     )?;
     writeln!(
         out,
-        "{:>2} {:<22} {:>9} {:>9} {:>9} {:>10}  params ± std",
-        "#", "model", "aic", "rms_n", "equations", "condition"
+        "{:>2} {:<22} {:>9} {:>9} {:>9} {:>9} {:>10}  params ± std",
+        "#", "model", "bic", "aic", "rms_n", "equations", "condition"
     )?;
     for ((fit, rank), _) in fits
         .fits
@@ -172,9 +172,10 @@ fn print_table(
             .collect();
         writeln!(
             out,
-            "{:>2} {:<22} {:>9.1} {:>9.3} {:>9} {:>10.2e}  {}",
+            "{:>2} {:<22} {:>9.1} {:>9.1} {:>9.3} {:>9} {:>10.2e}  {}",
             rank.map_or("-".to_string(), |r| r.to_string()),
             fit.model.name(),
+            fit.bic,
             fit.aic,
             fit.fit.rms_n,
             fit.fit.equations,

@@ -348,7 +348,7 @@ impl FieldShell {
 }
 
 /// The fits' part of the field route's JSON: frames, the stretches reached, each fit
-/// (parameters, σ, RMS force, equations, condition number, AIC; best first) and the models
+/// (parameters, σ, RMS force, equations, condition number, AIC, BIC; best BIC first) and the models
 /// refused with why. `identification.json`'s `field_route` and `identify --fields --json`.
 pub fn fits_json(fits: &FieldFits) -> Value {
     json!({
@@ -364,6 +364,7 @@ pub fn fits_json(fits: &FieldFits) -> Value {
                 "equations": fit.fit.equations,
                 "condition": fit.fit.condition,
                 "aic": fit.aic,
+                "bic": fit.bic,
                 "identifiable": fit.ranked(),
                 "warning": fit.identifiability.warning(),
             })
@@ -410,7 +411,8 @@ fn mean_stretching(grid: &FieldGrid) -> f64 {
     }
 }
 
-/// The wire report of the field route's fits (best AIC first): their ranking and, when the
+/// The wire report of the field route's fits (best BIC first, each with its AIC: the wire's
+/// `RankedModel` carries one criterion, the gauge route's): their ranking and, when the
 /// paper's law is among them, its a and b. `rms_mpa` is NaN: the route's residuals are forces.
 fn report(fits: &FieldFits, frame_id: Option<u64>) -> IdentificationReport {
     let mut report = IdentificationReport {
