@@ -209,23 +209,6 @@ impl Gauge {
     }
 }
 
-macro_rules! text_serde {
-    ($t:ty) => {
-        impl serde::Serialize for $t {
-            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-                s.collect_str(self)
-            }
-        }
-
-        impl<'de> serde::Deserialize<'de> for $t {
-            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-                use serde::de::Error as _;
-                String::deserialize(d)?.parse().map_err(D::Error::custom)
-            }
-        }
-    };
-}
-
 text_serde!(Gauge);
 text_serde!(ControlGauge);
 

@@ -25,6 +25,10 @@
 //! `fields` out); [`state`] saves and restores the reference so that a restarted process
 //! resumes measuring the same total displacement.
 
+// First: its macro is used by the modules below.
+#[macro_use]
+mod text_serde;
+
 mod correlator;
 mod fft2d;
 pub mod field;

@@ -152,18 +152,7 @@ impl FromStr for Polygon {
     }
 }
 
-impl serde::Serialize for Polygon {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_str(self)
-    }
-}
-
-impl<'de> serde::Deserialize<'de> for Polygon {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        use serde::de::Error as _;
-        String::deserialize(d)?.parse().map_err(D::Error::custom)
-    }
-}
+text_serde!(Polygon);
 
 /// Where the correlator measures (module documentation).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
