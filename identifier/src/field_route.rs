@@ -20,6 +20,7 @@
 //! ([`FieldRoute::fit_job`]) owns their concatenation and may run on another thread.
 
 use crate::field_layout::{place_fields, ArmLayout, LayoutError, PlacedField, GRIPS};
+use crate::fit::gaussian_fit_term;
 use crate::identifiability::Identifiability;
 use crate::models::Model;
 use crate::section_cut::FieldGrid;
@@ -484,14 +485,14 @@ impl FitJob {
 /// nodes), so the likelihood overstates the evidence for extra parameters, and BIC's larger
 /// penalty (ln m per parameter: 4.6 at the 100 equations of a short default run, against 2)
 /// is the one that holds. Measured on the default run's cruciform (a Mooney-Rivlin specimen,
-/// `dicstream run`, 9 runs): Lambert-Diani-Rey 2,2 (6 parameters) came within −4 to +6 of
-/// Mooney-Rivlin's AIC and once ranked first by it (CI: uniaxial stress missed by 26 %); by BIC
-/// Mooney-Rivlin led by 6 to 16 in every run.
+/// `dicstream run` on `tests/default_run.rs`'s campaign, 6 runs): Lambert-Diani-Rey 2,2
+/// (6 parameters) came within −4.0 to +5.8 of Mooney-Rivlin's AIC in 5 (its sixth fit
+/// diverged), and in CI once ranked first by AIC and missed the uniaxial stress by 26 %; by
+/// BIC Mooney-Rivlin led it by 6.4 to 16.6 in those 5.
 pub fn information_criteria(fit: &VfmFit) -> (f64, f64) {
-    let (m, k) = (fit.equations as f64, fit.params.len() as f64);
-    let rss = fit.rms_n.powi(2) * m;
-    let fit_term = m * (rss.max(f64::MIN_POSITIVE) / m).ln();
-    (fit_term + 2.0 * k, fit_term + k * m.ln())
+    let (m, k) = (fit.equations, fit.params.len() as f64);
+    let fit_term = gaussian_fit_term(m, fit.rms_n.powi(2) * m as f64);
+    (fit_term + 2.0 * k, fit_term + k * (m as f64).ln())
 }
 
 fn refusal(error: &VfmError) -> String {

@@ -525,7 +525,7 @@ fn fit_at(
         stderr,
         rms_mpa,
         cases,
-        aic: m as f64 * (objective.max(f64::MIN_POSITIVE) / m as f64).ln() + 2.0 * n as f64,
+        aic: gaussian_fit_term(m, objective) + 2.0 * n as f64,
         objective,
         stability,
         converged,
@@ -534,6 +534,12 @@ fn fit_at(
 }
 
 /// Σ (P_model − P_data)² over `points` (unweighted, MPa²).
+/// m ln(RSS/m): the residuals' part of an information criterion over m Gaussian residuals
+/// (AIC adds 2 per parameter, BIC ln m: the field route's `information_criteria`).
+pub(crate) fn gaussian_fit_term(m: usize, rss: f64) -> f64 {
+    m as f64 * (rss.max(f64::MIN_POSITIVE) / m as f64).ln()
+}
+
 fn r_abs_sq(model: &Model, params: &[f64], points: &[(DataGroup, Kinematics, f64, f64)]) -> f64 {
     points
         .iter()
