@@ -1,10 +1,14 @@
 //! `dicstream`: one binary, one subcommand per process and per tool a user runs by hand.
 //! Each subcommand lives in its own file under `src/cmd/`; this file only dispatches.
 
-// The one unsafe item is the load-time signal installer below (`link_section`), allowed there.
+// The unsafe items, each allowed where it stands: the load-time signal installer below
+// (`link_section`) and, with the `genicam` feature, the view of the camera driver's buffer
+// (`genicam/device.rs`, `Frame::bytes`).
 #![deny(unsafe_code)]
 
 mod cmd;
+#[cfg(feature = "genicam")]
+mod genicam;
 
 use clap::{Parser, Subcommand};
 

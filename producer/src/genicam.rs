@@ -1,12 +1,10 @@
-//! Real GenICam cameras (GigE Vision, USB3 Vision). The pure part, built always and tested
+//! Real GenICam cameras (GigE Vision, USB3 Vision): the pure part, built always and tested
 //! without a camera: pixel formats and their conversion into the `frames` payload
 //! (`pixels.rs`), the region of interest (`roi.rs`), the trigger mode, and the link's
-//! bookkeeping (buffer outcomes, lost/reconnect backoff, `link.rs`). The Aravis part
-//! (`genicam/device.rs`: list, open, configure, acquire) exists only with the `genicam`
-//! feature, and stays thin.
+//! bookkeeping (buffer outcomes, lost/reconnect backoff, `link.rs`). The Aravis part (list,
+//! open, configure, acquire, and the streaming loop) is the binary's, with its `genicam`
+//! feature (`src/genicam/`): turning that feature on or off rebuilds the binary alone.
 
-#[cfg(feature = "genicam")]
-pub mod device;
 mod link;
 mod pixels;
 mod roi;

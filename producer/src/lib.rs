@@ -4,10 +4,7 @@
 //! [`FrameSource`] (scenario, replay), the rig-driven [`RigCamera`] or a watched folder
 //! ([`Watcher`]) gives.
 
-// Forbidden outright, except with the `genicam` feature, where one function reads the camera
-// driver's buffer in place (`genicam/device.rs`, `Frame::bytes`).
-#![cfg_attr(not(feature = "genicam"), forbid(unsafe_code))]
-#![cfg_attr(feature = "genicam", deny(unsafe_code))]
+#![forbid(unsafe_code)]
 
 pub mod camera;
 mod error;

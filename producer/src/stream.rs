@@ -5,9 +5,10 @@
 //! The loops share the same shell: [`stream`] pulls a [`FrameSource`] (scenario, replay),
 //! [`stream_following_rig`] subscribes to `rig/state` and renders each frame from the most
 //! recent rig sample with a [`RigCamera`], and [`stream_watched`] (`stream/watched.rs`)
-//! publishes the images of a watched folder as they become complete, and [`stream_genicam`]
-//! (`stream/genicam.rs`, feature `genicam`) those of a real camera. Everything else
-//! (rendering, the rig kinematics, the envelope, the folder watcher) lives in the pure modules.
+//! publishes the images of a watched folder as they become complete. The [`Shell`] is public:
+//! the binary's real-camera loop (feature `genicam`, `src/genicam/stream.rs`) drives it, so
+//! Aravis stays out of this crate. Everything else (rendering, the rig kinematics, the
+//! envelope, the folder watcher) lives in the pure modules.
 
 use crate::{FrameDims, FrameInfo, FrameSource, NextMotion, ProducerError, RigCamera};
 use iceoryx2::prelude::*;
@@ -16,11 +17,7 @@ use wire::frame::pixel_checksum;
 use wire::pubsub::{SlicePublisher, SliceSubscriber, ValueSubscriber};
 use wire::{services, FrameHeader, GroundTruth, Instance, InstanceError, RigState};
 
-#[cfg(feature = "genicam")]
-mod genicam;
 mod watched;
-#[cfg(feature = "genicam")]
-pub use genicam::{stream_genicam, CameraNote, CameraReport};
 pub use watched::stream_watched;
 
 /// Longest sleep while waiting for the first rig sample (a signal is seen within it).
@@ -120,18 +117,6 @@ pub enum StreamError {
     /// A `specimen` sample the camera cannot read (another layout, a malformed mesh).
     #[error("specimen state refused: {0}")]
     Specimen(#[from] crate::specimen_states::StateError),
-    #[cfg(feature = "genicam")]
-    #[error(transparent)]
-    Camera(#[from] crate::genicam::device::GenicamError),
-    /// The camera came back with another image size or format than the stream was opened
-    /// with: the frames service cannot change shape mid-run.
-    #[cfg(feature = "genicam")]
-    #[error("camera {id} came back with {now}, the stream was opened with {before}: restart the producer")]
-    CameraChanged {
-        id: String,
-        before: String,
-        now: String,
-    },
 }
 
 /// Shared memory the `frames` service needs for frames of `width_px` x `height_px` (bytes).
@@ -146,8 +131,10 @@ pub fn check_shm_for_frames(width_px: u32, height_px: u32) -> Result<(), Instanc
     wire::shm::ensure_free(wire::shm::SHM_PATH, frames_shm_bytes(width_px, height_px))
 }
 
-/// The part both loops share: node, publisher, pacing, header stamping, the report.
-struct Shell {
+/// The part every source's loop shares: node, publisher, pacing, header stamping, the report.
+/// Public for a loop that drives its own source, e.g. the binary's real-camera loop (feature
+/// `genicam`, `src/genicam/stream.rs`), which keeps Aravis out of this crate.
+pub struct Shell {
     /// The camera's claim on the instance (one producer per instance).
     _owner: wire::owner::Owner,
     node: Node<ipc::Service>,
@@ -165,7 +152,7 @@ struct Shell {
 }
 
 impl Shell {
-    fn open(
+    pub fn open(
         instance: &Instance,
         dims: FrameDims,
         settings: &StreamSettings,
@@ -197,12 +184,12 @@ impl Shell {
         })
     }
 
-    fn done(&self) -> bool {
+    pub fn done(&self) -> bool {
         self.report.frames_sent >= self.limit
     }
 
     /// Restarts the pacing clock (when frames start late, e.g. after the first rig sample).
-    fn restart_clock(&mut self) {
+    pub fn restart_clock(&mut self) {
         self.start = Instant::now();
         self.slots = 0;
     }
@@ -210,7 +197,7 @@ impl Shell {
     /// Sleeps until the next frame slot is due (`node.wait` returns early on a signal, and a
     /// wake-up that is not a termination request sleeps again). False when a termination signal
     /// arrived.
-    fn wait_for_slot(&mut self) -> bool {
+    pub fn wait_for_slot(&mut self) -> bool {
         let due = self
             .period
             .map(|period| self.start + period.mul_f64(self.slots as f64));
@@ -233,7 +220,7 @@ impl Shell {
 
     /// Loans a slice, lets `render` write the pixels, stamps the header and sends it. `None`
     /// when `render` says the source has ended (the loan goes back unsent).
-    fn publish(
+    pub fn publish(
         &mut self,
         render: impl FnOnce(&mut [u16]) -> Result<Option<FrameInfo>, ProducerError>,
     ) -> Result<Option<FrameHeader>, StreamError> {
@@ -243,7 +230,7 @@ impl Shell {
     /// [`Shell::publish`] with the capture time given (a real camera's host receive time,
     /// [`wire::monotonic_ns`]) instead of read when the slice is loaned, and the camera's own
     /// timestamp (`FrameHeader::t_camera_ns`, 0 for none).
-    fn publish_stamped(
+    pub fn publish_stamped(
         &mut self,
         t_capture_ns: Option<u64>,
         t_camera_ns: u64,
@@ -305,7 +292,12 @@ impl Shell {
         Ok(Some(sent_header))
     }
 
-    fn finish(mut self) -> StreamReport {
+    /// Marks the stream as ended by a termination signal (a loop that waits on its own).
+    pub fn interrupted(&mut self) {
+        self.report.interrupted = true;
+    }
+
+    pub fn finish(mut self) -> StreamReport {
         self.report.elapsed_s = self.start.elapsed().as_secs_f64();
         self.report
     }

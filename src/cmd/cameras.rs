@@ -23,7 +23,7 @@ pub fn run(_args: CamerasArgs) -> anyhow::Result<()> {
 
 #[cfg(feature = "genicam")]
 pub fn run(args: CamerasArgs) -> anyhow::Result<()> {
-    use producer::genicam::device::list_cameras;
+    use crate::genicam::device::list_cameras;
     use producer::genicam::PixelFormat;
 
     let cameras = list_cameras();

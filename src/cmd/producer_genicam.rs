@@ -94,7 +94,7 @@ pub fn run(
     settings: &StreamSettings,
     on_event: impl FnMut(StreamEvent),
 ) -> anyhow::Result<(StreamReport, String)> {
-    use producer::stream::stream_genicam;
+    use crate::genicam::stream_genicam;
 
     let camera = args.camera;
     camera.check()?;
@@ -133,9 +133,9 @@ struct NotePrinter<'a> {
 
 #[cfg(feature = "genicam")]
 impl NotePrinter<'_> {
-    fn print(&mut self, note: &producer::stream::CameraNote) {
+    fn print(&mut self, note: &crate::genicam::CameraNote) {
+        use crate::genicam::CameraNote;
         use producer::genicam::{FIRST_RETRY, MAX_RETRY};
-        use producer::stream::CameraNote;
         match note {
             CameraNote::Opened {
                 id,
@@ -230,7 +230,7 @@ const STATUS_EVERY: std::time::Duration = std::time::Duration::from_secs(5);
 
 /// The final line's source part: the camera's buffers, losses and reconnections.
 #[cfg(feature = "genicam")]
-fn summary_line(id: &str, report: &producer::stream::CameraReport) -> String {
+fn summary_line(id: &str, report: &crate::genicam::CameraReport) -> String {
     let c = report.counts;
     format!(
         "camera {id}: {} buffer(s) published, {} skipped ({} incomplete, {} failed, {} of the \

@@ -2,7 +2,7 @@
 //! hand its buffers out and back. Everything that can be decided without a camera (formats,
 //! conversion, region checks, buffer accounting, reconnect backoff) lives in the pure modules.
 //!
-//! The one `unsafe` of the crate is here: viewing the driver's buffer as a byte slice
+//! The one `unsafe` of the binary's camera code is here: viewing the driver's buffer as a byte slice
 //! ([`Frame::bytes`]), so that the pixels are copied once, into the loaned slice, instead of
 //! twice through the `Vec` the bindings' `image_data` returns.
 
@@ -13,8 +13,9 @@ use std::time::Duration;
 use aravis::prelude::*;
 use aravis::{AcquisitionMode, Auto, Buffer, Camera, Stream};
 
-use super::Trigger;
-use super::{BufferStatus, CameraSettings, CameraSpec, PixelFormat, RoiError, RoiLimits};
+use producer::genicam::{
+    BufferStatus, CameraSettings, CameraSpec, PixelFormat, RoiError, RoiLimits, Trigger,
+};
 
 /// Buffers queued to the driver: the camera keeps streaming while the producer publishes one.
 const QUEUED_BUFFERS: usize = 10;

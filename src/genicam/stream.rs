@@ -1,4 +1,4 @@
-//! The real-camera loop of the producer shell (feature `genicam`): opens the camera (a camera
+//! The real-camera loop of the producer (feature `genicam`), on producer's stream [`Shell`]: opens the camera (a camera
 //! that cannot be opened or set up is an error before anything is published), opens the
 //! `frames` publisher with the camera's image size, then copies each complete buffer once,
 //! converting, into a loaned slice and sends it. Incomplete, failed or misshapen buffers are
@@ -15,12 +15,12 @@
 
 use std::time::{Duration, Instant};
 
-use super::{Shell, StreamError, StreamEvent, StreamReport, StreamSettings};
-use crate::genicam::device::{Acquisition, Frame, GenicamError};
-use crate::genicam::{
+use super::device::{Acquisition, Frame, GenicamError};
+use producer::genicam::{
     convert_into, BufferCounts, CameraSettings, CameraSpec, Link, PixelFormat, Trigger,
 };
-use crate::{FrameDims, FrameInfo};
+use producer::stream::{Shell, StreamError, StreamEvent, StreamReport, StreamSettings};
+use producer::{FrameDims, FrameInfo};
 use wire::Instance;
 
 /// Longest single wait for a buffer: signals and the link are looked at within it.
@@ -59,6 +59,24 @@ pub enum CameraNote<'a> {
     Reconnected { id: &'a str, away: Duration },
 }
 
+/// Why the camera's stream could not start or stopped: the shared memory or the stream's
+/// shell, the camera, or a camera back with another shape.
+#[derive(Debug, thiserror::Error)]
+pub enum CameraStreamError {
+    #[error(transparent)]
+    Stream(#[from] StreamError),
+    #[error(transparent)]
+    Camera(#[from] GenicamError),
+    /// The camera came back with another image size or format than the stream was opened
+    /// with: the frames service cannot change shape mid-run.
+    #[error("camera {id} came back with {now}, the stream was opened with {before}: restart the producer")]
+    CameraChanged {
+        id: String,
+        before: String,
+        now: String,
+    },
+}
+
 /// What the camera loop did, beside the stream's report.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct CameraReport {
@@ -82,7 +100,7 @@ pub fn stream_genicam(
     settings: &StreamSettings,
     mut on_event: impl FnMut(StreamEvent),
     mut on_note: impl FnMut(&CameraNote),
-) -> Result<(StreamReport, CameraReport), StreamError> {
+) -> Result<(StreamReport, CameraReport), CameraStreamError> {
     let first = Acquisition::open(spec, camera)?;
     let (width_px, height_px) = first.size_px();
     let format = first.format();
@@ -118,7 +136,7 @@ pub fn stream_genicam(
     };
     while !shell.done() {
         if wire::signals::requested().is_some() {
-            shell.report.interrupted = true;
+            shell.interrupted();
             break;
         }
         let Some(acq) = cam.acquisition.take() else {
@@ -154,7 +172,10 @@ struct CameraLoop<'a> {
 impl CameraLoop<'_> {
     /// Lost: waits for the next attempt (in slices, so a signal is seen), then tries to open
     /// the camera again. A camera back with another shape is an error.
-    fn reconnect(&mut self, on_note: &mut impl FnMut(&CameraNote)) -> Result<(), StreamError> {
+    fn reconnect(
+        &mut self,
+        on_note: &mut impl FnMut(&CameraNote),
+    ) -> Result<(), CameraStreamError> {
         let now = Instant::now();
         let wait = self.link.until_attempt(now).unwrap_or_default();
         if !wait.is_zero() {
@@ -165,7 +186,7 @@ impl CameraLoop<'_> {
             Ok(acq) => {
                 let (width_px, height_px) = (self.dims.width, self.dims.height);
                 if acq.size_px() != (width_px, height_px) || acq.format() != self.format {
-                    return Err(StreamError::CameraChanged {
+                    return Err(CameraStreamError::CameraChanged {
                         id: acq.id().to_string(),
                         before: format!("{width_px}x{height_px} {}", self.format),
                         now: format!("{}x{} {}", acq.size_px().0, acq.size_px().1, acq.format()),
@@ -196,7 +217,7 @@ impl CameraLoop<'_> {
         shell: &mut Shell,
         on_event: &mut impl FnMut(StreamEvent),
         on_note: &mut impl FnMut(&CameraNote),
-    ) -> Result<Option<String>, StreamError> {
+    ) -> Result<Option<String>, CameraStreamError> {
         let (timeout, trigger_failed) = self.trigger(acq);
         if trigger_failed.is_some() {
             return Ok(trigger_failed);
@@ -217,7 +238,7 @@ impl CameraLoop<'_> {
         } else if self.link.silent_too_long(Instant::now(), self.period) {
             Some(format!(
                 "no buffer for {} s while it should be sending",
-                crate::genicam::SILENCE.as_secs()
+                producer::genicam::SILENCE.as_secs()
             ))
         } else {
             None
@@ -255,7 +276,7 @@ impl CameraLoop<'_> {
         shell: &mut Shell,
         on_event: &mut impl FnMut(StreamEvent),
         on_note: &mut impl FnMut(&CameraNote),
-    ) -> Result<bool, StreamError> {
+    ) -> Result<bool, CameraStreamError> {
         if !self.report.counts.count(frame.status, frame.shape_ok) {
             return Ok(false);
         }
