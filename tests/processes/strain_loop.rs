@@ -6,7 +6,7 @@
 //! `on_interlock = "stop"`, unloads and ends there). No wall-clock assertion: waits are on
 //! result files, bounded by the hang guard.
 
-mod common;
+use crate::common;
 
 use common::bench_run::{child_pid, config, signal, start_run, summary, wait_rows, whole_rows};
 use common::Run;

@@ -1,4 +1,4 @@
-//! What only `tests/dashboard.rs` needs, beside the test kit (`testkit`: child processes,
+//! What only `tests/processes/dashboard.rs` needs, beside the test kit (`testkit`: child processes,
 //! instances, [`until`](testkit::until), the hang guard) and `common` (the dashboard's address
 //! from its stderr line): a plain HTTP/1.1 client and a server-sent-event reader over
 //! `TcpStream`, and a WebDriver client of Debian's chromium (`webdriver.rs`).

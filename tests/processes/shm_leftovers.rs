@@ -4,7 +4,7 @@
 //! Each test runs real processes on an instance of its own and looks before the `Run`'s own
 //! cleanup.
 
-mod common;
+use crate::common;
 
 use common::Run;
 

@@ -1,7 +1,7 @@
 //! Bad input to `dicstream producer` and `dicstream tap`, through the command line: each ends
 //! with a non-zero exit and a message naming the input and what was expected.
 
-mod common;
+use crate::common;
 
 use common::Run;
 use std::path::Path;

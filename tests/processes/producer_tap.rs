@@ -3,7 +3,7 @@
 //! producer keeps going, SIGTERM ending the producer cleanly, and `/dev/shm` clean afterwards.
 //! Then the rig-driven camera against a real `dicstream rig`.
 
-mod common;
+use crate::common;
 
 use common::{tap_json, Run, HANG_GUARD};
 use iceoryx2::prelude::*;

@@ -2,7 +2,7 @@
 //! `bench/benches/correlate.rs`), run small so that CI runs it: its JSON alone on stdout, one
 //! run per thread count, the time split and the sub-pixel shift found. No time is asserted.
 
-mod common;
+use crate::common;
 
 use common::Run;
 

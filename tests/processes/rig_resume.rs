@@ -6,7 +6,7 @@
 //! (refused before anything is created). Real processes on a unique instance; timeouts only
 //! guard against a hang.
 
-mod common;
+use crate::common;
 
 use common::Run;
 use std::path::{Path, PathBuf};

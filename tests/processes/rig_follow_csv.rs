@@ -9,7 +9,7 @@
 //! machine log's malformed line. Also: a GenICam camera the binary cannot open fails the run at
 //! start, said.
 
-mod common;
+use crate::common;
 
 use common::bench_run::{rows, start_run, summary};
 use common::Run;

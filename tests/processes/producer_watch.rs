@@ -9,7 +9,7 @@
 //!
 //! Timeouts only guard against a hang; no assertion on a wall-clock time.
 
-mod common;
+use crate::common;
 
 use std::fmt::Debug;
 use std::fs::File;

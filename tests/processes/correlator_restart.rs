@@ -2,7 +2,7 @@
 //! the same reference and keeps measuring the same total displacement; it loses only the frames
 //! it missed, also with its state saved off the frame path. Compared with an uninterrupted correlator fed the same frames (another instance).
 
-mod common;
+use crate::common;
 
 use common::camera::{final_line, render, translation, Bench, FieldCopy};
 use common::HANG_GUARD;

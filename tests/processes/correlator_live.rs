@@ -4,7 +4,7 @@
 //! queued, bad frames logged and skipped, signals, --reference, --max-frames, restart after
 //! SIGKILL with --state-dir.
 
-mod common;
+use crate::common;
 
 use common::camera::{
     affine, final_line, number_after, render, translation, unrelated_speckle, Bench, FieldCopy,

@@ -3,7 +3,7 @@
 //! images of different sizes, non-power-of-two ZOI, step 0, ZOI larger than the ROI, a flat
 //! image), each a clear message or a per-node status, never a crash or a NaN.
 
-mod common;
+use crate::common;
 
 use common::camera::{render, translation, unrelated_speckle};
 use std::path::{Path, PathBuf};

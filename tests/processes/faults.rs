@@ -9,7 +9,7 @@
 //! (`--nocapture` shows them). No wall-clock assertion: waits are on result files, bounded by
 //! the hang guard.
 
-mod common;
+use crate::common;
 
 use common::bench_run::{
     check_consistency, child_pid, config, signal, start_run, stray_file, summary, wait_child,

@@ -11,8 +11,8 @@
 //! Without chromium the browser test says so and passes, except under CI (`CI` set), where
 //! it fails: `.ci/run` installs chromium.
 
-mod common;
-mod dashboard_support;
+use crate::common;
+use crate::dashboard_support;
 
 use common::{dashboard_address, Run};
 use dashboard_support::webdriver::Browser;

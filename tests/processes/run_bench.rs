@@ -4,7 +4,7 @@
 //! `faults.rs`.
 //! Waits poll result files with a hang guard; nothing asserts a wall-clock time.
 
-mod common;
+use crate::common;
 
 use common::bench_run::{child_pid, config, rows, start_run, summary, wait_rows, SHORT_CAMPAIGN};
 use common::Run;
