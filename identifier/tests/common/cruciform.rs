@@ -84,6 +84,18 @@ pub fn solved_frames<L: SheetLaw + ?Sized>(
     element_size_mm: f64,
     grid_step_mm: f64,
 ) -> (membrane::Mesh, Vec<Frame>) {
+    let (mesh, mut frames) = solved_frames_on(law, stretches, element_size_mm, &[grid_step_mm]);
+    (mesh, frames.remove(0))
+}
+
+/// [`solved_frames`] with the same solutions sampled on grids of each of `grid_steps_mm`
+/// (frames by grid, then by stretch).
+pub fn solved_frames_on<L: SheetLaw + ?Sized>(
+    law: &L,
+    stretches: &[(f64, f64)],
+    element_size_mm: f64,
+    grid_steps_mm: &[f64],
+) -> (membrane::Mesh, Vec<Vec<Frame>>) {
     let specimen = CruciformGeometry {
         element_size_mm,
         ..CruciformGeometry::default()
@@ -98,19 +110,26 @@ pub fn solved_frames<L: SheetLaw + ?Sized>(
     )
     .unwrap();
     let probe = Probe::new(&specimen.mesh);
-    let n = (2.0 * HALF_VIEW_MM / grid_step_mm).round() as usize + 1;
-    // Where each grid node lies in the mesh, found once for every frame.
-    let locations: Vec<_> = (0..n * n)
-        .map(|k| {
-            probe.locate([
-                -HALF_VIEW_MM + (k % n) as f64 * grid_step_mm,
-                -HALF_VIEW_MM + (k / n) as f64 * grid_step_mm,
-            ])
+    // Each grid's size, and where each of its nodes lies in the mesh, found once for every
+    // frame.
+    let grids: Vec<_> = grid_steps_mm
+        .iter()
+        .map(|&step| {
+            let n = (2.0 * HALF_VIEW_MM / step).round() as usize + 1;
+            let locations: Vec<_> = (0..n * n)
+                .map(|k| {
+                    probe.locate([
+                        -HALF_VIEW_MM + (k % n) as f64 * step,
+                        -HALF_VIEW_MM + (k / n) as f64 * step,
+                    ])
+                })
+                .collect();
+            (step, n, locations)
         })
         .collect();
     let mut analysis = membrane::Analysis::default();
     let mut displacement_mm = vec![0.0; 2 * specimen.mesh.nodes_mm.len()];
-    let mut frames = vec![];
+    let mut frames: Vec<Vec<Frame>> = grids.iter().map(|_| vec![]).collect();
     let mut settings = NewtonSettings::default();
     for &(x, y) in stretches {
         let clamps = specimen.clamps_at(membrane::GripStretch { x, y });
@@ -121,22 +140,7 @@ pub fn solved_frames<L: SheetLaw + ?Sized>(
             panic!("grip stretches ({x}, {y}): {stopped}");
         }
         let solved = outcome.reached;
-        let gradients = locations
-            .iter()
-            .map(|at| {
-                let at = (*at)?;
-                membrane::sample_at(&specimen.mesh, &solved.displacement_mm, at).map(|s| s.f)
-            })
-            .collect();
-        let grid = FieldGrid {
-            cols: n,
-            rows: n,
-            x0_mm: -HALF_VIEW_MM,
-            y0_mm: -HALF_VIEW_MM,
-            step_mm: grid_step_mm,
-            gradients,
-        };
-        let forces = specimen
+        let forces: Vec<_> = specimen
             .grips
             .iter()
             .map(|grip| {
@@ -144,7 +148,27 @@ pub fn solved_frames<L: SheetLaw + ?Sized>(
                 (grip.name, f[0] * grip.axis[0] + f[1] * grip.axis[1])
             })
             .collect();
-        frames.push(Frame { grid, forces });
+        for ((step, n, locations), frames) in grids.iter().zip(&mut frames) {
+            let gradients = locations
+                .iter()
+                .map(|at| {
+                    let at = (*at)?;
+                    membrane::sample_at(&specimen.mesh, &solved.displacement_mm, at).map(|s| s.f)
+                })
+                .collect();
+            let grid = FieldGrid {
+                cols: *n,
+                rows: *n,
+                x0_mm: -HALF_VIEW_MM,
+                y0_mm: -HALF_VIEW_MM,
+                step_mm: *step,
+                gradients,
+            };
+            frames.push(Frame {
+                grid,
+                forces: forces.clone(),
+            });
+        }
         displacement_mm = solved.displacement_mm;
         // From a nearby equilibrium: two load steps (halved if one fails).
         settings.load_steps = 2;
