@@ -169,7 +169,8 @@ fn stress_gaps(model: &Model, params: &[f64], evidence: &Evidence) -> [f64; 3] {
 /// The field's evidence rejects Mooney-Rivlin on a Smactane specimen beyond 100 % strain and
 /// ranks Smactane's own family first, on two meshes (the ranking is not the mesh's).
 ///
-/// Measured when written (1 mm grid, 5 frames, 60 equations, 8 models; 27-31 s in release):
+/// Measured when written (1 mm grid, 5 frames, 60 equations, 8 models; 22-29 s in release on
+/// a machine shared with other builds):
 /// the field reached max λ1 4.52 (the fillets; ≈ 3.0 at the cuts), max λ2 1.305 (the centre,
 /// which the arms hold back). BIC ranking on 10 mm and 5 mm elements alike: LDR 2,2 (−167.2,
 /// −222.1), Ogden 2 (−49.3, −85.3), LDR 1,1 (−35.6, −9.7), Mooney-Rivlin (225.6, 190.1),

@@ -130,7 +130,11 @@ pub fn solved_frames_on<L: SheetLaw + ?Sized>(
     let mut analysis = membrane::Analysis::default();
     let mut displacement_mm = vec![0.0; 2 * specimen.mesh.nodes_mm.len()];
     let mut frames: Vec<Vec<Frame>> = grids.iter().map(|_| vec![]).collect();
-    let mut settings = NewtonSettings::default();
+    // Two load steps a solve (halved where one fails): the path's stretches are close enough.
+    let settings = NewtonSettings {
+        load_steps: 2,
+        ..NewtonSettings::default()
+    };
     for &(x, y) in stretches {
         let clamps = specimen.clamps_at(membrane::GripStretch { x, y });
         let outcome =
@@ -170,8 +174,6 @@ pub fn solved_frames_on<L: SheetLaw + ?Sized>(
             });
         }
         displacement_mm = solved.displacement_mm;
-        // From a nearby equilibrium: two load steps (halved if one fails).
-        settings.load_steps = 2;
     }
     (specimen.mesh, frames)
 }
