@@ -53,8 +53,8 @@ const HALF_GRID_STEP_MM: f64 = 0.5 * GRID_STEP_MM;
 ///
 /// Issue 25's 1e-4 on every parameter, noise-free: signed relative errors of cuts and ramps
 /// (C10, C01) and the worst gap, by element size (mm) and camera grid step (mm), measured with
-/// this file's frames (`solved_frames_on`; 12-93 s a row when measured, the rows other than 10 and 5 mm by a
-/// scratch run):
+/// this file's frames (`solved_frames_on`; 12-93 s a row when measured, the rows other than
+/// 10 and 5 mm by a scratch run):
 ///
 /// | elements | grid | C10 | C01 | worst gap |
 /// |---|---|---|---|---|
@@ -71,8 +71,8 @@ const HALF_GRID_STEP_MM: f64 = 0.5 * GRID_STEP_MM;
 /// | 2.5 | 0.5 | −6.9e-5 | +6.5e-4 | 7.4e-5 |
 /// | 2.5 | 0.25 | −8.7e-6 | +5.7e-5 | 9.6e-6 |
 ///
-/// Only the last row reaches 1e-4 on both parameters (`the_law_comes_back_to_1e_4_on_a_fine_mesh_and_grid`,
-/// ignored in CI: 61 s). Below 10 mm the errors are in no asymptotic regime: C01 changes sign
+/// Only the last row reaches 1e-4 on both parameters
+/// (`the_law_comes_back_to_1e_4_on_a_fine_mesh_and_grid`, ignored in CI: 61 s). Below 10 mm the errors are in no asymptotic regime: C01 changes sign
 /// with the mesh and with the grid, so Richardson extrapolation across two meshes has no order
 /// to use. Refining one of mesh and grid alone stalls (5 mm: the gap 1.5e-4, 7.8e-5, 8.9e-5 on
 /// 1, 0.5, 0.25 mm grids; 0.5 mm grid: 7.8e-5, 7.1e-5, 7.4e-5 on 5, 3.54, 2.5 mm elements): the
