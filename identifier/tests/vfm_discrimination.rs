@@ -210,7 +210,10 @@ fn the_field_rejects_mooney_rivlin_beyond_100_percent_and_ranks_smactane_s_famil
     for (mesh, evidence) in [("10 mm", &coarse), ("5 mm", &fine)] {
         let gaps = stress_gaps(&LDR, &evidence.fit_of(&LDR).fit.params, evidence)
             .map(|g| format!("{g:.2e}"));
-        println!("{mesh}: LDR 2,2's worst nominal-stress gaps to Smactane (uniaxial, equibiaxial, pure shear): {gaps:.2?}");
+        println!(
+            "{mesh}: LDR 2,2's worst nominal-stress gaps to Smactane (uniaxial, equibiaxial, \
+             pure shear): {gaps:.2?}"
+        );
     }
     // Uniaxial and equibiaxial within 1 %; pure shear (I1 = I2) is not a state the cruciform's
     // field holds beyond small strains (its arms: I1 far above I2), reported only.

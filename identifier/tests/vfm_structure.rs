@@ -72,9 +72,9 @@ const HALF_GRID_STEP_MM: f64 = 0.5 * GRID_STEP_MM;
 /// | 2.5 | 0.25 | −8.7e-6 | +5.7e-5 | 9.6e-6 |
 ///
 /// Only the last row reaches 1e-4 on both parameters
-/// (`the_law_comes_back_to_1e_4_on_a_fine_mesh_and_grid`, ignored in CI: 61 s). Below 10 mm the errors are in no asymptotic regime: C01 changes sign
-/// with the mesh and with the grid, so Richardson extrapolation across two meshes has no order
-/// to use. Refining one of mesh and grid alone stalls (5 mm: the gap 1.5e-4, 7.8e-5, 8.9e-5 on
+/// (`the_law_comes_back_to_1e_4_on_a_fine_mesh_and_grid`, ignored in CI: 61 s). Below 10 mm
+/// the errors are in no asymptotic regime: C01 changes sign with the mesh and with the grid,
+/// so Richardson extrapolation across two meshes has no order to use. Refining one of mesh and grid alone stalls (5 mm: the gap 1.5e-4, 7.8e-5, 8.9e-5 on
 /// 1, 0.5, 0.25 mm grids; 0.5 mm grid: 7.8e-5, 7.1e-5, 7.4e-5 on 5, 3.54, 2.5 mm elements): the
 /// grid's node-square quadrature (and the ramps' edge squares, whose material takes its nearest
 /// node's stress, where the fillets' curved edges cross their taper) integrates a field that is
