@@ -331,21 +331,28 @@ impl FieldRoute {
 
     /// The largest major and minor principal stretches of the kept frames' measured nodes.
     fn max_stretches(&self) -> [f64; 2] {
-        let mut range = [1.0_f64, 1.0_f64];
-        for frame in &self.frames {
-            for f in frame.grid.gradients.iter().flatten() {
-                let c = [
-                    f[0][0] * f[0][0] + f[1][0] * f[1][0],
-                    f[0][0] * f[0][1] + f[1][0] * f[1][1],
-                    f[0][1] * f[0][1] + f[1][1] * f[1][1],
-                ];
-                let (mean, radius) = (0.5 * (c[0] + c[2]), (0.5 * (c[0] - c[2])).hypot(c[1]));
-                range[0] = range[0].max((mean + radius).sqrt());
-                range[1] = range[1].max((mean - radius).max(0.0).sqrt());
-            }
-        }
-        range
+        max_stretches(self.frames.iter().map(|f| &f.grid))
     }
+}
+
+/// The largest major and largest minor in-plane principal stretch over the measured nodes of
+/// `grids` ([1, 1] for none): how far the field went towards uniaxial-like (λ1) and equibiaxial
+/// (λ2) states ([`FieldFits::max_stretches`]).
+pub fn max_stretches<'a>(grids: impl IntoIterator<Item = &'a FieldGrid>) -> [f64; 2] {
+    let mut range = [1.0_f64, 1.0_f64];
+    for grid in grids {
+        for f in grid.gradients.iter().flatten() {
+            let c = [
+                f[0][0] * f[0][0] + f[1][0] * f[1][0],
+                f[0][0] * f[0][1] + f[1][0] * f[1][1],
+                f[0][1] * f[0][1] + f[1][1] * f[1][1],
+            ];
+            let (mean, radius) = (0.5 * (c[0] + c[2]), (0.5 * (c[0] - c[2])).hypot(c[1]));
+            range[0] = range[0].max((mean + radius).sqrt());
+            range[1] = range[1].max((mean - radius).max(0.0).sqrt());
+        }
+    }
+    range
 }
 
 /// One kept frame's force balance on one grip: the grip's measured force, and the force its
@@ -501,7 +508,9 @@ fn refusal(error: &VfmError) -> String {
 
 /// A nonlinear model's start from the Mooney-Rivlin fit (C10, C01): Lambert-Diani-Rey's ln f
 /// and ln g at their constants, Gent's and Arruda-Boyce's μ = 2 (C10 + C01) with a moderate
-/// limit; other models are linear or get no start.
+/// limit, Hart-Smith's G = C10, k1 = 0, k2 = 3 C01 / C10 (Mooney-Rivlin at I2 = 3), Ogden's terms α = 2 and −2 with μ = 2 C10 and −2 C01 (Mooney-Rivlin exactly; one term:
+/// the neo-Hookean μ = 2 (C10 + C01), α = 2; further terms μ = C10 / 100, α = 4, −4, 6…); other
+/// models are linear or get no start.
 pub fn start_from_mooney(model: &Model, c10: f64, c01: f64) -> Option<Vec<f64>> {
     let positive = |v: f64, fallback: f64| if v > 0.0 { v } else { fallback };
     let c10 = positive(c10, 0.1);
@@ -515,6 +524,19 @@ pub fn start_from_mooney(model: &Model, c10: f64, c01: f64) -> Option<Vec<f64>> 
         }
         Model::Gent => vec![2.0 * (c10 + c01), 30.0],
         Model::ArrudaBoyce => vec![2.0 * (c10 + c01), 5.0],
+        Model::HartSmith => vec![c10, 0.0, 3.0 * c01 / c10],
+        Model::Ogden(1) => vec![2.0 * (c10 + c01), 2.0],
+        Model::Ogden(n) => {
+            let mut mu = vec![2.0 * c10, -2.0 * c01];
+            let mut alpha = vec![2.0, -2.0];
+            for k in 2..*n {
+                mu.push(0.01 * c10);
+                let magnitude = 2.0 * (k / 2 + 1) as f64;
+                alpha.push(if k % 2 == 0 { magnitude } else { -magnitude });
+            }
+            mu.extend(alpha);
+            mu
+        }
         m if m.linear_params().iter().all(|&l| l) => vec![0.0; m.param_names().len()],
         _ => return None,
     })
@@ -783,6 +805,37 @@ mod tests {
         assert_eq!((balance[0].frame_id, balance[0].grip), (0, "x+"));
         let stiffer = route.force_balance(&model, &[0.33, 0.055]);
         assert!(stiffer.iter().all(|b| b.computed_n > 1.05 * b.measured_n));
+    }
+
+    /// Ogden's and Hart-Smith's starts are Mooney-Rivlin's law (Ogden 2 exactly, Hart-Smith at
+    /// I2 = 3); a further Ogden term starts small.
+    #[test]
+    fn ogden_and_hart_smith_start_at_the_mooney_rivlin_fit() {
+        let (c10, c01) = (0.3, 0.05);
+        for (l1, l2) in [(1.5, 0.8), (2.0, 1.7), (3.0, 1.0)] {
+            let mooney = Model::Mooney
+                .in_plane_cauchy_stress_mpa(&[c10, c01], l1, l2)
+                .unwrap();
+            let ogden = Model::Ogden(2);
+            let start = start_from_mooney(&ogden, c10, c01).unwrap();
+            let got = ogden.in_plane_cauchy_stress_mpa(&start, l1, l2).unwrap();
+            for k in 0..2 {
+                assert!((got[k] - mooney[k]).abs() < 1e-12, "{got:?} {mooney:?}");
+            }
+        }
+        let three = start_from_mooney(&Model::Ogden(3), c10, c01).unwrap();
+        assert_eq!(three, vec![0.6, -0.1, 0.003, 2.0, -2.0, 4.0]);
+        let hart_smith = start_from_mooney(&Model::HartSmith, c10, c01).unwrap();
+        let (w1, w2) = Model::HartSmith
+            .invariant_derivatives_mpa(&hart_smith, 3.0, 3.0)
+            .unwrap();
+        assert!((w1 - c10).abs() < 1e-15 && (w2 - c01).abs() < 1e-15);
+        // A field's reach: the largest major and minor stretches over its nodes.
+        let g = grid([[1.2, 0.0], [0.0, 0.9]]);
+        assert_eq!(max_stretches([&g]), [1.2, 1.0]);
+        let h = grid([[1.1, 0.0], [0.0, 1.3]]);
+        let reach = max_stretches([&g, &h]);
+        assert!((reach[0] - 1.3).abs() < 1e-15 && (reach[1] - 1.1).abs() < 1e-15);
     }
 
     /// The default run's case: at 100 equations a six-parameter fit whose RMS force is 6 %
