@@ -508,8 +508,9 @@ fn refusal(error: &VfmError) -> String {
 
 /// A nonlinear model's start from the Mooney-Rivlin fit (C10, C01): Lambert-Diani-Rey's ln f
 /// and ln g at their constants, Gent's and Arruda-Boyce's μ = 2 (C10 + C01) with a moderate
-/// limit, Hart-Smith's G = C10, k1 = 0, k2 = 3 C01 / C10 (Mooney-Rivlin at I2 = 3), Ogden's terms α = 2 and −2 with μ = 2 C10 and −2 C01 (Mooney-Rivlin exactly; one term:
-/// the neo-Hookean μ = 2 (C10 + C01), α = 2; further terms μ = C10 / 100, α = 4, −4, 6…); other
+/// limit, Hart-Smith's G = C10, k1 = 0, k2 = 3 C01 / C10 (Mooney-Rivlin at I2 = 3), Ogden's
+/// terms α = 2 and −2 with μ = 2 C10 and −2 C01 (Mooney-Rivlin exactly; one term: the
+/// neo-Hookean μ = 2 (C10 + C01), α = 2; further terms μ = C10 / 100, α = 4, −4, 6…); other
 /// models are linear or get no start.
 pub fn start_from_mooney(model: &Model, c10: f64, c01: f64) -> Option<Vec<f64>> {
     let positive = |v: f64, fallback: f64| if v > 0.0 { v } else { fallback };

@@ -38,6 +38,14 @@ impl std::ops::DerefMut for Run {
     }
 }
 
+/// Runs `dicstream ARGS` (the binary under test) to its end; its exit status and output.
+pub fn dicstream(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_dicstream"))
+        .args(args)
+        .output()
+        .expect("run dicstream")
+}
+
 /// Parses the one JSON object a `tap --json` prints.
 pub fn tap_json(stdout: &str) -> serde_json::Value {
     serde_json::from_str(stdout.trim())

@@ -4,14 +4,8 @@
 //! `identifier` refuses an output folder that does not exist before it runs (it failed at the
 //! end without the path); a missing replay folder is said once, not twice.
 
-use std::process::{Command, Output};
-
-fn dicstream(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_dicstream"))
-        .args(args)
-        .output()
-        .expect("run dicstream")
-}
+use crate::common::dicstream;
+use std::process::Command;
 
 fn instance() -> String {
     format!("cli_refusals_{}", std::process::id())

@@ -4,10 +4,10 @@
 //! image), each a clear message or a per-node status, never a crash or a NaN.
 
 use crate::common;
+use crate::common::dicstream;
 
 use common::camera::{render, translation, unrelated_speckle};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 const W: usize = 192;
 const H: usize = 160;
@@ -44,13 +44,6 @@ fn write_png(path: &Path, pixels: &[u16], width: usize, height: usize) {
         &mut Vec::new(),
     )
     .unwrap();
-}
-
-fn dicstream(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_dicstream"))
-        .args(args)
-        .output()
-        .expect("run dicstream")
 }
 
 fn path(p: &Path) -> &str {

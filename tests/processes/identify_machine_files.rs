@@ -3,16 +3,9 @@
 //! kN and an extension in mm with the specimen's section and gauge length give the same fit
 //! as the identifier's own clean CSV; a bad cell is an error naming the file, line and column.
 
+use crate::common::dicstream;
 use std::path::Path;
-use std::process::{Command, Output};
 use testkit::Run;
-
-fn dicstream(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_dicstream"))
-        .args(args)
-        .output()
-        .expect("run dicstream")
-}
 
 const SECTION_MM2: f64 = 8.0;
 const GAUGE_MM: f64 = 40.0;

@@ -4,17 +4,11 @@
 //! stress far from its clamps), and its refusals (a y stretch on a strip, a folder that holds
 //! something, a geometry that cannot be meshed, a path that does not converge).
 
+use crate::common::dicstream;
 use serde_json::Value;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 use testkit::Run;
-
-fn dicstream(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_dicstream"))
-        .args(args)
-        .output()
-        .expect("run dicstream")
-}
 
 fn text(p: &Path) -> &str {
     p.to_str().unwrap()
