@@ -12,6 +12,7 @@
 //!
 //! Run: `cargo bench -p bench --bench field_route` (options: `-- --frames N --runs N`).
 
+use bench::{arg_value, median, ms};
 use std::time::{Duration, Instant};
 
 use correlator::{Correlator, CorrelatorSettings, Region, Roi};
@@ -31,25 +32,6 @@ const STEP_PX: usize = 16;
 const NODES: usize = 64;
 const TRUTH: [f64; 2] = [0.3, 0.05];
 const LAST_STRETCH: f64 = 1.3;
-
-fn median(mut samples: Vec<Duration>) -> Duration {
-    assert!(!samples.is_empty());
-    samples.sort();
-    samples[samples.len() / 2]
-}
-
-fn ms(d: Duration) -> f64 {
-    d.as_secs_f64() * 1e3
-}
-
-fn arg_value(name: &str, default: usize) -> usize {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
 
 /// One field as the identifier receives it: each node's F (None off the specimen), and each
 /// grip's axial force in [`GRIPS`] order.

@@ -4,6 +4,7 @@
 //!
 //! Run: `cargo bench -p bench --bench render` (options: `-- --threads N --exact-runs N`).
 
+use bench::{arg_value, median, ms};
 use std::time::{Duration, Instant};
 
 use producer::{
@@ -13,25 +14,6 @@ use producer::{
 
 const SIDE_PX: usize = 1024;
 const MARGIN_PX: f64 = 72.0;
-
-fn median(mut samples: Vec<Duration>) -> Duration {
-    assert!(!samples.is_empty());
-    samples.sort();
-    samples[samples.len() / 2]
-}
-
-fn ms(d: Duration) -> f64 {
-    d.as_secs_f64() * 1e3
-}
-
-fn arg_value(name: &str, default: usize) -> usize {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
 
 fn main() {
     let threads = arg_value("--threads", producer::parallel::default_threads());
