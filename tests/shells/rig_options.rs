@@ -1,4 +1,4 @@
-//! Shared by the rig's process tests.
+//! The rig process tests' starting options.
 
 use rig::process::{ProcessOptions, Speed};
 use rig::RigConfig;

@@ -1,7 +1,7 @@
 //! The process shell over iceoryx2: rig/state is published, rig/command answers accepted or
 //! refused with a reason. Runs under its own instance prefix and removes its files.
 
-mod common;
+use crate::rig_options::rig_options;
 
 use iceoryx2::prelude::*;
 use rig::process::{run, ProcessOptions, Speed};
@@ -31,7 +31,7 @@ fn state_is_published_and_commands_are_answered() {
     let options = ProcessOptions {
         speed: Speed::Factor(5.0),
         duration_s: Some(15.0),
-        ..common::rig_options(&name)
+        ..rig_options(&name)
     };
     let rig_thread = std::thread::spawn(move || run(options).unwrap());
 

@@ -4,7 +4,7 @@
 //! pause mid-ramp: the rig holds (rig.csv `held`, the grips still) and resumes when they come
 //! back; the test ends unloaded. Runs under its own instance prefix and removes its files.
 
-mod common;
+use crate::rig_options::rig_options;
 
 use rig::process::{run, ProcessOptions, StrainOptions};
 use rig::strain::StrainTest;
@@ -40,7 +40,7 @@ fn a_strain_controlled_rig_follows_fields_holds_while_they_stop_and_resumes() {
             test,
             specimen: rig::builtin::BuiltinTest::Equibiaxial.specimen(&Default::default()),
         }),
-        ..common::rig_options(&name)
+        ..rig_options(&name)
     };
     let rig_options = options.clone();
     let rig_thread = std::thread::spawn(move || run(rig_options));
