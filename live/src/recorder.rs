@@ -461,6 +461,61 @@ mod tests {
 
     /// The wire's node gradient reaches the field files' gradient columns.
     #[test]
+    fn the_runs_fields_carry_mm_columns_and_the_pvd_lists_each_vts_with_its_time() {
+        let dir = std::env::temp_dir().join(format!("dicstream_pvd_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let results = ResultsDir::at(&dir).unwrap();
+        std::fs::create_dir_all(results.fields()).unwrap();
+        let settings = RecorderSettings {
+            fields_every: 10,
+            vtk: true,
+            truth: false,
+            framing: producer::Framing {
+                mm_per_px: 0.25,
+                strip_mm_per_px: 0.12,
+            },
+            gauges: Vec::new(),
+            control_gauge: correlator::ControlGauge::default(),
+            scale: crate::field_scale::FieldScale::User(wire::scale::MmPerPx::new(0.5).unwrap()),
+        };
+        let mut recorder = Recorder::new(&results, settings, 0).unwrap();
+        let nodes = [FieldNode {
+            x_px: 10.0,
+            u_px: 2.0,
+            status: wire::NodeStatus::Ok as u32,
+            ..FieldNode::default()
+        }];
+        for (frame_id, t_s) in [(10u64, 1.0f64), (20, 2.5)] {
+            let header = FieldHeader {
+                frame_id,
+                mesh_cols: 1,
+                mesh_rows: 1,
+                rig_sample_id: wire::NO_RIG_SAMPLE,
+                t_capture_ns: (t_s * 1e9) as u64,
+                t_published_ns: (t_s * 1e9) as u64,
+                ..FieldHeader::default()
+            };
+            recorder.on_field(&header, &nodes, header.t_published_ns);
+        }
+        assert!(recorder.write_error.is_none(), "{:?}", recorder.write_error);
+        let csv = std::fs::read_to_string(results.fields().join("field_000020.csv")).unwrap();
+        let mut lines = csv.lines();
+        assert!(lines.next().unwrap().ends_with(",x_mm,y_mm,u_mm,v_mm"));
+        assert!(lines
+            .next()
+            .unwrap()
+            .ends_with(",5.000000,0.000000,1.0000000,0.0000000"));
+        let pvd = std::fs::read_to_string(results.fields().join(PVD_FILE)).unwrap();
+        assert!(pvd
+            .contains("<DataSet timestep=\"1\" group=\"\" part=\"0\" file=\"field_000010.vts\"/>"));
+        assert!(pvd.contains(
+            "<DataSet timestep=\"2.5\" group=\"\" part=\"0\" file=\"field_000020.vts\"/>"
+        ));
+        assert!(results.fields().join("field_000020.vts").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn wire_gradient_reaches_the_field_csv() {
         let header = FieldHeader {
             mesh_cols: 2,

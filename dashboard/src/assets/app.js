@@ -349,7 +349,9 @@ function updateUserGauges(gauges) {
       canvas.id = id; canvas.className = 'chart'; canvas.width = 560; canvas.height = 200;
       box.append(title, canvas);
     }
-    const series = Object.keys(g.series).map((k, j) => ({ x: g.t_s, y: g.series[k], color: SERIES_COLORS[j], label: k }));
+    // The gauge strains' colours (exx, eyy, exy), whatever the JSON's key order.
+    const keys = ['exx', 'eyy', 'exy', 'elongation'].filter((k) => k in g.series);
+    const series = keys.map((k, j) => ({ x: g.t_s, y: g.series[k], color: SERIES_COLORS[j], label: k }));
     lineChart(canvas, series, { xlabel: 'test time (s)', ylabel: `${g.name}: ${g.quantity} (${g.unit})`, yZero: true, empty: 'no reading yet' });
   });
 }
