@@ -44,6 +44,7 @@ mod peak;
 mod pool;
 #[cfg(feature = "process")]
 pub mod process;
+pub mod pvd;
 mod real_fft2d;
 pub mod region;
 pub mod settings;
@@ -54,6 +55,7 @@ pub mod state;
 pub mod strain;
 pub mod timing;
 mod verify;
+pub mod vts;
 mod window;
 mod zoi;
 

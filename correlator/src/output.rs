@@ -3,21 +3,34 @@
 //! ParaView, and an RGB colour map of a node value over a grey image.
 
 use crate::field::{Field, Node, NodeStatus};
+use crate::StrainMeasure;
 use std::fmt::Write as _;
+use wire::column_units::{Column, CsvUnits, ONE};
+use wire::scale::MmPerPx;
 
 /// The CSV contract: header `x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy`,
 /// one row per node (row-major), x/y the ZOI centre in the reference image (px), u/v in px,
 /// status a word, then the node's displacement gradient (dimensionless, `Field::gradients`:
 /// IC-GN's own with `icgn1`/`icgn2`, the least-squares fit of the neighbouring nodes with
 /// `correli`; 0 where the node is not `ok`). The gradient columns come last so that readers of
-/// the first ten columns are unaffected.
+/// the first ten columns are unaffected. Without a scale: px only ([`field_csv_scaled`] adds
+/// the mm columns). Each column's unit: [`field_csv_units`].
 pub fn field_csv(field: &Field, text: &mut String) {
+    field_csv_scaled(field, None, text);
+}
+
+/// [`field_csv`], and with a scale `x_mm,y_mm,u_mm,v_mm` after the gradient (the px columns
+/// times the scale; the origin of x_mm, y_mm is the image's, as x, y's).
+pub fn field_csv_scaled(field: &Field, scale: Option<MmPerPx>, text: &mut String) {
     text.clear();
     text.push_str(CSV_HEADER);
+    if scale.is_some() {
+        text.push_str(CSV_MM_COLUMNS);
+    }
     text.push('\n');
     for (k, n) in field.nodes.iter().enumerate() {
         let g = node_gradient(field, k);
-        let _ = writeln!(
+        let _ = write!(
             text,
             "{},{},{:.6},{:.6},{:.7},{:.7},{:.7},{:.5},{},{},{:.7},{:.7},{:.7},{:.7}",
             n.x_px,
@@ -35,6 +48,78 @@ pub fn field_csv(field: &Field, text: &mut String) {
             g[1][0],
             g[1][1]
         );
+        if let Some(s) = scale {
+            let _ = write!(
+                text,
+                ",{:.6},{:.6},{:.7},{:.7}",
+                s.mm(n.x_px),
+                s.mm(n.y_px),
+                s.mm(n.u_px),
+                s.mm(n.v_px)
+            );
+        }
+        text.push('\n');
+    }
+}
+
+/// The columns [`field_csv_scaled`] appends when a scale is known, each with its comma.
+pub const CSV_MM_COLUMNS: &str = ",x_mm,y_mm,u_mm,v_mm";
+
+/// Each column of a field CSV written with `scale` in strain measure `strain`, and what holds
+/// for the file (`files`: which files, relative to the sidecar), for the `units.json` sidecar.
+pub fn field_csv_units(files: &str, strain: StrainMeasure, scale: Option<MmPerPx>) -> CsvUnits {
+    let measure = match strain {
+        StrainMeasure::Small => "small (infinitesimal) strain, sym(grad u)",
+        StrainMeasure::Green => "Green-Lagrange strain, (C - 1)/2",
+        StrainMeasure::Nominal => "nominal (Biot) strain, C^(1/2) - 1",
+        StrainMeasure::Log => "logarithmic (Hencky) strain, ln(C)/2",
+    };
+    let mut notes = vec![
+        format!("strain measure: {} ({measure})", strain.name()),
+        "exy is the tensor component, half the engineering shear strain gamma_xy".to_string(),
+        "x, y: pixel column and row in the node's origin image, origin at the centre of the \
+         top-left pixel; u, v: Lagrangian displacements along x and y"
+            .to_string(),
+    ];
+    notes.push(match scale {
+        Some(s) => format!("scale: {s} mm per px (the mm columns are the px ones times it)"),
+        None => "no scale known: px only, no mm columns".to_string(),
+    });
+    let mut columns = vec![
+        Column::new("x", "px", "node (ZOI centre) column in the reference image"),
+        Column::new("y", "px", "node (ZOI centre) row in the reference image"),
+        Column::new("u", "px", "displacement along x"),
+        Column::new("v", "px", "displacement along y"),
+        Column::new("exx", ONE, format!("{} strain xx", strain.name())),
+        Column::new("eyy", ONE, format!("{} strain yy", strain.name())),
+        Column::new(
+            "exy",
+            ONE,
+            format!(
+                "{} strain xy, tensor component (gamma_xy / 2)",
+                strain.name()
+            ),
+        ),
+        Column::new("score", ONE, "final check's ZNCC of the match, in [-1, 1]"),
+        Column::new("iterations", ONE, "sub-pixel iterations"),
+        Column::new("status", "", "ok, or why the node is not measured"),
+        Column::new("du_dx", ONE, "displacement gradient du/dx (0 where not ok)"),
+        Column::new("du_dy", ONE, "displacement gradient du/dy"),
+        Column::new("dv_dx", ONE, "displacement gradient dv/dx"),
+        Column::new("dv_dy", ONE, "displacement gradient dv/dy"),
+    ];
+    if scale.is_some() {
+        columns.extend([
+            Column::new("x_mm", "mm", "x times the scale"),
+            Column::new("y_mm", "mm", "y times the scale"),
+            Column::new("u_mm", "mm", "displacement along x"),
+            Column::new("v_mm", "mm", "displacement along y"),
+        ]);
+    }
+    CsvUnits {
+        files: files.to_string(),
+        notes,
+        columns,
     }
 }
 
@@ -266,6 +351,40 @@ mod tests {
             tensors.lines().nth(1).unwrap(),
             "0.01 0.002 0 -0.003 0.25 0 0 0 0"
         );
+    }
+
+    #[test]
+    fn a_scale_adds_the_mm_columns_and_the_units_say_each_columns_unit() {
+        let f = field();
+        let mut text = String::new();
+        let scale = MmPerPx::new(0.25).unwrap();
+        field_csv_scaled(&f, Some(scale), &mut text);
+        let header = text.lines().next().unwrap();
+        assert_eq!(header, format!("{CSV_HEADER},x_mm,y_mm,u_mm,v_mm"));
+        let columns = header.split(',').count();
+        assert!(text.lines().all(|l| l.split(',').count() == columns));
+        // Node (1, 0): x 6 px, y 2 px, u 0.1 px.
+        let row: Vec<&str> = text.lines().nth(2).unwrap().split(',').collect();
+        assert_eq!(
+            &row[14..],
+            ["1.500000", "0.500000", "0.0250000", "0.0000000"]
+        );
+        let units = field_csv_units("field_*.csv", StrainMeasure::Green, Some(scale));
+        assert_eq!(units.header(), header);
+        assert_eq!(units.column("u").unwrap().unit, "px");
+        assert_eq!(units.column("u_mm").unwrap().unit, "mm");
+        assert!(units
+            .column("exy")
+            .unwrap()
+            .meaning
+            .contains("tensor component"));
+        assert!(units.notes[0].contains("green"));
+        // No scale: px only, and nothing says mm.
+        field_csv(&f, &mut text);
+        let plain = field_csv_units("field_*.csv", StrainMeasure::Log, None);
+        assert_eq!(plain.header(), text.lines().next().unwrap());
+        assert!(plain.columns.iter().all(|c| c.unit != "mm"));
+        assert!(plain.notes.iter().any(|n| n.contains("no scale known")));
     }
 
     #[test]

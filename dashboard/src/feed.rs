@@ -119,7 +119,9 @@ pub fn feed(
             png = Some(p);
         }
         if Instant::now() >= next_publish {
-            let snapshot = state.snapshot(wire::monotonic_ns(), hub.viewers(), &hub.processes());
+            let mut snapshot =
+                state.snapshot(wire::monotonic_ns(), hub.viewers(), &hub.processes());
+            snapshot["user_gauges"] = hub.user_gauges();
             hub.publish(snapshot.to_string(), png.take());
             next_publish = Instant::now()
                 + if watched {

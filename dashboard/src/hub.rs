@@ -14,6 +14,7 @@ struct Published {
     snapshot: Option<Arc<str>>,
     png: Option<Arc<[u8]>>,
     processes: Value,
+    user_gauges: Value,
 }
 
 #[derive(Default)]
@@ -73,6 +74,16 @@ impl Hub {
 
     pub fn processes(&self) -> Value {
         self.lock().processes.clone()
+    }
+
+    /// The user's named gauges against the test's time, as `dicstream run` reads them from
+    /// its configuration's shapes (shown as is; `null` from a monitor, which has no shapes).
+    pub fn set_user_gauges(&self, gauges: Value) {
+        self.lock().user_gauges = gauges;
+    }
+
+    pub fn user_gauges(&self) -> Value {
+        self.lock().user_gauges.clone()
     }
 
     /// Counts a viewer (an event stream) in, if fewer than `max` are connected; counted out

@@ -109,6 +109,12 @@ impl Dashboard {
         self.hub.set_processes(processes);
     }
 
+    /// The user's named gauges against the test's time (`dicstream run`: each gauge's name,
+    /// kind, quantity, unit, times and series), shown as one chart per gauge.
+    pub fn set_user_gauges(&self, gauges: serde_json::Value) {
+        self.hub.set_user_gauges(gauges);
+    }
+
     /// Serves until a termination signal (the feeder notes it), then stops.
     pub fn wait(mut self) -> Result<(), DashboardError> {
         let result = match self.feeder.take() {

@@ -61,6 +61,13 @@ pub fn update(
     }));
 }
 
+/// Hands the user's named gauges' readings to the page (one chart per gauge).
+pub fn update_gauges(dashboard: &Option<Dashboard>, gauges: &crate::gauge_history::GaugeHistory) {
+    if let Some(dashboard) = dashboard {
+        dashboard.set_user_gauges(gauges.to_json());
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -30,6 +30,8 @@ pub struct RecorderSettings {
     /// header carries (its truth is taken over the same nodes).
     pub gauges: Vec<correlator::Gauge>,
     pub control_gauge: correlator::ControlGauge,
+    /// The fields' scale, for their mm columns (`field_scale`).
+    pub scale: crate::field_scale::FieldScale,
 }
 
 pub struct Recorder {
@@ -80,8 +82,12 @@ pub struct Recorder {
     /// The user's gauges' cells of the row being written.
     gauge_cells: String,
     text: String,
-    /// The VTK fields written so far, as one time series (`fields/fields.vtk.series`).
+    /// The VTK fields written so far, as one time series (`fields/fields.vtk.series`), and
+    /// their `.vts` twins as a ParaView collection (`fields/fields.pvd`).
     vtk_series: crate::vtk_series::VtkSeries,
+    pvd: correlator::pvd::Pvd,
+    /// The user's gauges' readings against the test's time, for the dashboard.
+    pub gauge_history: crate::gauge_history::GaugeHistory,
     /// Errors writing results (the run goes on, the error is reported once).
     pub write_error: Option<FileError>,
 }
@@ -93,6 +99,10 @@ impl Recorder {
         t0_ns: u64,
     ) -> Result<Recorder, FileError> {
         assert!(settings.fields_every > 0);
+        let gauge_history = crate::gauge_history::GaugeHistory::new(
+            &settings.gauges,
+            settings.scale.of_field(None).is_some(),
+        );
         Ok(Recorder {
             frames_csv: RowFile::create(
                 &results.frames_csv(),
@@ -127,6 +137,8 @@ impl Recorder {
             frames_dropped_by_correlator: 0,
             origin_frames: OriginFrames::default(),
             vtk_series: crate::vtk_series::VtkSeries::new(),
+            pvd: correlator::pvd::Pvd::new(),
+            gauge_history,
             peak_field: None,
             max_stretch: [1.0; 3],
             row: String::with_capacity(1024),
@@ -277,6 +289,14 @@ impl Recorder {
         let step_px = f64::from(header.step_px);
         let gauges = &self.settings.gauges;
         crate::gauge_columns::write_cells(gauges, nodes, step_px, &mut self.gauge_cells);
+        let grips = origin
+            .and_then(|o| o.specimen_solve())
+            .and_then(|id| self.specimen.solve(id))
+            .map(|s| s.field.grip_mm.len());
+        let scale = self.settings.scale.of_field(grips);
+        let test_time_s = row.t_sim_s.unwrap_or(row.t_capture_s);
+        self.gauge_history
+            .push(gauges, nodes, step_px, test_time_s, scale);
         row.write_csv_with(&mut self.row, self.settings.truth, &self.gauge_cells);
         let line = std::mem::take(&mut self.row);
         let result = self.frames_csv.append(&line);
@@ -286,7 +306,7 @@ impl Recorder {
             .frame_id
             .is_multiple_of(u64::from(self.settings.fields_every))
         {
-            let result = self.write_field_files(header, nodes);
+            let result = self.write_field_files(header, nodes, scale);
             self.note_error(result);
         }
         self.last_field = Some(*header);
@@ -336,13 +356,14 @@ impl Recorder {
         &mut self,
         header: &FieldHeader,
         nodes: &[FieldNode],
+        scale: Option<wire::scale::MmPerPx>,
     ) -> Result<(), FileError> {
         let field = to_correlator_field(header, nodes);
         let stem = self
             .results
             .fields()
             .join(format!("field_{:06}", header.frame_id));
-        correlator::output::field_csv(&field, &mut self.text);
+        correlator::output::field_csv_scaled(&field, scale, &mut self.text);
         write_atomic(&stem.with_extension("csv"), self.text.as_bytes())?;
         if self.settings.vtk {
             correlator::output::field_vtk(
@@ -359,10 +380,24 @@ impl Recorder {
                 &self.results.fields().join(crate::vtk_series::FILE_NAME),
                 self.vtk_series.to_json().as_bytes(),
             )?;
+            correlator::vts::field_vts(&field, scale, &mut self.text);
+            let vts = stem.with_extension("vts");
+            write_atomic(&vts, self.text.as_bytes())?;
+            let name = vts.file_name().map(|n| n.to_string_lossy().into_owned());
+            // A time that does not increase (none expected) is left out of the collection.
+            if self.pvd.push(name.unwrap_or_default(), time_s) {
+                write_atomic(
+                    &self.results.fields().join(PVD_FILE),
+                    self.pvd.to_xml().as_bytes(),
+                )?;
+            }
         }
         Ok(())
     }
 }
+
+/// The ParaView collection of the `.vts` fields, in the fields folder.
+pub const PVD_FILE: &str = "fields.pvd";
 
 /// A field from the wire as the correlator's own type (for the shared file writers).
 pub fn to_correlator_field(header: &FieldHeader, nodes: &[FieldNode]) -> correlator::Field {
@@ -425,6 +460,61 @@ mod tests {
     use super::*;
 
     /// The wire's node gradient reaches the field files' gradient columns.
+    #[test]
+    fn the_runs_fields_carry_mm_columns_and_the_pvd_lists_each_vts_with_its_time() {
+        let dir = std::env::temp_dir().join(format!("dicstream_pvd_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let results = ResultsDir::at(&dir).unwrap();
+        std::fs::create_dir_all(results.fields()).unwrap();
+        let settings = RecorderSettings {
+            fields_every: 10,
+            vtk: true,
+            truth: false,
+            framing: producer::Framing {
+                mm_per_px: 0.25,
+                strip_mm_per_px: 0.12,
+            },
+            gauges: Vec::new(),
+            control_gauge: correlator::ControlGauge::default(),
+            scale: crate::field_scale::FieldScale::User(wire::scale::MmPerPx::new(0.5).unwrap()),
+        };
+        let mut recorder = Recorder::new(&results, settings, 0).unwrap();
+        let nodes = [FieldNode {
+            x_px: 10.0,
+            u_px: 2.0,
+            status: wire::NodeStatus::Ok as u32,
+            ..FieldNode::default()
+        }];
+        for (frame_id, t_s) in [(10u64, 1.0f64), (20, 2.5)] {
+            let header = FieldHeader {
+                frame_id,
+                mesh_cols: 1,
+                mesh_rows: 1,
+                rig_sample_id: wire::NO_RIG_SAMPLE,
+                t_capture_ns: (t_s * 1e9) as u64,
+                t_published_ns: (t_s * 1e9) as u64,
+                ..FieldHeader::default()
+            };
+            recorder.on_field(&header, &nodes, header.t_published_ns);
+        }
+        assert!(recorder.write_error.is_none(), "{:?}", recorder.write_error);
+        let csv = std::fs::read_to_string(results.fields().join("field_000020.csv")).unwrap();
+        let mut lines = csv.lines();
+        assert!(lines.next().unwrap().ends_with(",x_mm,y_mm,u_mm,v_mm"));
+        assert!(lines
+            .next()
+            .unwrap()
+            .ends_with(",5.000000,0.000000,1.0000000,0.0000000"));
+        let pvd = std::fs::read_to_string(results.fields().join(PVD_FILE)).unwrap();
+        assert!(pvd
+            .contains("<DataSet timestep=\"1\" group=\"\" part=\"0\" file=\"field_000010.vts\"/>"));
+        assert!(pvd.contains(
+            "<DataSet timestep=\"2.5\" group=\"\" part=\"0\" file=\"field_000020.vts\"/>"
+        ));
+        assert!(results.fields().join("field_000020.vts").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn wire_gradient_reaches_the_field_csv() {
         let header = FieldHeader {

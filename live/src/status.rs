@@ -167,6 +167,7 @@ mod tests {
             },
             gauges: Vec::new(),
             control_gauge: correlator::ControlGauge::default(),
+            scale: crate::field_scale::FieldScale::None,
         };
         let mut recorder = Recorder::new(&results, settings, 0).unwrap();
         let mut rig = RigState {

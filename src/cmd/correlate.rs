@@ -17,6 +17,7 @@ use correlator::{
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use wire::scale::MmPerPx;
 
 /// The library's defaults, the command line's defaults.
 fn defaults() -> CorrelatorSettings {
@@ -131,7 +132,16 @@ pub struct CorrelateArgs {
     /// Output folder (created if missing).
     #[arg(long)]
     pub out: PathBuf,
-    /// Also write legacy VTK structured grids (field_NNNN.vtk) for ParaView.
+    /// The image's scale, mm per px: the field files get x_mm,y_mm,u_mm,v_mm beside the px
+    /// columns (without a scale, or --known-length, px only).
+    #[arg(long, value_name = "MM_PER_PX", conflicts_with = "known_length")]
+    pub mm_per_px: Option<wire::scale::MmPerPx>,
+    /// The scale from a known length: two points of the reference image (px) and the distance
+    /// between them on the specimen (mm), "X1,Y1 X2,Y2 MM".
+    #[arg(long, value_name = "X1,Y1 X2,Y2 MM")]
+    pub known_length: Option<wire::scale::KnownLength>,
+    /// Also write the fields for ParaView: legacy VTK structured grids (field_NNNN.vtk), VTK
+    /// XML ones (field_NNNN.vts) and fields.pvd, their collection (time step = image index).
     #[arg(long)]
     pub vtk: bool,
     /// Also write colour maps of |u| and exx over the reference image (u_NNNN.png, exx_NNNN.png).
@@ -142,6 +152,24 @@ pub struct CorrelateArgs {
 impl CorrelateArgs {
     fn settings(&self) -> CorrelatorSettings {
         self.correlation.settings(self.reference_mode)
+    }
+
+    /// The scale given, directly or from a known length (None: px only).
+    fn scale(&self) -> Option<MmPerPx> {
+        self.mm_per_px
+            .or_else(|| self.known_length.map(|k| k.scale()))
+    }
+
+    /// How the scale was given, for `summary.json`.
+    fn scale_from(&self) -> Option<String> {
+        match (&self.mm_per_px, &self.known_length) {
+            (Some(_), _) => Some("--mm-per-px".to_string()),
+            (None, Some(k)) => Some(format!(
+                "--known-length {k} ({:.3} px apart)",
+                k.distance_px()
+            )),
+            (None, None) => None,
+        }
     }
 }
 
@@ -168,6 +196,8 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
     correlator.set_reference(&reference.pixels)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
+    write_units(&args, settings.strain)?;
+    let mut pvd = correlator::pvd::Pvd::new();
     let progress = progress_bar(args.deformed.len());
     let settings_value = settings_json(&args, &correlator);
     let mut frames = Vec::new();
@@ -191,7 +221,7 @@ pub fn run(args: CorrelateArgs) -> Result<()> {
         frames_with_valid_nodes += usize::from(field.valid > 0);
         valid.push(field.valid);
         warn_if_few_valid(path, field, progress.as_ref());
-        write_field_files(&args, &reference, field, index)?;
+        write_field_files(&args, &reference, field, index, &mut pvd)?;
         frames.push(frame_json(
             index,
             path,
@@ -286,9 +316,10 @@ fn write_field_files(
     reference: &producer::Image16,
     field: &Field,
     index: usize,
+    pvd: &mut correlator::pvd::Pvd,
 ) -> Result<()> {
     let mut text = String::new();
-    correlator::output::field_csv(field, &mut text);
+    correlator::output::field_csv_scaled(field, args.scale(), &mut text);
     write(
         &args.out.join(format!("field_{index:04}.csv")),
         text.as_bytes(),
@@ -303,6 +334,11 @@ fn write_field_files(
             &args.out.join(format!("field_{index:04}.vtk")),
             text.as_bytes(),
         )?;
+        let vts = format!("field_{index:04}.vts");
+        correlator::vts::field_vts(field, args.scale(), &mut text);
+        write(&args.out.join(&vts), text.as_bytes())?;
+        pvd.push(vts, index as f64);
+        write(&args.out.join(PVD), pvd.to_xml().as_bytes())?;
     }
     if args.png {
         let magnitude = |n: &correlator::Node| n.u_px.hypot(n.v_px);
@@ -326,6 +362,22 @@ fn write_field_files(
         )?;
     }
     Ok(())
+}
+
+/// The ParaView collection of the `.vts` fields, in the output folder.
+const PVD: &str = "fields.pvd";
+
+/// `units.json`: the unit of each column of the field files, their strain measure and scale.
+fn write_units(args: &CorrelateArgs, strain: StrainMeasure) -> Result<()> {
+    let fields = correlator::output::field_csv_units("field_*.csv", strain, args.scale());
+    let units = serde_json::json!({
+        "about": "units of the columns of this folder's CSV files (dicstream correlate)",
+        "files": { "field_*.csv": fields },
+    });
+    write(
+        &args.out.join(wire::column_units::SIDECAR),
+        serde_json::to_string_pretty(&units)?.as_bytes(),
+    )
 }
 
 /// Frame `index`'s entry of `summary.json`.
@@ -401,6 +453,8 @@ fn settings_json(args: &CorrelateArgs, correlator: &Correlator) -> serde_json::V
         "threads": args.correlation.threads,
         "max_iterations": args.correlation.max_iterations,
         "strain_window_nodes": correlator.settings().strain_window_nodes,
+        "mm_per_px": args.scale().map(MmPerPx::get),
+        "scale_from": args.scale_from(),
     })
 }
 

@@ -50,6 +50,160 @@ fn path(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// Correlates `ref.png` against two translated images into `out` with `extra` arguments.
+fn correlate_two(dir: &TempDir, out: &str, extra: &[&str]) -> (std::process::Output, PathBuf) {
+    let reference = dir.0.join("ref.png");
+    write_png(&reference, &render(W, H, &translation(0.0, 0.0).0, 1), W, H);
+    let mut args = vec!["correlate".to_string(), path(&reference).to_string()];
+    for (k, (u, v)) in [(0.4, 0.0), (0.8, -0.2)].into_iter().enumerate() {
+        let file = dir.0.join(format!("def_{k}.png"));
+        write_png(
+            &file,
+            &render(W, H, &translation(u, v).0, 2 + k as u64),
+            W,
+            H,
+        );
+        args.push(path(&file).to_string());
+    }
+    let out = dir.0.join(out);
+    args.extend(["--zoi", "32", "--step", "16", "--out", path(&out)].map(String::from));
+    args.extend(extra.iter().map(|a| a.to_string()));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    (dicstream(&args), out)
+}
+
+#[test]
+fn a_scale_gives_mm_columns_units_json_says_each_unit_and_the_pvd_lists_the_vts_files() {
+    let dir = TempDir::new("scale");
+    // 0,0 to 300,400 px is 500 px: 125 mm is 0.25 mm per px, as given directly.
+    let (known, out_known) = correlate_two(
+        &dir,
+        "known",
+        &["--known-length", "0,0 300,400 125", "--vtk"],
+    );
+    assert!(
+        known.status.success(),
+        "{}",
+        String::from_utf8_lossy(&known.stderr)
+    );
+    let (direct, out_direct) = correlate_two(&dir, "direct", &["--mm-per-px", "0.25"]);
+    assert!(
+        direct.status.success(),
+        "{}",
+        String::from_utf8_lossy(&direct.stderr)
+    );
+    let field = |out: &Path| std::fs::read_to_string(out.join("field_0001.csv")).unwrap();
+    assert_eq!(field(&out_known), field(&out_direct));
+    let csv = field(&out_known);
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    assert_eq!(&header[14..], ["x_mm", "y_mm", "u_mm", "v_mm"]);
+    for line in csv.lines().skip(1) {
+        let row: Vec<f64> = line
+            .split(',')
+            .enumerate()
+            .filter(|(k, _)| *k != 9)
+            .map(|(_, c)| c.parse().unwrap())
+            .collect();
+        // u_mm = 0.25 u (the status column left out: u is row[2], u_mm row[15]).
+        assert!((row[15] - 0.25 * row[2]).abs() < 1e-5, "{line}");
+        assert!((row[13] - 0.25 * row[0]).abs() < 1e-5, "{line}");
+    }
+    // units.json names every column of the header with its unit, and the strain measure.
+    let units: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_known.join("units.json")).unwrap())
+            .unwrap();
+    let fields = &units["files"]["field_*.csv"];
+    let names: Vec<&str> = fields["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, header);
+    assert_eq!(fields["columns"][2]["unit"], "px");
+    assert_eq!(fields["columns"][16]["unit"], "mm");
+    assert!(fields["columns"][6]["meaning"]
+        .as_str()
+        .unwrap()
+        .contains("tensor component"));
+    let notes = fields["notes"].to_string();
+    assert!(
+        notes.contains("strain measure: log") && notes.contains("0.25 mm per px"),
+        "{notes}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_known.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["settings"]["mm_per_px"], 0.25);
+    // The collection lists each .vts with increasing time steps, and each is XML.
+    let pvd = std::fs::read_to_string(out_known.join("fields.pvd")).unwrap();
+    let doc = roxmltree::Document::parse(&pvd).unwrap();
+    let sets: Vec<(String, f64)> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("DataSet"))
+        .map(|n| {
+            let time = n.attribute("timestep").unwrap().parse().unwrap();
+            (n.attribute("file").unwrap().to_string(), time)
+        })
+        .collect();
+    assert_eq!(
+        sets,
+        [
+            ("field_0001.vts".to_string(), 1.0),
+            ("field_0002.vts".to_string(), 2.0)
+        ]
+    );
+    for (file, _) in &sets {
+        let vts = std::fs::read_to_string(out_known.join(file)).unwrap();
+        roxmltree::Document::parse(&vts).unwrap();
+        assert!(vts.contains("Name=\"displacement_mm\""));
+    }
+    // Without a scale: px only.
+    let (plain, out_plain) = correlate_two(&dir, "plain", &[]);
+    assert!(plain.status.success());
+    assert!(field(&out_plain)
+        .starts_with("x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy\n"));
+    let units = std::fs::read_to_string(out_plain.join("units.json")).unwrap();
+    assert!(
+        units.contains("no scale known") && !units.contains("\"mm\""),
+        "{units}"
+    );
+}
+
+#[test]
+fn a_bad_scale_is_refused_with_its_reason() {
+    let dir = TempDir::new("bad_scale");
+    for (args, expected) in [
+        (
+            ["--known-length", "5,5 5,5 10"],
+            "the two points are the same",
+        ),
+        (
+            ["--known-length", "0,0 10,0 0"],
+            "expected a distance above 0 mm",
+        ),
+        (["--known-length", "0,0 NaN,0 10"], "x2 is NaN"),
+        (["--mm-per-px", "0"], "expected a finite number above 0"),
+    ] {
+        let (output, _) = correlate_two(&dir, "out", &args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success() && stderr.contains(expected),
+            "{args:?}: {stderr}"
+        );
+    }
+    let (both, _) = correlate_two(
+        &dir,
+        "out",
+        &["--mm-per-px", "0.2", "--known-length", "0,0 10,0 1"],
+    );
+    assert!(
+        !both.status.success(),
+        "{}",
+        String::from_utf8_lossy(&both.stderr)
+    );
+}
+
 #[test]
 fn fields_and_summary_follow_the_contract() {
     let dir = TempDir::new("contract");

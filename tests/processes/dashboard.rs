@@ -225,6 +225,7 @@ fn write_config(dir: &std::path::Path) -> PathBuf {
             "[run]\nresults_dir = \"{}\"\nstatus_interval_s = 0.5\n\
              [camera]\nwidth_px = 256\nheight_px = 256\nfps = 10.0\n\
              [correlator]\nthreads = 1\n\
+             gauges = [\"middle=rect:64,64,128,128\", \"span=extensometer:64,128 192,128\"]\n\
              [rig]\npublish_hz = 100.0\nlog_hz = 20.0\n\
              [specimen]\nmodel = \"homogeneous\"\n\
              [[rig.tests]]\nkind = \"uniaxial\"\nstretch = 1.5\nrate_per_s = 0.01\n",
@@ -266,6 +267,8 @@ const READ_PAGE: &str = "
         force_grip_points: window.dash ? (dash.points['force-grip-chart'] || 0) : 0,
         state_points: window.dash ? (dash.statePoints || 0) : 0,
         gauge_clock: window.dash && dash.last ? dash.last.gauge.clock : null,
+        user_gauges: Array.from(document.querySelectorAll('#user-gauges .gauge-name')).map((e) => e.textContent),
+        user_gauge_points: window.dash ? (dash.points['user-gauge-0'] || 0) + (dash.points['user-gauge-1'] || 0) : 0,
     };";
 
 fn read_page(browser: &Browser) -> Value {
@@ -473,6 +476,20 @@ fn new_panels_have_data_pause_and_export(browser: &Browser) {
     until("the test's time advancing", || {
         (seconds(&read_page(browser)) > seconds(&first)).then_some(())
     });
+    // The user's named gauges, each by name with its unit, charted against the test's time
+    // (the simulated camera's scale is known: the extensometer in mm).
+    let named = until("the named gauges charted", || {
+        let p = read_page(browser);
+        (p["user_gauge_points"].as_u64() > Some(1)).then_some(p)
+    });
+    assert_eq!(
+        named["user_gauges"],
+        serde_json::json!([
+            "middle: strain gauge, mean log strain (-)",
+            "span: extensometer, elongation (mm)"
+        ]),
+        "{named}"
+    );
     // x pulls (which others count as loaded is the 10 % rule's, unit-tested in `wire::rig`: at
     // this test's small forces, about 50 N, the other load cells' noise passes it).
     let loaded = browser.eval("return dash.last.forces.actuators.map((a) => a.name).join(',');");

@@ -13,6 +13,7 @@
 //! origin at the centre of the top-left pixel; u, v are Lagrangian displacements in pixels.
 
 pub mod clock;
+pub mod column_units;
 pub mod delimited;
 pub mod descriptors;
 pub mod exit;
@@ -30,6 +31,7 @@ pub mod pubsub;
 #[cfg(feature = "ipc")]
 pub mod resources;
 pub mod rig;
+pub mod scale;
 pub mod seconds;
 pub mod services;
 #[cfg(feature = "ipc")]

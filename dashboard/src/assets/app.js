@@ -286,6 +286,7 @@ function update(s) {
     { xlabel: clock, ylabel: `${$('measure').value} strain (-)`, yZero: true, empty: 'no field yet' });
   setText('gauge-clock', s.gauge.clock === 'test' ? "the test's time (the rig's)" : 'the time since the dashboard started (no rig seen)');
   setText('gauge-points', s.gauge.t_s.length);
+  updateUserGauges(s.user_gauges);
 
   // Stress-stretch.
   const id = s.identification, series = [];
@@ -329,6 +330,30 @@ function drawInvariantFunctions(id) {
       if (p && p.invariant.length) series.push({ x: p.invariant, y: p.value_mpa, color, label, dots: true });
     });
   lineChart($('fg-chart'), series, { xlabel: 'invariant I1 or I2 (-)', ylabel: 'f, g (MPa)', yZero: true, empty: 'no coefficient identified yet' });
+}
+
+// The user's named gauges ([correlator] gauges), one chart each against the test's time, with
+// their unit; created once the run sends them (a monitor has no gauges' shapes: none).
+function updateUserGauges(gauges) {
+  if (!Array.isArray(gauges) || gauges.length === 0) return;
+  const box = $('user-gauges');
+  gauges.forEach((g, i) => {
+    const id = `user-gauge-${i}`;
+    let canvas = document.getElementById(id);
+    if (!canvas) {
+      if (i === 0) box.textContent = '';
+      const title = document.createElement('h3');
+      title.className = 'small gauge-name';
+      title.textContent = `${g.name}: ${g.kind}, ${g.quantity} (${g.unit})`;
+      canvas = document.createElement('canvas');
+      canvas.id = id; canvas.className = 'chart'; canvas.width = 560; canvas.height = 200;
+      box.append(title, canvas);
+    }
+    // The gauge strains' colours (exx, eyy, exy), whatever the JSON's key order.
+    const keys = ['exx', 'eyy', 'exy', 'elongation'].filter((k) => k in g.series);
+    const series = keys.map((k, j) => ({ x: g.t_s, y: g.series[k], color: SERIES_COLORS[j], label: k }));
+    lineChart(canvas, series, { xlabel: 'test time (s)', ylabel: `${g.name}: ${g.quantity} (${g.unit})`, yZero: true, empty: 'no reading yet' });
+  });
 }
 
 // Strain control: target against the newest field's gauge log strains, per axis.

@@ -25,6 +25,8 @@ const COMMENTS: &[(&str, &str)] = &[
     ("camera.bit_depth", "8, 10, 12 or 16 bit."),
     ("camera.mm_per_px", "Image scale of the specimen, mm per px: 256 mm across a 1024 px image, the\ncruciform's central square, fillets and the roots of its four arms (the field\nroute integrates forces through cuts across them)."),
     ("camera.strip_mm_per_px", "The scale when a finite-element strip is mounted (uniaxial tests on a\nstructure; the camera is re-framed on it): the 100 mm strip and its clamps."),
+    ("camera.scale_mm_per_px", "The fields' scale, mm per px, for their mm columns (x_mm,y_mm,u_mm,v_mm): 0 =\nthe simulated camera's own (mm_per_px, strip_mm_per_px), none for a real camera\n(px only). Or from a known length: two image points (px) and the distance\nbetween them on the specimen (mm), \"X1,Y1 X2,Y2 MM\" (give one of the two)."),
+    ("camera.scale_known_length", ""),
     ("camera.speckle_size_px", "Speckle spot size (FWHM), px; seed of the pattern and the noise."),
     ("camera.seed", ""),
     ("camera.threads", "Rendering threads (the correlator wants the cores more)."),

@@ -80,6 +80,11 @@ pub struct CameraSection {
     /// Scale of the image of a finite-element strip (the uniaxial tests' specimen on a
     /// structure: the camera is re-framed on it), mm per px.
     pub strip_mm_per_px: f64,
+    /// The fields' scale, mm per px, for their mm columns (0: not given: the simulated
+    /// camera's framing, none for a real camera); or from a known length, "X1,Y1 X2,Y2 MM".
+    pub scale_mm_per_px: f64,
+    #[serde(with = "wire::names::empty_is_none")]
+    pub scale_known_length: Option<wire::scale::KnownLength>,
     pub speckle_size_px: f64,
     pub seed: u64,
     /// Rendering threads of the simulated camera.
@@ -320,6 +325,8 @@ impl Default for CameraSection {
             bit_depth: 8,
             mm_per_px: producer::DEFAULT_MM_PER_PX,
             strip_mm_per_px: producer::DEFAULT_STRIP_MM_PER_PX,
+            scale_mm_per_px: 0.0,
+            scale_known_length: None,
             speckle_size_px: 4.0,
             seed: 1,
             threads: 1,

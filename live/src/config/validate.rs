@@ -83,6 +83,15 @@ impl RunConfig {
                 bail!("[camera] {key} = {scale}: expected a positive scale");
             }
         }
+        if c.scale_mm_per_px != 0.0 {
+            wire::scale::MmPerPx::new(c.scale_mm_per_px)
+                .map_err(|e| anyhow!("[camera] scale_mm_per_px = {}: {e}", c.scale_mm_per_px))?;
+            if c.scale_known_length.is_some() {
+                bail!(
+                    "[camera] scale_mm_per_px and scale_known_length: give one of them, not both"
+                );
+            }
+        }
         producer::SpeckleParams {
             size_px: c.speckle_size_px,
             ..producer::SpeckleParams::default()

@@ -126,6 +126,7 @@ impl Run<'_> {
             &self.incidents.restart_counts,
             self.started,
         );
+        crate::dashboard_view::update_gauges(&self.dashboard, &self.recorder.gauge_history);
         if clock.next_histograms <= Instant::now() {
             // Kept up to date, so a run killed outright still leaves its latencies (a write
             // error is reported once at the end, when they are written again).

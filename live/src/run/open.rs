@@ -72,7 +72,18 @@ impl<'a> Run<'a> {
             framing: config.camera.framing(),
             gauges: config.correlator.gauges.clone(),
             control_gauge: config.correlator.control_gauge.clone(),
+            scale: crate::field_scale::FieldScale::of(config),
         };
+        let units = crate::units_file::units_json(
+            &crate::frames::csv_header_with(
+                settings.truth,
+                &crate::gauge_columns::header(&settings.gauges),
+            ),
+            config.correlator.strain,
+            &settings.scale,
+        );
+        let units_path = prepared.results.path(wire::column_units::SIDECAR);
+        wire::files::write_atomic(&units_path, units.as_bytes())?;
         let recorder = Recorder::new(&prepared.results, settings, t0_ns)?;
         start::write_running(
             &prepared.results,

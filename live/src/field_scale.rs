@@ -1,0 +1,117 @@
+//! The scale of a run's fields, mm per px, for their mm columns (`fields/field_*.csv`
+//! `x_mm,y_mm,u_mm,v_mm`, the `.vts` `displacement_mm`): the user's (`[camera]
+//! scale_mm_per_px` or `scale_known_length`), else the simulated camera's own framing (known
+//! exactly: `mm_per_px` on a cruciform or the homogeneous sheet, `strip_mm_per_px` on a
+//! strip), else none (a real camera without a calibration: px only).
+
+use crate::config::RunConfig;
+use wire::scale::MmPerPx;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FieldScale {
+    /// The user's, for every field.
+    User(MmPerPx),
+    /// The simulated camera's, per specimen.
+    Framing(producer::Framing),
+    /// Unknown: px only.
+    None,
+}
+
+impl FieldScale {
+    /// The run's scale from its configuration (checked by `validate`).
+    pub fn of(config: &RunConfig) -> FieldScale {
+        let c = &config.camera;
+        if let Some(known) = c.scale_known_length {
+            return FieldScale::User(known.scale());
+        }
+        if let Ok(scale) = MmPerPx::new(c.scale_mm_per_px) {
+            return FieldScale::User(scale);
+        }
+        match c.source.has_truth() {
+            true => FieldScale::Framing(c.framing()),
+            false => FieldScale::None,
+        }
+    }
+
+    /// The scale of a field whose specimen is held by `grips` grips (None: the homogeneous
+    /// sheet, or a specimen unknown), or None when it is not known.
+    pub fn of_field(&self, grips: Option<usize>) -> Option<MmPerPx> {
+        match self {
+            FieldScale::User(s) => Some(*s),
+            FieldScale::Framing(f) => {
+                let mm_per_px = match grips {
+                    Some(2) => f.strip_mm_per_px,
+                    _ => f.mm_per_px,
+                };
+                MmPerPx::new(mm_per_px).ok()
+            }
+            FieldScale::None => None,
+        }
+    }
+
+    /// What `units.json` says of it.
+    pub fn note(&self) -> String {
+        match self {
+            FieldScale::User(s) => format!("scale: {s} mm per px, the user's ([camera])"),
+            FieldScale::Framing(f) => format!(
+                "scale: the simulated camera's, per test: {} mm per px on a cruciform or the \
+                 homogeneous sheet, {} mm per px on a strip; a file's own is x_mm / x",
+                f.mm_per_px, f.strip_mm_per_px
+            ),
+            FieldScale::None => {
+                "no scale known (a real camera without [camera] scale_mm_per_px or \
+                 scale_known_length): px only, no mm columns"
+                    .to_string()
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_users_scale_wins_the_simulated_cameras_is_the_default_a_real_camera_has_none() {
+        let config = |toml: &str| {
+            let c = RunConfig::from_toml(toml, "t.toml").unwrap();
+            c.validate().unwrap();
+            FieldScale::of(&c)
+        };
+        let simulated = config("");
+        assert_eq!(
+            simulated.of_field(None),
+            MmPerPx::new(producer::DEFAULT_MM_PER_PX).ok()
+        );
+        assert_eq!(
+            simulated.of_field(Some(2)),
+            MmPerPx::new(producer::DEFAULT_STRIP_MM_PER_PX).ok()
+        );
+        let direct = config("[camera]\nscale_mm_per_px = 0.05\n");
+        assert_eq!(direct.of_field(Some(2)), MmPerPx::new(0.05).ok());
+        let known = config("[camera]\nscale_known_length = \"0,0 300,400 25\"\n");
+        assert_eq!(known.of_field(None), MmPerPx::new(0.05).ok());
+        let real = RunConfig::from_toml("[camera]\nsource = \"replay\"\n", "t.toml").unwrap();
+        let real = FieldScale::of(&real);
+        assert_eq!(real.of_field(None), None);
+        assert!(real.note().contains("px only"));
+    }
+
+    #[test]
+    fn a_bad_scale_is_refused_before_the_run() {
+        let refused = |toml: &str| {
+            let read = RunConfig::from_toml(toml, "t.toml");
+            let e = match read {
+                Err(e) => e,
+                Ok(c) => c.validate().unwrap_err(),
+            };
+            format!("{e:#}")
+        };
+        let e = refused("[camera]\nscale_mm_per_px = -0.1\n");
+        assert!(e.contains("scale_mm_per_px = -0.1"), "{e}");
+        let e = refused("[camera]\nscale_known_length = \"1,1 1,1 10\"\n");
+        assert!(e.contains("the two points are the same"), "{e}");
+        let e = refused("[camera]\nscale_mm_per_px = 0.1\nscale_known_length = \"0,0 10,0 1\"\n");
+        assert!(e.contains("one of"), "{e}");
+    }
+}
