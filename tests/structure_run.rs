@@ -79,7 +79,11 @@ fn a_run_on_the_structure_compares_every_node_with_the_filmed_field() {
         column("gauge_mid_nodes"),
         column("ext_span_nominal_strain"),
     );
-    column("ext_span_elongation_px");
+    // The simulated camera's scale (0.015 mm/px on both specimens here) gives the mm column.
+    let (span_px, span_mm) = (
+        column("ext_span_elongation_px"),
+        column("ext_span_elongation_mm"),
+    );
     // The most stretched row (the campaign ends unloaded).
     let cell = |row: &Vec<String>, k: usize| -> f64 { row[k].parse().unwrap_or(f64::NAN) };
     let last = rows
@@ -96,6 +100,11 @@ fn a_run_on_the_structure_compares_every_node_with_the_filmed_field() {
         value(span)
     );
     assert!(value(control) > 0.05, "{last:?}");
+    let mm_per_px = value(span_mm) / value(span_px);
+    assert!(
+        (mm_per_px - 0.015).abs() < 1e-4,
+        "{mm_per_px} mm/px: {last:?}"
+    );
     assert!(value(mid_nodes) > 10.0, "{last:?}");
     assert!((value(mid) - value(control)).abs() < 0.01, "{last:?}");
     assert!(

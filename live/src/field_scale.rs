@@ -49,6 +49,12 @@ impl FieldScale {
         }
     }
 
+    /// Whether the fields have mm at all: `frames.csv`'s extensometers get mm columns, the
+    /// dashboard shows them in mm.
+    pub fn in_mm(&self) -> bool {
+        self.of_field(None).is_some()
+    }
+
     /// What `units.json` says of it.
     pub fn note(&self) -> String {
         match self {

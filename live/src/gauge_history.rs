@@ -6,11 +6,10 @@
 //! hands them to its dashboard (a `monitor` has no gauges). Bounded: past [`MAX_POINTS`] a
 //! gauge keeps every other point and then takes every second field (and so on).
 
-use correlator::gauges::{read, GaugeValue};
+use correlator::gauges::{GaugeReading, GaugeValue};
 use correlator::{Gauge, GaugeShape};
 use serde_json::{json, Value};
 use wire::scale::MmPerPx;
-use wire::FieldNode;
 
 /// Points kept per gauge.
 pub const MAX_POINTS: usize = 1000;
@@ -53,29 +52,21 @@ impl GaugeHistory {
         }
     }
 
-    /// The gauges' readings on one field (mesh step `step_px`) at the test's time `t_s`, its
-    /// scale `scale` (`gauges` in the order given to `new`). A gauge without a reading on this
-    /// field gets an empty point (null in the JSON), and an extensometer in mm a field
-    /// without a scale too.
-    pub fn push(
-        &mut self,
-        gauges: &[Gauge],
-        nodes: &[FieldNode],
-        step_px: f64,
-        t_s: f64,
-        scale: Option<MmPerPx>,
-    ) {
-        debug_assert_eq!(gauges.len(), self.gauges.len());
-        if gauges.is_empty() {
+    /// The gauges' `readings` on one field (`gauge_columns::read_all`, in the order of the
+    /// gauges given to `new`) at the test's time `t_s`, with the field's scale `scale`. A
+    /// gauge without a reading on this field gets an empty point (null in the JSON), and an
+    /// extensometer in mm a field without a scale too.
+    pub fn push(&mut self, readings: &[GaugeReading], t_s: f64, scale: Option<MmPerPx>) {
+        debug_assert_eq!(readings.len(), self.gauges.len());
+        if readings.is_empty() {
             return;
         }
         self.seen += 1;
         if !(self.seen - 1).is_multiple_of(self.stride) {
             return;
         }
-        for (g, h) in gauges.iter().zip(&mut self.gauges) {
-            let reading = read(&g.shape, nodes, step_px).value;
-            let values = match reading {
+        for (reading, h) in readings.iter().zip(&mut self.gauges) {
+            let values = match reading.value {
                 Ok(GaugeValue::Strain(s)) => [s.log.exx, s.log.eyy, s.log.exy],
                 Ok(value) => {
                     let px = value.elongation_px().unwrap_or(f64::NAN);
@@ -143,6 +134,8 @@ fn keep_every_other(values: &mut Vec<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gauge_columns::read_all;
+    use wire::FieldNode;
 
     /// A 5 x 5 mesh, 10 px apart, stretched by 1 % along x.
     fn nodes() -> Vec<FieldNode> {
@@ -170,7 +163,9 @@ mod tests {
         ];
         let mut history = GaugeHistory::new(&gauges, true);
         let scale = MmPerPx::new(0.5).ok();
-        history.push(&gauges, &nodes(), 10.0, 1.5, scale);
+        let mut readings = Vec::new();
+        read_all(&gauges, &nodes(), 10.0, &mut readings);
+        history.push(&readings, 1.5, scale);
         let json = history.to_json();
         assert_eq!(json[0]["name"], "mid");
         assert_eq!(json[0]["unit"], "-");
@@ -182,7 +177,7 @@ mod tests {
         let elongation = json[1]["series"]["elongation"][0].as_f64().unwrap();
         assert!((elongation - 0.2).abs() < 1e-3, "{elongation}");
         for k in 0..3 * MAX_POINTS {
-            history.push(&gauges, &nodes(), 10.0, 2.0 + k as f64, scale);
+            history.push(&readings, 2.0 + k as f64, scale);
         }
         let json = history.to_json();
         let kept = json[0]["t_s"].as_array().unwrap();

@@ -79,7 +79,9 @@ pub struct Recorder {
     /// Largest measured stretch per load case code (1 uniaxial, 2 equibiaxial).
     pub max_stretch: [f64; 3],
     row: String,
-    /// The user's gauges' cells of the row being written.
+    /// The user's gauges' readings on the field being recorded (for its row and the
+    /// dashboard's history), and their cells of the row.
+    gauge_readings: Vec<correlator::GaugeReading>,
     gauge_cells: String,
     text: String,
     /// The VTK fields written so far, as one time series (`fields/fields.vtk.series`), and
@@ -99,16 +101,14 @@ impl Recorder {
         t0_ns: u64,
     ) -> Result<Recorder, FileError> {
         assert!(settings.fields_every > 0);
-        let gauge_history = crate::gauge_history::GaugeHistory::new(
-            &settings.gauges,
-            settings.scale.of_field(None).is_some(),
-        );
+        let gauge_history =
+            crate::gauge_history::GaugeHistory::new(&settings.gauges, settings.scale.in_mm());
         Ok(Recorder {
             frames_csv: RowFile::create(
                 &results.frames_csv(),
                 &crate::frames::csv_header_with(
                     settings.truth,
-                    &crate::gauge_columns::header(&settings.gauges),
+                    &crate::gauge_columns::header(&settings.gauges, settings.scale.in_mm()),
                 ),
             )?,
             results: results.clone(),
@@ -142,6 +142,7 @@ impl Recorder {
             peak_field: None,
             max_stretch: [1.0; 3],
             row: String::with_capacity(1024),
+            gauge_readings: Vec::new(),
             gauge_cells: String::new(),
             text: String::new(),
             write_error: None,
@@ -288,15 +289,22 @@ impl Recorder {
         self.gauge_cells.clear();
         let step_px = f64::from(header.step_px);
         let gauges = &self.settings.gauges;
-        crate::gauge_columns::write_cells(gauges, nodes, step_px, &mut self.gauge_cells);
         let grips = origin
             .and_then(|o| o.specimen_solve())
             .and_then(|id| self.specimen.solve(id))
             .map(|s| s.field.grip_mm.len());
         let scale = self.settings.scale.of_field(grips);
+        crate::gauge_columns::read_all(gauges, nodes, step_px, &mut self.gauge_readings);
+        crate::gauge_columns::write_cells(
+            gauges,
+            &self.gauge_readings,
+            self.settings.scale.in_mm(),
+            scale,
+            &mut self.gauge_cells,
+        );
         let test_time_s = row.t_sim_s.unwrap_or(row.t_capture_s);
         self.gauge_history
-            .push(gauges, nodes, step_px, test_time_s, scale);
+            .push(&self.gauge_readings, test_time_s, scale);
         row.write_csv_with(&mut self.row, self.settings.truth, &self.gauge_cells);
         let line = std::mem::take(&mut self.row);
         let result = self.frames_csv.append(&line);

@@ -95,7 +95,10 @@ fn frames_column(name: &str) -> Column {
                 ONE,
                 format!("extensometer {e}'s nominal strain (elongation / initial length)"),
             ),
-            None => Column::new(name, "px", "extensometer's elongation"),
+            None => match ext.ends_with("_elongation_mm") {
+                true => Column::new(name, "mm", "extensometer's elongation (the field's scale)"),
+                false => Column::new(name, "px", "extensometer's elongation"),
+            },
         };
     }
     for measure in ["small", "green", "nominal", "log", "target_log"] {
@@ -120,8 +123,8 @@ fn rig_column(name: &str) -> Column {
     if name.ends_with("_command") || name.ends_with("_error") {
         return Column::new(
             name,
-            "mm or kN",
-            "position (mm) in displacement control, force (kN) in force control; the error is \
+            "mm or N",
+            "position (mm) in displacement control, force (N) in force control; the error is \
              the command minus its feedback",
         );
     }
@@ -147,7 +150,7 @@ mod tests {
     #[test]
     fn every_column_of_the_runs_files_has_its_unit_in_header_order() {
         let gauges = ",gauge_mid_log_exx,gauge_mid_log_eyy,gauge_mid_log_exy,gauge_mid_nodes\
-                      ,ext_arm_elongation_px,ext_arm_nominal_strain";
+                      ,ext_arm_elongation_px,ext_arm_elongation_mm,ext_arm_nominal_strain";
         let header = crate::frames::csv_header_with(true, gauges);
         let scale = FieldScale::User(wire::scale::MmPerPx::new(0.1).unwrap());
         let json: serde_json::Value =
@@ -174,6 +177,7 @@ mod tests {
         assert_eq!(unit("frames.csv", "cauchy_x_mpa"), "MPa");
         assert_eq!(unit("frames.csv", "log_exy"), "1");
         assert_eq!(unit("frames.csv", "ext_arm_elongation_px"), "px");
+        assert_eq!(unit("frames.csv", "ext_arm_elongation_mm"), "mm");
         assert_eq!(unit("rig.csv", "X+_force_n"), "N");
         assert_eq!(unit("rig.csv", "X+_position_mm"), "mm");
         assert_eq!(unit("fields/field_*.csv", "u_mm"), "mm");

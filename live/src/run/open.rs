@@ -77,7 +77,7 @@ impl<'a> Run<'a> {
         let units = crate::units_file::units_json(
             &crate::frames::csv_header_with(
                 settings.truth,
-                &crate::gauge_columns::header(&settings.gauges),
+                &crate::gauge_columns::header(&settings.gauges, settings.scale.in_mm()),
             ),
             config.correlator.strain,
             &settings.scale,
