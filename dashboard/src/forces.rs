@@ -1,4 +1,4 @@
-//! Each loaded actuator's force (kN) against the test's time (s) and against its grip's
+//! Each loaded actuator's force (N, as in every file of a run) against the test's time (s) and against its grip's
 //! displacement (mm), bounded (pure). Which actuators are loaded is `wire::rig`'s one rule
 //! (their peak |force| over every sample seen, not only the kept ones).
 
@@ -7,7 +7,7 @@ use serde_json::{json, Value};
 use wire::rig::{loaded_actuators, ACTUATOR_NAMES};
 use wire::RigState;
 
-/// Columns: t_sim_s, then force (kN) and position (mm) of each of the 6 actuators.
+/// Columns: t_sim_s, then force (N) and position (mm) of each of the 6 actuators.
 const WIDTH: usize = 13;
 
 #[derive(Clone, Debug)]
@@ -27,7 +27,7 @@ impl ForceHistory {
     pub fn push(&mut self, state: &RigState) {
         let mut row = [state.t_sim_s; WIDTH];
         for (k, a) in state.actuators.iter().enumerate() {
-            row[1 + 2 * k] = a.force_kn;
+            row[1 + 2 * k] = 1e3 * a.force_kn;
             row[2 + 2 * k] = a.position_mm;
             if a.force_kn.is_finite() {
                 self.peaks_abs_kn[k] = self.peaks_abs_kn[k].max(a.force_kn.abs());
@@ -36,7 +36,7 @@ impl ForceHistory {
         self.rows.push(row);
     }
 
-    /// `{"t_sim_s": [..], "actuators": [{"name", "force_kn": [..], "grip_mm": [..]}]}`, the
+    /// `{"t_sim_s": [..], "actuators": [{"name", "force_n": [..], "grip_mm": [..]}]}`, the
     /// loaded actuators only.
     pub fn json(&self) -> Value {
         let actuators: Vec<Value> = loaded_actuators(&self.peaks_abs_kn)
@@ -46,7 +46,7 @@ impl ForceHistory {
             .map(|(k, _)| {
                 json!({
                     "name": ACTUATOR_NAMES[k],
-                    "force_kn": self.rows.column(1 + 2 * k),
+                    "force_n": self.rows.column(1 + 2 * k),
                     "grip_mm": self.rows.column(2 + 2 * k),
                 })
             })
@@ -88,13 +88,13 @@ mod tests {
         let t = j["t_sim_s"].as_array().unwrap();
         assert!(t.len() <= 50 && t.len() >= 25, "{}", t.len());
         let a = &j["actuators"][0];
-        assert_eq!(a["force_kn"].as_array().unwrap().len(), t.len());
+        assert_eq!(a["force_n"].as_array().unwrap().len(), t.len());
         let last = t.len() - 1;
-        let (t_s, f_kn, x_mm) = (
+        let (t_s, f_n, x_mm) = (
             t[last].as_f64().unwrap(),
-            a["force_kn"][last].as_f64().unwrap(),
+            a["force_n"][last].as_f64().unwrap(),
             a["grip_mm"][last].as_f64().unwrap(),
         );
-        assert!((f_kn - 0.2 * t_s).abs() < 1e-4 && (x_mm - t_s).abs() < 1e-4);
+        assert!((f_n - 200.0 * t_s).abs() < 0.1 && (x_mm - t_s).abs() < 1e-4);
     }
 }

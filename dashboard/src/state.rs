@@ -110,7 +110,7 @@ pub struct LiveState {
     rig_ids: IdGaps,
     rig_rate: Rate,
     last_rig: Option<RigState>,
-    /// t_sim, stretch x, y, force X, Y (kN).
+    /// t_sim, stretch x, y, force X, Y (N).
     rig_history: Decimated<5>,
     /// Per load case (uniaxial, equibiaxial): stretch, nominal stress (MPa).
     curves: [Decimated<2>; 2],
@@ -251,8 +251,8 @@ impl LiveState {
             state.t_sim_s,
             state.specimen_stretch_x,
             state.specimen_stretch_y,
-            force_kn(0),
-            force_kn(1),
+            1e3 * force_kn(0),
+            1e3 * force_kn(1),
         ]);
         // Nominal stress along x: F / S0 = sigma / lambda, sigma = F / S (incompressible sheet,
         // uniaxial or equibiaxial: S = S0 / lambda).
@@ -433,10 +433,10 @@ impl LiveState {
                 json!({
                     "name": name,
                     "position_mm": a.position_mm,
-                    "force_kn": a.force_kn,
-                    "command": a.command_mm,
-                    "error": a.following_error_mm,
-                    "unit": if force_control { "kN" } else { "mm" },
+                    "force_n": 1e3 * a.force_kn,
+                    "command": a.command_mm * if force_control { 1e3 } else { 1.0 },
+                    "error": a.following_error_mm * if force_control { 1e3 } else { 1.0 },
+                    "unit": if force_control { "N" } else { "mm" },
                     "mode": MODE_NAMES.get(a.mode as usize).copied().unwrap_or("?"),
                     "limits": limits,
                 })
@@ -465,8 +465,8 @@ impl LiveState {
                 "t_sim_s": h.column(0),
                 "stretch_x": h.column(1),
                 "stretch_y": h.column(2),
-                "force_x_kn": h.column(3),
-                "force_y_kn": h.column(4),
+                "force_x_n": h.column(3),
+                "force_y_n": h.column(4),
             },
         })
     }

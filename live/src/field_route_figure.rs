@@ -95,7 +95,7 @@ fn capture_times_s(frames_csv: &str) -> anyhow::Result<std::collections::HashMap
         .collect())
 }
 
-/// The series of `force_balance.png` (kN against s): per grip, its measured force (line) and
+/// The series of `force_balance.png` (N against s): per grip, its measured force (line) and
 /// the computed one (markers), from the route's `force_balance` and `frames.csv`'s text.
 pub fn force_balance_series(balance: &Value, frames_csv: &str) -> anyhow::Result<Vec<Series>> {
     let times = capture_times_s(frames_csv)?;
@@ -116,7 +116,7 @@ pub fn force_balance_series(balance: &Value, frames_csv: &str) -> anyhow::Result
         }
         let series = |label: String, pick: fn(&(f64, f64, f64)) -> f64, markers| Series {
             label,
-            points: rows.iter().map(|r| (r.0, 1e-3 * pick(r))).collect(),
+            points: rows.iter().map(|r| (r.0, pick(r))).collect(),
             markers,
         };
         out.push(series(format!("{grip}: measured"), |r| r.1, false));
@@ -145,7 +145,7 @@ pub fn force_balance_png(
         path,
         &format!("grip forces: measured, and from the field under {model}"),
         "time (s)",
-        "force (kN)",
+        "force (N)",
         &series,
         true,
     )?;
@@ -232,9 +232,9 @@ mod tests {
                 "y+: from the field"
             ]
         );
-        // kN against the frames' capture times; a frame frames.csv does not hold is left out.
-        assert_eq!(series[0].points, vec![(1.5, 0.1), (2.5, 0.2)]);
-        assert_eq!(series[1].points, vec![(1.5, 0.098), (2.5, 0.203)]);
+        // N against the frames' capture times; a frame frames.csv does not hold is left out.
+        assert_eq!(series[0].points, vec![(1.5, 100.0), (2.5, 200.0)]);
+        assert_eq!(series[1].points, vec![(1.5, 98.0), (2.5, 203.0)]);
         assert!(series[1].markers && !series[0].markers);
         let error = force_balance_series(&balance, "frame_id,x\n")
             .err()

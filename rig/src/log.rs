@@ -52,12 +52,17 @@ pub fn write_csv_row_with(s: &RigSnapshot, control: &ControlColumns, out: &mut S
         s.limits_tripped
     );
     for a in &s.actuators {
+        // The command and its error are a force in force control: N, as every force here.
+        let unit = match a.mode {
+            Some(crate::control::ControlMode::Force) => 1e3,
+            _ => 1.0,
+        };
         let _ = write!(
             out,
             ",{:.6},{:.6},{:.6},{:.6},{:.6}",
             a.position_mm,
-            a.command,
-            a.error,
+            a.command * unit,
+            a.error * unit,
             a.force_kn * 1e3,
             a.valve
         );
@@ -88,5 +93,37 @@ pub fn write_csv_row_with(s: &RigSnapshot, control: &ControlColumns, out: &mut S
             let _ = writeln!(out, ",{x:.6},{y:.6}");
         }
         None => out.push_str(",,\n"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::control::ControlMode;
+
+    #[test]
+    fn forces_are_newtons_also_as_a_command_and_its_error() {
+        let mut s = RigSnapshot::default();
+        s.actuators[0].mode = Some(ControlMode::Force);
+        s.actuators[0].command = 1.5; // kN
+        s.actuators[0].error = -0.002;
+        s.actuators[0].force_kn = 1.502;
+        s.actuators[1].mode = Some(ControlMode::Displacement);
+        s.actuators[1].command = 2.25; // mm
+        let mut row = String::new();
+        write_csv_row(&s, &mut row);
+        let header = csv_header();
+        let names: Vec<&str> = header.split(',').collect();
+        let cells: Vec<&str> = row.trim_end().split(',').collect();
+        assert_eq!(names.len(), cells.len());
+        let cell = |name: &str| -> f64 {
+            let k = names.iter().position(|n| *n == name).unwrap();
+            cells[k].parse().unwrap()
+        };
+        let (a, b) = (ActuatorId::ALL[0].name(), ActuatorId::ALL[1].name());
+        assert_eq!(cell(&format!("{a}_command")), 1500.0);
+        assert_eq!(cell(&format!("{a}_error")), -2.0);
+        assert_eq!(cell(&format!("{a}_force_n")), 1502.0);
+        assert_eq!(cell(&format!("{b}_command")), 2.25);
     }
 }

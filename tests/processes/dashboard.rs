@@ -532,7 +532,7 @@ fn new_panels_have_data_pause_and_export(browser: &Browser) {
         "{csv:.200}"
     );
     assert!(
-        csv.contains("\"force-time-chart\",\"X+\",\"test time (s)\",\"force (kN)\",")
+        csv.contains("\"force-time-chart\",\"X+\",\"test time (s)\",\"force (N)\",")
             && csv.contains("\"states-chart\",\"nodes\","),
         "{csv:.400}"
     );

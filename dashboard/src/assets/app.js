@@ -370,7 +370,7 @@ function updateRig(r) {
   setText('rig-info', `t_sim ${fmt(r.t_sim_s, 2)} s, ${r.rate_hz.toFixed(0)} samples/s`);
   body.innerHTML = r.actuators.map((a) => `<tr><td class="text">${esc(a.name)}</td><td class="text">${esc(a.mode)}</td>` +
     `<td>${fmt(a.position_mm, 3)}</td><td>${fmt(a.command, 3)} ${a.unit}</td><td>${fmt(a.error, 4)} ${a.unit}</td>` +
-    `<td>${fmt(a.force_kn, 4)}</td><td class="text ${a.limits.length ? 'bad' : ''}">${a.limits.length ? esc(a.limits.join(', ')) : 'none'}</td></tr>`).join('');
+    `<td>${fmt(a.force_n, 1)}</td><td class="text ${a.limits.length ? 'bad' : ''}">${a.limits.length ? esc(a.limits.join(', ')) : 'none'}</td></tr>`).join('');
   const drift = r.axis_centre_mm.map((c) => fmt(c, 3)).join(' / ');
   $('rig-more').innerHTML = `program <b id="rig-program">${esc(r.program)}</b>, test ${r.test_index} (${esc(r.load_case)}), ` +
     `hydraulics <b class="${r.hydraulics_on ? 'good' : 'bad'}">${r.hydraulics_on ? 'on' : 'off'}</b>, ` +
@@ -389,10 +389,10 @@ function updateRig(r) {
 function updateForces(f) {
   const a = f ? f.actuators : [];
   setText('forces-info', a.length ? `loaded: ${a.map((x) => x.name).join(', ')}; ${f.t_sim_s.length} points` : 'no load yet');
-  lineChart($('force-time-chart'), a.map((x, i) => ({ x: f.t_sim_s, y: x.force_kn, color: SERIES_COLORS[i % 5], label: x.name })),
-    { xlabel: 'test time (s)', ylabel: 'force (kN)', yZero: true, empty: 'no loaded actuator yet' });
-  lineChart($('force-grip-chart'), a.map((x, i) => ({ x: x.grip_mm, y: x.force_kn, color: SERIES_COLORS[i % 5], label: x.name })),
-    { xlabel: 'grip displacement (mm)', ylabel: 'force (kN)', yZero: true, empty: 'no loaded actuator yet' });
+  lineChart($('force-time-chart'), a.map((x, i) => ({ x: f.t_sim_s, y: x.force_n, color: SERIES_COLORS[i % 5], label: x.name })),
+    { xlabel: 'test time (s)', ylabel: 'force (N)', yZero: true, empty: 'no loaded actuator yet' });
+  lineChart($('force-grip-chart'), a.map((x, i) => ({ x: x.grip_mm, y: x.force_n, color: SERIES_COLORS[i % 5], label: x.name })),
+    { xlabel: 'grip displacement (mm)', ylabel: 'force (N)', yZero: true, empty: 'no loaded actuator yet' });
 }
 
 // The latest field's node states in the (λ1, λ2) plane and the canonical paths (paper Fig. 5).
