@@ -131,6 +131,18 @@ fn node_gradient(field: &Field, k: usize) -> [[f64; 2]; 2] {
     field.gradients.get(k).copied().unwrap_or([[0.0; 2]; 2])
 }
 
+/// The per-node scalars both VTK writers (legacy here, XML in `vts`) carry, by name: the
+/// strains (tensor components, the field's measure), the score, the iterations and validity
+/// (1 for a converged node).
+pub(crate) const NODE_SCALARS: [(&str, fn(&Node) -> f64); 6] = [
+    ("exx", |n| n.exx),
+    ("eyy", |n| n.eyy),
+    ("exy", |n| n.exy),
+    ("score", |n| n.score),
+    ("iterations", |n| n.iterations as f64),
+    ("valid", |n| f64::from(u8::from(n.status == NodeStatus::Ok))),
+];
+
 /// Legacy VTK structured grid at the reference node positions (z = 0), titled `title`.
 pub fn field_vtk(field: &Field, title: &str, text: &mut String) {
     text.clear();
@@ -148,16 +160,7 @@ pub fn field_vtk(field: &Field, title: &str, text: &mut String) {
     for n in &field.nodes {
         let _ = writeln!(text, "{} {} 0", n.u_px, n.v_px);
     }
-    type Get = fn(&Node) -> f64;
-    let scalars: [(&str, Get); 6] = [
-        ("exx", |n| n.exx),
-        ("eyy", |n| n.eyy),
-        ("exy", |n| n.exy),
-        ("score", |n| n.score),
-        ("iterations", |n| n.iterations as f64),
-        ("valid", |n| f64::from(u8::from(n.status == NodeStatus::Ok))),
-    ];
-    for (name, get) in scalars {
+    for (name, get) in NODE_SCALARS {
         let _ = writeln!(text, "SCALARS {name} double 1\nLOOKUP_TABLE default");
         for n in &field.nodes {
             let _ = writeln!(text, "{}", get(n));

@@ -4,7 +4,7 @@
 //! The same arrays as the legacy file, at the nodes' reference positions (px, z = 0), and with
 //! a scale the displacement in mm too.
 
-use crate::field::{Field, NodeStatus};
+use crate::field::Field;
 use std::fmt::Write as _;
 use wire::scale::MmPerPx;
 
@@ -35,16 +35,7 @@ pub fn field_vts(field: &Field, scale: Option<MmPerPx>, text: &mut String) {
         }
         close_array(text);
     }
-    type Get = fn(&crate::field::Node) -> f64;
-    let scalars: [(&str, Get); 6] = [
-        ("exx", |n| n.exx),
-        ("eyy", |n| n.eyy),
-        ("exy", |n| n.exy),
-        ("score", |n| n.score),
-        ("iterations", |n| n.iterations as f64),
-        ("valid", |n| f64::from(u8::from(n.status == NodeStatus::Ok))),
-    ];
-    for (name, get) in scalars {
+    for (name, get) in crate::output::NODE_SCALARS {
         open_array(text, name, 1);
         for n in &field.nodes {
             let _ = writeln!(text, "{}", get(n));
@@ -74,7 +65,7 @@ fn close_array(text: &mut String) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::field::Node;
+    use crate::field::{Node, NodeStatus};
 
     #[test]
     fn the_vts_is_xml_with_one_value_per_node_in_each_array() {
