@@ -131,10 +131,13 @@ fn node_gradient(field: &Field, k: usize) -> [[f64; 2]; 2] {
     field.gradients.get(k).copied().unwrap_or([[0.0; 2]; 2])
 }
 
+/// One scalar of a node.
+pub(crate) type NodeScalar = fn(&Node) -> f64;
+
 /// The per-node scalars both VTK writers (legacy here, XML in `vts`) carry, by name: the
 /// strains (tensor components, the field's measure), the score, the iterations and validity
 /// (1 for a converged node).
-pub(crate) const NODE_SCALARS: [(&str, fn(&Node) -> f64); 6] = [
+pub(crate) const NODE_SCALARS: [(&str, NodeScalar); 6] = [
     ("exx", |n| n.exx),
     ("eyy", |n| n.eyy),
     ("exy", |n| n.exy),

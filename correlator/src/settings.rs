@@ -80,7 +80,7 @@ impl ReferenceMode {
     /// deformation since the reference, so it may grow to 2 px at a corner (12.5 % strain on a
     /// 33 px subset; on the same ramp `icgn1`'s mean node error is 0.0084 px with 6 renewals,
     /// 0.0086 px with the 34 of the displacement rule it replaces; at 4 px the 30 % stretch of
-    /// `tests/icgn.rs` loses 4 % of its accuracy).
+    /// `tests/suite/icgn.rs` loses 4 % of its accuracy).
     pub const AUTO_DEFAULT_ICGN: ReferenceMode = ReferenceMode::Auto {
         max_deformation_px: 2.0,
         min_mean_score: 0.5,

@@ -17,7 +17,7 @@
 pub const MIN_SIDE_RATIO: f32 = 0.02;
 
 /// Smallest corner square tested, px: a smaller one fits in the gap between a sparse
-/// pattern's dots (9 px dots with 21 px subsets, `tests/icgn.rs`), a backdrop's corner does not
+/// pattern's dots (9 px dots with 21 px subsets, `tests/suite/icgn.rs`), a backdrop's corner does not
 /// need it (ZOIs of 32 px and more).
 pub const MIN_CORNER_PX: usize = 8;
 

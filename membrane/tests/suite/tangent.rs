@@ -1,7 +1,7 @@
 //! The consistent tangent against finite differences: at a point (taut and wrinkled states, the
 //! analytic law and a catalogue-style closure) and assembled over a distorted sheet.
 
-mod common;
+use crate::common;
 
 use common::{noise, square};
 use material::InvariantLaw;

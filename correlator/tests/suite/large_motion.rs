@@ -4,7 +4,7 @@
 //! the image that are `ok` (≥ 95 %), the RMS error of the `ok` nodes, and no `ok` node more
 //! than 0.5 px off (a wrong value reported as valid is the defect this suite guards against).
 
-mod common;
+use crate::common;
 
 use common::{accuracy, render};
 use correlator::{Correlator, CorrelatorSettings, Field};

@@ -3,7 +3,7 @@
 //! for all (Ogden included). A free square in uniaxial tension gives the catalogue's own
 //! in-plane stress.
 
-mod common;
+use crate::common;
 
 use common::{close, roller, square};
 use identifier::models::Model;

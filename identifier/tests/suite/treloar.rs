@@ -1,6 +1,6 @@
 //! Treloar (1944): every model on uniaxial + equibiaxial + pure shear; Ogden reference check.
 
-mod common;
+use crate::common;
 
 use common::treloar;
 use identifier::data::LoadCase;

@@ -1,7 +1,7 @@
 //! Bad input stops with the state and the reason: an element inverted by the load, Newton out
 //! of iterations, a law that is not stable along the path, clamps that hold nothing.
 
-mod common;
+use crate::common;
 
 use common::square;
 use material::InvariantLaw;

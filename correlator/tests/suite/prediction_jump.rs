@@ -3,7 +3,7 @@
 //! confirmed; `icgn1`: no FFT guess at all) must fall back to the full search and find the
 //! jump: every node whose ZOI stays in the image valid, and none off.
 
-mod common;
+use crate::common;
 
 use common::{render, translation};
 use correlator::settings::Method;

@@ -4,7 +4,7 @@
 //! paper's (whose global (U0, V0) needs the significance test and the smaller centred square
 //! here: on the whole ROI the rotation decorrelates its border).
 
-mod common;
+use crate::common;
 
 use common::{accuracy, render, rotation_deg};
 use correlator::strain::node_strains;

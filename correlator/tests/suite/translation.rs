@@ -1,7 +1,7 @@
 //! Sub-pixel translation sweep 0..1 px (issue 3): |mean error| <= 0.01 px, std <= 0.02 px,
 //! 1 % noise, 32 px ZOI. Prints the bias curve.
 
-mod common;
+use crate::common;
 
 use common::{mean_std, render, translation};
 use correlator::{Correlator, CorrelatorSettings, GuessMode, NodeStatus};

@@ -1,7 +1,7 @@
 //! Homogeneous states: the patch test on a distorted mesh, and a free square in uniaxial and
 //! equibiaxial tension against `material`'s analytic membrane stresses (1e-9 relative).
 
-mod common;
+use crate::common;
 
 use common::{close, noise, roller, square};
 use material::InvariantLaw;

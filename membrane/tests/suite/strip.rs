@@ -2,7 +2,7 @@
 //! strip (λ2 = 1 within 2e-3 farther than 4 lengths from its free edges), a sheared sheet that
 //! wrinkles, and Newton's quadratic convergence on one of them.
 
-mod common;
+use crate::common;
 
 use common::Solved;
 use material::InvariantLaw;

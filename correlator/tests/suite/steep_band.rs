@@ -4,9 +4,9 @@
 //! steepest strain A / 4w from 0.28 to 0.07), each method at its usual size (`correli` 32 px,
 //! IC-GN 33 px). Prints the RMS error in the band (|X − x0| ≤ 2.2 w, the 10-90 % rise) and
 //! elsewhere, per method and width:
-//! `cargo test --release -p correlator --test steep_band -- --nocapture`.
+//! `cargo test --release -p correlator --test suite -- steep_band:: --nocapture`.
 
-mod common;
+use crate::common;
 
 use common::independent::{render, IndependentSpeckle};
 use correlator::{Correlator, CorrelatorSettings, Method, NodeStatus};

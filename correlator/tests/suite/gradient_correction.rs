@@ -7,7 +7,7 @@
 //! bases measured against the first frame at every update now keep it from adding up with or
 //! without the correction).
 
-mod common;
+use crate::common;
 
 use common::{render, stretch};
 use correlator::{Correlator, CorrelatorSettings, GuessMode, NodeStatus, ReferenceMode};

@@ -1,6 +1,6 @@
 //! DIC Challenge 1.0 sample 5 (translation with contrast changes) and sample 14 (chirp).
 
-mod common;
+use crate::common;
 
 use common::{accuracy, command_columns, load};
 use correlator::{Correlator, CorrelatorSettings, GuessMode, NodeStatus};

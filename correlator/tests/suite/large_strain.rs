@@ -5,7 +5,7 @@
 //! on their own material (not as false "ok" matches on other material); the gauge strain must
 //! follow the true ln λ to the end.
 
-mod common;
+use crate::common;
 
 use correlator::{Correlator, CorrelatorSettings, NodeStatus, ReferenceMode};
 use producer::motion::Affine;

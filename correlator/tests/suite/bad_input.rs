@@ -1,6 +1,6 @@
 //! Bad input is refused with a clear message, or flagged per node, never NaN or panic.
 
-mod common;
+use crate::common;
 
 use common::{render, translation};
 use correlator::{Correlator, CorrelatorSettings, Method, NodeStatus, Roi, SettingsError};

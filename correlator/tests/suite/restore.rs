@@ -2,7 +2,7 @@
 //! a correlator restored from `reference_pixels` + `reference_base_px` measures the next frame
 //! like the uninterrupted one, in every reference mode.
 
-mod common;
+use crate::common;
 
 use common::{render, translation};
 use correlator::{Correlator, CorrelatorSettings, GuessMode, NodeStatus, ReferenceMode};

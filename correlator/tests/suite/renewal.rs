@@ -4,7 +4,7 @@
 //! search, also when the camera dropped a frame in between (the predictions extrapolate over
 //! the frames missed). Counts, not times: `Correlator::fft_searches`.
 
-mod common;
+use crate::common;
 
 use common::{render, stretch, translation};
 use correlator::settings::Roi;

@@ -24,8 +24,8 @@ segments = [{ kind = "hold", duration_s = 1.0 }, { kind = "ramp", to = 100.0, ra
 #[test]
 fn equibiaxial_ramp_to_stretch_two() {
     // The homogeneous sheet with rigid grips: this test checks the grips against eq. (19);
-    // the structure's grip effects have their own tests (tests/strain_control.rs,
-    // rig/tests/structure.rs).
+    // the structure's grip effects have their own tests (tests/suite/strain_control.rs,
+    // rig/tests/suite/structure.rs).
     let mut config = RigConfig::default();
     config.specimen.as_mut().unwrap().grip_compliance_mm_per_kn = 0.0;
     let specimen = config.specimen.clone().unwrap();

@@ -1,7 +1,7 @@
 //! The cruciform: its mesh (area, grips, slits, refusals) and the mesh convergence of the arm
 //! force at a grip stretch of 2.
 
-mod common;
+use crate::common;
 
 use common::Solved;
 use membrane::specimens::cruciform::CruciformGeometry;

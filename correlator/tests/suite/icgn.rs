@@ -6,7 +6,7 @@
 //! a fixed and a followed reference, subsets of odd and even sizes, a subset that leaves the
 //! image, and images from the independent generator. Accuracy only: no test reads a clock.
 
-mod common;
+use crate::common;
 
 use common::{
     accuracy, command_columns, cramer_rao_std_px, load, mean_std, render, stretch, translation,

@@ -3,7 +3,7 @@
 //! guess now fails honestly: the final check refuses the nodes it sent onto other material
 //! (fewer than 90 % of the nodes inside the image valid), and the gauge stays right.
 
-mod common;
+use crate::common;
 
 use common::{accuracy, render, stretch};
 use correlator::{Correlator, CorrelatorSettings, Field, GuessMode, NodeStatus, StrainMeasure};

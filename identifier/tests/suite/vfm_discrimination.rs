@@ -5,8 +5,7 @@
 //! `vfm_structure.rs`), fitted and ranked by the field route's own code (`FitJob::run`: BIC,
 //! identifiability) over the field route's default models and the families the paper discusses.
 
-#[path = "common/cruciform.rs"]
-mod cruciform;
+use crate::cruciform;
 
 use cruciform::{observations, ramp_quadratures, solved_frames, GRID_STEP_MM};
 use identifier::data::LoadCase;

@@ -5,10 +5,10 @@
 //! 30 % uniaxial stretch against a fixed reference, with the default settings and with
 //! `--method icgn1` (32 px subsets both). Every case: no `ok` node more than 0.5 px off, most
 //! of the measurable nodes `ok`, and a bounded RMS (margins per method, from what was measured:
-//! `cargo test --release -p correlator --test independent_images -- --nocapture --test-threads 1`
+//! `cargo test --release -p correlator --test suite -- independent_images:: --nocapture --test-threads 1`
 //! prints the table that is in the README).
 
-mod common;
+use crate::common;
 
 use common::accuracy;
 use common::independent::{affine_inverse, render, rotation, IndependentSpeckle};

@@ -5,8 +5,7 @@
 //! cut across each arm beyond the fillets, and each arm's grip force from the solution
 //! (`common/cruciform.rs`).
 
-#[path = "common/cruciform.rs"]
-mod cruciform;
+use crate::cruciform;
 
 use cruciform::{
     observations, ramp_quadratures, relative_errors, solved_frames_on, worst_gap, GRID_STEP_MM,

@@ -2,7 +2,7 @@
 //! and a finite-difference Jacobian, the code before it): same fits on Treloar's data, same
 //! normal equations; and the same bits whatever the thread count.
 
-mod common;
+use crate::common;
 
 use common::treloar;
 use identifier::data::{Curve, LoadCase};
