@@ -26,16 +26,15 @@
 
 use crate::field_layout::GRIPS;
 use crate::lsq::{
-    inverse_normal_matrix, minimise_until, scaled_condition_number, LeastSquares, LmStop,
-    LsqError,
+    inverse_normal_matrix, minimise_until, scaled_condition_number, LeastSquares, LmStop, LsqError,
 };
 use crate::measured_displacement::{DisplacementGrid, MIN_FIT_NODES};
 use crate::models::Model;
 use membrane::specimens::cruciform::CruciformGeometry;
 use membrane::specimens::Specimen;
 use membrane::{
-    Analysis, Clamp, GeometryError, Held, InvariantDerivatives, Location, Membrane,
-    NewtonSettings, PrincipalStresses, RigidMotion, SheetLaw, SolveError, Wrinkling,
+    Analysis, Clamp, GeometryError, Held, InvariantDerivatives, Location, Membrane, NewtonSettings,
+    PrincipalStresses, RigidMotion, SheetLaw, SolveError, Wrinkling,
 };
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
@@ -98,8 +97,8 @@ pub enum FemuError {
         y_mm: [f64; 2],
         straight_mm: f64,
     },
-    #[error("the view's finite-element model: {0} (FEMU needs the view's edges across all four arms)")]
-    Geometry(#[from] GeometryError),
+    #[error("the view's finite-element model: {reason} (FEMU needs the view's edges across all four arms)")]
+    Geometry { reason: GeometryError },
     #[error(
         "frame {frame_id}, arm {arm}: fewer than {MIN_FIT_NODES} valid nodes around the edge \
          point ({x_mm:.2}, {y_mm:.2}) mm (within {radius_mm:.2} mm): too few valid boundary \
@@ -116,7 +115,9 @@ pub enum FemuError {
     Sigma { name: &'static str, value: f64 },
     #[error("{residuals} residuals for {params} parameters: need at least {}", .params + 1)]
     TooFewResiduals { residuals: usize, params: usize },
-    #[error("frame {frame_id}: the finite-element solve with {model} at {params:?} failed: {error}")]
+    #[error(
+        "frame {frame_id}: the finite-element solve with {model} at {params:?} failed: {error}"
+    )]
     Solve {
         frame_id: u64,
         model: String,
@@ -127,7 +128,8 @@ pub enum FemuError {
     Lsq(#[from] LsqError),
     #[error(
         "the frames do not separate the {params} parameters of {model}: condition number \
-         {condition:.3e} > {:e}", crate::vfm::MAX_CONDITION
+         {condition:.3e} > {:e}",
+        crate::vfm::MAX_CONDITION
     )]
     NotIdentifiable {
         model: String,
@@ -235,7 +237,9 @@ impl Femu {
                 straight_mm,
             });
         }
-        let specimen = c.clipped(view_x, view_y)?;
+        let specimen = c
+            .clipped(view_x, view_y)
+            .map_err(|reason| FemuError::Geometry { reason })?;
         let grip_order: Vec<usize> = specimen
             .grips
             .iter()
@@ -283,7 +287,8 @@ impl Femu {
             self.settings.cruciform.thickness_mm,
             &*law,
             Wrinkling::default(),
-        )?;
+        )
+        .map_err(|reason| FemuError::Geometry { reason })?;
         let mut solutions = self.solutions.borrow_mut();
         let mut analysis = self.analysis.borrow_mut();
         let mut out = Vec::with_capacity(self.frames.len());
@@ -314,14 +319,9 @@ impl Femu {
                         load_steps: FRAME_LOAD_STEPS,
                         ..self.settings.newton
                     };
-                    let outcome = membrane::solve_from(
-                        &sheet,
-                        &frame.clamps,
-                        &start,
-                        stepped,
-                        &mut analysis,
-                    )
-                    .map_err(fail)?;
+                    let outcome =
+                        membrane::solve_from(&sheet, &frame.clamps, &start, stepped, &mut analysis)
+                            .map_err(fail)?;
                     if let Some(stopped) = outcome.stopped {
                         return Err(fail(stopped));
                     }
@@ -454,15 +454,13 @@ fn prepare(
     for grip in &specimen.grips {
         for &node in &grip.nodes {
             let x = specimen.mesh.nodes_mm[node];
-            let u = field
-                .interpolate(x)
-                .ok_or(FemuError::TooFewBoundaryNodes {
-                    frame_id: frame.frame_id,
-                    arm: grip.name,
-                    x_mm: x[0],
-                    y_mm: x[1],
-                    radius_mm: crate::measured_displacement::FIT_RADII_STEPS[1] * field.step_mm,
-                })?;
+            let u = field.interpolate(x).ok_or(FemuError::TooFewBoundaryNodes {
+                frame_id: frame.frame_id,
+                arm: grip.name,
+                x_mm: x[0],
+                y_mm: x[1],
+                radius_mm: crate::measured_displacement::FIT_RADII_STEPS[1] * field.step_mm,
+            })?;
             clamps.push(Clamp {
                 nodes: vec![node],
                 held: Held::Both,

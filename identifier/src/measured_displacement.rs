@@ -49,7 +49,13 @@ impl DisplacementGrid {
     /// The same nodes (size, origin, step) as `other`.
     pub fn same_nodes(&self, other: &DisplacementGrid) -> bool {
         (self.cols, self.rows, self.x0_mm, self.y0_mm, self.step_mm)
-            == (other.cols, other.rows, other.x0_mm, other.y0_mm, other.step_mm)
+            == (
+                other.cols,
+                other.rows,
+                other.x0_mm,
+                other.y0_mm,
+                other.step_mm,
+            )
     }
 
     /// The valid nodes within `radius_mm` of `x_mm`: (offset from `x_mm` in steps, u mm).
@@ -91,7 +97,9 @@ impl DisplacementGrid {
             });
             let fit = |c: usize| {
                 let b = DVector::from_iterator(nodes.len(), nodes.iter().map(|n| n.1[c]));
-                linear_least_squares(&a, &b).ok().map(|coefficients| coefficients[0])
+                linear_least_squares(&a, &b)
+                    .ok()
+                    .map(|coefficients| coefficients[0])
             };
             Some([fit(0)?, fit(1)?])
         })
@@ -102,7 +110,10 @@ impl DisplacementGrid {
 mod tests {
     use super::*;
 
-    fn grid(valid: impl Fn([f64; 2]) -> bool, u: impl Fn([f64; 2]) -> [f64; 2]) -> DisplacementGrid {
+    fn grid(
+        valid: impl Fn([f64; 2]) -> bool,
+        u: impl Fn([f64; 2]) -> [f64; 2],
+    ) -> DisplacementGrid {
         let (cols, rows, step) = (21, 15, 0.5);
         let mut grid = DisplacementGrid {
             cols,

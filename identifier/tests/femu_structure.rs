@@ -146,7 +146,10 @@ fn bad_input_is_named() {
         ),
         "{error}"
     );
-    assert!(error.to_string().contains("too few valid boundary nodes"), "{error}");
+    assert!(
+        error.to_string().contains("too few valid boundary nodes"),
+        "{error}"
+    );
     // Another grid.
     let mut moved = frames.clone();
     moved[1].field.x0_mm += 0.5;
@@ -161,7 +164,10 @@ fn bad_input_is_named() {
         matches!(error, FemuError::Solve { frame_id: 20, .. }),
         "{text}"
     );
-    assert!(text.contains("frame 20: the finite-element solve with gent"), "{text}");
+    assert!(
+        text.contains("frame 20: the finite-element solve with gent"),
+        "{text}"
+    );
     let error = Femu::new(
         &frames,
         FemuSettings {

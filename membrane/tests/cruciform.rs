@@ -286,7 +286,10 @@ fn a_cruciform_clipped_to_a_view_ends_at_the_views_edges() {
             straight_mm: 70.0
         }
     );
-    assert!(error.to_string().contains("arm x-: the view reaches 65 mm"), "{error}");
+    assert!(
+        error.to_string().contains("arm x-: the view reaches 65 mm"),
+        "{error}"
+    );
     let slit = CruciformGeometry {
         slits_per_arm: 1,
         slit_length_mm: 40.0,

@@ -62,7 +62,10 @@ pub fn run(
     let route_settings = config.field_route_settings();
     let saved = fit_saved(dir, &route_settings, &models, args.forces.as_deref())?;
     for (model, why) in &saved.fits.refused {
-        writeln!(err, "not fitted by the virtual fields method: {model}: {why}")?;
+        writeln!(
+            err,
+            "not fitted by the virtual fields method: {model}: {why}"
+        )?;
     }
     let vfm = match &args.model {
         Some(_) => saved.fits.fits.first(),
@@ -136,7 +139,13 @@ pub fn run(
         });
         writeln!(out, "{}", serde_json::to_string_pretty(&value)?)?;
     } else {
-        print_table(out, &vfm.model, &fit, &vfm.fit.params, (femu_s, saved.fit_s))?;
+        print_table(
+            out,
+            &vfm.model,
+            &fit,
+            &vfm.fit.params,
+            (femu_s, saved.fit_s),
+        )?;
     }
     Ok(())
 }
@@ -160,7 +169,11 @@ fn print_table(
         fit.iterations,
         fit.evaluations
     )?;
-    writeln!(out, "{:<10} {:>14} {:>11} {:>14}", "param", "femu", "± std", "vfm")?;
+    writeln!(
+        out,
+        "{:<10} {:>14} {:>11} {:>14}",
+        "param", "femu", "± std", "vfm"
+    )?;
     for (((name, p), s), v) in model
         .param_names()
         .iter()
@@ -259,7 +272,10 @@ mod tests {
                 "x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy\n",
             );
             for p in &nodes_px {
-                let x_mm = [(p[0] - CENTRE_PX) * MM_PER_PX, (p[1] - CENTRE_PX) * MM_PER_PX];
+                let x_mm = [
+                    (p[0] - CENTRE_PX) * MM_PER_PX,
+                    (p[1] - CENTRE_PX) * MM_PER_PX,
+                ];
                 match probe.sample(&solved.displacement_mm, x_mm) {
                     Some(s) => {
                         let [u, v] = s.displacement_mm.map(|u| u / MM_PER_PX);
@@ -316,8 +332,13 @@ mod tests {
         println!("FEMU from a run's fields (10 mm elements, 2.88 mm grid): relative errors {errors:?}; {value}");
         assert!(errors.iter().all(|&e| e < 1e-3), "{errors:?} {value}");
         assert_eq!(value["femu"]["balance"].as_array().unwrap().len(), 16);
-        let e = identify(&run.0, &["--femu", "--model", "mooney,yeoh"]).1.unwrap_err();
-        assert!(e.to_string().contains("--femu fits one model family"), "{e}");
+        let e = identify(&run.0, &["--femu", "--model", "mooney,yeoh"])
+            .1
+            .unwrap_err();
+        assert!(
+            e.to_string().contains("--femu fits one model family"),
+            "{e}"
+        );
         // Frame 20 lost the nodes of the last 5 columns (x ≥ 464 px, the x+ arm's edge).
         let path = run.0.join("fields/field_000020.csv");
         let text = std::fs::read_to_string(&path).unwrap();

@@ -8,8 +8,8 @@
 // Each test file compiles this module and uses part of it.
 #![allow(dead_code)]
 
-use identifier::models::Model;
 use identifier::measured_displacement::DisplacementGrid;
+use identifier::models::Model;
 use identifier::section_cut::{ArmAxis, FieldGrid, SectionCut};
 use identifier::tapered_ramp::{RampQuadrature, TaperedRamp};
 use identifier::vfm::{CutObservation, VirtualField};
@@ -174,7 +174,10 @@ pub fn solved_frames_on<L: SheetLaw + ?Sized>(
                 x0_mm: -HALF_VIEW_MM,
                 y0_mm: -HALF_VIEW_MM,
                 step_mm: *step,
-                displacements_mm: samples.iter().map(|s| s.map(|s| s.displacement_mm)).collect(),
+                displacements_mm: samples
+                    .iter()
+                    .map(|s| s.map(|s| s.displacement_mm))
+                    .collect(),
             };
             frames.push(Frame {
                 grid,
