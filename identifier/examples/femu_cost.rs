@@ -72,6 +72,19 @@ fn main() {
         by_femu = Some((fit, femu.mesh().elements.len()));
     }
     let (by_vfm, (by_femu, elements)) = (by_vfm.unwrap(), by_femu.unwrap());
+    println!(
+        "{} frames, {} grid nodes a frame; VFM: {} equations, params {:?}; FEMU: {elements} \
+         elements, {} + {} residuals, {} iterations, {} solves of all frames, params {:?}",
+        frames.len(),
+        frames[0].grid.gradients.len(),
+        by_vfm.equations,
+        by_vfm.params,
+        by_femu.force_residuals,
+        by_femu.displacement_residuals,
+        by_femu.iterations,
+        by_femu.evaluations,
+        by_femu.params
+    );
     let column = |runs: &[[f64; 2]], k: usize| median(runs.iter().map(|r| r[k]).collect());
     let (vfm_fit, femu_fit) = (column(&vfm_s, 1), column(&femu_s, 1));
     println!(

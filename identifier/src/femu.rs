@@ -149,6 +149,10 @@ struct PreparedFrame {
     interior: Vec<(Location, [f64; 2])>,
 }
 
+/// A frame solved: its grips' forces (N, in [`GRIPS`] order) and the displacements at its
+/// interior nodes (mm).
+type Solved = ([f64; 4], Vec<[f64; 2]>);
+
 /// A grip's measured and computed force at a frame.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct FemuBalance {
@@ -230,7 +234,7 @@ impl Femu {
         let (view_x, view_y) = ([x_mm[0] + s, x_mm[1] - s], [y_mm[0] + s, y_mm[1] - s]);
         let straight_mm = 0.5 * c.arm_width_mm + c.fillet_radius_mm;
         let reaches = [view_x[1], -view_x[0], view_y[1], -view_y[0]];
-        if reaches.iter().all(|&r| !(r > straight_mm)) {
+        if reaches.iter().all(|&r| r.is_nan() || r <= straight_mm) {
             return Err(FemuError::NoArmInView {
                 x_mm,
                 y_mm,
@@ -275,11 +279,7 @@ impl Femu {
 
     /// Solves every frame under `model` at `p`: the grips' computed forces (in [`GRIPS`]
     /// order) and the computed displacements at the interior nodes, frame by frame.
-    fn solve_all(
-        &self,
-        model: &Model,
-        p: &[f64],
-    ) -> Result<Vec<([f64; 4], Vec<[f64; 2]>)>, FemuError> {
+    fn solve_all(&self, model: &Model, p: &[f64]) -> Result<Vec<Solved>, FemuError> {
         *self.evaluations.borrow_mut() += 1;
         let law = sheet_law(model, p);
         let sheet = Membrane::new(
@@ -397,7 +397,7 @@ impl Femu {
         let p = lm.params;
         let j = objective.jacobian(&p)?;
         let condition = scaled_condition_number(&j);
-        if !(condition <= crate::vfm::MAX_CONDITION) {
+        if condition.is_nan() || condition > crate::vfm::MAX_CONDITION {
             return Err(FemuError::NotIdentifiable {
                 model: model.name(),
                 params: n,

@@ -200,26 +200,11 @@ fn print_table(
 
 #[cfg(test)]
 mod tests {
+    use super::super::identify_fields::tests::{edit_lines, identify, Cli, RunDir};
     use super::*;
     use clap::Parser;
     use membrane::specimens::cruciform::CruciformGeometry;
     use membrane::{GripStretch, InvariantDerivatives, Membrane, NewtonSettings, Probe, Wrinkling};
-    use std::path::PathBuf;
-
-    #[derive(Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: IdentifyArgs,
-    }
-
-    /// A results folder removed on drop.
-    struct RunDir(PathBuf);
-
-    impl Drop for RunDir {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
 
     const TRUTH: [f64; 2] = [0.3, 0.05];
     /// 512 px at 0.36 mm/px (±92 mm), nodes every 8 px from 16 to 496 px.
@@ -301,23 +286,13 @@ mod tests {
         RunDir(dir)
     }
 
-    fn identify(dir: &Path, extra: &[&str]) -> (String, anyhow::Result<()>) {
-        let mut argv = vec!["identify".to_string(), "--fields".into()];
-        argv.push(dir.display().to_string());
-        argv.extend(extra.iter().map(|s| s.to_string()));
-        let cli = Cli::try_parse_from(argv).unwrap();
-        let (mut out, mut err) = (vec![], vec![]);
-        let result = super::super::identify::run_with(cli.args, &mut out, &mut err, false);
-        (String::from_utf8(out).unwrap(), result)
-    }
-
     /// A run's finite-element fields through the whole offline path (field files, frames.csv,
     /// the camera's px to mm): FEMU gives the law back, the JSON alone on stdout; then bad
     /// input (two families, an edge whose nodes are lost, `--femu` without `--fields`).
     #[test]
     fn femu_on_a_runs_fields_gives_the_law_back_and_names_bad_input() {
         let run = fe_run_dir("law");
-        let (out, result) = identify(&run.0, &["--femu", "--json"]);
+        let (out, _, result) = identify(&run.0, &["--femu", "--json"]);
         result.unwrap();
         let value: Value = serde_json::from_str(&out).expect("stdout is JSON alone");
         assert_eq!(value["model"], "mooney", "{value}");
@@ -333,28 +308,22 @@ mod tests {
         assert!(errors.iter().all(|&e| e < 1e-3), "{errors:?} {value}");
         assert_eq!(value["femu"]["balance"].as_array().unwrap().len(), 16);
         let e = identify(&run.0, &["--femu", "--model", "mooney,yeoh"])
-            .1
+            .2
             .unwrap_err();
         assert!(
             e.to_string().contains("--femu fits one model family"),
             "{e}"
         );
         // Frame 20 lost the nodes of the last 5 columns (x ≥ 464 px, the x+ arm's edge).
-        let path = run.0.join("fields/field_000020.csv");
-        let text = std::fs::read_to_string(&path).unwrap();
-        let lost: String = text
-            .lines()
-            .map(|line| {
-                let x: f64 = line.split(',').next().unwrap().parse().unwrap_or(0.0);
-                if x >= 464.0 {
-                    line.replace(",ok,", ",low_contrast,") + "\n"
-                } else {
-                    line.to_string() + "\n"
-                }
+        edit_lines(&run.0.join("fields/field_000020.csv"), |line| {
+            let x: f64 = line.split(',').next()?.parse().unwrap_or(0.0);
+            Some(if x >= 464.0 {
+                line.replace(",ok,", ",low_contrast,")
+            } else {
+                line.to_string()
             })
-            .collect();
-        std::fs::write(&path, lost).unwrap();
-        let e = format!("{:#}", identify(&run.0, &["--femu"]).1.unwrap_err());
+        });
+        let e = format!("{:#}", identify(&run.0, &["--femu"]).2.unwrap_err());
         assert!(
             e.contains("frame 20, arm x+") && e.contains("too few valid boundary nodes"),
             "{e}"

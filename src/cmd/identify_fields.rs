@@ -190,8 +190,10 @@ fn print_table(
     )
 }
 
+/// The `identify --fields` tests and their helpers (a results folder, the command run
+/// captured), shared with `identify_femu`'s.
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use clap::Parser;
     use identifier::data::LoadCase;
@@ -199,15 +201,15 @@ mod tests {
     use std::path::PathBuf;
 
     #[derive(Parser)]
-    struct Cli {
+    pub(in crate::cmd) struct Cli {
         #[command(flatten)]
-        args: IdentifyArgs,
+        pub args: IdentifyArgs,
     }
 
     /// A results folder of homogeneous equibiaxial fields (512 px square images, a 31 x 31
     /// mesh 16 px apart) whose grips pull what an arm of the default cruciform (100 mm wide, 2
     /// mm thick) carries under a Mooney law; removed on drop.
-    struct RunDir(PathBuf);
+    pub(in crate::cmd) struct RunDir(pub PathBuf);
 
     impl Drop for RunDir {
         fn drop(&mut self) {
@@ -252,7 +254,10 @@ mod tests {
     }
 
     /// `identify --fields DIR extra...`: its stdout, stderr and result.
-    fn identify(dir: &Path, extra: &[&str]) -> (String, String, anyhow::Result<()>) {
+    pub(in crate::cmd) fn identify(
+        dir: &Path,
+        extra: &[&str],
+    ) -> (String, String, anyhow::Result<()>) {
         let mut argv = vec!["identify".to_string(), "--fields".into()];
         argv.push(dir.display().to_string());
         argv.extend(extra.iter().map(|s| s.to_string()));
@@ -268,7 +273,7 @@ mod tests {
 
     /// Rewrites the file at `path` line by line (None: the line left out); returns its text
     /// before.
-    fn edit_lines(path: &Path, edit: impl Fn(&str) -> Option<String>) -> String {
+    pub(in crate::cmd) fn edit_lines(path: &Path, edit: impl Fn(&str) -> Option<String>) -> String {
         let text = std::fs::read_to_string(path).unwrap();
         let edited: String = text.lines().filter_map(edit).map(|l| l + "\n").collect();
         std::fs::write(path, edited).unwrap();

@@ -163,7 +163,7 @@ impl CruciformGeometry {
         ];
         let mut lengths = [0.0; 4];
         for (length, (arm, reach_mm)) in lengths.iter_mut().zip(reaches) {
-            if !(reach_mm > straight_mm) {
+            if reach_mm.is_nan() || reach_mm <= straight_mm {
                 return Err(GeometryError::ArmNotCut {
                     arm,
                     reach_mm,
