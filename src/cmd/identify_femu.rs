@@ -42,9 +42,7 @@ pub fn run(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> anyhow::Result<()> {
-    let config_path = dir.join("config.toml");
-    let config = live::RunConfig::read(Some(&config_path))
-        .with_context(|| format!("{}: the run's configuration", dir.display()))?;
+    let config = super::identify_fields::run_config(dir)?;
     let models = match &args.model {
         Some(list) => {
             let models = parse_model_list(list)?;

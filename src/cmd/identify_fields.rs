@@ -38,9 +38,7 @@ pub fn run(
              fields method); give it without --fields"
         );
     }
-    let config_path = dir.join("config.toml");
-    let config = live::RunConfig::read(Some(&config_path))
-        .with_context(|| format!("{}: the run's configuration", dir.display()))?;
+    let config = run_config(dir)?;
     let models = match &args.model {
         Some(list) => parse_model_list(list)?,
         None => config.identifier.models.0.clone(),
@@ -86,6 +84,12 @@ pub fn run(
         );
     }
     Ok(())
+}
+
+/// The configuration of the run whose results folder is `dir` (its `config.toml`).
+pub(super) fn run_config(dir: &Path) -> anyhow::Result<live::RunConfig> {
+    live::RunConfig::read(Some(&dir.join("config.toml")))
+        .with_context(|| format!("{}: the run's configuration", dir.display()))
 }
 
 /// The ranks shown: identifiable fits in BIC order, None for the others.
