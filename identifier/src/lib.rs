@@ -18,6 +18,9 @@
 //! - [`field_layout`]: where the cuts and ramps go, from the cruciform and the view.
 //! - [`grip_forces`]: the grips' forces of recent rig samples, by id or by time.
 //! - [`field_route`]: the frames of a test kept for the field route, fitted together.
+//! - [`femu`]: finite-element model updating, the field route's reference (offline): the
+//!   view's finite-element model under the measured edge displacements against the grips'
+//!   forces and the interior displacements ([`measured_displacement`]: the edges' values).
 //! - [`saved_fields`]: a run's saved fields, frames and rig log read for the field route
 //!   offline (`identify --fields`).
 //! - [`route`]: the paper's f-then-g route (eqs 20-25) feeding the LM refinement.
@@ -32,6 +35,7 @@
 pub mod columns;
 pub mod data;
 pub mod fe_cards;
+pub mod femu;
 pub mod field_layout;
 pub mod field_route;
 pub mod field_stress;
@@ -46,6 +50,7 @@ pub mod kinematics;
 pub use material as law;
 pub mod lsq;
 pub mod map_figure;
+pub mod measured_displacement;
 pub mod models;
 pub mod online;
 pub mod plot;

@@ -237,8 +237,40 @@ where
     )
 }
 
+/// When a Levenberg-Marquardt run stops: the gauge and virtual-fields fits run to the
+/// precision of their closed-form residuals (the defaults); a costly problem whose residuals
+/// are themselves converged iterates (finite-element model updating) stops at their precision.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LmStop {
+    pub max_iterations: usize,
+    /// An accepted step that lowers the cost by less than this fraction ends the run.
+    pub min_relative_decrease: f64,
+    /// Rejected trial steps (each with 4 times the damping) before the run ends at a point
+    /// no step lowers.
+    pub max_rejected: usize,
+}
+
+impl Default for LmStop {
+    fn default() -> Self {
+        LmStop {
+            max_iterations: LM_MAX_ITERATIONS,
+            min_relative_decrease: 1e-14,
+            max_rejected: 40,
+        }
+    }
+}
+
 /// Levenberg-Marquardt on any [`LeastSquares`] problem from `start`.
 pub fn minimise<P: LeastSquares>(problem: &mut P, start: &[f64]) -> Result<LmResult, LsqError> {
+    minimise_until(problem, start, LmStop::default())
+}
+
+/// [`minimise`] with its stopping rule.
+pub fn minimise_until<P: LeastSquares>(
+    problem: &mut P,
+    start: &[f64],
+    stop: LmStop,
+) -> Result<LmResult, LsqError> {
     let n = start.len();
     let m = problem.points();
     if m < n {
@@ -256,7 +288,7 @@ pub fn minimise<P: LeastSquares>(problem: &mut P, start: &[f64]) -> Result<LmRes
     let mut damping = 1e-3;
     let mut converged = false;
     let mut iterations = 0;
-    while iterations < LM_MAX_ITERATIONS && !converged {
+    while iterations < stop.max_iterations && !converged {
         iterations += 1;
         problem.normal_equations(&p, &mut jtj, &mut jtr);
         if jtr.amax() <= 1e-15 * (1.0 + cost) {
@@ -264,7 +296,7 @@ pub fn minimise<P: LeastSquares>(problem: &mut P, start: &[f64]) -> Result<LmRes
             break;
         }
         let mut accepted = false;
-        for _ in 0..40 {
+        for _ in 0..stop.max_rejected {
             lhs.copy_from(&jtj);
             for k in 0..n {
                 lhs[(k, k)] += damping * jtj[(k, k)].max(1e-12);
@@ -290,7 +322,7 @@ pub fn minimise<P: LeastSquares>(problem: &mut P, start: &[f64]) -> Result<LmRes
                     cost = new_cost;
                     damping = (damping / 3.0).max(1e-12);
                     accepted = true;
-                    if relative_decrease < 1e-14 || step_small {
+                    if relative_decrease < stop.min_relative_decrease || step_small {
                         converged = true;
                     }
                     break;

@@ -25,6 +25,8 @@ pub struct SavedField {
     pub rows: usize,
     /// F = I + ∇u of every `ok` node, row-major; None for the others.
     pub gradients: Vec<Option<Mat2>>,
+    /// The displacement (u, v) of every `ok` node, px, row-major; None for the others.
+    pub displacements_px: Vec<Option<[f64; 2]>>,
 }
 
 /// Why saved fields cannot be identified.
@@ -68,6 +70,11 @@ pub struct SavedFit {
     pub per_grip: bool,
     /// The kept frames' force balance per grip under the first ranked fit.
     pub force_balance: Vec<crate::field_route::GripBalance>,
+    /// The kept frames' measured displacements (mm, on the reference grid) and grip forces:
+    /// what finite-element model updating fits (`crate::femu`).
+    pub kept_frames: Vec<crate::femu::FemuFrame>,
+    /// Wall time of the fit of every model to the kept frames, s (reading excluded).
+    pub fit_s: f64,
 }
 
 /// Fits the saved fields of results folder `dir` with the live route's feed: each field file
@@ -88,9 +95,20 @@ pub fn fit_saved(
     };
     let mut feed = crate::process::FieldFeed::new(settings, models)
         .map_err(|e| SavedFieldsError::Geometry(e.to_string()))?;
+    let mut displacements = std::collections::BTreeMap::new();
     for (frame_id, path) in &files {
-        let field = read_field(path, *frame_id)?;
+        let mut field = read_field(path, *frame_id)?;
         let (sequence, forces) = frame_forces(&frames, &source, &field)?;
+        let measured = std::mem::take(&mut field.displacements_px);
+        displacements.insert(
+            *frame_id,
+            feed.displacement_grid(
+                field.first_px,
+                field.step_px,
+                (field.cols, field.rows),
+                measured,
+            ),
+        );
         let grid = feed.grid(
             field.first_px,
             field.step_px,
@@ -105,7 +123,10 @@ pub fn fit_saved(
     }
     let route = &feed.route;
     let c = route.counters;
-    let Some(fits) = route.fit() else {
+    let started = std::time::Instant::now();
+    let fitted = route.fit();
+    let fit_s = started.elapsed().as_secs_f64();
+    let Some(fits) = fitted else {
         return Err(SavedFieldsError::TooFewFrames {
             dir: dir.display().to_string(),
             read: files.len(),
@@ -116,7 +137,20 @@ pub fn fit_saved(
             without_gradients: c.without_gradients,
         });
     };
+    let kept_frames = route
+        .frames()
+        .iter()
+        .filter_map(|kept| {
+            Some(crate::femu::FemuFrame {
+                frame_id: kept.frame_id,
+                field: displacements.remove(&kept.frame_id)?,
+                forces_n: kept.forces_n,
+            })
+        })
+        .collect();
     Ok(SavedFit {
+        kept_frames,
+        fit_s,
         force_balance: crate::process::force_balance(route, &fits),
         fits,
         counters: c,
@@ -155,8 +189,9 @@ pub fn read_field(path: &Path, frame_id: u64) -> Result<SavedField, DataError> {
             missing.join(", ")
         )));
     }
-    let [x, y, status] = ["x", "y", "status"].map(|n| column(&table, n, "the field CSV contract"));
-    let (x, y, status) = (x?, y?, status?);
+    let [x, y, u, v, status] =
+        ["x", "y", "u", "v", "status"].map(|n| column(&table, n, "the field CSV contract"));
+    let (x, y, u, v, status) = (x?, y?, u?, v?, status?);
     let g: Vec<usize> = GRADIENT_COLUMNS
         .iter()
         .map(|n| column(&table, n, "a gradient"))
@@ -183,6 +218,7 @@ pub fn read_field(path: &Path, frame_id: u64) -> Result<SavedField, DataError> {
         },
     };
     let mut gradients = Vec::with_capacity(table.rows.len());
+    let mut displacements_px = Vec::with_capacity(table.rows.len());
     for (k, row) in table.rows.iter().enumerate() {
         let p = at(row)?;
         let want = [
@@ -214,6 +250,11 @@ pub fn read_field(path: &Path, frame_id: u64) -> Result<SavedField, DataError> {
             }
         }
         gradients.push(ok.then_some(f));
+        displacements_px.push(if ok {
+            Some([table.number(row, u)?, table.number(row, v)?])
+        } else {
+            None
+        });
     }
     Ok(SavedField {
         path: path.to_path_buf(),
@@ -223,6 +264,7 @@ pub fn read_field(path: &Path, frame_id: u64) -> Result<SavedField, DataError> {
         cols,
         rows,
         gradients,
+        displacements_px,
     })
 }
 
@@ -487,6 +529,8 @@ mod tests {
         assert_eq!(field.first_px, [10.0, 20.0]);
         assert_eq!(field.gradients[0], Some([[1.1, 0.02], [-0.01, 1.05]]));
         assert_eq!(field.gradients[2], None);
+        assert_eq!(field.displacements_px[1], Some([0.0, 0.0]));
+        assert_eq!(field.displacements_px[2], None);
         // Without the gradient columns: the file, its header's line and the columns named.
         let old = "x,y,u,v,exx,eyy,exy,score,iterations,status\n10,20,0,0,0,0,0,1,3,ok\n";
         let e = read_field(&write(&dir, "old.csv", old), 1)
@@ -517,6 +561,7 @@ mod tests {
             cols: 0,
             rows: 0,
             gradients: vec![],
+            displacements_px: vec![],
         };
         let source = ForceSource::RigLog(rig);
         assert_eq!(

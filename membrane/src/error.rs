@@ -25,6 +25,16 @@ pub enum GeometryError {
     InvertedElement { element: usize, jacobian_mm2: f64 },
     #[error("the region holds no element of the mesh")]
     EmptyRegion,
+    #[error(
+        "arm {arm}: the view reaches {reach_mm} mm along it, the arm is straight (past its \
+         fillets) from {straight_mm} mm: a clipped cruciform needs every arm cut beyond its \
+         fillets"
+    )]
+    ArmNotCut {
+        arm: &'static str,
+        reach_mm: f64,
+        straight_mm: f64,
+    },
 }
 
 /// Where the solution of a load stopped, and why.

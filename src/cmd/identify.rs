@@ -74,6 +74,8 @@ pub struct IdentifyArgs {
     /// `Y-_force_n`), at each frame's rig time, instead of `frames.csv`'s.
     #[arg(long, value_name = "rig.csv", requires = "fields")]
     pub forces: Option<PathBuf>,
+    #[command(flatten)]
+    pub femu: super::identify_femu::FemuArgs,
     /// Residual measure of the fit.
     #[arg(long, value_enum, default_value = "absolute")]
     pub residual: ResidualArg,
@@ -132,6 +134,9 @@ pub fn run_with(
     progress: bool,
 ) -> anyhow::Result<()> {
     if let Some(dir) = &args.fields {
+        if args.femu.femu {
+            return super::identify_femu::run(&args, dir, out, err);
+        }
         return super::identify_fields::run(&args, dir, out, err);
     }
     let (curves, states) = read_data(&args)?;
@@ -544,6 +549,7 @@ mod tests {
                 threads: 2,
                 fields: None,
                 forces: None,
+                femu: Default::default(),
             }
         }
     }
@@ -706,6 +712,7 @@ mod tests {
             threads: 1,
             fields: None,
             forces: None,
+            femu: Default::default(),
         }
     }
 

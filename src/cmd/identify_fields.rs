@@ -38,9 +38,7 @@ pub fn run(
              fields method); give it without --fields"
         );
     }
-    let config_path = dir.join("config.toml");
-    let config = live::RunConfig::read(Some(&config_path))
-        .with_context(|| format!("{}: the run's configuration", dir.display()))?;
+    let config = run_config(dir)?;
     let models = match &args.model {
         Some(list) => parse_model_list(list)?,
         None => config.identifier.models.0.clone(),
@@ -86,6 +84,12 @@ pub fn run(
         );
     }
     Ok(())
+}
+
+/// The configuration of the run whose results folder is `dir` (its `config.toml`).
+pub(super) fn run_config(dir: &Path) -> anyhow::Result<live::RunConfig> {
+    live::RunConfig::read(Some(&dir.join("config.toml")))
+        .with_context(|| format!("{}: the run's configuration", dir.display()))
 }
 
 /// The ranks shown: identifiable fits in BIC order, None for the others.
@@ -190,8 +194,10 @@ fn print_table(
     )
 }
 
+/// The `identify --fields` tests and their helpers (a results folder, the command run
+/// captured), shared with `identify_femu`'s.
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use clap::Parser;
     use identifier::data::LoadCase;
@@ -199,15 +205,15 @@ mod tests {
     use std::path::PathBuf;
 
     #[derive(Parser)]
-    struct Cli {
+    pub(in crate::cmd) struct Cli {
         #[command(flatten)]
-        args: IdentifyArgs,
+        pub args: IdentifyArgs,
     }
 
     /// A results folder of homogeneous equibiaxial fields (512 px square images, a 31 x 31
     /// mesh 16 px apart) whose grips pull what an arm of the default cruciform (100 mm wide, 2
     /// mm thick) carries under a Mooney law; removed on drop.
-    struct RunDir(PathBuf);
+    pub(in crate::cmd) struct RunDir(pub PathBuf);
 
     impl Drop for RunDir {
         fn drop(&mut self) {
@@ -252,7 +258,10 @@ mod tests {
     }
 
     /// `identify --fields DIR extra...`: its stdout, stderr and result.
-    fn identify(dir: &Path, extra: &[&str]) -> (String, String, anyhow::Result<()>) {
+    pub(in crate::cmd) fn identify(
+        dir: &Path,
+        extra: &[&str],
+    ) -> (String, String, anyhow::Result<()>) {
         let mut argv = vec!["identify".to_string(), "--fields".into()];
         argv.push(dir.display().to_string());
         argv.extend(extra.iter().map(|s| s.to_string()));
@@ -268,7 +277,7 @@ mod tests {
 
     /// Rewrites the file at `path` line by line (None: the line left out); returns its text
     /// before.
-    fn edit_lines(path: &Path, edit: impl Fn(&str) -> Option<String>) -> String {
+    pub(in crate::cmd) fn edit_lines(path: &Path, edit: impl Fn(&str) -> Option<String>) -> String {
         let text = std::fs::read_to_string(path).unwrap();
         let edited: String = text.lines().filter_map(edit).map(|l| l + "\n").collect();
         std::fs::write(path, edited).unwrap();

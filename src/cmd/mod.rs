@@ -8,6 +8,7 @@ pub mod correlator;
 pub mod gauge_report;
 pub mod identifier;
 pub mod identify;
+pub mod identify_femu;
 pub mod identify_fields;
 pub mod log_rows;
 pub mod monitor;

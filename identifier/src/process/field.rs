@@ -128,15 +128,44 @@ impl FieldFeed {
         (cols, rows): (usize, usize),
         gradients: Vec<Option<Mat2>>,
     ) -> FieldGrid {
-        let origin = self.view.to_mm(first_px);
-        let next = self.view.to_mm([first_px[0] + step_px, first_px[1]]);
+        let (origin, step_mm) = self.placement(first_px, step_px);
         FieldGrid {
             cols,
             rows,
             x0_mm: origin[0],
             y0_mm: origin[1],
-            step_mm: next[0] - origin[0],
+            step_mm,
             gradients,
+        }
+    }
+
+    /// The first node in specimen mm and the nodes' pitch, mm.
+    fn placement(&self, first_px: [f64; 2], step_px: f64) -> ([f64; 2], f64) {
+        let origin = self.view.to_mm(first_px);
+        let next = self.view.to_mm([first_px[0] + step_px, first_px[1]]);
+        (origin, next[0] - origin[0])
+    }
+
+    /// The measured displacements (px) of the same grid as [`Self::grid`] in specimen mm.
+    pub fn displacement_grid(
+        &self,
+        first_px: [f64; 2],
+        step_px: f64,
+        (cols, rows): (usize, usize),
+        displacements_px: Vec<Option<[f64; 2]>>,
+    ) -> crate::measured_displacement::DisplacementGrid {
+        let (origin, step_mm) = self.placement(first_px, step_px);
+        let to_mm = |u: [f64; 2]| {
+            let moved = self.view.to_mm([first_px[0] + u[0], first_px[1] + u[1]]);
+            [moved[0] - origin[0], moved[1] - origin[1]]
+        };
+        crate::measured_displacement::DisplacementGrid {
+            cols,
+            rows,
+            x0_mm: origin[0],
+            y0_mm: origin[1],
+            step_mm,
+            displacements_mm: displacements_px.into_iter().map(|u| u.map(to_mm)).collect(),
         }
     }
 

@@ -8,6 +8,7 @@
 // Each test file compiles this module and uses part of it.
 #![allow(dead_code)]
 
+use identifier::measured_displacement::DisplacementGrid;
 use identifier::models::Model;
 use identifier::section_cut::{ArmAxis, FieldGrid, SectionCut};
 use identifier::tapered_ramp::{RampQuadrature, TaperedRamp};
@@ -64,9 +65,11 @@ pub fn ramps() -> Vec<(TaperedRamp, &'static str)> {
     ramps
 }
 
-/// A frame: the measured field and each arm's axial grip force (N) by grip name.
+/// A frame: the measured field (its gradients, and its displacements on the same nodes) and
+/// each arm's axial grip force (N) by grip name.
 pub struct Frame {
     pub grid: FieldGrid,
+    pub displacements: DisplacementGrid,
     pub forces: Vec<(&'static str, f64)>,
 }
 
@@ -153,12 +156,9 @@ pub fn solved_frames_on<L: SheetLaw + ?Sized>(
             })
             .collect();
         for ((step, n, locations), frames) in grids.iter().zip(&mut frames) {
-            let gradients = locations
+            let samples: Vec<_> = locations
                 .iter()
-                .map(|at| {
-                    let at = (*at)?;
-                    membrane::sample_at(&specimen.mesh, &solved.displacement_mm, at).map(|s| s.f)
-                })
+                .map(|at| membrane::sample_at(&specimen.mesh, &solved.displacement_mm, (*at)?))
                 .collect();
             let grid = FieldGrid {
                 cols: *n,
@@ -166,10 +166,22 @@ pub fn solved_frames_on<L: SheetLaw + ?Sized>(
                 x0_mm: -HALF_VIEW_MM,
                 y0_mm: -HALF_VIEW_MM,
                 step_mm: *step,
-                gradients,
+                gradients: samples.iter().map(|s| s.map(|s| s.f)).collect(),
+            };
+            let displacements = DisplacementGrid {
+                cols: *n,
+                rows: *n,
+                x0_mm: -HALF_VIEW_MM,
+                y0_mm: -HALF_VIEW_MM,
+                step_mm: *step,
+                displacements_mm: samples
+                    .iter()
+                    .map(|s| s.map(|s| s.displacement_mm))
+                    .collect(),
             };
             frames.push(Frame {
                 grid,
+                displacements,
                 forces: forces.clone(),
             });
         }

@@ -9,6 +9,7 @@ mod cruciform;
 
 mod bad_input;
 mod fast_path;
+mod femu_structure;
 mod plot;
 mod round_trip;
 mod treloar;

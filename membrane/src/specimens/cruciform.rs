@@ -133,52 +133,98 @@ impl CruciformGeometry {
     /// The meshed cruciform with grips "x+", "y+", "x-", "y-" at the arms' ends.
     pub fn mesh(&self) -> Result<Specimen, GeometryError> {
         self.check()?;
+        self.mesh_to([self.arm_length_mm; 4])
+    }
+
+    /// The part of the cruciform inside the rectangle `x_mm` × `y_mm` (reference mm, the
+    /// centre at 0; a camera's field of view): each arm cut where the rectangle's edge crosses
+    /// its straight part (or at its grip if the rectangle reaches beyond it). Its "grips" are
+    /// the nodes on those edges, pulled along the arm: where the finite-element model updating
+    /// prescribes the measured displacements and reads each arm's force. Every arm must be cut
+    /// beyond its fillets; a cruciform with slits is refused (its slits would have to be cut
+    /// too).
+    pub fn clipped(&self, x_mm: [f64; 2], y_mm: [f64; 2]) -> Result<Specimen, GeometryError> {
+        self.check()?;
+        if self.slits_per_arm > 0 {
+            return Err(GeometryError::Slit {
+                reason: "a cruciform clipped to a view is meshed without slits",
+                count: self.slits_per_arm,
+                length_mm: self.slit_length_mm,
+            });
+        }
+        let straight_mm = 0.5 * self.arm_width_mm + self.fillet_radius_mm;
+        let grip_mm = 0.5 * self.arm_width_mm + self.arm_length_mm;
+        // Quarter order: x+, y+, x-, y-.
+        let reaches = [
+            ("x+", x_mm[1]),
+            ("y+", y_mm[1]),
+            ("x-", -x_mm[0]),
+            ("y-", -y_mm[0]),
+        ];
+        let mut lengths = [0.0; 4];
+        for (length, (arm, reach_mm)) in lengths.iter_mut().zip(reaches) {
+            if reach_mm.is_nan() || reach_mm <= straight_mm {
+                return Err(GeometryError::ArmNotCut {
+                    arm,
+                    reach_mm,
+                    straight_mm,
+                });
+            }
+            *length = reach_mm.min(grip_mm) - 0.5 * self.arm_width_mm;
+        }
+        self.mesh_to(lengths)
+    }
+
+    /// The mesh with each arm `lengths_mm` long (x+, y+, x-, y-), its grips at their ends.
+    fn mesh_to(&self, lengths_mm: [f64; 4]) -> Result<Specimen, GeometryError> {
         let (c, r, h) = (
             0.5 * self.arm_width_mm,
             self.fillet_radius_mm,
             self.element_size_mm,
         );
-        let grip_x = c + self.arm_length_mm;
         let fingers = self.slits_per_arm + 1;
         let across = cells(2.0 * c, h, 1).div_ceil(fingers) * fingers;
-        let curve = SectorCurve {
+        let curves = lengths_mm.map(|length_mm| SectorCurve {
             half_width: c,
             radius: r,
-            grip_x,
+            grip_x: c + length_mm,
             cells: if r > 0.0 {
                 [
                     cells(r * (1.0 - FRAC_1_SQRT_2) * 2f64.sqrt(), h, 1),
                     cells(0.25 * PI * r, h, 2),
-                    cells(self.arm_length_mm - r, h, 1),
+                    cells(length_mm - r, h, 1),
                 ]
             } else {
-                [0, 0, cells(self.arm_length_mm, h, 1)]
+                [0, 0, cells(length_mm, h, 1)]
             },
-        };
-        let along = curve.total_cells();
-        check_size(2 * (across * across + 4 * across * along))?;
-        // Slits: cut lines j = 2 across · m / fingers, from the node nearest the slit's tip on.
-        let slit_tip_x = grip_x - self.slit_length_mm;
-        let tip = (0..=2 * along)
-            .step_by(2)
-            .min_by(|&a, &b| {
-                let da = (curve.at(a)[0] - slit_tip_x).abs();
-                let db = (curve.at(b)[0] - slit_tip_x).abs();
-                da.total_cmp(&db)
-            })
-            .unwrap_or(2 * along);
-        let cut = |i: usize, j: usize| {
-            self.slits_per_arm > 0
-                && i > tip
-                && j.is_multiple_of(2 * across / fingers)
-                && j > 0
-                && j < 2 * across
-        };
-        let tolerance = tolerance_mm(grip_x);
+        });
+        let along: usize = curves.iter().map(SectorCurve::total_cells).sum();
+        check_size(2 * (across * across + across * along))?;
+        let longest_mm = c + lengths_mm.iter().copied().fold(0.0, f64::max);
+        let tolerance = tolerance_mm(longest_mm);
         let mut builder = MeshBuilder::new(tolerance);
         let across_at = |j: usize| 2.0 * j as f64 / (2 * across) as f64 - 1.0;
         builder.add_patch(across, across, |i, j| [c * across_at(i), c * across_at(j)]);
-        for quarter in 0..4 {
+        for (quarter, curve) in curves.iter().enumerate() {
+            let along = curve.total_cells();
+            // Slits: cut lines j = 2 across · m / fingers, from the node nearest the slit's
+            // tip on.
+            let slit_tip_x = curve.grip_x - self.slit_length_mm;
+            let tip = (0..=2 * along)
+                .step_by(2)
+                .min_by(|&a, &b| {
+                    let da = (curve.at(a)[0] - slit_tip_x).abs();
+                    let db = (curve.at(b)[0] - slit_tip_x).abs();
+                    da.total_cmp(&db)
+                })
+                .unwrap_or(2 * along);
+            let cut = |i: usize, j: usize| {
+                self.slits_per_arm > 0
+                    && i > tip
+                    && j.is_multiple_of(2 * across / fingers)
+                    && j > 0
+                    && j < 2 * across
+            };
             builder.add_cut_patch(
                 along,
                 across,
@@ -193,6 +239,7 @@ impl CruciformGeometry {
         let grips = [("x+", 0), ("y+", 1), ("x-", 2), ("y-", 3)]
             .map(|(name, quarter)| {
                 let axis = turn([1.0, 0.0], quarter);
+                let grip_x = curves[quarter].grip_x;
                 Grip {
                     name,
                     nodes: mesh.nodes_where(|p| {

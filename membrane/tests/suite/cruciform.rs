@@ -249,3 +249,54 @@ fn a_slit_cruciform_is_solved_with_its_fingers_free() {
     // The fingers do not pull each other sideways: the slit arm is softer.
     assert!(slit < whole && slit > 0.5 * whole, "{slit} vs {whole}");
 }
+
+/// A camera's view of the cruciform: the arms cut at the view's edges (each at its own
+/// reach), the area of the drawing less the arms' parts outside, grips on the cut edges; a
+/// view short of an arm's straight part, or a slit cruciform, refused.
+#[test]
+fn a_cruciform_clipped_to_a_view_ends_at_the_views_edges() {
+    let geometry = CruciformGeometry::default();
+    let (x_mm, y_mm) = ([-78.0, 76.0], [-74.5, 79.0]);
+    let clipped = geometry.clipped(x_mm, y_mm).unwrap();
+    let outside_mm: f64 = [130.0 - 78.0, 130.0 - 76.0, 130.0 - 74.5, 130.0 - 79.0]
+        .iter()
+        .map(|length| 100.0 * length)
+        .sum();
+    let exact = geometry.area_mm2() - outside_mm;
+    let area = clipped.mesh.area_mm2().unwrap();
+    assert!((area - exact).abs() < 1e-4 * exact, "{area} vs {exact} mm²");
+    for (name, reach_mm) in [("x+", 76.0), ("x-", 78.0), ("y+", 79.0), ("y-", 74.5)] {
+        let grip = clipped.grip(name).unwrap();
+        assert!(grip.nodes.len() >= 11, "{name}: {}", grip.nodes.len());
+        for &n in &grip.nodes {
+            let p = clipped.mesh.nodes_mm[n];
+            assert!((p[0] * grip.axis[0] + p[1] * grip.axis[1] - reach_mm).abs() < 1e-9);
+        }
+    }
+    // Beyond the grips: the whole specimen.
+    let whole = geometry.clipped([-200.0, 200.0], [-200.0, 200.0]).unwrap();
+    assert_eq!(whole, geometry.mesh().unwrap());
+    // The view stops in the x− fillet.
+    let error = geometry.clipped([-65.0, 78.0], y_mm).unwrap_err();
+    assert_eq!(
+        error,
+        GeometryError::ArmNotCut {
+            arm: "x-",
+            reach_mm: 65.0,
+            straight_mm: 70.0
+        }
+    );
+    assert!(
+        error.to_string().contains("arm x-: the view reaches 65 mm"),
+        "{error}"
+    );
+    let slit = CruciformGeometry {
+        slits_per_arm: 1,
+        slit_length_mm: 40.0,
+        ..CruciformGeometry::default()
+    };
+    assert!(matches!(
+        slit.clipped(x_mm, y_mm),
+        Err(GeometryError::Slit { .. })
+    ));
+}
