@@ -249,19 +249,26 @@ pub fn write_plots(
     }
     // f(I1) along the uniaxial path and g(I2) along the equibiaxial path (Figs 8 and 14): the
     // route's points against the identified law (the best-ranked fit that has f and g).
+    // A model without f and g (Ogden's is in the principal stretches) is passed over: the
+    // law drawn is then the best-ranked one that has them, and its label says so.
+    let wanted = if options.all_models {
+        MAX_FITS_PLOTTED
+    } else {
+        1
+    };
     let invariant_fits: Vec<&Fit> = shown
         .iter()
-        .take(if options.all_models {
-            MAX_FITS_PLOTTED
-        } else {
-            1
-        })
         .filter(|f| {
             f.model
                 .invariant_derivatives_mpa(&f.params, 3.0, 3.0)
                 .is_some()
         })
+        .take(wanted)
         .collect();
+    let identified = match (invariant_fits.first(), shown.first()) {
+        (Some(law), Some(best)) if std::ptr::eq(*law, best) => "identified law",
+        _ => "best-ranked law with f and g",
+    };
     for (case, which, name) in [
         (LoadCase::Uniaxial, 0, "f_I1"),
         (LoadCase::Equibiaxial, 1, "g_I2"),
@@ -276,7 +283,7 @@ pub fn write_plots(
         };
         series.extend(invariant_series(&invariant_fits, case, which, max_stretch));
         if let (Some(law), false) = (series.iter_mut().find(|s| !s.markers), options.all_models) {
-            law.label = format!("identified law: {}", law.label);
+            law.label = format!("{identified}: {}", law.label);
         }
         if series.is_empty() {
             continue;

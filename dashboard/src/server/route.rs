@@ -59,3 +59,30 @@ pub fn route(method: &str, path: &str, hub: &Hub) -> Route {
         _ => Route::Reply(Reply::text(404, "not found\n")),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_page_gets_the_figures_colour_maps() {
+        let js = colour_maps_js();
+        let viridis = wire::colour_map::ColourMap::Viridis.table(MAP_SAMPLES);
+        let diverging = wire::colour_map::ColourMap::Diverging.table(MAP_SAMPLES);
+        assert!(js.contains(&format!(
+            "viridis: {}",
+            serde_json::to_string(&viridis).unwrap()
+        )));
+        assert!(js.contains(&format!(
+            "diverging: {}",
+            serde_json::to_string(&diverging).unwrap()
+        )));
+        assert!(js.contains(&format!(
+            "NOISE_FLOOR_SIGMAS = {}",
+            wire::colour_range::NOISE_FLOOR_SIGMAS
+        )));
+        // The page loads it before its script.
+        let script = INDEX_HTML.find("/colour_maps.js").unwrap();
+        assert!(script < INDEX_HTML.find("/app.js").unwrap());
+    }
+}
