@@ -132,7 +132,7 @@ pub fn chart_paired(
                 (_, false) => palette(coloured),
             };
             lines += usize::from(!s.markers);
-            coloured += usize::from(!paired && !(s.markers && only_data));
+            coloured += usize::from(!(paired || s.markers && only_data));
             let pts: Vec<(f64, f64)> = s
                 .points
                 .iter()
