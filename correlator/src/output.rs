@@ -1,10 +1,13 @@
 //! Field files, one format each, shared by every tool that writes fields (`dicstream
 //! correlate`, the live bench's results): the CSV contract, legacy VTK structured grids for
-//! ParaView, and an RGB colour map of a node value over a grey image.
+//! ParaView, and an RGB colour map of a node value over a grey image (the maps and their
+//! ranges: `wire::colour_map`, `wire::colour_range`).
 
 use crate::field::{Field, Node, NodeStatus};
 use crate::StrainMeasure;
 use std::fmt::Write as _;
+use wire::colour_map::ColourScale;
+use wire::colour_range::{NodeGrid, RangeChoice};
 use wire::column_units::{Column, CsvUnits, ONE};
 use wire::scale::MmPerPx;
 
@@ -181,67 +184,54 @@ pub fn field_vtk(field: &Field, title: &str, text: &mut String) {
     }
 }
 
-/// Range of a colour map: the values at its blue and red ends.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ColourRange {
-    pub low: f64,
-    pub high: f64,
+/// Each node's `value` on the mesh's grid, `None` where the node is not `ok` or the value not
+/// finite: what [`wire::colour_range`] reads.
+pub fn node_values(field: &Field, value: impl Fn(&Node) -> f64) -> Vec<Option<f64>> {
+    field
+        .nodes
+        .iter()
+        .map(|n| Some(value(n)).filter(|v| n.status == NodeStatus::Ok && v.is_finite()))
+        .collect()
 }
 
-/// The narrowest range of a strain map: 0.2 %, ten times the strain noise of a good field, so a
-/// uniform field shows one colour.
-pub const MIN_STRAIN_SPAN: f64 = 0.002;
-/// The narrowest range of a displacement map, px.
-pub const MIN_DISPLACEMENT_SPAN_PX: f64 = 0.1;
-
-/// The colour map's colour at `t` in [0, 1] (0 blue, 0.5 green, 1 red), RGB in [0, 255].
-pub fn blue_to_red(t: f64) -> [f64; 3] {
-    [
-        255.0 * t,
-        255.0 * (1.0 - (2.0 * t - 1.0).abs()),
-        255.0 * (1.0 - t),
-    ]
+/// The colour scale of `value` over the field's valid nodes (`signed`, `lag_nodes` and
+/// `choice` as [`wire::colour_range::choose`]'s).
+pub fn field_colour_scale(
+    field: &Field,
+    value: impl Fn(&Node) -> f64,
+    signed: bool,
+    lag_nodes: usize,
+    choice: RangeChoice,
+) -> ColourScale {
+    let values = node_values(field, value);
+    let grid = NodeGrid {
+        values: &values,
+        nx: field.nx,
+        ny: field.ny,
+    };
+    wire::colour_range::choose(grid, lag_nodes, signed, choice)
 }
 
 /// RGB bytes (row-major, 3 per pixel) of the grey image `grey` (`width` px wide), overlaid
-/// inside the mesh with a blue-to-red map of `value` (bilinear between valid nodes; range =
-/// the 2nd to 98th percentile of the valid nodes' values, so that a few outliers do not flatten
-/// the map; values beyond saturate), widened about its middle to `min_span` at least, so that
-/// a uniform field shows one colour rather than its noise stretched over the whole map.
-/// Returns the range used.
+/// inside the mesh with `value` coloured by `scale` (bilinear between valid nodes; values
+/// beyond the scale's range at the colour of its end).
 pub fn colour_map_rgb(
     grey: &[u16],
     width: usize,
     field: &Field,
     value: impl Fn(&Node) -> f64,
-    min_span: f64,
-) -> (Vec<u8>, ColourRange) {
+    scale: &ColourScale,
+) -> Vec<u8> {
     assert!(width > 0 && grey.len().is_multiple_of(width), "image shape");
     let (w, h) = (width, grey.len() / width);
     let max_grey = grey.iter().copied().max().unwrap_or(1).max(1) as f64;
-    let mut valid: Vec<f64> = field
-        .nodes
-        .iter()
-        .filter(|n| n.status == NodeStatus::Ok)
-        .map(&value)
-        .filter(|v| v.is_finite())
-        .collect();
-    valid.sort_by(f64::total_cmp);
-    let quantile = |q: f64| valid[((valid.len() - 1) as f64 * q).round() as usize];
-    let (lo, hi) = if valid.is_empty() {
-        (0.0, 0.0)
-    } else {
-        let (lo, hi) = (quantile(0.02), quantile(0.98));
-        let widen = (min_span - (hi - lo)).max(0.0) / 2.0;
-        (lo - widen, hi + widen)
-    };
-    let span = if hi > lo { hi - lo } else { 1.0 };
+    let any_valid = node_values(field, &value).iter().any(Option::is_some);
     let mut rgb = vec![0u8; w * h * 3];
     for (k, &p) in grey.iter().enumerate() {
         let g = (255.0 * p as f64 / max_grey) as u8;
         rgb[3 * k..3 * k + 3].copy_from_slice(&[g, g, g]);
     }
-    if field.nx >= 2 && field.ny >= 2 && !valid.is_empty() {
+    if field.nx >= 2 && field.ny >= 2 && any_valid {
         let first = field.node(0, 0);
         let last = field.node(field.nx - 1, field.ny - 1);
         let (sx, sy) = (
@@ -279,23 +269,15 @@ pub fn colour_map_rgb(
                 if weight <= 1e-9 {
                     continue;
                 }
-                let colour = blue_to_red(((sum / weight - lo) / span).clamp(0.0, 1.0));
+                let colour = scale.rgb(sum / weight);
                 let px = &mut rgb[3 * (y * w + x)..3 * (y * w + x) + 3];
                 for (c, &col) in px.iter_mut().zip(&colour) {
-                    *c = (0.35 * *c as f64 + 0.65 * col) as u8;
+                    *c = (0.35 * *c as f64 + 0.65 * col as f64) as u8;
                 }
             }
         }
     }
-    let range = if valid.is_empty() {
-        ColourRange {
-            low: 0.0,
-            high: 0.0,
-        }
-    } else {
-        ColourRange { low: lo, high: hi }
-    };
-    (rgb, range)
+    rgb
 }
 
 #[cfg(test)]
@@ -410,36 +392,41 @@ mod tests {
     fn colour_map_spans_the_valid_values() {
         let f = field();
         let grey = vec![100u16; 16 * 12];
-        let (rgb, range) = colour_map_rgb(&grey, 16, &f, |n| n.exx, MIN_STRAIN_SPAN);
-        assert_eq!(rgb.len(), 16 * 12 * 3);
+        let scale = field_colour_scale(&f, |n| n.exx, true, 1, RangeChoice::Auto);
+        // exx 0 to 3 along x (one sign, linear: no noise, no floor): viridis over 0 to 3.
         assert_eq!(
-            range,
-            ColourRange {
+            scale,
+            ColourScale {
+                map: wire::colour_map::ColourMap::Viridis,
                 low: 0.0,
                 high: 3.0
             }
         );
-        // Left column of nodes (exx 0) is blue, right column (exx 3) red.
+        let rgb = colour_map_rgb(&grey, 16, &f, |n| n.exx, &scale);
+        assert_eq!(rgb.len(), 16 * 12 * 3);
+        // Left column of nodes (exx 0) dark violet, right column (exx 3) yellow.
         let px = |x: usize, y: usize| &rgb[3 * (y * 16 + x)..3 * (y * 16 + x) + 3];
-        assert!(px(2, 2)[2] > px(2, 2)[0]);
-        assert!(px(14, 2)[0] > px(14, 2)[2]);
+        assert!(px(2, 2)[2] > px(2, 2)[1], "{:?}", px(2, 2));
+        assert!(px(14, 2)[0] > 2 * px(14, 2)[2], "{:?}", px(14, 2));
         // Outside the mesh: grey.
         assert_eq!(px(0, 0), &[255, 255, 255]);
+        // The invalid node (3, 2) takes no part: a fixed range that only it would exceed.
+        let values = node_values(&f, |n| n.exx);
+        assert_eq!(values[11], None);
+        assert_eq!(values.iter().flatten().count(), 11);
     }
 
     #[test]
-    fn a_uniform_field_is_drawn_on_the_narrowest_range_about_its_value() {
+    fn a_signed_value_across_zero_is_drawn_white_at_zero() {
         let f = field();
-        let grey = vec![100u16; 16 * 12];
-        // exx 0.5 + 1e-4 x: noise about a uniform value.
-        let (_, range) = colour_map_rgb(&grey, 16, &f, |n| 0.5 + 1e-4 * n.exx, MIN_STRAIN_SPAN);
-        assert!(
-            (range.high - range.low - MIN_STRAIN_SPAN).abs() < 1e-12,
-            "{range:?}"
-        );
-        assert!(
-            (0.5 + 1.5e-4 - (range.low + range.high) / 2.0).abs() < 1e-12,
-            "{range:?}"
-        );
+        let grey = vec![0u16; 16 * 12];
+        // exx - 1.5: -1.5 to 1.5, the diverging map; at x = 8 (between nodes 1 and 2) zero.
+        let scale = field_colour_scale(&f, |n| n.exx - 1.5, true, 1, RangeChoice::Auto);
+        assert_eq!(scale.map, wire::colour_map::ColourMap::Diverging);
+        let rgb = colour_map_rgb(&grey, 16, &f, |n| n.exx - 1.5, &scale);
+        let px = |x: usize, y: usize| &rgb[3 * (y * 16 + x)..3 * (y * 16 + x) + 3];
+        // Over a black image 65 % of the map's white.
+        assert!(px(8, 4).iter().all(|&c| c > 150), "{:?}", px(8, 4));
+        assert!(px(2, 4)[2] > px(2, 4)[0] && px(13, 4)[0] > px(13, 4)[2]);
     }
 }

@@ -359,6 +359,28 @@ impl LiveState {
                 }
             }
         }
+        // Each strain's noise over the whole mesh, the floor of the page's automatic range
+        // (wire::colour_range; the live correlator's strain window is the library's, 1 node).
+        let lag = wire::colour_range::strain_noise_lag_nodes(1);
+        let noise = |get: fn(&FieldNode) -> f32| -> Option<f64> {
+            if self.nodes.len() != cols * rows {
+                return None;
+            }
+            let values: Vec<Option<f64>> = self
+                .nodes
+                .iter()
+                .map(|n| (n.status == NodeStatus::Ok as u32).then(|| f64::from(get(n))))
+                .collect();
+            let grid = wire::colour_range::NodeGrid {
+                values: &values,
+                nx: cols,
+                ny: rows,
+            };
+            wire::colour_range::noise_sigma(grid, lag).map(|s| significant(s, 3))
+        };
+        let noise_sigma = json!({
+            "exx": noise(|n| n.exx), "eyy": noise(|n| n.eyy), "exy": noise(|n| n.exy),
+        });
         let status_counts: Vec<Value> = NodeStatus::ALL
             .iter()
             .map(|&s| {
@@ -380,6 +402,7 @@ impl LiveState {
             "nodes": cols * rows,
             "status_counts": status_counts,
             "x": x, "y": y, "exx": exx, "eyy": eyy, "exy": exy, "status": status,
+            "noise_sigma": noise_sigma,
         })
     }
 

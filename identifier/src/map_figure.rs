@@ -5,6 +5,7 @@
 use crate::plot::{text_available, PlotError};
 use plotters::prelude::*;
 use std::path::Path;
+use wire::colour_map::ColourScale;
 
 /// Margins around the map, px: top (title), left and bottom.
 const TOP_PX: usize = 44;
@@ -23,13 +24,11 @@ pub struct MapFigure<'a> {
     pub height_px: usize,
     /// E.g. `exx (log strain), frame 530`.
     pub title: &'a str,
-    /// The values at the bar's bottom and top (the map's range).
-    pub low: f64,
-    pub high: f64,
+    /// The map's colours and the values at the bar's bottom and top: the scale the map
+    /// was coloured with, so that the bar shows the map's own colours.
+    pub scale: ColourScale,
     /// How a bar value is written, e.g. `|v| format!("{:.2} %", 100.0 * v)`.
     pub label: &'a dyn Fn(f64) -> String,
-    /// The map's colour at t in [0, 1], RGB 0-255 (the bar's colours).
-    pub colour: &'a dyn Fn(f64) -> [f64; 3],
 }
 
 /// The figure's size, px.
@@ -58,8 +57,7 @@ pub fn draw(figure: &MapFigure) -> Result<(Vec<u8>, (usize, usize)), PlotError> 
     let bar_x = SIDE_PX + w + SIDE_PX;
     for y in 0..h {
         // Top: the high end.
-        let t = 1.0 - y as f64 / (h - 1).max(1) as f64;
-        let colour = (figure.colour)(t).map(|c| c.clamp(0.0, 255.0) as u8);
+        let colour = figure.scale.bar_rgb(1.0 - y as f64 / (h - 1).max(1) as f64);
         for x in bar_x..bar_x + BAR_PX {
             let at = 3 * ((TOP_PX + y) * cw + x);
             canvas[at..at + 3].copy_from_slice(&colour);
@@ -75,7 +73,7 @@ pub fn draw(figure: &MapFigure) -> Result<(Vec<u8>, (usize, usize)), PlotError> 
         let small = ("sans-serif", 16).into_font().color(&BLACK);
         for k in 0..TICKS {
             let t = k as f64 / (TICKS - 1) as f64;
-            let value = figure.low + t * (figure.high - figure.low);
+            let value = figure.scale.low + t * (figure.scale.high - figure.scale.low);
             let y = TOP_PX as f64 + (1.0 - t) * (h - 1) as f64;
             let x = (bar_x + BAR_PX) as i32;
             root.draw(&PathElement::new(
@@ -105,26 +103,32 @@ mod tests {
     fn the_map_sits_under_its_title_beside_a_bar_from_low_to_high() {
         let (w, h) = (40, 30);
         let rgb = vec![7u8; w * h * 3];
-        let colour = |t: f64| [255.0 * t, 0.0, 255.0 * (1.0 - t)];
+        let scale = ColourScale {
+            map: wire::colour_map::ColourMap::Diverging,
+            low: -1.0,
+            high: 1.0,
+        };
         let label = |v: f64| format!("{v:.1}");
         let figure = MapFigure {
             rgb: &rgb,
             width_px: w,
             height_px: h,
             title: "exx",
-            low: 0.0,
-            high: 1.0,
+            scale,
             label: &label,
-            colour: &colour,
         };
         let (canvas, (cw, ch)) = draw(&figure).unwrap();
         assert_eq!((cw, ch), canvas_size(&figure));
         let px = |x: usize, y: usize| &canvas[3 * (y * cw + x)..3 * (y * cw + x) + 3];
         assert_eq!(px(SIDE_PX + 5, TOP_PX + 5), [7, 7, 7]);
         let bar_x = SIDE_PX + w + SIDE_PX + 3;
-        // Red (high) at the top of the bar, blue (low) at its bottom.
-        assert_eq!(px(bar_x, TOP_PX), [255, 0, 0]);
-        assert_eq!(px(bar_x, TOP_PX + h - 1), [0, 0, 255]);
+        // The scale's colours: red (high) at the top of the bar, blue (low) at its bottom.
+        assert_eq!(px(bar_x, TOP_PX), scale.rgb(1.0));
+        assert_eq!(px(bar_x, TOP_PX + h - 1), scale.rgb(-1.0));
+        assert_eq!(
+            px(bar_x, TOP_PX + h / 2),
+            scale.bar_rgb(1.0 - (h / 2) as f64 / (h - 1) as f64)
+        );
         let short = MapFigure {
             rgb: &rgb[3..],
             ..figure

@@ -20,14 +20,11 @@ const FONT_CANDIDATES: [&str; 4] = [
     "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
     "/usr/share/fonts/TTF/DejaVuSans.ttf",
 ];
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-];
+/// The `index`-th line's colour (`wire::colour_map::line_colour`, ten distinct in turn).
+fn palette(index: usize) -> RGBColor {
+    let [r, g, b] = wire::colour_map::line_colour(index);
+    RGBColor(r, g, b)
+}
 
 /// A plotting error naming the file.
 #[derive(Debug, thiserror::Error)]
@@ -74,7 +71,9 @@ pub fn chart(
 }
 
 /// [`chart`], where with `paired` a series of markers takes the colour of the line just
-/// before it (a model's points against its reference curve) instead of black (data).
+/// before it (a model's points against its reference curve). Otherwise every series takes
+/// the next of ten distinct colours, but for a chart's only series of markers (its data),
+/// black.
 pub fn chart_paired(
     path: &Path,
     title: &str,
@@ -122,15 +121,18 @@ pub fn chart_paired(
             .map_err(|e| err(&e))?;
         }
         // Paired: the lines take the palette in turn and each line's markers its colour.
-        let mut lines = 0;
-        for (k, s) in series.iter().enumerate() {
+        let only_data = series.iter().filter(|s| s.markers).count() == 1;
+        let (mut lines, mut coloured) = (0, 0);
+        for s in series {
             let color = match (s.markers, paired) {
-                (true, true) if lines > 0 => PALETTE[(lines - 1) % PALETTE.len()],
-                (true, _) => BLACK,
-                (false, true) => PALETTE[lines % PALETTE.len()],
-                (false, false) => PALETTE[k % PALETTE.len()],
+                (true, true) if lines > 0 => palette(lines - 1),
+                (true, true) => BLACK,
+                (false, true) => palette(lines),
+                (true, false) if only_data => BLACK,
+                (_, false) => palette(coloured),
             };
             lines += usize::from(!s.markers);
+            coloured += usize::from(!(paired || s.markers && only_data));
             let pts: Vec<(f64, f64)> = s
                 .points
                 .iter()
@@ -212,12 +214,23 @@ fn sample(from: f64, to: f64) -> impl Iterator<Item = f64> {
     (0..=CURVE_SAMPLES).map(move |k| from + (to - from) * k as f64 / CURVE_SAMPLES as f64)
 }
 
-/// Writes `stress_<case>.png` per load case, `f_I1.png` and `g_I2.png` into `dir`; returns the paths.
+/// What the f(I1) and g(I2) plots show besides the route's points.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PlotOptions {
+    /// Every shown fit (at most [`MAX_FITS_PLOTTED`]) and the route's own fitted f and g, not
+    /// only the identified law (the best-ranked fit).
+    pub all_models: bool,
+}
+
+/// Writes `stress_<case>.png` per load case, `f_I1.png` and `g_I2.png` into `dir`; returns the
+/// paths. `route`: the paper's route, or why it could not run (the f and g plots then say so
+/// in their title, over the identified law alone).
 pub fn write_plots(
     dir: &Path,
     curves: &[Curve],
     fits: &[Fit],
-    route: Option<&RouteResult>,
+    route: Result<&RouteResult, &str>,
+    options: PlotOptions,
 ) -> Result<Vec<PathBuf>, PlotError> {
     std::fs::create_dir_all(dir)
         .map_err(|e| PlotError(format!("{}: cannot create the folder: {e}", dir.display())))?;
@@ -234,7 +247,15 @@ pub fn write_plots(
         )?;
         written.push(path);
     }
-    // f(I1) along the uniaxial path and g(I2) along the equibiaxial path (Figs 8 and 14).
+    // f(I1) along the uniaxial path and g(I2) along the equibiaxial path (Figs 8 and 14): the
+    // route's points against the identified law (the best-ranked fit that has f and g).
+    // A model without f and g (Ogden's is in the principal stretches) is passed over: the
+    // law drawn is then the best-ranked one that has them, and its label says so.
+    let wanted = if options.all_models {
+        MAX_FITS_PLOTTED
+    } else {
+        1
+    };
     let invariant_fits: Vec<&Fit> = shown
         .iter()
         .filter(|f| {
@@ -242,7 +263,12 @@ pub fn write_plots(
                 .invariant_derivatives_mpa(&f.params, 3.0, 3.0)
                 .is_some()
         })
+        .take(wanted)
         .collect();
+    let identified = match (invariant_fits.first(), shown.first()) {
+        (Some(law), Some(best)) if std::ptr::eq(*law, best) => "identified law",
+        _ => "best-ranked law with f and g",
+    };
     for (case, which, name) in [
         (LoadCase::Uniaxial, 0, "f_I1"),
         (LoadCase::Equibiaxial, 1, "g_I2"),
@@ -252,10 +278,13 @@ pub fn write_plots(
         };
         let max_stretch = curve.stretch.last().copied().unwrap_or(1.0);
         let mut series = match route {
-            Some(r) => route_series(r, case, which, max_stretch),
-            None => Vec::new(),
+            Ok(r) => route_series(r, case, which, max_stretch, options.all_models),
+            Err(_) => Vec::new(),
         };
         series.extend(invariant_series(&invariant_fits, case, which, max_stretch));
+        if let (Some(law), false) = (series.iter_mut().find(|s| !s.markers), options.all_models) {
+            law.label = format!("{identified}: {}", law.label);
+        }
         if series.is_empty() {
             continue;
         }
@@ -265,7 +294,11 @@ pub fn write_plots(
         } else {
             ("g(I2) = dW/dI2 along the equibiaxial path", "I2", "g (MPa)")
         };
-        chart(&path, title, x, y, &series)?;
+        let title = match route {
+            Ok(_) => title.to_string(),
+            Err(why) => format!("{title}: no data points ({why})"),
+        };
+        chart(&path, &title, x, y, &series)?;
         written.push(path);
     }
     Ok(written)
@@ -301,11 +334,17 @@ fn stress_series(curve: &Curve, shown: &[Fit]) -> Vec<Series> {
     series
 }
 
-/// The paper's route along `case`'s path: f (`which` 0: eq. 19 and 20, and its fit) or g (1:
-/// eq. 23, and its two fits).
-fn route_series(r: &RouteResult, case: LoadCase, which: usize, max_stretch: f64) -> Vec<Series> {
+/// The paper's route along `case`'s path: f (`which` 0: eq. 19 and 20, and with `fitted` its
+/// fit) or g (1: eq. 23, and with `fitted` its two fits).
+fn route_series(
+    r: &RouteResult,
+    case: LoadCase,
+    which: usize,
+    max_stretch: f64,
+    fitted: bool,
+) -> Vec<Series> {
     let mut series = Vec::new();
-    let (points, label, fitted): (&Vec<(f64, f64)>, &str, Vec<LabelledFn>) = if which == 0 {
+    let (points, label, functions): (&Vec<(f64, f64)>, &str, Vec<LabelledFn>) = if which == 0 {
         (
             &r.f_points,
             "f from eq. 19 (g-corrected)",
@@ -342,7 +381,7 @@ fn route_series(r: &RouteResult, case: LoadCase, which: usize, max_stretch: f64)
             markers: true,
         });
     }
-    for (label, func) in fitted {
+    for (label, func) in functions.into_iter().filter(|_| fitted) {
         let points = sample(1.0 + 1e-3, max_stretch)
             .map(|l| {
                 let (i1, i2) = case.invariants(l);

@@ -73,6 +73,53 @@ impl FieldScale {
     }
 }
 
+/// The run's scale as `summary.json` says it: mm per px (on a strip too, when the simulated
+/// camera re-frames on it) and where it came from.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ScaleReport {
+    /// None: no scale known (px only).
+    pub mm_per_px: Option<f64>,
+    /// The simulated camera's on a strip, when it differs from `mm_per_px`'s framing.
+    pub strip_mm_per_px: Option<f64>,
+    pub from: String,
+}
+
+impl ScaleReport {
+    pub fn of(config: &RunConfig) -> ScaleReport {
+        let c = &config.camera;
+        let user = |scale: MmPerPx, from: String| ScaleReport {
+            mm_per_px: Some(scale.get()),
+            strip_mm_per_px: None,
+            from,
+        };
+        match FieldScale::of(config) {
+            FieldScale::User(scale) => match c.scale_known_length {
+                Some(known) => user(
+                    scale,
+                    format!(
+                        "[camera] scale_known_length = \"{known}\": {} mm over {:.3} px",
+                        known.length_mm,
+                        known.distance_px()
+                    ),
+                ),
+                None => user(scale, "[camera] scale_mm_per_px".to_string()),
+            },
+            FieldScale::Framing(f) => ScaleReport {
+                mm_per_px: Some(f.mm_per_px),
+                strip_mm_per_px: Some(f.strip_mm_per_px),
+                from: "the simulated camera's framing ([camera] mm_per_px; strip_mm_per_px \
+                       on a strip)"
+                    .to_string(),
+            },
+            FieldScale::None => ScaleReport {
+                mm_per_px: None,
+                strip_mm_per_px: None,
+                from: FieldScale::None.note(),
+            },
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -97,6 +144,29 @@ mod tests {
         assert_eq!(direct.of_field(Some(2)), MmPerPx::new(0.05).ok());
         let known = config("[camera]\nscale_known_length = \"0,0 300,400 25\"\n");
         assert_eq!(known.of_field(None), MmPerPx::new(0.05).ok());
+        let report = |toml: &str| ScaleReport::of(&RunConfig::from_toml(toml, "t.toml").unwrap());
+        let from_length = report("[camera]\nscale_known_length = \"0,0 300,400 25\"\n");
+        assert_eq!(from_length.mm_per_px, Some(0.05));
+        assert!(
+            from_length.from.contains("scale_known_length")
+                && from_length.from.contains("500.000 px"),
+            "{from_length:?}"
+        );
+        let direct = report("[camera]\nscale_mm_per_px = 0.05\n");
+        assert_eq!(
+            (direct.mm_per_px, direct.from.as_str()),
+            (Some(0.05), "[camera] scale_mm_per_px")
+        );
+        let framing = report("");
+        assert_eq!(framing.mm_per_px, Some(producer::DEFAULT_MM_PER_PX));
+        assert_eq!(
+            framing.strip_mm_per_px,
+            Some(producer::DEFAULT_STRIP_MM_PER_PX)
+        );
+        assert!(framing.from.contains("simulated camera"));
+        let none = report("[camera]\nsource = \"replay\"\n");
+        assert_eq!(none.mm_per_px, None);
+        assert!(none.from.contains("no scale known"), "{none:?}");
         let real = RunConfig::from_toml("[camera]\nsource = \"replay\"\n", "t.toml").unwrap();
         let real = FieldScale::of(&real);
         assert_eq!(real.of_field(None), None);

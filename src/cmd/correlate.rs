@@ -3,7 +3,7 @@
 //!
 //! Writes `DIR/field_NNNN.csv` per deformed image (NNNN from 0001 in argument order),
 //! `DIR/summary.json` (rewritten after every frame), and with `--vtk` / `--png` a legacy VTK
-//! structured grid and colour maps of |u| and exx over the reference image. Every file is
+//! structured grid and figures of u, v, exx, eyy, exy over the reference image. Every file is
 //! written atomically (temporary sibling, then rename). Images are read by `producer::read_image`.
 
 use super::gauge_report::{reading_line, readings_json, strains_json};
@@ -17,6 +17,7 @@ use correlator::{
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use wire::colour_range::RangeChoice;
 use wire::scale::MmPerPx;
 
 /// The library's defaults, the command line's defaults.
@@ -144,9 +145,17 @@ pub struct CorrelateArgs {
     /// XML ones (field_NNNN.vts) and fields.pvd, their collection (time step = image index).
     #[arg(long)]
     pub vtk: bool,
-    /// Also write colour maps of |u| and exx over the reference image (u_NNNN.png, exx_NNNN.png).
+    /// Also write figures of u, v, exx, eyy and exy over the reference image
+    /// (u_NNNN.png, v_NNNN.png, exx_NNNN.png, ...), each with its title and colour bar.
     #[arg(long)]
     pub png: bool,
+    /// The figures' colour range: auto (the 2nd to 98th percentile of the valid nodes, at
+    /// least 30 times the field's own noise wide, so that a uniform field shows one colour),
+    /// symmetric (about zero) or LO:HI (in the quantity's unit: px, or strain as a fraction,
+    /// e.g. -0.01:0.01). A signed quantity across zero takes a blue-white-red map centred on
+    /// zero, any other viridis.
+    #[arg(long, default_value_t = RangeChoice::Auto, value_name = "auto|symmetric|LO:HI")]
+    pub range: RangeChoice,
 }
 
 impl CorrelateArgs {
@@ -341,25 +350,7 @@ fn write_field_files(
         write(&args.out.join(PVD), pvd.to_xml().as_bytes())?;
     }
     if args.png {
-        let magnitude = |n: &correlator::Node| n.u_px.hypot(n.v_px);
-        write(
-            &args.out.join(format!("u_{index:04}.png")),
-            &colour_map(
-                reference,
-                field,
-                magnitude,
-                correlator::output::MIN_DISPLACEMENT_SPAN_PX,
-            )?,
-        )?;
-        write(
-            &args.out.join(format!("exx_{index:04}.png")),
-            &colour_map(
-                reference,
-                field,
-                |n| n.exx,
-                correlator::output::MIN_STRAIN_SPAN,
-            )?,
-        )?;
+        write_figures(args, reference, field, index)?;
     }
     Ok(())
 }
@@ -455,32 +446,74 @@ fn settings_json(args: &CorrelateArgs, correlator: &Correlator) -> serde_json::V
         "strain_window_nodes": correlator.settings().strain_window_nodes,
         "mm_per_px": args.scale().map(MmPerPx::get),
         "scale_from": args.scale_from(),
+        "figure_range": args.range.to_string(),
     })
 }
 
-/// PNG of `value` over the reference image (see `correlator::output::colour_map_rgb`).
-fn colour_map(
+/// The quantities `--png` draws: file prefix, value, unit (px or strain) and what they are.
+type Quantity = (
+    &'static str,
+    fn(&correlator::Node) -> f64,
+    bool,
+    &'static str,
+);
+const FIGURES: [Quantity; 5] = [
+    ("u", |n| n.u_px, false, "displacement along x"),
+    ("v", |n| n.v_px, false, "displacement along y"),
+    ("exx", |n| n.exx, true, "strain xx"),
+    ("eyy", |n| n.eyy, true, "strain yy"),
+    ("exy", |n| n.exy, true, "strain xy (tensor)"),
+];
+
+/// Frame `index`'s figures of [`FIGURES`] over the reference image, each with its title and
+/// colour bar (`correlator::output::colour_map_rgb`, `identifier::map_figure`).
+fn write_figures(
+    args: &CorrelateArgs,
     reference: &producer::Image16,
     field: &Field,
-    value: impl Fn(&correlator::Node) -> f64,
-    min_span: f64,
-) -> Result<Vec<u8>> {
-    let (rgb, _range) = correlator::output::colour_map_rgb(
-        &reference.pixels,
-        reference.width as usize,
-        field,
-        value,
-        min_span,
-    );
-    let (w, h) = (reference.width as usize, reference.height as usize);
-    let mut bytes = Vec::new();
-    image::ImageEncoder::write_image(
-        image::codecs::png::PngEncoder::new(&mut bytes),
-        &rgb,
-        w as u32,
-        h as u32,
-        image::ExtendedColorType::Rgb8,
-    )
-    .context("PNG encoding of the colour map")?;
-    Ok(bytes)
+    index: usize,
+) -> Result<()> {
+    let settings = args.settings();
+    let strain_lag = wire::colour_range::strain_noise_lag_nodes(settings.strain_window_nodes);
+    let scale_note = args
+        .scale()
+        .map(|s| format!("; {s} mm per px"))
+        .unwrap_or_default();
+    for (name, value, strain, what) in FIGURES {
+        let lag = if strain { strain_lag } else { 1 };
+        let scale = correlator::output::field_colour_scale(field, value, true, lag, args.range);
+        let rgb = correlator::output::colour_map_rgb(
+            &reference.pixels,
+            reference.width as usize,
+            field,
+            value,
+            &scale,
+        );
+        let title = if strain {
+            format!(
+                "{name}, {what} ({} strain, %), image {index:04}",
+                settings.strain.name()
+            )
+        } else {
+            format!("{name}, {what} (px{scale_note}), image {index:04}")
+        };
+        let label = |v: f64| match strain {
+            true => format!("{:+.3} %", 100.0 * v),
+            false => format!("{v:+.3} px"),
+        };
+        let path = args.out.join(format!("{name}_{index:04}.png"));
+        identifier::map_figure::write(
+            &path,
+            &identifier::map_figure::MapFigure {
+                rgb: &rgb,
+                width_px: reference.width as usize,
+                height_px: reference.height as usize,
+                title: &title,
+                scale,
+                label: &label,
+            },
+        )
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
 }

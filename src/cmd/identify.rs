@@ -86,6 +86,10 @@ pub struct IdentifyArgs {
     /// into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// With --plot: f(I1) and g(I2) show every ranked model (up to six) and the route's own
+    /// fitted f and g, not only the identified law (the best-ranked model) against the points.
+    #[arg(long, requires = "plot")]
+    pub all_models: bool,
     /// Write each fit's FE coefficient cards into this folder: `abaqus_<model>.inp`
     /// (`*HYPERELASTIC`) and `ansys_<model>.mac` (`TB,HYPER`), for the models the codes have.
     #[arg(long, value_name = "DIR")]
@@ -157,7 +161,7 @@ pub fn run_with(
         for (m, e) in &outcome.failures {
             writeln!(err, "not fitted: {m}: {e}")?;
         }
-        if let Some(r) = &outcome.route {
+        if let Ok(r) = &outcome.route {
             writeln!(
                 out,
                 "\npaper route (eqs 20-25, n = 2): ln f: a = {:?}; ln g: b = {:?}; g = Σ c_i/I2^i: c = {:?}",
@@ -172,9 +176,22 @@ pub fn run_with(
         )?;
     }
     if let Some(dir) = &args.plot {
-        let written =
-            identifier::plot::write_plots(dir, &curves, &outcome.fits, outcome.route.as_ref())
-                .with_context(|| format!("writing plots into {}", dir.display()))?;
+        let written = identifier::plot::write_plots(
+            dir,
+            &curves,
+            &outcome.fits,
+            outcome.route.as_ref().map_err(String::as_str),
+            identifier::plot::PlotOptions {
+                all_models: args.all_models,
+            },
+        )
+        .with_context(|| format!("writing plots into {}", dir.display()))?;
+        if let Err(why) = &outcome.route {
+            writeln!(
+                err,
+                "plots: f(I1) and g(I2) without data points: the paper's route did not run ({why})"
+            )?;
+        }
         for path in written {
             writeln!(err, "wrote {}", path.display())?;
         }
@@ -246,7 +263,7 @@ fn read_data(args: &IdentifyArgs) -> anyhow::Result<(Vec<Curve>, Vec<BiaxialStat
 struct Outcome {
     fits: Vec<Fit>,
     failures: Vec<(Model, FitError)>,
-    route: Option<RouteResult>,
+    route: Result<RouteResult, String>,
     subsample: Option<Subsample>,
 }
 
@@ -290,13 +307,10 @@ fn fit(
             (fit.rms_mpa, fit.cases) = evaluate_data(&fit.model, &fit.params, all);
         }
     }
-    let route = match paper_route(all.curves, 2, 2) {
-        Ok(route) => Some(route),
-        Err(e) => {
-            writeln!(err, "paper route (eqs. 20-25) not run: {e}")?;
-            None
-        }
-    };
+    let route = paper_route(all.curves, 2, 2).map_err(|e| e.to_string());
+    if let Err(e) = &route {
+        writeln!(err, "paper route (eqs. 20-25) not run: {e}")?;
+    }
     Ok(Outcome {
         fits,
         failures,
@@ -329,7 +343,7 @@ fn write_json(out: &mut dyn Write, outcome: &Outcome) -> anyhow::Result<()> {
         .map(|(m, e)| json!({"model": m.name(), "error": e.to_string()}))
         .collect();
     let mut json_out = json!({"fits": fits_json, "failures": failures_json});
-    if let Some(r) = &outcome.route {
+    if let Ok(r) = &outcome.route {
         json_out["paper_route"] = json!({"a": r.a, "b": r.b, "c": r.c});
     }
     if let Some(s) = &outcome.subsample {
@@ -541,6 +555,7 @@ mod tests {
                 residual: ResidualArg::Absolute,
                 json,
                 plot: None,
+                all_models: false,
                 cards: None,
                 max_fit_points,
                 skip_lines: 0,
@@ -704,6 +719,7 @@ mod tests {
             residual: ResidualArg::Absolute,
             json: true,
             plot: None,
+            all_models: false,
             cards: None,
             max_fit_points: DEFAULT_MAX_FIT_POINTS as u64,
             skip_lines: 0,
@@ -836,6 +852,13 @@ mod tests {
             "{err}"
         );
         assert!(image::open(&residuals).is_ok(), "residuals.png is a PNG");
+        // Uniaxial data alone: the route cannot run; f(I1) is drawn with the identified law
+        // alone, its title and stderr saying why there are no points.
+        assert!(
+            err.contains("f(I1) and g(I2) without data points: the paper's route did not run"),
+            "{err}"
+        );
+        assert!(image::open(data.0.join("plots/f_I1.png")).is_ok(), "{err}");
         let value: Value = serde_json::from_str(&out).expect("stdout is one JSON document");
         let fits = value["fits"].as_array().unwrap();
         eprintln!("{err}");

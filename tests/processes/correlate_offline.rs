@@ -205,6 +205,44 @@ fn a_bad_scale_is_refused_with_its_reason() {
 }
 
 #[test]
+fn figure_ranges_are_obeyed_and_bad_ones_refused() {
+    let dir = TempDir::new("ranges");
+    for (range, expected) in [
+        ("0.2:0.1", "LO 0.2 is not below HI 0.1"),
+        ("NaN:1", "LO NaN is not finite"),
+        ("0.1:0.1", "is not below"),
+        ("wide", "neither a word nor LO:HI"),
+    ] {
+        let (output, _) = correlate_two(&dir, "out", &["--png", "--range", range]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !output.status.success() && stderr.contains(expected),
+            "{range}: {stderr}"
+        );
+    }
+    // A fixed range: the bar's ends are its values, whatever the field.
+    let (output, out) = correlate_two(&dir, "fixed", &["--png", "--range", "-2:2"]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["settings"]["figure_range"], "-2:2");
+    // u 0.4 px on a range of -2 to 2 px, centred on zero: pale red, red above blue.
+    let png = image::open(out.join("u_0001.png")).unwrap().to_rgb8();
+    let centre = png.get_pixel(12 + W as u32 / 2, 44 + H as u32 / 2).0;
+    let grey = image::open(out.join("v_0001.png")).unwrap().to_rgb8();
+    let v_centre = grey.get_pixel(12 + W as u32 / 2, 44 + H as u32 / 2).0;
+    assert!(centre[0] > centre[2], "u > 0 reddish: {centre:?}");
+    assert!(
+        (v_centre[0] as i32 - v_centre[2] as i32).abs() < (centre[0] as i32 - centre[2] as i32),
+        "v 0 nearer white than u 0.4: {v_centre:?} {centre:?}"
+    );
+}
+
+#[test]
 fn fields_and_summary_follow_the_contract() {
     let dir = TempDir::new("contract");
     let shifts = [(0.3, -0.2), (0.75, 0.45)];
@@ -271,9 +309,15 @@ fn fields_and_summary_follow_the_contract() {
         let vtk = std::fs::read_to_string(out.join(format!("field_{index:04}.vtk"))).unwrap();
         assert!(vtk.starts_with("# vtk DataFile Version 3.0"));
         assert!(vtk.contains("VECTORS displacement_px double"));
-        for map in ["u", "exx"] {
+        // Each quantity's figure: the image under its title, beside its colour bar.
+        for map in ["u", "v", "exx", "eyy", "exy"] {
             let png = producer::read_image(out.join(format!("{map}_{index:04}.png"))).unwrap();
-            assert_eq!((png.width as usize, png.height as usize), (W, H));
+            assert!(
+                png.width as usize > W + 100 && png.height as usize > H + 40,
+                "{map}: {} x {}",
+                png.width,
+                png.height
+            );
         }
     }
     let summary: serde_json::Value =

@@ -13,6 +13,8 @@
 //! origin at the centre of the top-left pixel; u, v are Lagrangian displacements in pixels.
 
 pub mod clock;
+pub mod colour_map;
+pub mod colour_range;
 pub mod column_units;
 pub mod delimited;
 pub mod descriptors;

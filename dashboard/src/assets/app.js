@@ -17,12 +17,21 @@ const esc = (s) => String(s).replace(/[&<>"]/g, (c) => ({ '&': '&amp;', '<': '&l
 const STATUS_COLORS = ['#00000000', '#ff00ff', '#808080', '#ffffff', '#ff8c00', '#ffff00', '#00ffff'];
 const SERIES_COLORS = ['#d64545', '#2b6cb0', '#2f8132', '#8e44ad', '#c65d07'];
 
-// ---- colour map (jet, as the paper's strain maps) ----
-function jet(t) {
-  t = Math.min(1, Math.max(0, t));
-  const c = (x) => Math.round(255 * Math.min(1, Math.max(0, 1.5 - Math.abs(4 * t - x))));
-  return [c(3), c(2), c(1)];
+// ---- colour maps: the figures' own (wire::colour_map, served as /colour_maps.js) ----
+function mapColour(name, t) {
+  const table = COLOUR_MAPS[name];
+  t = isFinite(t) ? Math.min(1, Math.max(0, t)) : 0.5;
+  const x = t * (table.length - 1), i = Math.min(table.length - 2, Math.floor(x)), f = x - i;
+  return [0, 1, 2].map((k) => Math.round(table[i][k] + f * (table[i + 1][k] - table[i][k])));
 }
+// Where a value falls on a scale {map, lo, hi}: the diverging map is centred on zero.
+function scaleT(s, v) {
+  if (s.map === 'diverging') {
+    return 0.5 + Math.min(s.hi, Math.max(s.lo, v)) / (2 * Math.max(Math.abs(s.lo), Math.abs(s.hi)));
+  }
+  return (v - s.lo) / (s.hi - s.lo);
+}
+const scaleColour = (s, v) => mapColour(s.map, scaleT(s, v));
 
 // ---- charts ----
 function niceTicks(lo, hi, n) {
@@ -151,31 +160,62 @@ const img = new Image();
 let imgVersion = -1, imgReady = false;
 img.onload = () => { imgReady = true; drawSpecimen(); };
 
-function colourRange(values) {
-  if ($('range-mode').value === 'fixed') {
-    return [parseFloat($('range-min').value), parseFloat($('range-max').value)];
+// The map's scale, as wire::colour_range::choose: automatic (2nd-98th percentile, at least
+// NOISE_FLOOR_SIGMAS times the field's noise `sigma` wide, centred on zero when it straddles it),
+// symmetric about zero, or fixed; a fixed range whose minimum is not below its maximum is
+// refused: {error}.
+function colourScale(values, sigma) {
+  const mode = $('range-mode').value;
+  if (mode === 'fixed') {
+    const lo = parseFloat($('range-min').value), hi = parseFloat($('range-max').value);
+    if (!isFinite(lo) || !isFinite(hi)) return { error: 'fixed range: min and max must be numbers' };
+    if (!(lo < hi)) return { error: `fixed range refused: min ${lo} is not below max ${hi}` };
+    return { map: lo < 0 && hi > 0 ? 'diverging' : 'viridis', lo, hi };
   }
   const v = values.filter((x) => x !== null && isFinite(x)).sort((a, b) => a - b);
-  if (v.length === 0) return [0, 1];
-  const lo = v[Math.floor(0.02 * (v.length - 1))], hi = v[Math.ceil(0.98 * (v.length - 1))];
-  return hi > lo ? [lo, hi] : [lo - 1e-4, hi + 1e-4];
+  const floor = (sigma !== null && sigma !== undefined && isFinite(sigma)) ? NOISE_FLOOR_SIGMAS * sigma : 0;
+  let [lo, hi] = v.length === 0 ? [0, 0]
+    : [v[Math.round(0.02 * (v.length - 1))], v[Math.round(0.98 * (v.length - 1))]];
+  let scale;
+  if (mode === 'symmetric') {
+    const reach = Math.max(Math.abs(lo), Math.abs(hi), floor / 2);
+    scale = { map: 'diverging', lo: -reach, hi: reach };
+  } else {
+    const widen = Math.max(0, floor - (hi - lo)) / 2;
+    lo -= widen; hi += widen;
+    const reach = Math.max(Math.abs(lo), Math.abs(hi));
+    scale = lo < 0 && hi > 0 ? { map: 'diverging', lo: -reach, hi: reach } : { map: 'viridis', lo, hi };
+  }
+  if (!(scale.hi > scale.lo)) {
+    const half = Math.max(Math.abs(scale.lo) * 1e-6, 1e-12);
+    scale.lo -= half; scale.hi += half;
+  }
+  return scale;
 }
 
-function drawColorbar(lo, hi, label) {
+function drawColorbar(scale, label) {
   const c = $('colorbar'), ctx = c.getContext('2d');
   ctx.clearRect(0, 0, c.width, c.height);
+  ctx.fillStyle = '#222'; ctx.font = '11px system-ui, sans-serif';
+  ctx.fillText(label, 0, 10);
   const T = 24, B = 14, h = c.height - T - B;
+  if (scale.error) {
+    dash.rangeError = scale.error;
+    ctx.fillStyle = '#b00'; ctx.fillText('range', 0, T + 10); ctx.fillText('refused', 0, T + 24);
+    return;
+  }
+  dash.rangeError = null;
+  const { lo, hi } = scale;
   for (let i = 0; i < h; i++) {
-    const [r, g, b] = jet(1 - i / h);
+    const [r, g, b] = scaleColour(scale, hi - (hi - lo) * i / (h - 1));
     ctx.fillStyle = `rgb(${r},${g},${b})`;
     ctx.fillRect(0, T + i, 16, 1);
   }
-  ctx.fillStyle = '#222'; ctx.font = '11px system-ui, sans-serif';
+  ctx.fillStyle = '#222';
   for (let k = 0; k <= 4; k++) {
     const v = hi - (hi - lo) * k / 4;
     ctx.fillText(Math.abs(v) < 1e-3 && v !== 0 ? v.toExponential(1) : v.toFixed(4), 19, T + h * k / 4 + 4);
   }
-  ctx.fillText(label, 0, 10);
 }
 
 // Seth-Hill strain measures are functions of the principal stretches on the same axes: log
@@ -217,14 +257,15 @@ function drawSpecimen() {
   if (f && f.x.length > 0) {
     const comp = $('component').value, [converted, measureName] = mapValues(f, comp);
     const values = converted || f[comp].map(() => null);
-    const [lo, hi] = colourRange(values);
+    const scale = colourScale(values, f.noise_sigma ? f.noise_sigma[comp] : null);
+    dash.mapScale = scale;
     const cell = Math.max(1, f.step_px * f.stride / im.factor);
-    if ($('show-map').checked) {
+    if ($('show-map').checked && !scale.error) {
       ctx.globalAlpha = 0.55;
       for (let i = 0; i < f.x.length; i++) {
         const v = values[i];
         if (v === null) continue;
-        const [r, g, b] = jet((v - lo) / (hi - lo));
+        const [r, g, b] = scaleColour(scale, v);
         ctx.fillStyle = `rgb(${r},${g},${b})`;
         ctx.fillRect(f.x[i] / im.factor - cell / 2, f.y[i] / im.factor - cell / 2, cell, cell);
       }
@@ -241,7 +282,7 @@ function drawSpecimen() {
         ctx.fillStyle = '#000'; ctx.fillRect(x - 1, y - 1, 2, 2);
       }
     }
-    drawColorbar(lo, hi, `${comp} (${measureName})`);
+    drawColorbar(scale, `${comp} (${measureName})`);
   }
 }
 

@@ -18,6 +18,7 @@ const COMMENTS: &[(&str, &str)] = &[
     ("run.stop_timeout_s", ""),
     ("run.stale_after_s", "Seconds after which a stopped (SIGSTOP) or silent process is killed as hung."),
     ("run.dashboard", "The live dashboard (ADDR:PORT, or \"off\"); a non-loopback address serves other\nmachines too."),
+    ("run.map_range", "Colour range of strain_map.png: auto (the 2nd-98th percentile, at least 30 times\nthe field's own noise wide), symmetric (about zero) or LO:HI (e.g. -0.01:0.05)."),
     ("[camera]", "The simulated camera renders the specimen as the rig deforms it."),
     ("camera.width_px", ""),
     ("camera.height_px", ""),
@@ -109,6 +110,7 @@ const COMMENTS: &[(&str, &str)] = &[
     ("[identifier]", ""),
     ("identifier.models", "Models ranked at each refit (see `dicstream identify --help`), or all."),
     ("identifier.route", "gauge (the gauge's averages), field (the whole field of the cruciform by the\nvirtual fields method; needs [specimen] model = \"structure\" and a view that\ncrosses the arms: [camera] mm_per_px), both, or auto (both on a structure)."),
+    ("identifier.plot_all_models", "f_I1.png and g_I2.png: every ranked model's curve, not only the identified\n(best-ranked) law's, against the route's points."),
 ];
 
 const PREAMBLE: &str =

@@ -65,6 +65,10 @@ pub struct RunSection {
     /// Where the live dashboard listens (ADDR:PORT), or off.
     #[serde(with = "wire::names::text")]
     pub dashboard: DashboardListen,
+    /// The colour range of `strain_map.png`: auto (a floor tied to the field's noise),
+    /// symmetric (about zero) or LO:HI (strain, e.g. -0.01:0.05).
+    #[serde(with = "wire::names::text")]
+    pub map_range: wire::colour_range::RangeChoice,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -279,6 +283,8 @@ pub struct IdentifierSection {
     /// The identification routes: `gauge`, `field` (the whole field of the cruciform, by the
     /// virtual fields method), `both`, or `auto` (both on a structure, the gauge otherwise).
     pub route: wire::identification::IdentifierRoutes,
+    /// f_I1.png and g_I2.png show every ranked model, not only the identified law.
+    pub plot_all_models: bool,
 }
 
 impl CameraSection {
@@ -312,6 +318,7 @@ impl Default for RunSection {
             stop_timeout_s: 5.0,
             stale_after_s: 5.0,
             dashboard: DashboardListen::default(),
+            map_range: wire::colour_range::RangeChoice::Auto,
         }
     }
 }
@@ -406,6 +413,7 @@ impl Default for IdentifierSection {
                 identifier::online::OnlineConfig::default().models,
             ),
             route: wire::identification::IdentifierRoutes::Auto,
+            plot_all_models: false,
         }
     }
 }

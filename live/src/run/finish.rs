@@ -88,6 +88,7 @@ impl Stopped<'_> {
             camera_source: config.camera.source,
             rig_source: config.rig.source,
             machine_csv,
+            scale: crate::field_scale::ScaleReport::of(config),
             strain_map: outputs.strain_map,
             leftover_shm_files: self.leftover_shm_files,
             exit_code: verdict.exit_code,

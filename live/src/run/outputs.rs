@@ -66,7 +66,15 @@ pub(super) fn write(config: &RunConfig, results: &ResultsDir, recorder: &Recorde
         crate::figures::latency_png(&results.path("latency.png"), &curves),
     );
     let models = &config.identifier.models.0;
-    let figures = crate::figures::identification_figures(&results.root, &results.journal(), models);
+    let options = identifier::plot::PlotOptions {
+        all_models: config.identifier.plot_all_models,
+    };
+    let figures =
+        crate::figures::identification_figures(&results.root, &results.journal(), models, options);
+    if let Ok((_, Some(why))) = &figures {
+        // Written, without points: not a missing file, said on stderr and in their titles.
+        eprintln!("f_I1.png, g_I2.png: no data points, the paper's route did not run: {why}");
+    }
     keep("identification figures", figures.map(|_| ()));
     keep(
         "forces.png",
@@ -81,7 +89,7 @@ pub(super) fn write(config: &RunConfig, results: &ResultsDir, recorder: &Recorde
         )
         .map(|_| ()),
     );
-    let strain_map = strain_map(results, recorder);
+    let strain_map = strain_map(results, recorder, config.run.map_range);
     let strain_map = strain_map.unwrap_or_else(|e| {
         keep("strain_map.png", Err(e));
         None
@@ -117,7 +125,11 @@ pub(super) fn field_route_figures(
 
 /// The most strained field of the last test over the image its mesh is defined in (its origin
 /// frame), as `strain_map.png`; none without a field, an error saying why without the image.
-fn strain_map(results: &ResultsDir, recorder: &Recorder) -> anyhow::Result<Option<StrainMapInfo>> {
+fn strain_map(
+    results: &ResultsDir,
+    recorder: &Recorder,
+    range: wire::colour_range::RangeChoice,
+) -> anyhow::Result<Option<StrainMapInfo>> {
     let Some((header, nodes)) = &recorder.peak_field else {
         return Ok(None);
     };
@@ -137,11 +149,21 @@ fn strain_map(results: &ResultsDir, recorder: &Recorder) -> anyhow::Result<Optio
         "exx ({measure} strain), frame {} from frame {}",
         header.frame_id, header.origin_frame_id
     );
-    let range = crate::figures::strain_map(&path, pixels, frame.width_px as usize, &field, &title)?;
+    // The run's correlator computes its strains on the library's window.
+    let window = correlator::CorrelatorSettings::default().strain_window_nodes;
+    let scale = crate::figures::strain_map(
+        &path,
+        pixels,
+        frame.width_px as usize,
+        &field,
+        &title,
+        range,
+        window,
+    )?;
     Ok(Some(StrainMapInfo {
         frame_id: header.frame_id,
         origin_frame_id: header.origin_frame_id,
         measure,
-        exx_blue_to_red: range,
+        exx_colours: scale,
     }))
 }

@@ -99,6 +99,8 @@ pub struct RunReport {
     /// skipped and restarts (truncations, rotations), as the follower kept them in
     /// `machine_csv.json`.
     pub machine_csv: Option<rig::csv_follow::FollowCounters>,
+    /// The fields' scale, mm per px, and where it came from.
+    pub scale: crate::field_scale::ScaleReport,
     /// What `strain_map.png` shows.
     pub strain_map: Option<StrainMapInfo>,
     /// Files of the instance left once every process had stopped (named, then removed).
@@ -107,12 +109,12 @@ pub struct RunReport {
     pub exit_code: u8,
 }
 
-/// The field drawn in `strain_map.png` (the most strained field of the last test) and the
-/// exx range of its colours.
+/// The field drawn in `strain_map.png` (the most strained field of the last test) and its
+/// colour scale (the map, and the exx values at the colour bar's ends).
 #[derive(Clone, Debug, Serialize)]
 pub struct StrainMapInfo {
     pub frame_id: u64,
     pub origin_frame_id: u64,
     pub measure: &'static str,
-    pub exx_blue_to_red: [f64; 2],
+    pub exx_colours: wire::colour_map::ColourScale,
 }
