@@ -154,7 +154,12 @@ pub struct CorrelateArgs {
     /// symmetric (about zero) or LO:HI (in the quantity's unit: px, or strain as a fraction,
     /// e.g. -0.01:0.01). A signed quantity across zero takes a blue-white-red map centred on
     /// zero, any other viridis.
-    #[arg(long, default_value_t = RangeChoice::Auto, value_name = "auto|symmetric|LO:HI")]
+    #[arg(
+        long,
+        default_value_t = RangeChoice::Auto,
+        value_name = "auto|symmetric|LO:HI",
+        allow_hyphen_values = true
+    )]
     pub range: RangeChoice,
 }
 
