@@ -27,8 +27,8 @@ use crate::strain::AffineSums;
 use crate::zoi::{
     spectrum_len, GradientSensitivity, Image, SubpixelIterations, TimeSplit, ZoiResult,
 };
+use fft2d::Complex32;
 use parts::{FrameResults, History, Origin, Reference, Scratch, SubsetState};
-use rustfft::num_complex::Complex32;
 
 /// Per-node state of the current reference image.
 #[derive(Clone, Copy, Debug, Default)]

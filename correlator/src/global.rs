@@ -10,10 +10,10 @@
 //! rotation moves a 512² square's corners by 31 px against each other, a 128² square's by 8).
 //! When no square has a significant peak, there is no guess, never a wrong one.
 
-use crate::fft2d::Fft2d;
 use crate::settings::Roi;
 use crate::zoi::Image;
-use rustfft::num_complex::Complex32;
+use fft2d::Complex32;
+use fft2d::Fft2d;
 
 pub const MAX_GLOBAL_PX: usize = 512;
 /// Smallest square tried.

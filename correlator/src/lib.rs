@@ -30,7 +30,6 @@
 mod text_serde;
 
 mod correlator;
-mod fft2d;
 pub mod field;
 pub mod gauges;
 mod global;
@@ -45,7 +44,6 @@ mod pool;
 #[cfg(feature = "process")]
 pub mod process;
 pub mod pvd;
-mod real_fft2d;
 pub mod region;
 pub mod settings;
 mod simd;

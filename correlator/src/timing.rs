@@ -1,9 +1,9 @@
 //! FFT timings for scale next to the ZOI figures of the benchmarks: the same 2-D transforms the
 //! ZOI loop uses, timed on the calling thread.
 
-use crate::fft2d::Fft2d;
-use crate::real_fft2d::RealFft2d;
-use rustfft::num_complex::Complex32;
+use fft2d::Complex32;
+use fft2d::Fft2d;
+use fft2d::RealFft2d;
 use std::time::Instant;
 
 /// Time of one n x n 2-D transform (ns, median over batches).

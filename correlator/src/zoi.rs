@@ -12,10 +12,10 @@ use crate::field::NodeStatus;
 pub use crate::image::Image;
 use crate::interpolate::{apply, bicubic, bicubic_clamped, identity_plus, Mat2, WarpedBlock};
 use crate::peak::quadratic_peak_3x3;
-use crate::real_fft2d::RealFft2d;
 use crate::simd::{dot, F32x4};
 use crate::window::modified_hanning_2d;
-use rustfft::num_complex::Complex32;
+use fft2d::Complex32;
+use fft2d::RealFft2d;
 
 mod flat_side;
 

@@ -9,7 +9,7 @@ use crate::icgn::subset::SubsetStats;
 use crate::interpolate::Mat2;
 use crate::keypoints::KeypointSet;
 use crate::zoi::{GradientSensitivity, ZoiResult};
-use rustfft::num_complex::Complex32;
+use fft2d::Complex32;
 
 /// The current reference image and what is prepared from it for every node.
 pub(super) struct Reference {

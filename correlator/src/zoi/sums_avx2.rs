@@ -13,7 +13,7 @@
 
 pub use crate::simd_avx2::available;
 use crate::simd_avx2::{load8, store8};
-use rustfft::num_complex::Complex32;
+use fft2d::Complex32;
 use std::arch::x86_64::{
     __m256, _mm256_fmadd_ps, _mm256_fmaddsub_ps, _mm256_movehdup_ps, _mm256_moveldup_ps,
     _mm256_mul_ps, _mm256_permute_ps, _mm256_set1_ps, _mm256_setr_ps, _mm256_setzero_ps,
@@ -187,7 +187,7 @@ pub unsafe fn window_rows(
 #[cfg(test)]
 mod tests {
     use super::super::{spectrum_len, ZoiEngine, PAD};
-    use rustfft::num_complex::Complex32;
+    use fft2d::Complex32;
 
     /// The phase ramp gives the portable products g (px py) to rounding.
     #[test]

@@ -5,7 +5,7 @@
 //! Products of spectra are element-wise, so the layout never matters to callers that only
 //! multiply spectra of the same `Fft2d` and use `frequency_index` for phase ramps.
 
-use rustfft::num_complex::Complex32;
+use crate::Complex32;
 use rustfft::{Fft, FftPlanner};
 use std::sync::Arc;
 
