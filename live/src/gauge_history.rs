@@ -3,7 +3,8 @@
 //! when the fields' scale is known, px otherwise), read from every field with the
 //! correlator's own gauge code (the numbers of `frames.csv`'s gauge columns). The gauges'
 //! shapes are the run's configuration, not on the wire: the run computes their readings and
-//! hands them to its dashboard (a `monitor` has no gauges). Bounded: past [`MAX_POINTS`] a
+//! hands them to its dashboard; `dicstream monitor --config` keeps one of its own
+//! (`monitor_gauges.rs`). Bounded: past [`MAX_POINTS`] a
 //! gauge keeps every other point and then takes every second field (and so on).
 
 use correlator::gauges::{GaugeReading, GaugeValue};
