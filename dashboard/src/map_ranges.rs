@@ -105,10 +105,16 @@ mod tests {
         let (map, lo, hi) = scale("log", "exx", "auto");
         assert_eq!(map, "viridis");
         // (A percentile range would be the noise's own 4e-5 wide: the floor widens it.)
-        assert!(hi - lo > 3.0 * 4e-5 && lo < 0.479 && hi > 0.479, "{lo} {hi}");
+        assert!(
+            hi - lo > 3.0 * 4e-5 && lo < 0.479 && hi > 0.479,
+            "{lo} {hi}"
+        );
         // eyy, a gradient from -0.2 to -0.171: spans the map.
         let (_, lo, hi) = scale("log", "eyy", "auto");
-        assert!((lo + 0.2).abs() < 2e-3 && (hi + 0.171).abs() < 2e-3, "{lo} {hi}");
+        assert!(
+            (lo + 0.2).abs() < 2e-3 && (hi + 0.171).abs() < 2e-3,
+            "{lo} {hi}"
+        );
         // Symmetric: diverging about zero.
         let (map, lo, hi) = scale("log", "eyy", "symmetric");
         assert_eq!(map, "diverging");

@@ -153,13 +153,22 @@ mod tests {
         // Uniaxial λ = 1.3 rotated by 30°, in log strain, expressed in Green-Lagrange.
         let t = 30f64.to_radians();
         let (c, s) = (t.cos(), t.sin());
-        let tensor = |a: f64, b: f64| [a * c * c + b * s * s, a * s * s + b * c * c, (a - b) * c * s];
+        let tensor = |a: f64, b: f64| {
+            [
+                a * c * c + b * s * s,
+                a * s * s + b * c * c,
+                (a - b) * c * s,
+            ]
+        };
         let (l1, l2) = (1.3f64, 1.3f64.powf(-0.5));
         let log = tensor(l1.ln(), l2.ln());
         let green = tensor(0.5 * (l1 * l1 - 1.0), 0.5 * (l2 * l2 - 1.0));
         let converted = convert_strain(log, StrainMeasure::Log, StrainMeasure::Green).unwrap();
         for k in 0..3 {
-            assert!((converted[k] - green[k]).abs() < 1e-12, "{converted:?} vs {green:?}");
+            assert!(
+                (converted[k] - green[k]).abs() < 1e-12,
+                "{converted:?} vs {green:?}"
+            );
         }
         // And back, through nominal.
         let nominal = convert_strain(green, StrainMeasure::Green, StrainMeasure::Nominal).unwrap();

@@ -116,7 +116,9 @@ mod tests {
         let toml = "[camera]\nscale_mm_per_px = 0.5\n[correlator]\ngauges = \
                     [\"mid=rect:0,0,40,40\", \"arm=extensometer:0,20 40,20\"]\n";
         let mut gauges = gauges_of(toml);
-        assert!(gauges.describe().contains("mid (strain), arm (extensometer)"));
+        assert!(gauges
+            .describe()
+            .contains("mid (strain), arm (extensometer)"));
         assert!(gauges.describe().contains("in mm (0.5 mm per px)"));
         let header = FieldHeader {
             step_px: 10,
@@ -147,7 +149,11 @@ mod tests {
         let structure = gauges_of(
             "[specimen]\nmodel = \"structure\"\n[correlator]\ngauges = [\"arm=extensometer:0,20 40,20\"]\n",
         );
-        assert!(structure.describe().contains("in px"), "{}", structure.describe());
+        assert!(
+            structure.describe().contains("in px"),
+            "{}",
+            structure.describe()
+        );
         assert_eq!(structure.to_json()[0]["unit"], "px");
         assert!(gauges_of("").is_empty());
     }

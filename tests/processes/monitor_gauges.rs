@@ -52,7 +52,13 @@ fn monitor_charts_the_runs_named_gauges_as_its_frames_csv_says() {
     let dir = bench.dir.clone();
     let config = write_config(&dir, GAUGES);
     let out = dir.join("out");
-    start_run(&mut bench, "run", &config, &out, &["--no-dashboard", "--quiet"]);
+    start_run(
+        &mut bench,
+        "run",
+        &config,
+        &out,
+        &["--no-dashboard", "--quiet"],
+    );
     bench
         .child("run")
         .wait_for_stderr("rig ready", |l| l.contains("rig ready"));
@@ -121,10 +127,7 @@ fn monitor_charts_the_runs_named_gauges_as_its_frames_csv_says() {
     let mut largest_elongation_mm = 0f64;
     for (k, t) in t_s.iter().enumerate() {
         let t = t.as_f64().unwrap();
-        let Some(row) = csv_rows
-            .iter()
-            .find(|r| (cell(r, t_col) - t).abs() < 1e-4)
-        else {
+        let Some(row) = csv_rows.iter().find(|r| (cell(r, t_col) - t).abs() < 1e-4) else {
             continue;
         };
         for (what, monitor, run, tolerance) in [
@@ -175,7 +178,10 @@ fn monitor_without_a_config_says_gauges_need_one() {
         "{}",
         monitor.stderr()
     );
-    assert_eq!(get_json(&addr, "/snapshot.json")["user_gauges"], Value::Null);
+    assert_eq!(
+        get_json(&addr, "/snapshot.json")["user_gauges"],
+        Value::Null
+    );
     monitor.signal(libc::SIGINT);
     monitor.wait_exit();
 }
@@ -216,7 +222,15 @@ fn monitor_refuses_a_config_with_bad_gauges_or_bad_toml() {
     );
     let broken = bench.dir.join("broken.toml");
     std::fs::write(&broken, "[camera\nwidth_px = 256\n").unwrap();
-    refuse("a configuration that does not parse", &broken, "broken.toml");
+    refuse(
+        "a configuration that does not parse",
+        &broken,
+        "broken.toml",
+    );
     let missing = bench.dir.join("missing.toml");
-    refuse("a configuration that is not there", &missing, "missing.toml");
+    refuse(
+        "a configuration that is not there",
+        &missing,
+        "missing.toml",
+    );
 }
