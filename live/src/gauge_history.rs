@@ -133,13 +133,13 @@ fn keep_every_other(values: &mut Vec<f64>) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::gauge_columns::read_all;
     use wire::FieldNode;
 
-    /// A 5 x 5 mesh, 10 px apart, stretched by 1 % along x.
-    fn nodes() -> Vec<FieldNode> {
+    /// A 5 x 5 mesh, 10 px apart, stretched by 1 % along x (also `monitor_gauges`' test's).
+    pub(crate) fn nodes() -> Vec<FieldNode> {
         (0..25)
             .map(|k| {
                 let (i, j) = ((k % 5) as f32, (k / 5) as f32);

@@ -86,24 +86,7 @@ impl UserGauges for MonitorGauges {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A 5 x 5 mesh, 10 px apart, stretched by 1 % along x.
-    fn nodes() -> Vec<FieldNode> {
-        (0..25)
-            .map(|k| {
-                let (i, j) = ((k % 5) as f32, (k / 5) as f32);
-                FieldNode {
-                    x_px: 10.0 * i,
-                    y_px: 10.0 * j,
-                    u_px: 0.1 * i,
-                    exx: 0.00995,
-                    du_dx: 0.01,
-                    status: wire::NodeStatus::Ok as u32,
-                    ..FieldNode::default()
-                }
-            })
-            .collect()
-    }
+    use crate::gauge_history::tests::nodes;
 
     fn gauges_of(toml: &str) -> MonitorGauges {
         let config = RunConfig::from_toml(toml, "t.toml").unwrap();

@@ -16,7 +16,7 @@ use crate::dashboard_support;
 
 use common::{dashboard_address, Run};
 use dashboard_support::webdriver::Browser;
-use dashboard_support::{get_json, http, Events};
+use dashboard_support::{get_json, http, spawn_monitor, Events};
 use serde_json::Value;
 use std::path::PathBuf;
 use testkit::until;
@@ -323,20 +323,7 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
         .and_then(|s| s.trim_end_matches(')').parse().ok())
         .unwrap_or_else(|| panic!("{correlator_line}"));
     run.wait_for_stderr("rig ready", |l| l.contains("rig ready"));
-    let monitor = bench.spawn(
-        "monitor",
-        &[
-            "monitor",
-            "--instance",
-            &instance,
-            "--dashboard",
-            "127.0.0.1:0",
-            "--config",
-            config.to_str().unwrap(),
-        ],
-    );
-    let monitor_addr =
-        dashboard_address(&monitor.wait_for_stderr("dashboard URL", |l| l.contains("http://")));
+    let (monitor_addr, _) = spawn_monitor(&mut bench, &["--config", config.to_str().unwrap()]);
 
     // 1. The monitor's page: image, charts and counters update; with the run's configuration
     // it charts the run's named gauges too, as the run's page does.

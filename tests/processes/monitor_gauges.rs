@@ -4,10 +4,10 @@
 //! are wrong, or that does not parse, refused before anything is served.
 
 use crate::common;
-use crate::dashboard_support::get_json;
+use crate::dashboard_support::{get_json, spawn_monitor};
 
 use common::bench_run::{rows, start_run};
-use common::{dashboard_address, dicstream, Run};
+use common::{dicstream, Run};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use testkit::until;
@@ -48,7 +48,6 @@ fn series(gauge: &Value, key: &str) -> Vec<f64> {
 #[test]
 fn monitor_charts_the_runs_named_gauges_as_its_frames_csv_says() {
     let mut bench = Run::new("monitor_gauges");
-    let instance = bench.name().to_string();
     let dir = bench.dir.clone();
     let config = write_config(&dir, GAUGES);
     let out = dir.join("out");
@@ -63,21 +62,7 @@ fn monitor_charts_the_runs_named_gauges_as_its_frames_csv_says() {
         .child("run")
         .wait_for_stderr("rig ready", |l| l.contains("rig ready"));
     let config_arg = config.display().to_string();
-    let monitor = bench.spawn(
-        "monitor",
-        &[
-            "monitor",
-            "--instance",
-            &instance,
-            "--dashboard",
-            "127.0.0.1:0",
-            "--config",
-            &config_arg,
-        ],
-    );
-    let addr =
-        dashboard_address(&monitor.wait_for_stderr("dashboard URL", |l| l.contains("http://")));
-    let said = monitor.stderr();
+    let (addr, said) = spawn_monitor(&mut bench, &["--config", &config_arg]);
     assert!(
         said.contains("gauges middle (strain), span (extensometer); extensometers in mm"),
         "{said}"
@@ -159,29 +144,13 @@ fn monitor_charts_the_runs_named_gauges_as_its_frames_csv_says() {
 #[test]
 fn monitor_without_a_config_says_gauges_need_one() {
     let mut bench = Run::new("monitor_no_config");
-    let instance = bench.name().to_string();
-    let monitor = bench.spawn(
-        "monitor",
-        &[
-            "monitor",
-            "--instance",
-            &instance,
-            "--dashboard",
-            "127.0.0.1:0",
-            "--wait",
-        ],
-    );
-    let addr =
-        dashboard_address(&monitor.wait_for_stderr("dashboard URL", |l| l.contains("http://")));
-    assert!(
-        monitor.stderr().contains("add --config FILE"),
-        "{}",
-        monitor.stderr()
-    );
+    let (addr, said) = spawn_monitor(&mut bench, &["--wait"]);
+    assert!(said.contains("add --config FILE"), "{said}");
     assert_eq!(
         get_json(&addr, "/snapshot.json")["user_gauges"],
         Value::Null
     );
+    let monitor = bench.child("monitor");
     monitor.signal(libc::SIGINT);
     monitor.wait_exit();
 }

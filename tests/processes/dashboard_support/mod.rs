@@ -15,6 +15,23 @@ use std::io::{BufRead, BufReader, Read};
 use std::net::TcpStream;
 use testkit::send_request;
 
+/// Starts `dicstream monitor` (child `monitor` of `bench`) on `instance` at a free loopback
+/// port with `extra` arguments; its dashboard's address once it serves, and its stderr so far.
+pub fn spawn_monitor(bench: &mut crate::common::Run, extra: &[&str]) -> (String, String) {
+    let instance = bench.name().to_string();
+    let mut args = vec![
+        "monitor",
+        "--instance",
+        &instance,
+        "--dashboard",
+        "127.0.0.1:0",
+    ];
+    args.extend_from_slice(extra);
+    let monitor = bench.spawn("monitor", &args);
+    let line = monitor.wait_for_stderr("dashboard URL", |l| l.contains("http://"));
+    (crate::common::dashboard_address(&line), monitor.stderr())
+}
+
 /// One HTTP/1.1 request (`Connection: close`): status and body.
 pub fn http(addr: &str, method: &str, path: &str, body: Option<&Value>) -> (u16, Vec<u8>) {
     let body = body.map(|b| b.to_string()).unwrap_or_default();
