@@ -4,7 +4,7 @@
 //! are wrong, or that does not parse, refused before anything is served.
 
 use crate::common;
-use crate::dashboard_support::{get_json, spawn_monitor};
+use crate::dashboard_support::{spawn_monitor, try_snapshot};
 
 use common::bench_run::{rows, start_run};
 use common::{dicstream, Run};
@@ -70,7 +70,7 @@ fn monitor_charts_the_runs_named_gauges_as_its_frames_csv_says() {
 
     // The monitor's snapshot carries both gauges by name, with points on the test's clock.
     let snapshot = until("12 points of the named gauges on the monitor", || {
-        let s = get_json(&addr, "/snapshot.json");
+        let s = try_snapshot(&addr)?;
         let points = s["user_gauges"][1]["t_s"].as_array().map_or(0, Vec::len);
         (points >= 12 && s["gauge"]["clock"] == "test").then_some(s)
     });
@@ -146,10 +146,8 @@ fn monitor_without_a_config_says_gauges_need_one() {
     let mut bench = Run::new("monitor_no_config");
     let (addr, said) = spawn_monitor(&mut bench, &["--wait"]);
     assert!(said.contains("add --config FILE"), "{said}");
-    assert_eq!(
-        get_json(&addr, "/snapshot.json")["user_gauges"],
-        Value::Null
-    );
+    let snapshot = until("the monitor's first snapshot", || try_snapshot(&addr));
+    assert_eq!(snapshot["user_gauges"], Value::Null);
     let monitor = bench.child("monitor");
     monitor.signal(libc::SIGINT);
     monitor.wait_exit();

@@ -116,6 +116,19 @@ pub fn get_json(addr: &str, path: &str) -> Value {
     serde_json::from_slice(&body).unwrap()
 }
 
+/// `/snapshot.json`, or None before the dashboard's first snapshot (503).
+pub fn try_snapshot(addr: &str) -> Option<Value> {
+    let (status, body) = http(addr, "GET", "/snapshot.json", None);
+    match status {
+        503 => None,
+        200 => Some(serde_json::from_slice(&body).unwrap()),
+        _ => panic!(
+            "GET /snapshot.json: {status} {}",
+            String::from_utf8_lossy(&body)
+        ),
+    }
+}
+
 /// A viewer of `/events`, read from Rust.
 pub struct Events {
     reader: BufReader<TcpStream>,
