@@ -3,9 +3,11 @@
 //! until a sample or the publishing tick. Frames are looked at in place and released at once
 //! (a thumbnail is made only when someone watches and the image rate cap allows); the four
 //! services have safe overflow, so a slow feeder loses samples, never stalls a publisher.
+//! A monitor's user gauges (`UserGauges`) read every field received, in place.
 
 use crate::hub::Hub;
 use crate::state::{LiveState, Settings};
+use crate::user_gauges::UserGauges;
 use crate::DashboardError;
 use iceoryx2::prelude::*;
 use std::sync::Arc;
@@ -42,6 +44,7 @@ impl Ports {
     fn drain(
         &self,
         state: &mut LiveState,
+        gauges: &mut Option<Box<dyn UserGauges>>,
         encode: bool,
     ) -> Result<Option<Vec<u8>>, DashboardError> {
         self.frames.clear_events();
@@ -59,7 +62,10 @@ impl Ports {
             }
         }
         while let Some(field) = self.fields.receive().map_err(err)? {
-            state.on_field(field.user_header(), field.payload());
+            let time = state.on_field(field.user_header(), field.payload());
+            if let Some(gauges) = gauges {
+                gauges.on_field(field.user_header(), field.payload(), time);
+            }
         }
         while let Some(r) = self.reports.receive().map_err(err)? {
             state.on_report(&r);
@@ -69,11 +75,14 @@ impl Ports {
 }
 
 /// Opens the ports on `instance`, then calls `ready` (with the error if they could not be
-/// opened) and feeds `hub` until it is stopped or a termination signal is noted.
+/// opened) and feeds `hub` until it is stopped or a termination signal is noted. With
+/// `gauges`, every field received is read into them and they are the snapshots'
+/// `user_gauges` (else the hub's, which `dicstream run` sets).
 pub fn feed(
     instance: &str,
     settings: Settings,
     hub: Arc<Hub>,
+    mut gauges: Option<Box<dyn UserGauges>>,
     ready: impl FnOnce(Result<(), DashboardError>),
 ) -> Result<(), DashboardError> {
     let opened: Result<_, DashboardError> = (|| {
@@ -115,13 +124,16 @@ pub fn feed(
             .wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, wait)
             .map_err(|e| err(format!("WaitSet: {e:?}")))?;
         let watched = hub.viewers() > 0;
-        if let Some(p) = ports.drain(&mut state, watched)? {
+        if let Some(p) = ports.drain(&mut state, &mut gauges, watched)? {
             png = Some(p);
         }
         if Instant::now() >= next_publish {
             let mut snapshot =
                 state.snapshot(wire::monotonic_ns(), hub.viewers(), &hub.processes());
-            snapshot["user_gauges"] = hub.user_gauges();
+            snapshot["user_gauges"] = match &gauges {
+                Some(gauges) => gauges.to_json(),
+                None => hub.user_gauges(),
+            };
             hub.publish(snapshot.to_string(), png.take());
             next_publish = Instant::now()
                 + if watched {

@@ -77,7 +77,8 @@ impl Hub {
     }
 
     /// The user's named gauges against the test's time, as `dicstream run` reads them from
-    /// its configuration's shapes (shown as is; `null` from a monitor, which has no shapes).
+    /// its configuration's shapes (shown as is; `null` from a monitor without `--config`, whose
+    /// feeder reads them itself with one: `crate::user_gauges`).
     pub fn set_user_gauges(&self, gauges: Value) {
         self.lock().user_gauges = gauges;
     }

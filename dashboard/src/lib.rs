@@ -6,7 +6,9 @@
 //! - [`state`] (pure): what is kept of the four services and the snapshot sent to viewers;
 //!   [`image`] the capped thumbnail, [`series`] and [`latency`] the bounded histories;
 //!   [`test_clock`] the test's time of a field, [`forces`] each loaded actuator's force,
-//!   [`stretch_states`] the field's (λ1, λ2) states;
+//!   [`stretch_states`] the field's (λ1, λ2) states; [`map_ranges`] the strain map's colour
+//!   ranges (`wire::colour_range`'s, per quantity shown); [`user_gauges`] what reads a monitor's
+//!   named gauges on every field;
 //! - [`hub`]: the latest snapshot and image, shared with the viewers' threads;
 //! - [`server`]: read-only HTTP on std with server-sent events, assets compiled in, a
 //!   deadline on every read and write so no viewer holds another or the stop;
@@ -21,15 +23,18 @@ pub mod forces;
 pub mod hub;
 pub mod image;
 pub mod latency;
+pub mod map_ranges;
 pub mod series;
 pub mod server;
 mod slots;
 pub mod state;
 pub mod stretch_states;
 pub mod test_clock;
+pub mod user_gauges;
 
 pub use error::DashboardError;
 pub use state::{Mode, Settings};
+pub use user_gauges::{FieldTime, UserGauges};
 
 use hub::Hub;
 use std::net::SocketAddr;
@@ -46,12 +51,15 @@ pub struct Dashboard {
 
 impl Dashboard {
     /// Listens on `addr` (with `fallback`, the next free port when it is taken) and attaches
-    /// the feeder to `instance`. Fails when neither can start.
+    /// the feeder to `instance`; with `user_gauges`, the feeder reads them on every field
+    /// (`dicstream monitor --config`; without, the page shows what `set_user_gauges` gives).
+    /// Fails when neither can start.
     pub fn start(
         instance: &str,
         mode: Mode,
         addr: SocketAddr,
         fallback: bool,
+        user_gauges: Option<Box<dyn UserGauges>>,
     ) -> Result<Dashboard, DashboardError> {
         let listener = server::bind(addr, fallback)?;
         let addr = listener.local_addr().map_err(|e| DashboardError::Listen {
@@ -68,7 +76,7 @@ impl Dashboard {
                 .spawn(move || {
                     let settings = Settings::new(&instance, mode);
                     let mut started = false;
-                    let fed = feed::feed(&instance, settings, hub, |r| {
+                    let fed = feed::feed(&instance, settings, hub, user_gauges, |r| {
                         started = r.is_ok();
                         let _ = ready_tx.send(r);
                     });

@@ -7,8 +7,10 @@
 use crate::forces::ForceHistory;
 use crate::image::{downsample, encode_png};
 use crate::latency::LatencyStats;
+use crate::map_ranges::SentStrains;
 use crate::series::{significant, Decimated, Rate};
 use crate::test_clock::TestClock;
+use crate::user_gauges::FieldTime;
 use material::InvariantFn;
 use serde_json::{json, Value};
 use wire::stats::IdGaps;
@@ -204,7 +206,8 @@ impl LiveState {
         }
     }
 
-    pub fn on_field(&mut self, header: &FieldHeader, nodes: &[FieldNode]) {
+    /// A field, looked at in place; returns its time on the charts' clock.
+    pub fn on_field(&mut self, header: &FieldHeader, nodes: &[FieldNode]) -> FieldTime {
         self.fields_seen += 1;
         self.field_ids.observe(header.frame_id);
         self.latency_field
@@ -220,7 +223,8 @@ impl LiveState {
             ),
         };
         // One clock per chart: the first rig sample restarts the history on the test's.
-        if clock != self.gauge_clock {
+        let restarted = clock != self.gauge_clock;
+        if restarted {
             self.gauge.clear();
             self.gauge_clock = clock;
         }
@@ -236,6 +240,7 @@ impl LiveState {
         if nodes.len() == header.node_count() {
             self.nodes.extend_from_slice(nodes);
         }
+        FieldTime { t_s, restarted }
     }
 
     pub fn on_rig(&mut self, state: &RigState) {
@@ -341,7 +346,11 @@ impl LiveState {
         let mut x = Vec::new();
         let (mut y, mut exx, mut eyy, mut exy, mut status) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut strains = Vec::new();
+        let (mut sent_cols, mut sent_rows) = (0, 0);
         if self.nodes.len() == cols * rows {
+            sent_cols = cols.div_ceil(stride);
+            sent_rows = rows.div_ceil(stride);
             for r in (0..rows).step_by(stride) {
                 for c in (0..cols).step_by(stride) {
                     let n = &self.nodes[r * cols + c];
@@ -350,37 +359,28 @@ impl LiveState {
                     x.push(px(n.x_px + n.u_px));
                     y.push(px(n.y_px + n.v_px));
                     let ok = n.status == NodeStatus::Ok as u32;
-                    let value =
-                        |v: f32| (ok && v.is_finite()).then(|| significant(f64::from(v), 5));
-                    exx.push(value(n.exx));
-                    eyy.push(value(n.eyy));
-                    exy.push(value(n.exy));
+                    let e = [n.exx, n.eyy, n.exy].map(f64::from);
+                    let strain = (ok && e.iter().all(|v| v.is_finite())).then_some(e);
+                    strains.push(strain);
+                    let value = |k: usize| strain.map(|e| significant(e[k], 5));
+                    exx.push(value(0));
+                    eyy.push(value(1));
+                    exy.push(value(2));
                     status.push(n.status);
                 }
             }
         }
-        // Each strain's noise over the whole mesh, the floor of the page's automatic range
-        // (wire::colour_range; the live correlator's strain window is the library's, 1 node).
-        let lag = wire::colour_range::strain_noise_lag_nodes(1);
-        let noise = |get: fn(&FieldNode) -> f32| -> Option<f64> {
-            if self.nodes.len() != cols * rows {
-                return None;
-            }
-            let values: Vec<Option<f64>> = self
-                .nodes
-                .iter()
-                .map(|n| (n.status == NodeStatus::Ok as u32).then(|| f64::from(get(n))))
-                .collect();
-            let grid = wire::colour_range::NodeGrid {
-                values: &values,
-                nx: cols,
-                ny: rows,
-            };
-            wire::colour_range::noise_sigma(grid, lag).map(|s| significant(s, 3))
+        let measure = wire::StrainMeasure::from_code(h.strain_measure);
+        let ranges = match measure {
+            Some(measure) if !strains.is_empty() => crate::map_ranges::json(&SentStrains {
+                strains: &strains,
+                nx: sent_cols,
+                ny: sent_rows,
+                stride,
+                measure,
+            }),
+            _ => Value::Null,
         };
-        let noise_sigma = json!({
-            "exx": noise(|n| n.exx), "eyy": noise(|n| n.eyy), "exy": noise(|n| n.exy),
-        });
         let status_counts: Vec<Value> = NodeStatus::ALL
             .iter()
             .map(|&s| {
@@ -392,7 +392,7 @@ impl LiveState {
             "frame_id": h.frame_id,
             "reference_frame_id": h.reference_frame_id,
             "origin_frame_id": h.origin_frame_id,
-            "measure": wire::StrainMeasure::from_code(h.strain_measure).map_or("?", |m| m.name()),
+            "measure": measure.map_or("?", |m| m.name()),
             "mesh_cols": cols,
             "mesh_rows": rows,
             "stride": stride,
@@ -402,7 +402,7 @@ impl LiveState {
             "nodes": cols * rows,
             "status_counts": status_counts,
             "x": x, "y": y, "exx": exx, "eyy": eyy, "exy": exy, "status": status,
-            "noise_sigma": noise_sigma,
+            "ranges": ranges,
         })
     }
 
@@ -682,6 +682,14 @@ mod tests {
         assert!((f["exx"][1].as_f64().unwrap() - 0.01).abs() < 1e-6);
         assert_eq!(f["status"][0], NodeStatus::LowZncc as u32);
         assert_eq!(f["status_counts"][4]["count"], 1);
+        // The map's range resolved here for each measure shown: a uniform field's range is
+        // one value's (log strain 0.01 is Green-Lagrange (e^0.02 - 1) / 2).
+        for (measure, exx) in [("log", 0.01), ("green", 0.5 * (0.02f64.exp() - 1.0))] {
+            let auto = &f["ranges"][measure]["exx"]["auto"];
+            let (lo, hi) = (auto["lo"].as_f64().unwrap(), auto["hi"].as_f64().unwrap());
+            assert!(lo < exx && hi > exx && hi - lo < 1e-6, "{measure}: {auto}");
+        }
+        assert!(f["ranges"]["small"].is_null());
         assert!((snap["correlator"]["latency_ms"]["p50"].as_f64().unwrap() - 20.0).abs() < 0.1);
         // A snapshot stays small whatever the mesh.
         assert!(

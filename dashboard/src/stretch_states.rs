@@ -19,12 +19,7 @@ pub fn node_stretches(n: &FieldNode, measure: StrainMeasure) -> Option<[f64; 2]>
     let (exx, eyy, exy) = (f64::from(n.exx), f64::from(n.eyy), f64::from(n.exy));
     let mean = 0.5 * (exx + eyy);
     let radius = (0.5 * (exx - eyy)).hypot(exy);
-    let stretch = |e: f64| match measure {
-        StrainMeasure::Log => Some(e.exp()),
-        StrainMeasure::Green => (1.0 + 2.0 * e > 0.0).then(|| (1.0 + 2.0 * e).sqrt()),
-        StrainMeasure::Nominal => Some(1.0 + e),
-        StrainMeasure::Small => None,
-    };
+    let stretch = |e: f64| principal_stretch(measure, e);
     let stretches = match measure {
         StrainMeasure::Small => {
             let f = [
@@ -41,6 +36,51 @@ pub fn node_stretches(n: &FieldNode, measure: StrainMeasure) -> Option<[f64; 2]>
         .iter()
         .all(|l| l.is_finite() && *l > 0.0)
         .then_some(stretches)
+}
+
+/// The stretch λ of a principal strain `e` in a Seth-Hill measure (None for small strain,
+/// which carries no rotation, or outside the measure's domain).
+pub fn principal_stretch(measure: StrainMeasure, e: f64) -> Option<f64> {
+    let stretch = match measure {
+        StrainMeasure::Log => e.exp(),
+        StrainMeasure::Green => (1.0 + 2.0 * e).sqrt(),
+        StrainMeasure::Nominal => 1.0 + e,
+        StrainMeasure::Small => return None,
+    };
+    (stretch.is_finite() && stretch > 0.0).then_some(stretch)
+}
+
+/// The principal strain of a stretch `stretch` in a Seth-Hill measure (None for small strain).
+pub fn principal_strain(measure: StrainMeasure, stretch: f64) -> Option<f64> {
+    match measure {
+        StrainMeasure::Log => Some(stretch.ln()),
+        StrainMeasure::Green => Some(0.5 * (stretch * stretch - 1.0)),
+        StrainMeasure::Nominal => Some(stretch - 1.0),
+        StrainMeasure::Small => None,
+    }
+}
+
+/// A strain `[exx, eyy, exy]` in measure `from` expressed in measure `to`: the same principal
+/// axes, each principal strain through its stretch. None when either measure is small strain
+/// (and not the same) or the strain is outside `from`'s domain. The page's map of another
+/// measure converts its node values the same way (`app.js`, `convertStrain`).
+pub fn convert_strain(e: [f64; 3], from: StrainMeasure, to: StrainMeasure) -> Option<[f64; 3]> {
+    if from == to {
+        return Some(e);
+    }
+    let [exx, eyy, exy] = e;
+    let mean = 0.5 * (exx + eyy);
+    let radius = (0.5 * (exx - eyy)).hypot(exy);
+    let theta = 0.5 * (2.0 * exy).atan2(exx - eyy);
+    let (s, c) = theta.sin_cos();
+    let principal = |e: f64| principal_strain(to, principal_stretch(from, e)?);
+    let (a, b) = (principal(mean + radius)?, principal(mean - radius)?);
+    let converted = [
+        a * c * c + b * s * s,
+        a * s * s + b * c * c,
+        (a - b) * c * s,
+    ];
+    converted.iter().all(|v| v.is_finite()).then_some(converted)
 }
 
 /// `{"l1": [..], "l2": [..], "valid": n, "shown": k}` for the nodes of one field.
@@ -106,6 +146,41 @@ mod tests {
         let mut bad = node(0.1, 0.1, 0.0);
         bad.status = NodeStatus::LowZncc as u32;
         assert!(node_stretches(&bad, StrainMeasure::Log).is_none());
+    }
+
+    #[test]
+    fn a_strain_converts_between_measures_on_its_principal_axes() {
+        // Uniaxial λ = 1.3 rotated by 30°, in log strain, expressed in Green-Lagrange.
+        let t = 30f64.to_radians();
+        let (c, s) = (t.cos(), t.sin());
+        let tensor = |a: f64, b: f64| {
+            [
+                a * c * c + b * s * s,
+                a * s * s + b * c * c,
+                (a - b) * c * s,
+            ]
+        };
+        let (l1, l2) = (1.3f64, 1.3f64.powf(-0.5));
+        let log = tensor(l1.ln(), l2.ln());
+        let green = tensor(0.5 * (l1 * l1 - 1.0), 0.5 * (l2 * l2 - 1.0));
+        let converted = convert_strain(log, StrainMeasure::Log, StrainMeasure::Green).unwrap();
+        for k in 0..3 {
+            assert!(
+                (converted[k] - green[k]).abs() < 1e-12,
+                "{converted:?} vs {green:?}"
+            );
+        }
+        // And back, through nominal.
+        let nominal = convert_strain(green, StrainMeasure::Green, StrainMeasure::Nominal).unwrap();
+        let back = convert_strain(nominal, StrainMeasure::Nominal, StrainMeasure::Log).unwrap();
+        for k in 0..3 {
+            assert!((back[k] - log[k]).abs() < 1e-12, "{back:?} vs {log:?}");
+        }
+        // Small strain converts to nothing; a Green strain below -1/2 has no stretch.
+        assert!(convert_strain(log, StrainMeasure::Small, StrainMeasure::Log).is_none());
+        assert!(convert_strain(log, StrainMeasure::Log, StrainMeasure::Small).is_none());
+        let impossible = [-0.6, 0.0, 0.0];
+        assert!(convert_strain(impossible, StrainMeasure::Green, StrainMeasure::Log).is_none());
     }
 
     #[test]

@@ -20,7 +20,14 @@ pub fn start(
         eprintln!("run: {warning}");
     }
     // The default port moves to the next free one (another run has it); a chosen one does not.
-    let dashboard = Dashboard::start(instance, Mode::Run, addr, config.run.dashboard.is_default())?;
+    // The run's recorder reads the user's gauges (for frames.csv) and hands them over.
+    let dashboard = Dashboard::start(
+        instance,
+        Mode::Run,
+        addr,
+        config.run.dashboard.is_default(),
+        None,
+    )?;
     eprintln!("run: dashboard at {} (read-only)", dashboard.url());
     Ok(Some(dashboard))
 }

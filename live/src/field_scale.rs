@@ -49,6 +49,17 @@ impl FieldScale {
         }
     }
 
+    /// The scale of every field when it can be known without the specimen's solves (which
+    /// `dicstream monitor` does not receive): the user's, or the simulated camera's when one
+    /// framing serves every test (`structure`: the specimen is `membrane`'s, whose strip may
+    /// be framed apart from the cruciform). None otherwise: px only.
+    pub fn without_solves(&self, structure: bool) -> Option<MmPerPx> {
+        match self {
+            FieldScale::Framing(f) if structure && f.strip_mm_per_px != f.mm_per_px => None,
+            _ => self.of_field(None),
+        }
+    }
+
     /// Whether the fields have mm at all: `frames.csv`'s extensometers get mm columns, the
     /// dashboard shows them in mm.
     pub fn in_mm(&self) -> bool {
@@ -140,8 +151,17 @@ mod tests {
             simulated.of_field(Some(2)),
             MmPerPx::new(producer::DEFAULT_STRIP_MM_PER_PX).ok()
         );
+        // Without the solves (a monitor): the homogeneous sheet's framing serves every field, a
+        // structure's strip is framed apart.
+        assert_eq!(simulated.without_solves(false), simulated.of_field(None));
+        assert_ne!(
+            producer::DEFAULT_STRIP_MM_PER_PX,
+            producer::DEFAULT_MM_PER_PX
+        );
+        assert_eq!(simulated.without_solves(true), None);
         let direct = config("[camera]\nscale_mm_per_px = 0.05\n");
         assert_eq!(direct.of_field(Some(2)), MmPerPx::new(0.05).ok());
+        assert_eq!(direct.without_solves(true), MmPerPx::new(0.05).ok());
         let known = config("[camera]\nscale_known_length = \"0,0 300,400 25\"\n");
         assert_eq!(known.of_field(None), MmPerPx::new(0.05).ok());
         let report = |toml: &str| ScaleReport::of(&RunConfig::from_toml(toml, "t.toml").unwrap());

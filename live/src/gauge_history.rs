@@ -3,7 +3,8 @@
 //! when the fields' scale is known, px otherwise), read from every field with the
 //! correlator's own gauge code (the numbers of `frames.csv`'s gauge columns). The gauges'
 //! shapes are the run's configuration, not on the wire: the run computes their readings and
-//! hands them to its dashboard (a `monitor` has no gauges). Bounded: past [`MAX_POINTS`] a
+//! hands them to its dashboard; `dicstream monitor --config` keeps one of its own
+//! (`monitor_gauges.rs`). Bounded: past [`MAX_POINTS`] a
 //! gauge keeps every other point and then takes every second field (and so on).
 
 use correlator::gauges::{GaugeReading, GaugeValue};
@@ -132,13 +133,13 @@ fn keep_every_other(values: &mut Vec<f64>) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::gauge_columns::read_all;
     use wire::FieldNode;
 
-    /// A 5 x 5 mesh, 10 px apart, stretched by 1 % along x.
-    fn nodes() -> Vec<FieldNode> {
+    /// A 5 x 5 mesh, 10 px apart, stretched by 1 % along x (also `monitor_gauges`' test's).
+    pub(crate) fn nodes() -> Vec<FieldNode> {
         (0..25)
             .map(|k| {
                 let (i, j) = ((k % 5) as f32, (k / 5) as f32);

@@ -23,6 +23,7 @@ pub mod latency;
 pub mod leftovers;
 pub mod liveness;
 pub mod mechanics_figures;
+pub mod monitor_gauges;
 pub mod origin_frames;
 pub mod pipeline;
 pub mod recorder;

@@ -1,9 +1,15 @@
-//! `dicstream monitor --instance NAME [--dashboard ADDR:PORT]`: the live dashboard attached,
-//! read-only, to any running instance: a node of its own subscribing to frames, fields,
-//! rig/state and identification (several monitors may attach to one instance). Prints the URL
-//! on stderr, serves until Ctrl-C (SIGINT, SIGTERM, SIGHUP).
+//! `dicstream monitor --instance NAME [--dashboard ADDR:PORT] [--config FILE]`: the live
+//! dashboard attached, read-only, to any running instance: a node of its own subscribing to
+//! frames, fields, rig/state and identification (several monitors may attach to one
+//! instance). With the run's configuration it also charts the user's named gauges
+//! (`live::monitor_gauges`); their shapes are not on the wire, so without it it says so.
+//! Prints the URL on stderr, serves until Ctrl-C (SIGINT, SIGTERM, SIGHUP).
 
-use dashboard::{address, Dashboard, Mode};
+use anyhow::Context;
+use dashboard::{address, Dashboard, Mode, UserGauges};
+use live::monitor_gauges::MonitorGauges;
+use live::RunConfig;
+use std::path::PathBuf;
 use wire::Instance;
 
 /// Options of `dicstream monitor`.
@@ -19,6 +25,29 @@ pub struct MonitorArgs {
     /// Serve even though no process runs on the instance yet (a run about to start)
     #[arg(long)]
     pub wait: bool,
+    /// The run's configuration (TOML, as given to `dicstream run --config`): its named gauges
+    /// (`[correlator] gauges`) are charted, read from every field as the run reads them
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+}
+
+/// The gauges of `--config`, checked as `run` checks its configuration; without it, none
+/// (said on stderr: the gauges' shapes are the run's configuration, not on the wire).
+fn user_gauges(config: Option<&std::path::Path>) -> anyhow::Result<Option<Box<dyn UserGauges>>> {
+    let Some(path) = config else {
+        eprintln!(
+            "monitor: no named gauges shown: their shapes are the run's configuration, not on \
+             the wire; add --config FILE (the run's) to chart them"
+        );
+        return Ok(None);
+    };
+    let config = RunConfig::read(Some(path))?;
+    config
+        .validate()
+        .with_context(|| format!("--config {}: configuration refused", path.display()))?;
+    let gauges = MonitorGauges::of(&config);
+    eprintln!("monitor: {}", gauges.describe());
+    Ok((!gauges.is_empty()).then(|| Box::new(gauges) as Box<dyn UserGauges>))
 }
 
 /// Refuses an instance on which no process runs (unless waiting for one), naming the
@@ -56,13 +85,14 @@ fn check_running(instance: &str, wait: bool) -> anyhow::Result<()> {
 
 pub fn run(args: MonitorArgs) -> anyhow::Result<()> {
     let addr = address::parse(&args.dashboard)?;
+    let gauges = user_gauges(args.config.as_deref())?;
     check_running(&args.instance, args.wait)?;
     if let Some(warning) = address::exposure_warning(&addr) {
         eprintln!("{warning}");
     }
     // The default port falls back to the next free one; an address given is taken as is.
     let fallback = args.dashboard == address::DEFAULT;
-    let dashboard = Dashboard::start(&args.instance, Mode::Monitor, addr, fallback)?;
+    let dashboard = Dashboard::start(&args.instance, Mode::Monitor, addr, fallback, gauges)?;
     eprintln!(
         "monitor: dashboard of instance {} at {} (read-only; Ctrl-C to stop)",
         args.instance,

@@ -16,7 +16,7 @@ use crate::dashboard_support;
 
 use common::{dashboard_address, Run};
 use dashboard_support::webdriver::Browser;
-use dashboard_support::{get_json, http, Events};
+use dashboard_support::{get_json, http, spawn_monitor, Events};
 use serde_json::Value;
 use std::path::PathBuf;
 use testkit::until;
@@ -323,20 +323,10 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
         .and_then(|s| s.trim_end_matches(')').parse().ok())
         .unwrap_or_else(|| panic!("{correlator_line}"));
     run.wait_for_stderr("rig ready", |l| l.contains("rig ready"));
-    let monitor = bench.spawn(
-        "monitor",
-        &[
-            "monitor",
-            "--instance",
-            &instance,
-            "--dashboard",
-            "127.0.0.1:0",
-        ],
-    );
-    let monitor_addr =
-        dashboard_address(&monitor.wait_for_stderr("dashboard URL", |l| l.contains("http://")));
+    let (monitor_addr, _) = spawn_monitor(&mut bench, &["--config", config.to_str().unwrap()]);
 
-    // 1. The monitor's page: image, charts and counters update.
+    // 1. The monitor's page: image, charts and counters update; with the run's configuration
+    // it charts the run's named gauges too, as the run's page does.
     browser.goto(&format!("http://{monitor_addr}/"));
     let before = page_live(&browser);
     assert_eq!(before["mode"], "dicstream monitor");
@@ -351,6 +341,11 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
         .then_some(p)
     });
     assert!(after["faults"].as_str().unwrap().contains("dicstream run"));
+    let named = until("the named gauges charted on the monitor", || {
+        let p = read_page(&browser);
+        (p["user_gauge_points"].as_u64() > Some(1)).then_some(p)
+    });
+    assert_eq!(named["user_gauges"], named_gauges(), "{named}");
 
     // 2. A second viewer (read from Rust) is counted on the page and gets the same stream.
     let mut second = Events::connect(&monitor_addr);
@@ -386,6 +381,7 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
     });
     assert!(read_page(&browser)["rig_strain"].is_null());
     new_panels_have_data_pause_and_export(&browser);
+    the_map_is_drawn_on_the_servers_range(&browser);
     until("the process table", || {
         (read_page(&browser)["correlator_restarts"] == "0").then_some(())
     });
@@ -451,6 +447,71 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
     });
 }
 
+/// The named gauges of `write_config` as the page titles their charts.
+fn named_gauges() -> Value {
+    serde_json::json!([
+        "middle: strain gauge, mean log strain (-)",
+        "span: extensometer, elongation (mm)"
+    ])
+}
+
+/// The strain map's colour range is the one the server sent for the quantity shown (the page
+/// computes none): the automatic range of the field's own measure, recomputed here from the
+/// node values the page drew by `wire::colour_range::choose`; the symmetric one and another
+/// measure's, switched on the page, the server's too.
+fn the_map_is_drawn_on_the_servers_range(browser: &Browser) {
+    let drawn = until("the strain map drawn", || {
+        let d = browser.eval(
+            "if (!dash.mapField || !dash.mapField.ranges) return null; \
+             const f = dash.mapField; \
+             return { scale: dash.mapScale, measure: dash.mapMeasure, comp: dash.mapComp, \
+                      same: dash.mapScale === f.ranges[dash.mapMeasure][dash.mapComp].auto, \
+                      values: f[dash.mapComp], cols: f.mesh_cols, rows: f.mesh_rows, \
+                      stride: f.stride, field_measure: f.measure };",
+        );
+        (!d.is_null()).then_some(d)
+    });
+    assert_eq!(drawn["same"], true, "{drawn}");
+    assert_eq!(drawn["measure"], drawn["field_measure"]);
+    let stride = drawn["stride"].as_u64().unwrap() as usize;
+    let nx = (drawn["cols"].as_u64().unwrap() as usize).div_ceil(stride);
+    let ny = (drawn["rows"].as_u64().unwrap() as usize).div_ceil(stride);
+    let values: Vec<Option<f64>> = drawn["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(Value::as_f64)
+        .collect();
+    assert_eq!(values.len(), nx * ny, "{drawn}");
+    let lag = wire::colour_range::strain_noise_lag_nodes(1).div_ceil(stride);
+    let grid = wire::colour_range::NodeGrid {
+        values: &values,
+        nx,
+        ny,
+    };
+    let expected = wire::colour_range::choose(grid, lag, true, Default::default());
+    let (lo, hi) = (
+        drawn["scale"]["lo"].as_f64().unwrap(),
+        drawn["scale"]["hi"].as_f64().unwrap(),
+    );
+    // (The page's values are the server's to 5 significant digits.)
+    let tolerance = 1e-3 * (expected.high - expected.low);
+    assert!(
+        (lo - expected.low).abs() <= tolerance && (hi - expected.high).abs() <= tolerance,
+        "drawn {lo}..{hi}, wire::colour_range {expected:?}"
+    );
+    let switched = browser.eval(
+        "const set = (id, v) => { const e = document.getElementById(id); e.value = v; e.dispatchEvent(new Event('change')); }; \
+         set('range-mode', 'symmetric'); set('map-measure', 'green'); \
+         const f = dash.mapField, ok = dash.mapMeasure === 'green' \
+           && dash.mapScale === f.ranges.green[dash.mapComp].symmetric \
+           && dash.mapScale.lo === -dash.mapScale.hi; \
+         set('range-mode', 'auto'); set('map-measure', 'measured'); \
+         return ok;",
+    );
+    assert_eq!(switched, true);
+}
+
 /// The test's time in the header advances; the force charts (the uniaxial test loads x: X+
 /// and X−) and the (λ1, λ2) states have points; pause freezes the charts while snapshots go
 /// on; each export button produces content, read back through the page's `dash` hooks; a
@@ -482,14 +543,7 @@ fn new_panels_have_data_pause_and_export(browser: &Browser) {
         let p = read_page(browser);
         (p["user_gauge_points"].as_u64() > Some(1)).then_some(p)
     });
-    assert_eq!(
-        named["user_gauges"],
-        serde_json::json!([
-            "middle: strain gauge, mean log strain (-)",
-            "span: extensometer, elongation (mm)"
-        ]),
-        "{named}"
-    );
+    assert_eq!(named["user_gauges"], named_gauges(), "{named}");
     // x pulls (which others count as loaded is the 10 % rule's, unit-tested in `wire::rig`: at
     // this test's small forces, about 50 N, the other load cells' noise passes it).
     let loaded = browser.eval("return dash.last.forces.actuators.map((a) => a.name).join(',');");

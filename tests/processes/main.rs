@@ -39,6 +39,7 @@ mod dashboard;
 mod faults;
 mod genicam_absent;
 mod identify_machine_files;
+mod monitor_gauges;
 mod producer_bad_input;
 mod producer_tap;
 mod producer_watch;

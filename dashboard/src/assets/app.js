@@ -160,11 +160,10 @@ const img = new Image();
 let imgVersion = -1, imgReady = false;
 img.onload = () => { imgReady = true; drawSpecimen(); };
 
-// The map's scale, as wire::colour_range::choose: automatic (2nd-98th percentile, at least
-// NOISE_FLOOR_SIGMAS times the field's noise `sigma` wide, centred on zero when it straddles it),
-// symmetric about zero, or fixed; a fixed range whose minimum is not below its maximum is
-// refused: {error}.
-function colourScale(values, sigma) {
+// The map's scale: automatic or symmetric, the server's (`ranges`, resolved per measure and
+// component by wire::colour_range::choose, the figures' own: dashboard/src/map_ranges.rs);
+// fixed, the user's two numbers, a minimum not below the maximum refused: {error}.
+function colourScale(f, measureName, comp) {
   const mode = $('range-mode').value;
   if (mode === 'fixed') {
     const lo = parseFloat($('range-min').value), hi = parseFloat($('range-max').value);
@@ -172,25 +171,8 @@ function colourScale(values, sigma) {
     if (!(lo < hi)) return { error: `fixed range refused: min ${lo} is not below max ${hi}` };
     return { map: lo < 0 && hi > 0 ? 'diverging' : 'viridis', lo, hi };
   }
-  const v = values.filter((x) => x !== null && isFinite(x)).sort((a, b) => a - b);
-  const floor = (sigma !== null && sigma !== undefined && isFinite(sigma)) ? NOISE_FLOOR_SIGMAS * sigma : 0;
-  let [lo, hi] = v.length === 0 ? [0, 0]
-    : [v[Math.round(0.02 * (v.length - 1))], v[Math.round(0.98 * (v.length - 1))]];
-  let scale;
-  if (mode === 'symmetric') {
-    const reach = Math.max(Math.abs(lo), Math.abs(hi), floor / 2);
-    scale = { map: 'diverging', lo: -reach, hi: reach };
-  } else {
-    const widen = Math.max(0, floor - (hi - lo)) / 2;
-    lo -= widen; hi += widen;
-    const reach = Math.max(Math.abs(lo), Math.abs(hi));
-    scale = lo < 0 && hi > 0 ? { map: 'diverging', lo: -reach, hi: reach } : { map: 'viridis', lo, hi };
-  }
-  if (!(scale.hi > scale.lo)) {
-    const half = Math.max(Math.abs(scale.lo) * 1e-6, 1e-12);
-    scale.lo -= half; scale.hi += half;
-  }
-  return scale;
+  const r = f.ranges && f.ranges[measureName] && f.ranges[measureName][comp];
+  return r ? r[mode] : { error: `no ${measureName} range` };
 }
 
 function drawColorbar(scale, label) {
@@ -221,6 +203,7 @@ function drawColorbar(scale, label) {
 // Seth-Hill strain measures are functions of the principal stretches on the same axes: log
 // ln λ, Green-Lagrange (λ² − 1)/2, nominal λ − 1. A node's strain in one of them gives its
 // stretches, hence the others. Small strain (sym ∇u) carries no rotation: it converts to none.
+// (The server converts the same way for the ranges it sends: stretch_states::convert_strain.)
 const STRETCH_OF = { log: (e) => Math.exp(e), green: (e) => Math.sqrt(1 + 2 * e), nominal: (e) => 1 + e };
 const STRAIN_OF = { log: (l) => Math.log(l), green: (l) => (l * l - 1) / 2, nominal: (l) => l - 1 };
 function convertStrain(exx, eyy, exy, from, to) {
@@ -257,8 +240,9 @@ function drawSpecimen() {
   if (f && f.x.length > 0) {
     const comp = $('component').value, [converted, measureName] = mapValues(f, comp);
     const values = converted || f[comp].map(() => null);
-    const scale = colourScale(values, f.noise_sigma ? f.noise_sigma[comp] : null);
-    dash.mapScale = scale;
+    const scale = colourScale(f, measureName, comp);
+    // What the map was drawn with, for the browser test: the scale, the field, the quantity.
+    Object.assign(dash, { mapScale: scale, mapField: f, mapMeasure: measureName, mapComp: comp });
     const cell = Math.max(1, f.step_px * f.stride / im.factor);
     if ($('show-map').checked && !scale.error) {
       ctx.globalAlpha = 0.55;

@@ -15,6 +15,23 @@ use std::io::{BufRead, BufReader, Read};
 use std::net::TcpStream;
 use testkit::send_request;
 
+/// Starts `dicstream monitor` (child `monitor` of `bench`) on `instance` at a free loopback
+/// port with `extra` arguments; its dashboard's address once it serves, and its stderr so far.
+pub fn spawn_monitor(bench: &mut crate::common::Run, extra: &[&str]) -> (String, String) {
+    let instance = bench.name().to_string();
+    let mut args = vec![
+        "monitor",
+        "--instance",
+        &instance,
+        "--dashboard",
+        "127.0.0.1:0",
+    ];
+    args.extend_from_slice(extra);
+    let monitor = bench.spawn("monitor", &args);
+    let line = monitor.wait_for_stderr("dashboard URL", |l| l.contains("http://"));
+    (crate::common::dashboard_address(&line), monitor.stderr())
+}
+
 /// One HTTP/1.1 request (`Connection: close`): status and body.
 pub fn http(addr: &str, method: &str, path: &str, body: Option<&Value>) -> (u16, Vec<u8>) {
     let body = body.map(|b| b.to_string()).unwrap_or_default();
@@ -97,6 +114,19 @@ pub fn get_json(addr: &str, path: &str) -> Value {
         String::from_utf8_lossy(&body)
     );
     serde_json::from_slice(&body).unwrap()
+}
+
+/// `/snapshot.json`, or None before the dashboard's first snapshot (503).
+pub fn try_snapshot(addr: &str) -> Option<Value> {
+    let (status, body) = http(addr, "GET", "/snapshot.json", None);
+    match status {
+        503 => None,
+        200 => Some(serde_json::from_slice(&body).unwrap()),
+        _ => panic!(
+            "GET /snapshot.json: {status} {}",
+            String::from_utf8_lossy(&body)
+        ),
+    }
 }
 
 /// A viewer of `/events`, read from Rust.
