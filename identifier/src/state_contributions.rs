@@ -48,6 +48,21 @@ pub struct FrameStates<'a> {
     pub equations: &'a Equations,
 }
 
+impl<'a> FrameStates<'a> {
+    /// The route's kept frames.
+    pub fn of_route(route: &'a FieldRoute) -> Vec<Self> {
+        route
+            .frames()
+            .iter()
+            .map(|f| FrameStates {
+                frame_id: f.frame_id,
+                grid: &f.grid,
+                equations: &f.equations,
+            })
+            .collect()
+    }
+}
+
 /// One state: a node of a frame, its principal stretches and its contribution.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StateContribution {
@@ -267,15 +282,7 @@ pub fn of_best_fit(
     fits: &FieldFits,
 ) -> Option<Result<StateContributions, ContributionError>> {
     let best = fits.fits.iter().find(|fit| fit.ranked())?;
-    let frames: Vec<FrameStates> = route
-        .frames()
-        .iter()
-        .map(|f| FrameStates {
-            frame_id: f.frame_id,
-            grid: &f.grid,
-            equations: &f.equations,
-        })
-        .collect();
+    let frames = FrameStates::of_route(route);
     Some(state_contributions(&best.model, &best.fit.params, &frames))
 }
 

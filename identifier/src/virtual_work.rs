@@ -27,6 +27,18 @@ pub struct WeightedNode {
     pub weight_mm2: Mat2,
 }
 
+impl WeightedNode {
+    /// A node's own measurement (not filled).
+    pub fn measured(at: (usize, usize), gradient: Mat2, weight_mm2: Mat2) -> Self {
+        Self {
+            at,
+            filled: false,
+            gradient,
+            weight_mm2,
+        }
+    }
+}
+
 /// A node whose stress is not defined, and why.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NodeFailure {
@@ -287,12 +299,7 @@ mod tests {
     }
 
     fn node(col: usize, gradient: Mat2, weight_mm2: Mat2) -> WeightedNode {
-        WeightedNode {
-            at: (col, 0),
-            filled: false,
-            gradient,
-            weight_mm2,
-        }
+        WeightedNode::measured((col, 0), gradient, weight_mm2)
     }
 
     /// The compiled equations give the direct evaluation's forces, for nodes shared between

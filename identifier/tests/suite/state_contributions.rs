@@ -15,12 +15,7 @@ use identifier::virtual_work::{EquationInput, Equations, WeightedNode};
 const THICKNESS_MM: f64 = 2.0;
 
 fn node(col: usize, gradient: Mat2, weight_mm2: Mat2) -> WeightedNode {
-    WeightedNode {
-        at: (col, 0),
-        filled: false,
-        gradient,
-        weight_mm2,
-    }
+    WeightedNode::measured((col, 0), gradient, weight_mm2)
 }
 
 /// One frame of `cols` x 1 nodes, 1 mm apart, whose one equation weighs `nodes`.
@@ -206,15 +201,7 @@ fn route_frames() -> FieldRoute {
 #[test]
 fn over_a_cruciforms_frames_they_sum_to_one_and_nodes_outside_every_field_give_nothing() {
     let route = route_frames();
-    let frames: Vec<FrameStates> = route
-        .frames()
-        .iter()
-        .map(|f| FrameStates {
-            frame_id: f.frame_id,
-            grid: &f.grid,
-            equations: &f.equations,
-        })
-        .collect();
+    let frames = FrameStates::of_route(&route);
     for (model, p) in [
         (Model::Mooney, vec![0.3, 0.05]),
         (Model::Gent, vec![0.7, 30.0]),
