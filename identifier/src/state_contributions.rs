@@ -117,6 +117,9 @@ pub enum ContributionError {
     Insensitive { parameter: String },
 }
 
+/// A filled node of a frame: its node, stretches and summed sensitivities S_nk.
+type FilledNode = ((usize, usize), [f64; 2], Vec<f64>);
+
 /// ∂s/∂θ_k of the principal Cauchy stresses at stretches (λ1, λ2), k = 0..K, MPa per unit.
 fn stress_derivatives(
     model: &Model,
@@ -209,7 +212,7 @@ pub fn state_contributions(
         };
         // The measured nodes the equations weigh, and the filled ones (by node, summed).
         let mut measured: HashMap<(usize, usize), usize> = HashMap::new();
-        let mut filled: Vec<((usize, usize), [f64; 2], Vec<f64>)> = vec![];
+        let mut filled: Vec<FilledNode> = vec![];
         for (d, origin) in frame.equations.origins().iter().enumerate() {
             if !origin.filled {
                 measured.insert(origin.at, d);
