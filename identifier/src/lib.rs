@@ -18,6 +18,8 @@
 //! - [`field_layout`]: where the cuts and ramps go, from the cruciform and the view.
 //! - [`grip_forces`]: the grips' forces of recent rig samples, by id or by time.
 //! - [`field_route`]: the frames of a test kept for the field route, fitted together.
+//! - [`state_contributions`]: each state's (node and frame) share of a field fit's
+//!   sensitivity to its parameters, and `states.csv`.
 //! - [`femu`]: finite-element model updating, the field route's reference (offline): the
 //!   view's finite-element model under the measured edge displacements against the grips'
 //!   forces and the interior displacements ([`measured_displacement`]: the edges' values).
@@ -63,6 +65,7 @@ pub mod route;
 pub mod saved_fields;
 pub mod section_cut;
 pub mod stability;
+pub mod state_contributions;
 pub mod subsample;
 pub mod table;
 pub mod tapered_ramp;

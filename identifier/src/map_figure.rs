@@ -13,6 +13,8 @@ const SIDE_PX: usize = 12;
 /// The colour bar's width and the room for its labels, px.
 const BAR_PX: usize = 26;
 const LABELS_PX: usize = 150;
+/// Room for the bar's title (written upwards) at the right of its labels, px.
+const BAR_TITLE_PX: usize = 24;
 /// Values written beside the bar.
 const TICKS: usize = 5;
 
@@ -29,12 +31,24 @@ pub struct MapFigure<'a> {
     pub scale: ColourScale,
     /// How a bar value is written, e.g. `|v| format!("{:.2} %", 100.0 * v)`.
     pub label: &'a dyn Fn(f64) -> String,
+    /// What the bar's colour is, with its unit or normalisation: written upwards along the
+    /// bar's labels (None: the title says it).
+    pub bar_title: Option<&'a str>,
 }
 
 /// The figure's size, px.
 fn canvas_size(figure: &MapFigure) -> (usize, usize) {
     (
-        SIDE_PX + figure.width_px + SIDE_PX + BAR_PX + LABELS_PX,
+        SIDE_PX
+            + figure.width_px
+            + SIDE_PX
+            + BAR_PX
+            + LABELS_PX
+            + if figure.bar_title.is_some() {
+                BAR_TITLE_PX
+            } else {
+                0
+            },
         TOP_PX + figure.height_px + SIDE_PX,
     )
 }
@@ -84,6 +98,16 @@ pub fn draw(figure: &MapFigure) -> Result<(Vec<u8>, (usize, usize)), PlotError> 
             root.draw_text(&(figure.label)(value), &small, (x + 8, y as i32 - 8))
                 .map_err(|e| err(&e))?;
         }
+        if let Some(bar_title) = figure.bar_title {
+            let upwards = ("sans-serif", 16)
+                .into_font()
+                .transform(FontTransform::Rotate270)
+                .color(&BLACK);
+            let x = (cw - BAR_TITLE_PX) as i32;
+            let y = (TOP_PX + h - 1) as i32;
+            root.draw_text(bar_title, &upwards, (x, y))
+                .map_err(|e| err(&e))?;
+        }
         root.present().map_err(|e| err(&e))?;
     }
     Ok((canvas, (cw, ch)))
@@ -116,6 +140,7 @@ mod tests {
             title: "exx",
             scale,
             label: &label,
+            bar_title: None,
         };
         let (canvas, (cw, ch)) = draw(&figure).unwrap();
         assert_eq!((cw, ch), canvas_size(&figure));

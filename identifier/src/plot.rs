@@ -9,6 +9,7 @@ use crate::route::RouteResult;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
+use wire::colour_map::ColourScale;
 
 /// Fits drawn per plot (best AIC first).
 pub const MAX_FITS_PLOTTED: usize = 6;
@@ -82,8 +83,69 @@ pub fn chart_paired(
     series: &[Series],
     paired: bool,
 ) -> Result<(), PlotError> {
+    let rgb = draw_chart(path, Some(title), x_desc, y_desc, series, paired, None)?;
+    write_png(path, &rgb)
+}
+
+/// Points coloured by a value on a scale, drawn under a chart's series, with a colour bar.
+pub struct ColouredPoints<'a> {
+    /// (x, y, value), drawn in this order (the last on top).
+    pub points: &'a [(f64, f64, f64)],
+    pub scale: ColourScale,
+    /// What the colour is, with its unit or normalisation (beside the bar).
+    pub bar_title: &'a str,
+    /// How a bar value is written.
+    pub label: &'a dyn Fn(f64) -> String,
+}
+
+/// [`chart`] over points coloured by their value (`coloured`, small markers drawn first), the
+/// colour bar of their scale on the right ([`crate::map_figure`]).
+pub fn chart_coloured(
+    path: &Path,
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[Series],
+    coloured: &ColouredPoints,
+) -> Result<(), PlotError> {
+    let rgb = draw_chart(path, None, x_desc, y_desc, series, false, Some(coloured))?;
+    crate::map_figure::write(
+        path,
+        &crate::map_figure::MapFigure {
+            rgb: &rgb,
+            width_px: SIZE_PX.0 as usize,
+            height_px: SIZE_PX.1 as usize,
+            title,
+            scale: coloured.scale,
+            label: coloured.label,
+            bar_title: Some(coloured.bar_title),
+        },
+    )
+}
+
+/// Marker radius of a coloured point, px.
+const COLOURED_RADIUS_PX: i32 = 2;
+
+/// The chart as RGB bytes of [`SIZE_PX`]: `title` as its caption (None: none), the coloured
+/// points under the series.
+fn draw_chart(
+    path: &Path,
+    title: Option<&str>,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[Series],
+    paired: bool,
+    coloured: Option<&ColouredPoints>,
+) -> Result<Vec<u8>, PlotError> {
     let err = |e: &dyn std::fmt::Display| PlotError(format!("{}: {e}", path.display()));
-    let Some((x0, x1, y0, y1)) = bounds(series) else {
+    let scatter = Series {
+        label: String::new(),
+        points: coloured.map_or(vec![], |c| c.points.iter().map(|p| (p.0, p.1)).collect()),
+        markers: true,
+    };
+    let mut all: Vec<&Series> = series.iter().collect();
+    all.push(&scatter);
+    let Some((x0, x1, y0, y1)) = bounds(all) else {
         return Err(PlotError(format!("{}: nothing to plot", path.display())));
     };
     let pad = 0.05 * (y1 - y0).max(1e-9);
@@ -96,11 +158,11 @@ pub fn chart_paired(
         root.fill(&WHITE).map_err(|e| err(&e))?;
         let mut builder = ChartBuilder::on(&root);
         builder.margin(20);
+        if let (true, Some(title)) = (text, title) {
+            builder.caption(title, ("sans-serif", 24));
+        }
         if text {
-            builder
-                .caption(title, ("sans-serif", 24))
-                .x_label_area_size(45)
-                .y_label_area_size(70);
+            builder.x_label_area_size(45).y_label_area_size(70);
         }
         let mut chart = builder
             .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
@@ -119,6 +181,18 @@ pub fn chart_paired(
                 BLACK.stroke_width(1),
             ))
             .map_err(|e| err(&e))?;
+        }
+        if let Some(c) = coloured {
+            let finite = c
+                .points
+                .iter()
+                .filter(|p| p.0.is_finite() && p.1.is_finite());
+            chart
+                .draw_series(finite.map(|&(x, y, v)| {
+                    let [r, g, b] = c.scale.rgb(v);
+                    Circle::new((x, y), COLOURED_RADIUS_PX, RGBColor(r, g, b).filled())
+                }))
+                .map_err(|e| err(&e))?;
         }
         // Paired: the lines take the palette in turn and each line's markers its colour.
         let only_data = series.iter().filter(|s| s.markers).count() == 1;
@@ -172,13 +246,13 @@ pub fn chart_paired(
         }
         root.present().map_err(|e| err(&e))?;
     }
-    write_png(path, &rgb)
+    Ok(rgb)
 }
 
 /// The finite points' (x0, x1, y0, y1); None when they span no x range.
-fn bounds(series: &[Series]) -> Option<(f64, f64, f64, f64)> {
+fn bounds<'a>(series: impl IntoIterator<Item = &'a Series>) -> Option<(f64, f64, f64, f64)> {
     let finite = series
-        .iter()
+        .into_iter()
         .flat_map(|s| s.points.iter())
         .filter(|p| p.0.is_finite() && p.1.is_finite());
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);

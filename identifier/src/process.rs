@@ -45,6 +45,11 @@ pub struct ProcessConfig {
     /// The field route's view and specimen (needed when `routes` runs it).
     #[serde(default)]
     pub field: Option<FieldRouteSettings>,
+    /// Where the field route writes, at the end, each state of its kept frames with its
+    /// contribution to the best fit (`crate::state_contributions::states_csv`); None: not
+    /// written. Nothing is written without a ranked fit.
+    #[serde(default)]
+    pub states_csv: Option<PathBuf>,
 }
 
 fn gauge_route() -> IdentifierRoutes {

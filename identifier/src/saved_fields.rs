@@ -75,6 +75,14 @@ pub struct SavedFit {
     pub kept_frames: Vec<crate::femu::FemuFrame>,
     /// Wall time of the fit of every model to the kept frames, s (reading excluded).
     pub fit_s: f64,
+    /// Each state of the kept frames with its contribution to the best ranked fit (None: no
+    /// fit is ranked).
+    pub states: Option<
+        Result<
+            crate::state_contributions::StateContributions,
+            crate::state_contributions::ContributionError,
+        >,
+    >,
 }
 
 /// Fits the saved fields of results folder `dir` with the live route's feed: each field file
@@ -151,6 +159,7 @@ pub fn fit_saved(
     Ok(SavedFit {
         kept_frames,
         fit_s,
+        states: crate::state_contributions::of_best_fit(route, &fits),
         force_balance: crate::process::force_balance(route, &fits),
         fits,
         counters: c,

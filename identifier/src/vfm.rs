@@ -172,11 +172,17 @@ fn condition(j: &DMatrix<f64>) -> f64 {
     }
 }
 
+/// The central-difference step of a parameter of value `p_k`: relative, floored at 1e-9 (the
+/// fit's Jacobian and `state_contributions`'s node sensitivities alike).
+pub(crate) fn difference_step(p_k: f64) -> f64 {
+    1e-6 * p_k.abs().max(1e-3)
+}
+
 /// Jacobian of the computed forces by central differences (relative step).
 fn jacobian(model: &Model, equations: &Equations, p: &[f64]) -> Result<DMatrix<f64>, VfmError> {
     let mut j = DMatrix::zeros(equations.len(), p.len());
     for k in 0..p.len() {
-        let h = 1e-6 * p[k].abs().max(1e-3);
+        let h = difference_step(p[k]);
         let mut plus = p.to_vec();
         let mut minus = p.to_vec();
         plus[k] += h;

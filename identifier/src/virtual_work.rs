@@ -27,6 +27,18 @@ pub struct WeightedNode {
     pub weight_mm2: Mat2,
 }
 
+impl WeightedNode {
+    /// A node's own measurement (not filled).
+    pub fn measured(at: (usize, usize), gradient: Mat2, weight_mm2: Mat2) -> Self {
+        Self {
+            at,
+            filled: false,
+            gradient,
+            weight_mm2,
+        }
+    }
+}
+
 /// A node whose stress is not defined, and why.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NodeFailure {
@@ -70,11 +82,25 @@ pub struct EquationInput<'a> {
     pub measured_n: f64,
 }
 
+/// Where a distinct node of compiled equations comes from: its frame (the index the inputs
+/// gave; [`Equations::append`] shifts the appended frames past the others), its grid node, and
+/// whether its value was filled across a hole (then it is its equation's alone).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NodeOrigin {
+    pub frame: usize,
+    pub at: (usize, usize),
+    pub filled: bool,
+}
+
 /// A set of virtual-work equations, compiled for many trial laws.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Equations {
     /// (λ1, λ2) of each distinct node.
     stretches: Vec<[f64; 2]>,
+    /// Where each distinct node comes from.
+    origins: Vec<NodeOrigin>,
+    /// Frames the inputs named (one past the largest index).
+    frames: usize,
     /// Equation i's terms are `terms[row_start[i]..row_start[i + 1]]`.
     row_start: Vec<usize>,
     /// (distinct node, h0 K1:W, h0 K2:W), mm³.
@@ -145,6 +171,11 @@ impl Equations {
                 let known = key.and_then(|key| index.get(&key).copied());
                 let distinct = known.unwrap_or_else(|| {
                     out.stretches.push(stretches);
+                    out.origins.push(NodeOrigin {
+                        frame: input.frame,
+                        at: node.at,
+                        filled: node.filled,
+                    });
                     let new = (out.stretches.len() - 1) as u32;
                     if let Some(key) = key {
                         index.insert(key, new);
@@ -162,6 +193,7 @@ impl Equations {
             }
             out.row_start.push(out.terms.len());
             out.measured_n.push(input.measured_n);
+            out.frames = out.frames.max(input.frame + 1);
             failures.push(None);
         }
         (out, failures)
@@ -174,6 +206,13 @@ impl Equations {
         }
         let offset = self.stretches.len() as u32;
         self.stretches.extend_from_slice(&other.stretches);
+        let frames = self.frames;
+        self.origins
+            .extend(other.origins.iter().map(|o| NodeOrigin {
+                frame: o.frame + frames,
+                ..*o
+            }));
+        self.frames += other.frames;
         let base = self.terms.len();
         self.terms
             .extend(other.terms.iter().map(|&(node, c)| (node + offset, c)));
@@ -202,6 +241,19 @@ impl Equations {
     /// The (λ1, λ2) of every distinct node.
     pub fn stretches(&self) -> &[[f64; 2]] {
         &self.stretches
+    }
+
+    /// Where every distinct node comes from, in the order of [`Self::stretches`].
+    pub fn origins(&self) -> &[NodeOrigin] {
+        &self.origins
+    }
+
+    /// Each equation's terms: (distinct node, h0 K1:W, h0 K2:W), mm³, so that its force is
+    /// Σ c1 s1 + c2 s2 over them with s1, s2 the node's principal Cauchy stresses, MPa.
+    pub fn rows(&self) -> impl Iterator<Item = &[(u32, [f64; 2])]> + '_ {
+        self.row_start
+            .windows(2)
+            .map(|range| &self.terms[range[0]..range[1]])
     }
 
     /// Each equation's force under `model` at `p`, N; an error where the law is not defined
@@ -247,12 +299,7 @@ mod tests {
     }
 
     fn node(col: usize, gradient: Mat2, weight_mm2: Mat2) -> WeightedNode {
-        WeightedNode {
-            at: (col, 0),
-            filled: false,
-            gradient,
-            weight_mm2,
-        }
+        WeightedNode::measured((col, 0), gradient, weight_mm2)
     }
 
     /// The compiled equations give the direct evaluation's forces, for nodes shared between

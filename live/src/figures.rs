@@ -76,6 +76,7 @@ pub fn strain_map(
             title,
             scale,
             label: &label,
+            bar_title: None,
         },
     )
     .with_context(|| path.display().to_string())?;

@@ -1,8 +1,11 @@
 //! The run's mechanical figures, drawn at the end from what the run wrote: each actuator's
 //! force against time (`forces.png`, from `rig.csv`: on a cruciform, each arm's), and the
-//! states the measured field reached in the (λ1, λ2) plane, a point per valid node of every
-//! saved field (`stretch_states.png`, the paper's Fig. 5) with the canonical paths (uniaxial
-//! λ2 = λ1^-1/2, pure shear λ2 = 1, equibiaxial λ2 = λ1) that the gauge route is limited to.
+//! states the measured field reached in the (λ1, λ2) plane (`stretch_states.png`, the paper's
+//! Fig. 5) with the canonical paths (uniaxial λ2 = λ1^-1/2, pure shear λ2 = 1, equibiaxial
+//! λ2 = λ1) that the gauge route is limited to: a point per node and frame the field route
+//! kept, coloured by its contribution to the route's best fit (`states.csv`, the identifier's,
+//! or `identify --fields --plot`'s), or, without a fit, every valid node of every saved field
+//! in one colour.
 
 use identifier::plot::{chart, Series};
 use std::path::{Path, PathBuf};
@@ -151,9 +154,66 @@ fn canonical_paths(max_l1: f64) -> Vec<Series> {
     ]
 }
 
-/// `stretch_states.png` from the saved fields; the number of node states drawn (0: no
-/// figure, no valid node with a gradient).
-pub fn stretch_states_png(fields_dir: &Path, path: &Path) -> anyhow::Result<usize> {
+/// The states of `states.csv` (the field route's, [`identifier::state_contributions`]):
+/// (λ1, λ2, contribution) of each.
+pub fn contributed_states(states_csv: &str) -> anyhow::Result<Vec<(f64, f64, f64)>> {
+    let (names, lines) = header(states_csv, "states.csv")?;
+    let column = |name: &str| column(&names, name, "states.csv");
+    let (l1, l2, share) = (
+        column("lambda1")?,
+        column("lambda2")?,
+        column("contribution")?,
+    );
+    lines
+        .enumerate()
+        .filter(|(_, line)| !line.is_empty())
+        .map(|(k, line)| {
+            let cells: Vec<&str> = line.split(',').collect();
+            let number = |i: usize| cells.get(i).and_then(|c| c.parse::<f64>().ok());
+            match (number(l1), number(l2), number(share)) {
+                (Some(a), Some(b), Some(c)) => Ok((a, b, c)),
+                _ => anyhow::bail!("states.csv: line {}: not a state: {line}", k + 2),
+            }
+        })
+        .collect()
+}
+
+/// What `stretch_states.png` drew.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StatesDrawn {
+    /// No valid node with a gradient: no figure.
+    Nothing,
+    /// The saved fields' nodes in one colour (no field-route fit), how many.
+    OneColour(usize),
+    /// The field route's states coloured by their contribution to its fit, how many.
+    Contributions(usize),
+}
+
+/// The bar's title of the coloured figure: what the colour is and how it is normalised.
+pub const CONTRIBUTION_BAR_TITLE: &str =
+    "contribution: share of the fit's sensitivity to its parameters (all states sum to 1)";
+
+/// `stretch_states.png`: with the field route's `states_csv` (a file that exists), its states
+/// coloured by their contribution to the fit of `model` (viridis from 0 to the largest, the
+/// largest drawn last); otherwise every valid node of the saved fields in `fields_dir`, one
+/// colour, the title saying why.
+pub fn stretch_states_png(
+    fields_dir: &Path,
+    states_csv: Option<&Path>,
+    model: Option<&str>,
+    path: &Path,
+) -> anyhow::Result<StatesDrawn> {
+    if let Some(csv) = states_csv.filter(|p| p.exists()) {
+        let text =
+            std::fs::read_to_string(csv).map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
+        let mut states =
+            contributed_states(&text).map_err(|e| anyhow::anyhow!("{}: {e}", csv.display()))?;
+        if !states.is_empty() {
+            states.sort_by(|a, b| a.2.total_cmp(&b.2));
+            draw_contributions(&states, model, path)?;
+            return Ok(StatesDrawn::Contributions(states.len()));
+        }
+    }
     let mut states = Vec::new();
     for file in field_files(fields_dir) {
         let text = std::fs::read_to_string(&file)
@@ -162,24 +222,64 @@ pub fn stretch_states_png(fields_dir: &Path, path: &Path) -> anyhow::Result<usiz
             .extend(node_stretches(&text).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?);
     }
     if states.is_empty() {
-        return Ok(0);
+        return Ok(StatesDrawn::Nothing);
     }
-    // At least to λ1 1.1: a field at rest (rigid motion, λ1 = 1 everywhere) still has axes.
-    let max_l1 = states.iter().map(|s| s.0).fold(MIN_MAX_STRETCH, f64::max);
     let mut series = vec![Series {
         label: format!("nodes of the saved fields ({} states)", states.len()),
         points: states.clone(),
         markers: true,
     }];
-    series.extend(canonical_paths(max_l1));
+    series.extend(canonical_paths(max_l1(states.iter().map(|s| s.0))));
     chart(
         path,
-        "states the field reached (paper Fig. 5)",
-        "λ1 (larger in-plane principal stretch)",
+        "states the field reached (paper Fig. 5); no field-route fit: one colour",
+        L1_DESC,
         "λ2",
         &series,
     )?;
-    Ok(states.len())
+    Ok(StatesDrawn::OneColour(states.len()))
+}
+
+const L1_DESC: &str = "λ1 (larger in-plane principal stretch)";
+
+/// The λ1 axis' reach: the largest λ1, at least [`MIN_MAX_STRETCH`] (a field at rest, λ1 = 1
+/// everywhere, still has axes).
+fn max_l1(l1: impl Iterator<Item = f64>) -> f64 {
+    l1.fold(MIN_MAX_STRETCH, f64::max)
+}
+
+/// The coloured figure of `states` (λ1, λ2, contribution), sorted by contribution.
+fn draw_contributions(
+    states: &[(f64, f64, f64)],
+    model: Option<&str>,
+    path: &Path,
+) -> anyhow::Result<()> {
+    let largest = states.iter().map(|s| s.2).fold(0.0, f64::max);
+    let scale = wire::colour_map::ColourScale {
+        map: wire::colour_map::ColourMap::Viridis,
+        low: 0.0,
+        high: if largest > 0.0 { largest } else { 1.0 },
+    };
+    let title = format!(
+        "states the field route used (paper Fig. 5), {} of them, coloured by contribution to {}",
+        states.len(),
+        model.map_or_else(|| "its fit".to_string(), |m| format!("the {m} fit"))
+    );
+    let label = |v: f64| format!("{v:.1e}");
+    identifier::plot::chart_coloured(
+        path,
+        &title,
+        L1_DESC,
+        "λ2",
+        &canonical_paths(max_l1(states.iter().map(|s| s.0))),
+        &identifier::plot::ColouredPoints {
+            points: states,
+            scale,
+            bar_title: CONTRIBUTION_BAR_TITLE,
+            label: &label,
+        },
+    )?;
+    Ok(())
 }
 
 #[cfg(test)]
@@ -252,8 +352,47 @@ mod tests {
         )
         .unwrap();
         let png = dir.join("stretch_states.png");
-        assert_eq!(stretch_states_png(&dir, &png).unwrap(), 2);
+        assert_eq!(
+            stretch_states_png(&dir, None, None, &png).unwrap(),
+            StatesDrawn::OneColour(2)
+        );
         assert!(png.exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The field route's `states.csv` colours the figure; a line that is no state is named.
+    #[test]
+    fn the_field_routes_states_are_drawn_coloured_by_their_contribution() {
+        let dir = std::env::temp_dir().join(format!("dicstream-states-csv-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let header = identifier::state_contributions::STATES_CSV_HEADER;
+        let csv = dir.join("states.csv");
+        std::fs::write(
+            &csv,
+            format!(
+                "{header},share_C10\n3,0,0,-80,-80,1.2,1.1,0,0e0,0e0\n3,1,0,-77.5,-80,1.5,0.8,0,7.5e-1,7.5e-1\n3,2,0,-75,-80,1.3,1.3,1,2.5e-1,2.5e-1\n"
+            ),
+        )
+        .unwrap();
+        let states = contributed_states(&std::fs::read_to_string(&csv).unwrap()).unwrap();
+        assert_eq!(states[1], (1.5, 0.8, 0.75));
+        let png = dir.join("stretch_states.png");
+        assert_eq!(
+            stretch_states_png(&dir, Some(&csv), Some("mooney"), &png).unwrap(),
+            StatesDrawn::Contributions(3)
+        );
+        assert!(std::fs::metadata(&png).unwrap().len() > 1000);
+        // No states.csv and no saved field: nothing drawn.
+        std::fs::remove_file(&png).unwrap();
+        assert_eq!(
+            stretch_states_png(&dir, Some(&dir.join("none.csv")), None, &png).unwrap(),
+            StatesDrawn::Nothing
+        );
+        assert!(!png.exists());
+        let error = contributed_states(&format!("{header}\n3,0,0,0,0,1.2,x,0,0.1\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("line 2: not a state"), "{error}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

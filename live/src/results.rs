@@ -87,6 +87,11 @@ impl ResultsDir {
     pub fn journal(&self) -> PathBuf {
         self.path("identification_points.csv")
     }
+    /// The field route's states with their contributions to its best fit (the identifier
+    /// writes it at its end; `stretch_states.png` colours them).
+    pub fn states_csv(&self) -> PathBuf {
+        self.path("states.csv")
+    }
     /// The settings a child of the run was started with (`settings/<role>.json`).
     pub fn settings_file(&self, role: &str) -> PathBuf {
         self.root.join("settings").join(format!("{role}.json"))

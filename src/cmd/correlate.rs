@@ -516,6 +516,7 @@ fn write_figures(
                 title: &title,
                 scale,
                 label: &label,
+                bar_title: None,
             },
         )
         .with_context(|| format!("cannot write {}", path.display()))?;

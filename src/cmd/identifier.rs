@@ -25,6 +25,10 @@ pub struct IdentifierArgs {
     /// rebuilds its path from it), appended as points are accepted.
     #[arg(long)]
     pub journal: Option<PathBuf>,
+    /// With the field route: write each state of its kept frames with its contribution to the
+    /// best fit here at the end (`states.csv`'s columns).
+    #[arg(long, value_name = "FILE")]
+    pub states_csv: Option<PathBuf>,
     /// Models ranked at each refit: NAME[,NAME...] or `all` (slow: refits run per point).
     #[arg(long, default_value_t = ModelList(OnlineConfig::default().models))]
     pub model: ModelList,
@@ -93,6 +97,7 @@ fn process_config(args: IdentifierArgs) -> anyhow::Result<ProcessConfig> {
         instance: args.instance,
         output_json: args.output,
         journal: args.journal,
+        states_csv: args.states_csv,
         max_fields: args.max_fields,
         idle_timeout,
         online: OnlineConfig {

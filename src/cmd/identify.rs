@@ -83,7 +83,8 @@ pub struct IdentifyArgs {
     #[arg(long)]
     pub json: bool,
     /// Write PNG plots (data and fitted curves, f(I1) and g(I2), the best fit's residuals)
-    /// into this folder.
+    /// into this folder. With --fields: `stretch_states.png`, the states of the kept frames
+    /// coloured by their contribution to the best fit, and those numbers in `states.csv`.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
     /// With --plot: f(I1) and g(I2) show every ranked model (up to six) and the route's own

@@ -29,7 +29,7 @@ pub fn run(
         (args.biaxial_general.is_some(), "--biaxial-general"),
         (args.gauge_length_mm.is_some(), "--gauge-length-mm"),
         (args.section_mm2.is_some(), "--section-mm2"),
-        (args.plot.is_some(), "--plot"),
+        (args.all_models, "--all-models"),
         (args.cards.is_some(), "--cards"),
     ];
     if let Some((_, flag)) = others.iter().find(|(given, _)| *given) {
@@ -77,12 +77,56 @@ pub fn run(
     } else {
         print_table(out, &saved, &identifiability)?;
     }
+    if let Some(plot_dir) = &args.plot {
+        write_states(dir, plot_dir, &saved, err)?;
+    }
     if saved.fits.fits.is_empty() {
         bail!(
             "no model could be fitted to the fields of {}",
             dir.display()
         );
     }
+    Ok(())
+}
+
+/// `--plot DIR`: `states.csv` (each state of the kept frames with its contribution to the best
+/// ranked fit) and `stretch_states.png` coloured by it; without a ranked fit, the saved fields'
+/// nodes in one colour, said on `err`.
+fn write_states(
+    dir: &Path,
+    plot_dir: &Path,
+    saved: &SavedFit,
+    err: &mut dyn Write,
+) -> anyhow::Result<()> {
+    std::fs::create_dir_all(plot_dir)
+        .with_context(|| format!("cannot create {}", plot_dir.display()))?;
+    let csv = plot_dir.join("states.csv");
+    let written = match &saved.states {
+        Some(Ok(states)) => {
+            wire::files::write_atomic(
+                &csv,
+                identifier::state_contributions::states_csv(states).as_bytes(),
+            )?;
+            Some((csv.as_path(), states.model.as_str()))
+        }
+        Some(Err(e)) => {
+            writeln!(err, "states.csv not written: {e}")?;
+            None
+        }
+        None => {
+            writeln!(
+                err,
+                "states.csv not written: no ranked fit to contribute to"
+            )?;
+            None
+        }
+    };
+    live::mechanics_figures::stretch_states_png(
+        &dir.join("fields"),
+        written.map(|w| w.0),
+        written.map(|w| w.1),
+        &plot_dir.join("stretch_states.png"),
+    )?;
     Ok(())
 }
 
@@ -393,5 +437,50 @@ pub(super) mod tests {
             "{err}"
         );
         assert!(!out.contains("rivlin"), "not ranked: {out}");
+    }
+
+    /// `--plot DIR`: `stretch_states.png`, and `states.csv` when a fit is ranked (a state per
+    /// node and kept frame, its contributions summing to 1); said on stderr otherwise.
+    #[test]
+    fn plot_writes_the_states_coloured_by_their_contribution() {
+        let run = run_dir("states", 0.36, &[1.05, 1.1, 1.15, 1.2, 1.25]);
+        let plots = run.0.join("plots");
+        let (out, err, result) = identify(&run.0, &["--json", "--plot", plots.to_str().unwrap()]);
+        result.unwrap();
+        let value: Value = serde_json::from_str(&out).unwrap();
+        assert!(plots.join("stretch_states.png").exists());
+        let ranked = value["fits"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| !f["rank"].is_null());
+        let csv = plots.join("states.csv");
+        if ranked {
+            let text = std::fs::read_to_string(&csv).unwrap();
+            let mut lines = text.lines();
+            assert_eq!(
+                lines.next().unwrap(),
+                format!(
+                    "{},share_C10,share_C01",
+                    identifier::state_contributions::STATES_CSV_HEADER
+                )
+            );
+            let rows: Vec<Vec<f64>> = lines
+                .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+                .collect();
+            // Every node of the 5 kept frames (31 x 31 each), no hole to fill.
+            assert_eq!(rows.len(), 5 * 31 * 31);
+            let total: f64 = rows.iter().map(|r| r[8]).sum();
+            assert!((total - 1.0).abs() < 1e-9, "{total}");
+        } else {
+            assert!(!csv.exists());
+            assert!(
+                err.contains("states.csv not written: no ranked fit"),
+                "{err}"
+            );
+        }
+        // --all-models is the gauge route's.
+        let (_, _, result) = identify(&run.0, &["--plot", plots.to_str().unwrap(), "--all-models"]);
+        assert!(format!("{:#}", result.unwrap_err()).contains("--all-models does not apply"));
     }
 }

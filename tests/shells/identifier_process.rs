@@ -32,6 +32,7 @@ fn live_process_identifies_smactane() {
         online: OnlineConfig::default(),
         routes: IdentifierRoutes::Gauge,
         field: None,
+        states_csv: None,
     };
     let worker = std::thread::spawn(move || run(config));
     {
@@ -147,6 +148,7 @@ fn live_process_identifies_smactane() {
         online: OnlineConfig::default(),
         routes: IdentifierRoutes::Gauge,
         field: None,
+        states_csv: None,
     };
     let summary = run(again).unwrap();
     assert_eq!(summary.points, [STEPS as usize, STEPS as usize, 0]);

@@ -351,6 +351,16 @@ impl FieldShell {
         report
     }
 
+    /// `states.csv` of the last fit: each state of the kept frames with its contribution to
+    /// the best ranked fit (None: no ranked fit).
+    pub fn states_csv(
+        &self,
+    ) -> Option<Result<String, crate::state_contributions::ContributionError>> {
+        let fits = self.fits.as_ref()?;
+        let contributions = crate::state_contributions::of_best_fit(&self.feed.route, fits)?;
+        Some(contributions.map(|c| crate::state_contributions::states_csv(&c)))
+    }
+
     /// The route's part of `identification.json`.
     pub fn json(&self) -> Value {
         let fits = self.fits.as_ref();

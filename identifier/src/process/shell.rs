@@ -194,6 +194,13 @@ impl<'c> Identifier<'c> {
         }
         self.summary.best_model = self.last_fits.first().map(|f| f.model.name());
         self.write_json()?;
+        if let (Some(path), Some(field)) = (&self.config.states_csv, &self.field) {
+            match field.states_csv() {
+                Some(Ok(csv)) => wire::files::write_atomic(path, csv.as_bytes())?,
+                Some(Err(e)) => eprintln!("identifier: {} not written: {e}", path.display()),
+                None => {}
+            }
+        }
         self.summary.points = self.online.point_counts();
         Ok(self.summary)
     }

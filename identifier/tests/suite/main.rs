@@ -12,6 +12,7 @@ mod fast_path;
 mod femu_structure;
 mod plot;
 mod round_trip;
+mod state_contributions;
 mod treloar;
 mod vfm_discrimination;
 mod vfm_structure;

@@ -240,6 +240,10 @@ pub fn identifier_settings(
             .identifier_routes()
             .runs(wire::identification::ReportRoute::Field)
             .then(|| config.field_route_settings()),
+        states_csv: config
+            .identifier_routes()
+            .runs(wire::identification::ReportRoute::Field)
+            .then(|| results.states_csv()),
     }
 }
 

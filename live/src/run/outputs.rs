@@ -1,6 +1,6 @@
 //! The files a run writes at its end from what it recorded: the latency histograms (also
 //! rewritten during the run), `latency.png`, the identification figures, `strain_map.png`,
-//! `forces.png` and `stretch_states.png`; once the field route is judged,
+//! `forces.png` and `stretch_states.png` (coloured by the identifier's `states.csv`); once the field route is judged,
 //! `field_route_law.png` and `force_balance.png`.
 //! A file that cannot be written is a note, never the end of the others.
 
@@ -81,10 +81,13 @@ pub(super) fn write(config: &RunConfig, results: &ResultsDir, recorder: &Recorde
         crate::mechanics_figures::forces_png(&results.rig_csv(), &results.path("forces.png"))
             .map(|_| ()),
     );
+    let model = best_field_model(&results.identification_json());
     keep(
         "stretch_states.png",
         crate::mechanics_figures::stretch_states_png(
             &results.fields(),
+            Some(&results.states_csv()),
+            model.as_deref(),
             &results.path("stretch_states.png"),
         )
         .map(|_| ()),
@@ -95,6 +98,18 @@ pub(super) fn write(config: &RunConfig, results: &ResultsDir, recorder: &Recorde
         None
     });
     Outputs { strain_map, notes }
+}
+
+/// The field route's best fit in `identification.json` (its first identifiable one: the fit
+/// `states.csv`'s contributions are to), if any.
+fn best_field_model(identification_json: &std::path::Path) -> Option<String> {
+    let text = std::fs::read_to_string(identification_json).ok()?;
+    let json: serde_json::Value = serde_json::from_str(&text).ok()?;
+    json["field_route"]["fits"]
+        .as_array()?
+        .iter()
+        .find(|fit| fit["identifiable"] == true)
+        .and_then(|fit| Some(fit["model"].as_str()?.to_string()))
 }
 
 /// `field_route_law.png` and `force_balance.png` when the field route identified a law and
