@@ -6,13 +6,12 @@
 //! multiply spectra of the same `Fft2d` and use `frequency_index` for phase ramps.
 
 use crate::Complex32;
-use rustfft::{Fft, FftPlanner};
-use std::sync::Arc;
+use crate::Plan;
 
 pub struct Fft2d {
     n: usize,
-    forward: Arc<dyn Fft<f32>>,
-    inverse: Arc<dyn Fft<f32>>,
+    forward: Plan,
+    inverse: Plan,
     scratch: Vec<Complex32>,
     transposed: Vec<Complex32>,
 }
@@ -20,18 +19,12 @@ pub struct Fft2d {
 impl Fft2d {
     pub fn new(n: usize) -> Self {
         assert!(n.is_power_of_two() && n >= 2);
-        let mut planner = FftPlanner::<f32>::new();
-        let forward = planner.plan_fft_forward(n);
-        let inverse = planner.plan_fft_inverse(n);
-        let scratch_len = forward
-            .get_inplace_scratch_len()
-            .max(inverse.get_inplace_scratch_len())
-            .max(1);
+        let (forward, inverse, scratch) = crate::plan_pair(n);
         Self {
             n,
             forward,
             inverse,
-            scratch: vec![Complex32::new(0.0, 0.0); scratch_len],
+            scratch,
             transposed: vec![Complex32::new(0.0, 0.0); n * n],
         }
     }

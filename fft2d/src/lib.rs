@@ -17,3 +17,22 @@ pub use complex::Fft2d;
 pub use real::RealFft2d;
 /// The complex sample of every spectrum here (rustfft's, i.e. `num_complex`'s).
 pub use rustfft::num_complex::Complex32;
+
+use rustfft::{Fft, FftPlanner};
+use std::sync::Arc;
+
+/// A 1-D plan of rustfft's, behind its trait object (nothing generic leaves this crate).
+type Plan = Arc<dyn Fft<f32>>;
+
+/// The forward and inverse 1-D plans of length `n`, and a scratch buffer both can use.
+fn plan_pair(n: usize) -> (Plan, Plan, Vec<Complex32>) {
+    let mut planner = FftPlanner::<f32>::new();
+    let forward = planner.plan_fft_forward(n);
+    let inverse = planner.plan_fft_inverse(n);
+    let scratch_len = forward
+        .get_inplace_scratch_len()
+        .max(inverse.get_inplace_scratch_len())
+        .max(1);
+    let scratch = vec![Complex32::new(0.0, 0.0); scratch_len];
+    (forward, inverse, scratch)
+}

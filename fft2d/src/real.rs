@@ -7,13 +7,12 @@
 //! Half-spectrum layout: `spectrum[kx * n + ky]`, kx in 0..=n/2, ky in 0..n.
 
 use crate::Complex32;
-use rustfft::{Fft, FftPlanner};
-use std::sync::Arc;
+use crate::Plan;
 
 pub struct RealFft2d {
     n: usize,
-    forward: Arc<dyn Fft<f32>>,
-    inverse: Arc<dyn Fft<f32>>,
+    forward: Plan,
+    inverse: Plan,
     scratch: Vec<Complex32>,
     /// n/2 packed row pairs of n complex values.
     rows: Vec<Complex32>,
@@ -22,19 +21,13 @@ pub struct RealFft2d {
 impl RealFft2d {
     pub fn new(n: usize) -> Self {
         assert!(n.is_power_of_two() && n >= 4);
-        let mut planner = FftPlanner::<f32>::new();
-        let forward = planner.plan_fft_forward(n);
-        let inverse = planner.plan_fft_inverse(n);
-        let scratch_len = forward
-            .get_inplace_scratch_len()
-            .max(inverse.get_inplace_scratch_len())
-            .max(1);
+        let (forward, inverse, scratch) = crate::plan_pair(n);
         let zero = Complex32::new(0.0, 0.0);
         Self {
             n,
             forward,
             inverse,
-            scratch: vec![zero; scratch_len],
+            scratch,
             rows: vec![zero; n * n / 2],
         }
     }
