@@ -31,23 +31,31 @@ impl Fft2d {
 
     /// Row-major image in, transposed spectrum out (in place).
     pub fn forward(&mut self, data: &mut [Complex32]) {
-        assert_eq!(data.len(), self.n * self.n);
-        self.forward.process_with_scratch(data, &mut self.scratch);
-        transpose(data, &mut self.transposed, self.n);
-        self.forward
-            .process_with_scratch(&mut self.transposed, &mut self.scratch);
-        data.copy_from_slice(&self.transposed);
+        let (scratch, transposed) = (&mut self.scratch, &mut self.transposed);
+        rows_then_columns(&self.forward, data, scratch, transposed, self.n);
     }
 
     /// Transposed spectrum in, row-major image out (in place), unnormalised (times n²).
     pub fn inverse(&mut self, data: &mut [Complex32]) {
-        assert_eq!(data.len(), self.n * self.n);
-        self.inverse.process_with_scratch(data, &mut self.scratch);
-        transpose(data, &mut self.transposed, self.n);
-        self.inverse
-            .process_with_scratch(&mut self.transposed, &mut self.scratch);
-        data.copy_from_slice(&self.transposed);
+        let (scratch, transposed) = (&mut self.scratch, &mut self.transposed);
+        rows_then_columns(&self.inverse, data, scratch, transposed, self.n);
     }
+}
+
+/// One 1-D plan along the rows, a transpose, the plan along the rows again (the columns), in
+/// place: both directions are this with their own plan.
+fn rows_then_columns(
+    plan: &Plan,
+    data: &mut [Complex32],
+    scratch: &mut [Complex32],
+    transposed: &mut [Complex32],
+    n: usize,
+) {
+    assert_eq!(data.len(), n * n);
+    plan.process_with_scratch(data, scratch);
+    transpose(data, transposed, n);
+    plan.process_with_scratch(transposed, scratch);
+    data.copy_from_slice(transposed);
 }
 
 fn transpose(src: &[Complex32], dst: &mut [Complex32], n: usize) {
