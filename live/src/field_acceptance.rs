@@ -145,13 +145,27 @@ impl FieldAcceptance {
 pub fn judge_route(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
     let best = route["fits"]
         .as_array()
-        .and_then(|f| f.iter().find(|fit| fit["identifiable"] != false))
-        .and_then(law_of);
+        .and_then(|f| f.iter().find(|fit| fit["identifiable"] != false));
+    judge_fit(truth, route, best)
+}
+
+/// The acceptance of one family's fit in a field route's JSON, ranked first or not (None
+/// model: the route did not fit it): how close the route's fit of that family came to
+/// `truth`, whichever family the ranking chose.
+pub fn judge_model(truth: &InvariantLaw, route: &Value, model: &str) -> FieldAcceptance {
+    let fit = route["fits"]
+        .as_array()
+        .and_then(|f| f.iter().find(|fit| fit["model"] == model));
+    judge_fit(truth, route, fit)
+}
+
+fn judge_fit(truth: &InvariantLaw, route: &Value, fit: Option<&Value>) -> FieldAcceptance {
+    let law = fit.and_then(law_of);
     let max_stretches = route["max_stretches"]
         .as_array()
         .and_then(|m| Some([m.first()?.as_f64()?, m.get(1)?.as_f64()?]));
     let [uniaxial, equibiaxial, pure_shear] = CASES.map(|(_, case, true_curve)| {
-        let (model, p) = best.as_ref()?;
+        let (model, p) = law.as_ref()?;
         let max = reach(case, max_stretches?)?;
         Some(worst(
             |l| true_curve(truth, l),
@@ -162,8 +176,8 @@ pub fn judge_route(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
     let within =
         |c: Option<CaseComparison>| c.is_some_and(|c| c.max_relative_error <= FIELD_TOLERANCE);
     FieldAcceptance {
-        model: best.as_ref().map(|(m, _)| m.name()),
-        params: best.map(|(_, p)| p).unwrap_or_default(),
+        model: law.as_ref().map(|(m, _)| m.name()),
+        params: law.map(|(_, p)| p).unwrap_or_default(),
         max_stretches,
         uniaxial,
         equibiaxial,
@@ -211,5 +225,29 @@ mod tests {
         let none = judge_route(&truth, &json!({"error": "crosses no arm", "fits": null}));
         assert!(!none.passed && none.uniaxial.is_none());
         assert_eq!(none.error.as_deref(), Some("crosses no arm"));
+    }
+
+    #[test]
+    fn a_family_ranked_second_is_judged_by_name() {
+        let truth = InvariantLaw::smactane();
+        let route = json!({
+            "frames": 12,
+            "max_stretches": [1.3, 1.1],
+            "fits": [
+                {"model": "neo-hookean", "params": {"C10": 0.5}},
+                {"model": "lambert-diani-rey:2,2",
+                 "params": {"a0": -1.27, "a1": -2.52e-2, "a2": 1.40e-3,
+                            "b0": -1.02, "b1": -3.92e-3, "b2": -5.30e-4}},
+            ],
+        });
+        let first = judge_route(&truth, &route);
+        assert_eq!(first.model.as_deref(), Some("neo-hookean"));
+        assert!(!first.passed, "{first:?}");
+        let second = judge_model(&truth, &route, "lambert-diani-rey:2,2");
+        assert_eq!(second.model.as_deref(), Some("lambert-diani-rey:2,2"));
+        assert!(second.passed, "{second:?}");
+        assert_eq!(second.uniaxial.unwrap().max_stretch, 1.3);
+        let absent = judge_model(&truth, &route, "mooney");
+        assert!(absent.model.is_none() && !absent.passed);
     }
 }
