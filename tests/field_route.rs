@@ -11,7 +11,7 @@ use common::bench_run::{completed_summary, config, start_run};
 use common::Run;
 use identifier::data::LoadCase;
 use identifier::models::Model;
-use live::field_acceptance::{judge_model, judge_route};
+use live::field_acceptance::judge_route;
 use serde_json::Value;
 use std::path::Path;
 
@@ -80,66 +80,25 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
     let reach = field["max_stretches"].as_array().unwrap();
     assert!(reach[0].as_f64().unwrap() > 1.3, "{field}");
     assert!(reach[1].as_f64().unwrap() > 1.05, "{field}");
-    // The route's fit of Mooney-Rivlin against the truth over the stretches reached. The true
-    // law (Smactane, `[specimen] law_f, law_g`: ln f and ln g of degree 2 whose terms beyond the
-    // constant are small) is Mooney-Rivlin's C10 0.277, C01 0.364 MPa to within 0.5 % (least
-    // squares over uniaxial and pure shear to λ 1.4, equibiaxial to 1.1); its own family's fit
-    // is not identifiable from one test (2σ ≥ |a2|, |b2|). Issue 25's target is 2 %; measured on
-    // 10 runs (camera noise moves them): uniaxial 1.3-1.5 %, equibiaxial 1.9-2.8 %, pure shear
-    // 1.7-2.0 %. Asserted with that spread's margin.
-    //
-    // Not asserted: which family the ranking puts first. In 5 of those 10 runs Hart-Smith
-    // ranked first (BIC 2.4 to 7.5 below Mooney-Rivlin's) and was 10-16 % off in uniaxial and
-    // 14-24 % in pure shear at the largest stretches. Its exponential term in I1 follows the
-    // ~1 % of node states above λ1 1.3, all at the fillets' edges (stress concentrations the
-    // 11.5 mm ZOI smooths, the material beyond the last measured node carried by it): an open
-    // defect of issue 25, printed here from `summary.json`.
-    let truth = live::RunConfig::read(Some(&out.join("config.toml")))
-        .unwrap()
-        .law()
-        .unwrap();
-    let mooney = judge_model(&truth, &live_route(&out), "mooney");
-    println!(
-        "ranked first: {}\nmooney-rivlin: {}",
-        field_verdict(field),
-        mooney.verdict_line()
-    );
-    for (case, c) in [
-        ("uniaxial", mooney.uniaxial),
-        ("equibiaxial", mooney.equibiaxial),
-        ("pure_shear", mooney.pure_shear),
-    ] {
-        let c = c.unwrap_or_else(|| panic!("{case}: {mooney:?}"));
-        assert!(c.max_relative_error < 0.035, "{case}: {c:?}");
+    // The first ranked law's nominal stresses against the truth over the stretches reached.
+    // Issue 25's target is 2 %. The true law (Smactane, `[specimen] law_f, law_g`) is
+    // Mooney-Rivlin's C10 0.277, C01 0.364 MPa within 0.5 % (least squares over uniaxial and
+    // pure shear to λ 1.4, equibiaxial to 1.1); its own family is not identifiable from one
+    // test (2σ ≥ |a2|, |b2|). Before `model_window` and the BIC over forces rather than
+    // equations (`field_route::information_criteria`), Hart-Smith ranked first in 5 of 10
+    // runs and missed the uniaxial stress by 10-16 % at λ 1.35 (its forces within the noise
+    // of Mooney-Rivlin's). Mooney-Rivlin first, measured on 10 runs: uniaxial 1.3-1.5 %,
+    // equibiaxial 1.9-2.8 %, pure shear 1.7-2.0 % (camera noise moves them). Asserted with
+    // that spread's margin.
+    for case in ["uniaxial", "equibiaxial", "pure_shear"] {
+        let error = field[case]["max_relative_error"].as_f64().unwrap();
+        assert!(error < 0.035, "{case}: {field}");
     }
 }
 
-/// The field route of the live identifier, from the run's `identification.json`.
-fn live_route(out: &Path) -> Value {
-    let text = std::fs::read_to_string(out.join("identification.json")).unwrap();
-    let json: Value = serde_json::from_str(&text).unwrap();
-    json["field_route"].clone()
-}
-
-/// The first ranked family of `summary.json`'s `field_acceptance` and its worst errors.
-fn field_verdict(field: &Value) -> String {
-    let error = |case: &str| {
-        field[case]["max_relative_error"]
-            .as_f64()
-            .unwrap_or(f64::NAN)
-    };
-    format!(
-        "{} (uniaxial {:.4}, equibiaxial {:.4}, pure shear {:.4})",
-        field["model"],
-        error("uniaxial"),
-        error("equibiaxial"),
-        error("pure_shear")
-    )
-}
-
-/// `dicstream identify --fields` on the run's results: the JSON alone on stdout, its
-/// Mooney-Rivlin fit within `AGREEMENT` of the live one and within the live test's margin of
-/// the truth.
+/// `dicstream identify --fields` on the run's results: the JSON alone on stdout, the live
+/// route's best model fitted offline within `AGREEMENT` of its live fit, the offline best law
+/// within the live test's margin of the truth.
 fn offline_agrees_with_the_live_fit(out: &Path) {
     let output = std::process::Command::new(env!("CARGO_BIN_EXE_dicstream"))
         .args(["identify", "--fields"])
@@ -150,6 +109,10 @@ fn offline_agrees_with_the_live_fit(out: &Path) {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");
     let offline: Value = serde_json::from_slice(&output.stdout).expect("stdout is JSON alone");
+    let live_json: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("identification.json")).unwrap())
+            .unwrap();
+    let live_route = &live_json["field_route"];
     println!(
         "offline: frames {} of {} files, counters {}, fits {}\nstderr: {stderr}",
         offline["frames"], offline["fields_read"], offline["counters"], offline["fits"]
@@ -158,29 +121,39 @@ fn offline_agrees_with_the_live_fit(out: &Path) {
     assert!(offline["frames"].as_u64().unwrap() >= 6, "{offline}");
     let config = live::RunConfig::read(Some(&out.join("config.toml"))).unwrap();
     let truth = config.law().unwrap();
-    let live_route = live_route(out);
-    let (offline_fit, live_fit) = (
-        judge_model(&truth, &offline, "mooney"),
-        judge_model(&truth, &live_route, "mooney"),
-    );
-    println!(
-        "offline, ranked first: {}",
-        judge_route(&truth, &offline).verdict_line()
+    let (offline_law, live_law) = (
+        judge_route(&truth, &offline),
+        judge_route(&truth, live_route),
     );
     // The truth: the live test's margin (see above).
     for (case, c) in [
-        ("uniaxial", offline_fit.uniaxial),
-        ("equibiaxial", offline_fit.equibiaxial),
-        ("pure_shear", offline_fit.pure_shear),
+        ("uniaxial", offline_law.uniaxial),
+        ("equibiaxial", offline_law.equibiaxial),
+        ("pure_shear", offline_law.pure_shear),
     ] {
         let c = c.unwrap_or_else(|| panic!("{case}: {offline}"));
-        println!("offline mooney-rivlin against the truth, {case}: {c:?}");
+        println!("offline best law against the truth, {case}: {c:?}");
         assert!(c.max_relative_error < 0.035, "{case}: {c:?}\n{offline}");
     }
-    // The live fit: the same family fitted offline against its live fit, nominal stress over
-    // the stretches both reached.
-    let model = Model::parse("mooney").unwrap();
-    let (live_p, offline_p) = (live_fit.params, offline_fit.params);
+    // The live fit: the live route's best model, as fitted offline, against its live fit,
+    // nominal stress over the stretches both reached.
+    let best = live_law.model.clone().unwrap();
+    let fit_of = |route: &Value| -> Value {
+        let fits = route["fits"].as_array().unwrap();
+        let fit = fits.iter().find(|f| f["model"] == best.as_str());
+        fit.unwrap_or_else(|| panic!("{best} not fitted: {route}"))
+            .clone()
+    };
+    let law = |fit: &Value| -> Vec<f64> {
+        let model = Model::parse(&best).unwrap();
+        let names = model.param_names();
+        names
+            .iter()
+            .map(|n| fit["params"][n].as_f64().unwrap())
+            .collect()
+    };
+    let model = Model::parse(&best).unwrap();
+    let (live_p, offline_p) = (law(&fit_of(live_route)), law(&fit_of(&offline)));
     let reached = |route: &Value, k: usize| route["max_stretches"][k].as_f64().unwrap();
     for case in [
         LoadCase::Uniaxial,
@@ -188,7 +161,7 @@ fn offline_agrees_with_the_live_fit(out: &Path) {
         LoadCase::PureShear,
     ] {
         let k = usize::from(case == LoadCase::Equibiaxial);
-        let max = reached(&live_route, k).min(reached(&offline, k));
+        let max = reached(live_route, k).min(reached(&offline, k));
         let worst = (1..=100)
             .map(|i| {
                 let l = 1.0 + (max - 1.0) * i as f64 / 100.0;
@@ -197,7 +170,7 @@ fn offline_agrees_with_the_live_fit(out: &Path) {
                 ((b - a) / a).abs()
             })
             .fold(0.0, f64::max);
-        println!("mooney-rivlin {case}: offline against live {worst:.4} up to {max:.3}");
+        println!("{best} {case}: offline against live {worst:.4} up to {max:.3}");
         assert!(worst < AGREEMENT, "{case}: {worst}\n{offline}");
     }
 }
@@ -205,7 +178,7 @@ fn offline_agrees_with_the_live_fit(out: &Path) {
 /// Largest relative difference in nominal stress between the offline and the live fit of one
 /// model. The two fit different frames of one test (the saved fields are every 2nd frame, kept
 /// and thinned by their own loading levels; the live route saw every frame), each with its
-/// camera noise: measured on 10 runs for Mooney-Rivlin, 0.02-0.7 %; asserted at the issue's
-/// 2 %. (Hart-Smith fitted offline once differed by 2.7 % from its live fit at λ 1.35: its
-/// parameters are looser, k1 ± 21 %.)
+/// camera noise: measured for Mooney-Rivlin on 10 runs, 0.02-0.7 %; asserted at the issue's
+/// 2 %. (A model of three parameters moves more: Hart-Smith fitted offline once differed by
+/// 2.7 % from its live fit at λ 1.35, its k1 ± 21 %.)
 const AGREEMENT: f64 = 0.02;

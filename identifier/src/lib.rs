@@ -18,6 +18,7 @@
 //! - [`field_layout`]: where the cuts and ramps go, from the cruciform and the view.
 //! - [`grip_forces`]: the grips' forces of recent rig samples, by id or by time.
 //! - [`field_route`]: the frames of a test kept for the field route, fitted together.
+//! - [`model_window`]: the models the forces do not tell apart, the fewest parameters first.
 //! - [`state_contributions`]: each state's (node and frame) share of a field fit's
 //!   sensitivity to its parameters, and `states.csv`.
 //! - [`femu`]: finite-element model updating, the field route's reference (offline): the
@@ -53,6 +54,7 @@ pub use material as law;
 pub mod lsq;
 pub mod map_figure;
 pub mod measured_displacement;
+pub mod model_window;
 pub mod models;
 pub mod online;
 pub mod plot;

@@ -445,16 +445,14 @@ impl Supervisor {
                 _ => {
                     let _ = child.kill();
                     let status = child.wait().ok()?;
-                    return Some(format!(
-                        "{} after SIGTERM timed out",
-                        describe_status(status)
-                    ));
+                    return Some(format!("{} {SIGTERM_TIMED_OUT}", describe_status(status)));
                 }
             }
         }
     }
 
-    /// Stops every child, in the given order.
+    /// Stops every child, in the given order: each one's end, described (ending with
+    /// [`SIGTERM_TIMED_OUT`] when it had to be killed).
     pub fn stop_all(&mut self, order: &[Role], timeout: Duration) -> Vec<(Role, String)> {
         order
             .iter()
@@ -462,6 +460,10 @@ impl Supervisor {
             .collect()
     }
 }
+
+/// How [`Supervisor::stop`] ends the description of a child killed after its SIGTERM's
+/// timeout.
+pub const SIGTERM_TIMED_OUT: &str = "after SIGTERM timed out";
 
 /// The child gets SIGTERM when this process dies (a supervisor killed with SIGKILL takes its
 /// children along).

@@ -39,6 +39,9 @@ pub struct FieldAcceptance {
     pub cost_ms: Value,
     pub fits: Value,
     pub refused: Value,
+    /// The models the forces did not tell apart from the first (`identifier::model_window`),
+    /// with their stresses' spread; null when the first stood out.
+    pub not_told_apart: Value,
     /// Each kept frame's grip forces, measured and computed from the field under the first
     /// ranked fit (`frame_id, grip, measured_n, computed_n, fields`), as the identifier wrote it.
     pub force_balance: Value,
@@ -135,7 +138,26 @@ impl FieldAcceptance {
         .collect::<Vec<_>>()
         .join("; ");
         let frames = self.frames.unwrap_or(0);
-        format!("field route, {model} over {frames} frames: {cases} -> {verdict} ({limit})")
+        let others = self.not_told_apart["models"]
+            .as_array()
+            .map(|models| {
+                let names: Vec<&str> = models.iter().skip(1).filter_map(Value::as_str).collect();
+                let spread = |key: &str| {
+                    self.not_told_apart[key]
+                        .as_f64()
+                        .map_or("-".into(), |s| format!("{:.1} %", 100.0 * s))
+                };
+                format!(
+                    " (the forces do not tell it apart from {}: stresses up to {} apart uniaxial, \
+                     {} equibiaxial, {} pure shear; it has the fewest parameters)",
+                    names.join(", "),
+                    spread("spread_uniaxial"),
+                    spread("spread_equibiaxial"),
+                    spread("spread_pure_shear")
+                )
+            })
+            .unwrap_or_default();
+        format!("field route, {model} over {frames} frames{others}: {cases} -> {verdict} ({limit})")
     }
 }
 
@@ -145,27 +167,13 @@ impl FieldAcceptance {
 pub fn judge_route(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
     let best = route["fits"]
         .as_array()
-        .and_then(|f| f.iter().find(|fit| fit["identifiable"] != false));
-    judge_fit(truth, route, best)
-}
-
-/// The acceptance of one family's fit in a field route's JSON, ranked first or not (None
-/// model: the route did not fit it): how close the route's fit of that family came to
-/// `truth`, whichever family the ranking chose.
-pub fn judge_model(truth: &InvariantLaw, route: &Value, model: &str) -> FieldAcceptance {
-    let fit = route["fits"]
-        .as_array()
-        .and_then(|f| f.iter().find(|fit| fit["model"] == model));
-    judge_fit(truth, route, fit)
-}
-
-fn judge_fit(truth: &InvariantLaw, route: &Value, fit: Option<&Value>) -> FieldAcceptance {
-    let law = fit.and_then(law_of);
+        .and_then(|f| f.iter().find(|fit| fit["identifiable"] != false))
+        .and_then(law_of);
     let max_stretches = route["max_stretches"]
         .as_array()
         .and_then(|m| Some([m.first()?.as_f64()?, m.get(1)?.as_f64()?]));
     let [uniaxial, equibiaxial, pure_shear] = CASES.map(|(_, case, true_curve)| {
-        let (model, p) = law.as_ref()?;
+        let (model, p) = best.as_ref()?;
         let max = reach(case, max_stretches?)?;
         Some(worst(
             |l| true_curve(truth, l),
@@ -176,8 +184,8 @@ fn judge_fit(truth: &InvariantLaw, route: &Value, fit: Option<&Value>) -> FieldA
     let within =
         |c: Option<CaseComparison>| c.is_some_and(|c| c.max_relative_error <= FIELD_TOLERANCE);
     FieldAcceptance {
-        model: law.as_ref().map(|(m, _)| m.name()),
-        params: law.map(|(_, p)| p).unwrap_or_default(),
+        model: best.as_ref().map(|(m, _)| m.name()),
+        params: best.map(|(_, p)| p).unwrap_or_default(),
         max_stretches,
         uniaxial,
         equibiaxial,
@@ -187,6 +195,7 @@ fn judge_fit(truth: &InvariantLaw, route: &Value, fit: Option<&Value>) -> FieldA
         cost_ms: route["cost_ms"].clone(),
         fits: route["fits"].clone(),
         refused: route["refused"].clone(),
+        not_told_apart: route["not_told_apart"].clone(),
         force_balance: route["force_balance"].clone(),
         error: route["error"].as_str().map(str::to_string),
         tolerance: FIELD_TOLERANCE,
@@ -213,6 +222,18 @@ mod tests {
         };
         let exact = judge_route(&truth, &route(-1.27));
         assert!(exact.passed, "{exact:?}");
+        assert!(!exact.verdict_line().contains("tell it apart"));
+        let mut tied = route(-1.27);
+        tied["not_told_apart"] = json!({
+            "models": ["lambert-diani-rey:2,2", "hart-smith"], "delta_bic": [3.0, 0.0],
+            "bic_window": 10.0, "spread_uniaxial": 0.081, "spread_equibiaxial": 0.004,
+            "spread_pure_shear": null,
+        });
+        let line = judge_route(&truth, &tied).verdict_line();
+        assert!(
+            line.contains("do not tell it apart from hart-smith: stresses up to 8.1 % apart uniaxial, 0.4 % equibiaxial, - pure shear"),
+            "{line}"
+        );
         assert_eq!(exact.model.as_deref(), Some("lambert-diani-rey:2,2"));
         assert_eq!(exact.uniaxial.unwrap().max_stretch, 1.5);
         assert_eq!(exact.equibiaxial.unwrap().max_stretch, 1.3);
@@ -225,29 +246,5 @@ mod tests {
         let none = judge_route(&truth, &json!({"error": "crosses no arm", "fits": null}));
         assert!(!none.passed && none.uniaxial.is_none());
         assert_eq!(none.error.as_deref(), Some("crosses no arm"));
-    }
-
-    #[test]
-    fn a_family_ranked_second_is_judged_by_name() {
-        let truth = InvariantLaw::smactane();
-        let route = json!({
-            "frames": 12,
-            "max_stretches": [1.3, 1.1],
-            "fits": [
-                {"model": "neo-hookean", "params": {"C10": 0.5}},
-                {"model": "lambert-diani-rey:2,2",
-                 "params": {"a0": -1.27, "a1": -2.52e-2, "a2": 1.40e-3,
-                            "b0": -1.02, "b1": -3.92e-3, "b2": -5.30e-4}},
-            ],
-        });
-        let first = judge_route(&truth, &route);
-        assert_eq!(first.model.as_deref(), Some("neo-hookean"));
-        assert!(!first.passed, "{first:?}");
-        let second = judge_model(&truth, &route, "lambert-diani-rey:2,2");
-        assert_eq!(second.model.as_deref(), Some("lambert-diani-rey:2,2"));
-        assert!(second.passed, "{second:?}");
-        assert_eq!(second.uniaxial.unwrap().max_stretch, 1.3);
-        let absent = judge_model(&truth, &route, "mooney");
-        assert!(absent.model.is_none() && !absent.passed);
     }
 }

@@ -136,7 +136,8 @@ pub(super) fn run_config(dir: &Path) -> anyhow::Result<live::RunConfig> {
         .with_context(|| format!("{}: the run's configuration", dir.display()))
 }
 
-/// The ranks shown: identifiable fits in BIC order, None for the others.
+/// The ranks shown: identifiable fits in the route's order (BIC, Occam's window), None for the
+/// others.
 fn ranks(identifiability: &[Identifiability]) -> Vec<Option<usize>> {
     let mut rank = 0;
     identifiability
@@ -230,6 +231,9 @@ fn print_table(
             fit.fit.condition,
             params.join(" ")
         )?;
+    }
+    if let Some(window) = &fits.window {
+        writeln!(out, "{}", window.describe())?;
     }
     writeln!(
         out,

@@ -292,7 +292,9 @@ impl FieldShell {
         }
         if now {
             if self.dirty {
-                if let Some(job) = self.feed.route.fit_job() {
+                // Started where the last fit ended, as on line: the end's fit must finish
+                // within the run's stop timeout.
+                if let Some(job) = self.warm_job() {
                     self.dirty = false;
                     report = Some(self.finished(run_timed(&job), job.last_frame_id));
                 }
@@ -301,13 +303,7 @@ impl FieldShell {
         }
         let due = self.last_fit.is_none_or(|t| t.elapsed() >= REFIT_INTERVAL);
         if self.running.is_none() && self.dirty && due {
-            if let Some(mut job) = self.feed.route.fit_job() {
-                job.warm_starts = self.fits.as_ref().map_or(vec![], |fits| {
-                    fits.fits
-                        .iter()
-                        .map(|f| (f.model.clone(), f.fit.params.clone()))
-                        .collect()
-                });
+            if let Some(job) = self.warm_job() {
                 self.dirty = false;
                 self.last_fit = Some(Instant::now());
                 let frame_id = job.last_frame_id;
@@ -326,6 +322,18 @@ impl FieldShell {
             }
         }
         report
+    }
+
+    /// A fit of all kept frames whose nonlinear models start where the last fit ended.
+    fn warm_job(&self) -> Option<FitJob> {
+        let mut job = self.feed.route.fit_job()?;
+        job.warm_starts = self.fits.as_ref().map_or(vec![], |fits| {
+            fits.fits
+                .iter()
+                .map(|f| (f.model.clone(), f.fit.params.clone()))
+                .collect()
+        });
+        Some(job)
     }
 
     /// The running fit's report (None if its thread panicked, which is said).
@@ -375,7 +383,7 @@ impl FieldShell {
             },
         });
         let fitted = fits.map_or(
-            json!({"frames": null, "max_stretches": null, "fits": null, "refused": null}),
+            json!({"frames": null, "max_stretches": null, "fits": null, "refused": null, "not_told_apart": null}),
             fits_json,
         );
         if let (Some(out), Value::Object(fitted)) = (out.as_object_mut(), fitted) {
@@ -387,7 +395,9 @@ impl FieldShell {
 }
 
 /// The fits' part of the field route's JSON: frames, the stretches reached, each fit
-/// (parameters, σ, RMS force, equations, condition number, AIC, BIC; best BIC first) and the models
+/// (parameters, σ, RMS force, equations, condition number, AIC, BIC; the first ranked first:
+/// by BIC, the fewest parameters first among the models the forces do not tell apart, listed
+/// in `not_told_apart` with their stresses' spread, null when one stands out) and the models
 /// refused with why. `identification.json`'s `field_route` and `identify --fields --json`.
 pub fn fits_json(fits: &FieldFits) -> Value {
     json!({
@@ -409,6 +419,7 @@ pub fn fits_json(fits: &FieldFits) -> Value {
             })
         }).collect::<Vec<_>>(),
         "refused": fits.refused.iter().map(|(m, why)| json!({"model": m, "why": why})).collect::<Vec<_>>(),
+        "not_told_apart": fits.window,
     })
 }
 

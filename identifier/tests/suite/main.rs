@@ -10,6 +10,7 @@ mod cruciform;
 mod bad_input;
 mod fast_path;
 mod femu_structure;
+mod field_resolution;
 mod plot;
 mod round_trip;
 mod state_contributions;

@@ -68,6 +68,8 @@ impl Evidence {
         let equations = compile(&observations(&frames, Some(&ramps))).unwrap();
         let fits = FitJob {
             equations: equations.clone(),
+            // Each frame's four grip forces, each balanced by a cut and two ramps.
+            forces: 4 * frames.len(),
             models: models(),
             frames: frames.len(),
             max_stretches: max_stretches(frames.iter().map(|f| &f.grid)),

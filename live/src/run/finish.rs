@@ -58,6 +58,7 @@ impl Stopped<'_> {
             frames_lost_to_faults: frames.lost_to_faults,
             signal: self.signal,
             faults: &self.incidents.faults,
+            killed_at_stop: &self.killed_at_stop,
             unwritten: &outputs.notes,
         });
         let report = RunReport {

@@ -38,6 +38,9 @@ pub(super) struct Stopped<'a> {
     pub(super) ending: Ending,
     /// Why it failed: the whole chain of the error that ended it.
     pub(super) failure: Option<String>,
+    /// The children that did not stop within the stop timeout and were killed (their last
+    /// results, the identifier's final fit, may be missing).
+    pub(super) killed_at_stop: Vec<String>,
 }
 
 impl<'a> Run<'a> {
@@ -62,8 +65,12 @@ impl<'a> Run<'a> {
             .map(|role| (role.name().to_string(), supervisor.cpu_seconds(role)))
             .into_iter()
             .collect();
+        let mut killed_at_stop = vec![];
         for (role, how) in supervisor.stop_all(&STOP_ORDER, timeout) {
             eprintln!("run: stopped {} ({how})", role.name());
+            if how.ends_with(crate::children::SIGTERM_TIMED_OUT) {
+                killed_at_stop.push(role.name().to_string());
+            }
         }
         // Samples published while stopping (last fields, last report).
         let _ = subscriptions.drain_all(&mut recorder, FINAL_DRAIN_ROUNDS);
@@ -91,6 +98,7 @@ impl<'a> Run<'a> {
             leftover_shm_files,
             ending,
             failure,
+            killed_at_stop,
         }
     }
 }

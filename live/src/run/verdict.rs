@@ -20,6 +20,9 @@ pub(super) struct Facts<'a> {
     /// The termination signal that interrupted the run.
     pub(super) signal: Option<i32>,
     pub(super) faults: &'a [String],
+    /// The children killed at the stop, its timeout passed (their last results may be
+    /// missing).
+    pub(super) killed_at_stop: &'a [String],
     /// Results files that could not be written, each with why.
     pub(super) unwritten: &'a [String],
 }
@@ -73,6 +76,23 @@ fn doubts(facts: &Facts) -> Option<String> {
             "{} frame(s) were lost to faults ({})",
             facts.frames_lost_to_faults,
             facts.faults.join("; ")
+        ));
+    }
+    if !facts.killed_at_stop.is_empty() {
+        doubts.push(format!(
+            "{} did not finish within the stop timeout ([run] stop_timeout_s) and {} killed: \
+             {} last results (the identifier's: the fit of the last frames) may be missing",
+            facts.killed_at_stop.join(", "),
+            if facts.killed_at_stop.len() == 1 {
+                "was"
+            } else {
+                "were"
+            },
+            if facts.killed_at_stop.len() == 1 {
+                "its"
+            } else {
+                "their"
+            }
         ));
     }
     (!doubts.is_empty()).then(|| doubts.join("; "))
@@ -145,6 +165,7 @@ mod tests {
             frames_lost_to_faults: 0,
             signal: None,
             faults: &[],
+            killed_at_stop: &[],
             unwritten: &[],
         }
     }
@@ -279,6 +300,22 @@ mod tests {
             ..facts(Ending::Interrupted)
         });
         assert_eq!(interrupted.exit_code, 143);
+        // The identifier killed at the stop, its final fit unfinished: doubtful, said.
+        let killed = ["identifier".to_string()];
+        let cut_short = verdict(Facts {
+            acceptance_skipped: true,
+            killed_at_stop: &killed,
+            ..facts(Ending::Completed)
+        });
+        assert_eq!(cut_short.exit_code, exit_code::DOUBTFUL);
+        assert_eq!(
+            cut_short.failure.as_deref(),
+            Some(
+                "identifier did not finish within the stop timeout ([run] stop_timeout_s) and \
+                 was killed: its last results (the identifier's: the fit of the last frames) \
+                 may be missing"
+            )
+        );
     }
 
     #[test]
