@@ -251,3 +251,30 @@ pub fn relative_errors(got: &[f64], truth: &[f64]) -> Vec<f64> {
         .map(|(got, want)| ((got - want) / want).abs())
         .collect()
 }
+
+/// The worst relative gap between `model`'s nominal stress at `params` and Smactane's over
+/// (1, top] of each case: `tops` uniaxial, equibiaxial, pure shear (50 stretches each).
+pub fn smactane_gaps(model: &Model, params: &[f64], tops: [f64; 3]) -> [f64; 3] {
+    use identifier::data::LoadCase;
+    let law = material::InvariantLaw::smactane();
+    let cases = [
+        LoadCase::Uniaxial,
+        LoadCase::Equibiaxial,
+        LoadCase::PureShear,
+    ];
+    std::array::from_fn(|k| {
+        let (case, top) = (cases[k], tops[k]);
+        (1..=50)
+            .map(|i| {
+                let stretch = 1.0 + (top - 1.0) * i as f64 / 50.0;
+                let want = match case {
+                    LoadCase::Uniaxial => law.uniaxial_nominal_stress_mpa(stretch),
+                    LoadCase::PureShear => law.pure_shear_nominal_stress_mpa(stretch),
+                    LoadCase::Equibiaxial => law.equibiaxial_nominal_stress_mpa(stretch),
+                };
+                let got = model.nominal_stress_mpa(params, case, stretch).unwrap();
+                ((got - want) / want).abs()
+            })
+            .fold(0.0, f64::max)
+    })
+}

@@ -13,10 +13,9 @@
 //! ranked first in half of the live runs, `tests/field_route.rs`); they cost Mooney-Rivlin's
 //! fit its equibiaxial accuracy (the edge's loss most).
 
-use crate::cruciform::{HALF_VIEW_MM, THICKNESS_MM};
-use identifier::data::LoadCase;
+use crate::cruciform::{smactane_gaps, HALF_VIEW_MM, THICKNESS_MM};
 use identifier::field_layout::{ArmLayout, GRIPS};
-use identifier::field_route::{FieldFit, FieldFits, FieldRoute, FieldRouteConfig};
+use identifier::field_route::{FieldFits, FieldRoute, FieldRouteConfig};
 use identifier::field_stress::Mat2;
 use identifier::models::Model;
 use identifier::online::OnlineConfig;
@@ -157,31 +156,6 @@ fn subset_gradient(
     ])
 }
 
-/// A fit's worst relative gap to Smactane's nominal stress, uniaxial and pure shear to the
-/// largest major stretch, equibiaxial to the largest minor one.
-fn gaps(fit: &FieldFit, reach: [f64; 2]) -> [f64; 3] {
-    let law = InvariantLaw::smactane();
-    [
-        (LoadCase::Uniaxial, reach[0]),
-        (LoadCase::Equibiaxial, reach[1]),
-        (LoadCase::PureShear, reach[0]),
-    ]
-    .map(|(case, top)| {
-        (1..=50)
-            .map(|k| {
-                let stretch = 1.0 + (top - 1.0) * k as f64 / 50.0;
-                let want = match case {
-                    LoadCase::Uniaxial => law.uniaxial_nominal_stress_mpa(stretch),
-                    LoadCase::PureShear => law.pure_shear_nominal_stress_mpa(stretch),
-                    LoadCase::Equibiaxial => law.equibiaxial_nominal_stress_mpa(stretch),
-                };
-                let got = fit.model.nominal_stress_mpa(&fit.fit.params, case, stretch);
-                ((got.unwrap() - want) / want).abs()
-            })
-            .fold(0.0, f64::max)
-    })
-}
-
 /// Measured when written (BIC, and Mooney-Rivlin's worst gaps uniaxial / equibiaxial / pure
 /// shear): exact, reach λ1 1.70, Mooney-Rivlin −165 against Hart-Smith −118, gaps 3.2 / 0.19
 /// / 1.8 %; edge lost, λ1 1.45, −173 against −97, 1.6 / 1.9 / 2.3 %; ZOI, λ1 1.46, −205 against
@@ -195,7 +169,13 @@ fn at_the_live_resolution_mooney_rivlin_ranks_above_hart_smith_and_fits_within_3
             found.unwrap_or_else(|| panic!("{way}: {model} not fitted {:?}", fits.refused))
         };
         let (mooney, hart_smith) = (of(Model::Mooney), of(Model::HartSmith));
-        let gaps = gaps(mooney, fits.max_stretches);
+        let reach = fits.max_stretches;
+        // Uniaxial and pure shear to the largest major stretch, equibiaxial to the minor one.
+        let gaps = smactane_gaps(
+            &mooney.model,
+            &mooney.fit.params,
+            [reach[0], reach[1], reach[0]],
+        );
         println!(
             "{way}: reach {:.3?}; BIC Mooney-Rivlin {:.1}, Hart-Smith {:.1}; Mooney-Rivlin's \
              worst gaps (uniaxial, equibiaxial, pure shear) {gaps:.4?}",

@@ -7,8 +7,7 @@
 
 use crate::cruciform;
 
-use cruciform::{observations, ramp_quadratures, solved_frames, GRID_STEP_MM};
-use identifier::data::LoadCase;
+use cruciform::{observations, ramp_quadratures, smactane_gaps, solved_frames, GRID_STEP_MM};
 use identifier::field_route::{max_stretches, FieldFits, FitJob};
 use identifier::models::Model;
 use identifier::online::OnlineConfig;
@@ -135,7 +134,6 @@ impl Evidence {
 /// largest minor one, pure shear (I1 = I2) up to the largest I2 of its nodes (beyond, g is
 /// extrapolated: the arms' uniaxial states reach I1 ≈ 21 but I2 ≈ 9 only). Each case's worst.
 fn stress_gaps(model: &Model, params: &[f64], evidence: &Evidence) -> [f64; 3] {
-    let law = InvariantLaw::smactane();
     let reach = evidence.fits.max_stretches;
     let max_i2 = evidence
         .equations
@@ -146,25 +144,7 @@ fn stress_gaps(model: &Model, params: &[f64], evidence: &Evidence) -> [f64; 3] {
     // λ² + 1 + λ⁻² = I2.
     let x = max_i2 - 1.0;
     let pure_shear_reach = (0.5 * (x + (x * x - 4.0).sqrt())).sqrt();
-    [
-        (LoadCase::Uniaxial, reach[0]),
-        (LoadCase::Equibiaxial, reach[1]),
-        (LoadCase::PureShear, pure_shear_reach),
-    ]
-    .map(|(case, top)| {
-        (1..=50)
-            .map(|k| {
-                let stretch = 1.0 + (top - 1.0) * k as f64 / 50.0;
-                let want = match case {
-                    LoadCase::Uniaxial => law.uniaxial_nominal_stress_mpa(stretch),
-                    LoadCase::PureShear => law.pure_shear_nominal_stress_mpa(stretch),
-                    LoadCase::Equibiaxial => law.equibiaxial_nominal_stress_mpa(stretch),
-                };
-                let got = model.nominal_stress_mpa(params, case, stretch).unwrap();
-                ((got - want) / want).abs()
-            })
-            .fold(0.0, f64::max)
-    })
+    smactane_gaps(model, params, [reach[0], reach[1], pure_shear_reach])
 }
 
 /// The field's evidence rejects Mooney-Rivlin on a Smactane specimen beyond 100 % strain and
