@@ -382,6 +382,7 @@ fn a_browser_watches_a_run_and_a_monitor_through_viewers_leaving_and_a_correlato
     assert!(read_page(&browser)["rig_strain"].is_null());
     new_panels_have_data_pause_and_export(&browser);
     the_map_is_drawn_on_the_servers_range(&browser);
+    the_page_converts_strains_as_the_server_does(&browser);
     until("the process table", || {
         (read_page(&browser)["correlator_restarts"] == "0").then_some(())
     });
@@ -513,6 +514,50 @@ fn the_map_is_drawn_on_the_servers_range(browser: &Browser) {
          return ok;",
     );
     assert_eq!(switched, true);
+}
+
+/// The page's `convertStrain` (its map in another measure) against the server's
+/// `stretch_states::convert_strain` (the ranges it sends for that measure): every pair of the
+/// Seth-Hill measures on strains with shear, in tension and compression; one rule written
+/// twice, held equal here.
+fn the_page_converts_strains_as_the_server_does(browser: &Browser) {
+    use dashboard::stretch_states::convert_strain;
+    use wire::field::StrainMeasure;
+    let strains = [
+        [0.01, -0.004, 0.002],
+        [0.25, 0.1, -0.07],
+        [-0.15, 0.05, 0.12],
+        [0.4, 0.4, 0.0],
+    ];
+    let measures = [
+        StrainMeasure::Log,
+        StrainMeasure::Green,
+        StrainMeasure::Nominal,
+    ];
+    for from in measures {
+        for to in measures {
+            for e in strains {
+                let page = browser.eval(&format!(
+                    "return convertStrain({}, {}, {}, '{}', '{}');",
+                    e[0],
+                    e[1],
+                    e[2],
+                    from.name(),
+                    to.name()
+                ));
+                let server = convert_strain(e, from, to).unwrap();
+                for (k, want) in server.iter().enumerate() {
+                    let got = page[k].as_f64().unwrap_or(f64::NAN);
+                    assert!(
+                        (got - want).abs() <= 1e-12 * (1.0 + want.abs()),
+                        "{e:?} {} -> {}: page {page}, server {server:?}",
+                        from.name(),
+                        to.name()
+                    );
+                }
+            }
+        }
+    }
 }
 
 /// The test's time in the header advances; the force charts (the uniaxial test loads x: X+

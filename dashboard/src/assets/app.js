@@ -203,7 +203,8 @@ function drawColorbar(scale, label) {
 // Seth-Hill strain measures are functions of the principal stretches on the same axes: log
 // ln λ, Green-Lagrange (λ² − 1)/2, nominal λ − 1. A node's strain in one of them gives its
 // stretches, hence the others. Small strain (sym ∇u) carries no rotation: it converts to none.
-// (The server converts the same way for the ranges it sends: stretch_states::convert_strain.)
+// (The server converts the same way for the ranges it sends: stretch_states::convert_strain;
+// tests/processes/dashboard.rs holds the two equal.)
 const STRETCH_OF = { log: (e) => Math.exp(e), green: (e) => Math.sqrt(1 + 2 * e), nominal: (e) => 1 + e };
 const STRAIN_OF = { log: (l) => Math.log(l), green: (l) => (l * l - 1) / 2, nominal: (l) => l - 1 };
 function convertStrain(exx, eyy, exy, from, to) {
