@@ -37,7 +37,8 @@ def correlate(reference, deformed, **settings):
     Returns a dict: ``x``, ``y``, ``u``, ``v`` (px), ``exx``, ``eyy``, ``exy``, ``du_dx``,
     ``du_dy``, ``dv_dx``, ``dv_dy``, ``score``, ``iterations`` as (ny, nx) float arrays in the
     order of the field's CSV rows; ``status`` the (ny, nx) array of node status words;
-    ``summary`` the frame's summary (the numbers of ``summary.json``'s frame entry).
+    ``summary`` the frame's summary (the numbers of ``summary.json``'s frame entry);
+    ``elapsed_ms`` the correlation's time (the frame's ``elapsed_ms`` there).
     """
     field = _dicstream.correlate(reference, deformed, **settings)
     field["status"] = np.array(field["status"]).reshape(field.pop("shape"))

@@ -65,7 +65,8 @@ fn roi_choice(roi: Option<&Bound<'_, PyAny>>) -> PyResult<RoiChoice> {
 /// uint16, or float grey levels in [0, 1]). Returns a dict: the node arrays (`x`, `y`, `u`,
 /// `v` in px, `exx`, `eyy`, `exy`, the gradient `du_dx`, `du_dy`, `dv_dx`, `dv_dy`, `score`,
 /// `iterations`: (ny, nx) arrays, row-major as the field's CSV), `status` (one word a node)
-/// and `summary` (JSON text of the frame's summary, as in `summary.json`).
+/// `summary` (JSON text of the frame's summary, as in `summary.json`) and `elapsed_ms` (the
+/// correlation's time, as the CLI's `elapsed_ms`).
 #[pyfunction]
 #[pyo3(signature = (
     reference, deformed, *, method=None, zoi=None, step=None, roi=None, polygons=vec![],
@@ -124,16 +125,19 @@ pub fn correlate<'py>(
             deformed.width_px, deformed.height_px, reference.width_px, reference.height_px
         )));
     }
-    let correlator = py.detach(|| run(settings, &reference, &deformed))?;
-    field_dict(py, &correlator)
+    let (correlator, elapsed_ms) = py.detach(|| run(settings, &reference, &deformed))?;
+    let dict = field_dict(py, &correlator)?;
+    dict.set_item("elapsed_ms", elapsed_ms)?;
+    Ok(dict)
 }
 
-/// The correlator made for `reference`, having measured `deformed` (its field).
+/// The correlator made for `reference`, having measured `deformed` (its field), and the time
+/// of that measurement in ms (what `dicstream correlate` reports as a frame's `elapsed_ms`).
 fn run(
     settings: CorrelatorSettings,
     reference: &Pixels,
     deformed: &Pixels,
-) -> PyResult<Correlator> {
+) -> PyResult<(Correlator, f64)> {
     let (width, height) = (reference.width_px, reference.height_px);
     let mut correlator = Correlator::new(settings, width, height).map_err(|e| {
         value_error(format!(
@@ -143,10 +147,11 @@ fn run(
     correlator
         .set_reference(&reference.pixels)
         .map_err(value_error)?;
+    let started = std::time::Instant::now();
     correlator
         .correlate(&deformed.pixels)
         .map_err(value_error)?;
-    Ok(correlator)
+    Ok((correlator, started.elapsed().as_secs_f64() * 1e3))
 }
 
 /// One value of every node.
