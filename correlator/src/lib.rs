@@ -51,6 +51,7 @@ mod simd;
 mod simd_avx2;
 pub mod state;
 pub mod strain;
+pub mod summary;
 pub mod timing;
 mod verify;
 pub mod vts;

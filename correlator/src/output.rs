@@ -130,7 +130,7 @@ pub fn field_csv_units(files: &str, strain: StrainMeasure, scale: Option<MmPerPx
 pub const CSV_HEADER: &str = "x,y,u,v,exx,eyy,exy,score,iterations,status,du_dx,du_dy,dv_dx,dv_dy";
 
 /// Node `k`'s gradient [[∂u/∂x, ∂u/∂y], [∂v/∂x, ∂v/∂y]], zero when the field carries none.
-fn node_gradient(field: &Field, k: usize) -> [[f64; 2]; 2] {
+pub fn node_gradient(field: &Field, k: usize) -> [[f64; 2]; 2] {
     field.gradients.get(k).copied().unwrap_or([[0.0; 2]; 2])
 }
 

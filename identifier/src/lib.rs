@@ -30,6 +30,7 @@
 //! - [`plot`]: PNG plots of the data, fits, f(I1) and g(I2) (plotters, bitmap backend).
 //! - [`online`]: pairing strains with rig forces, accumulating the load path, refitting (no IPC).
 //! - [`process`]: the live `identifier` process shell over iceoryx2 (`wire` services).
+//! - [`ranking`]: the offline identification on data in memory (`identify`, Python) and its JSON.
 //! - [`report`]: JSON of fits, atomic file writes.
 //! - [`subsample`]: the documented limit on fitted points and the load-path-preserving subsample.
 
@@ -60,6 +61,7 @@ pub mod online;
 pub mod plot;
 #[cfg(feature = "process")]
 pub mod process;
+pub mod ranking;
 pub mod report;
 pub mod residual_plot;
 pub mod residuals;

@@ -6,7 +6,7 @@
 //! structured grid and figures of u, v, exx, eyy, exy over the reference image. Every file is
 //! written atomically (temporary sibling, then rename). Images are read by `producer::read_image`.
 
-use super::gauge_report::{reading_line, readings_json, strains_json};
+use super::gauge_report::reading_line;
 use super::named_arg::named;
 use anyhow::{anyhow, bail, Context, Result};
 use correlator::settings::{Method, ReferenceKind};
@@ -376,7 +376,8 @@ fn write_units(args: &CorrelateArgs, strain: StrainMeasure) -> Result<()> {
     )
 }
 
-/// Frame `index`'s entry of `summary.json`.
+/// Frame `index`'s entry of `summary.json`: the frame's summary (`correlator::summary`), its
+/// index, file and time.
 fn frame_json(
     index: usize,
     path: &Path,
@@ -384,23 +385,11 @@ fn frame_json(
     gauges: &[Gauge],
     elapsed_ms: f64,
 ) -> serde_json::Value {
-    serde_json::json!({
-        "index": index,
-        "file": path.display().to_string(),
-        "nodes": field.nodes.len(),
-        "nodes_in_region": field.in_region(),
-        "valid": field.valid,
-        "u_mean": field.u_mean_px,
-        "v_mean": field.v_mean_px,
-        "gauge": strains_json(&field.gauge),
-        "gauge_nodes": field.gauge_nodes,
-        "gauges": readings_json(gauges, field),
-        "elapsed_ms": elapsed_ms,
-        "reference_updated": field.reference_updated,
-        "statuses": status_json(field),
-        "global_px": field.global_px.map(|(u, v)| [u, v]),
-        "keypoints_used": field.keypoints_used,
-    })
+    let mut entry = correlator::summary::frame_summary(field, gauges);
+    entry["index"] = index.into();
+    entry["file"] = path.display().to_string().into();
+    entry["elapsed_ms"] = elapsed_ms.into();
+    entry
 }
 
 /// The error when no node of any frame passed the final check, with a hint at why.
@@ -418,15 +407,6 @@ fn nothing_measured(args: &CorrelateArgs) -> anyhow::Error {
         args.reference.display(),
         args.out.display()
     )
-}
-
-/// Nodes per status, by status word.
-fn status_json(field: &Field) -> serde_json::Value {
-    correlator::NodeStatus::ALL
-        .iter()
-        .map(|&s| (s.name().to_owned(), field.count(s).into()))
-        .collect::<serde_json::Map<_, _>>()
-        .into()
 }
 
 fn settings_json(args: &CorrelateArgs, correlator: &Correlator) -> serde_json::Value {

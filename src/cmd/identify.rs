@@ -20,17 +20,13 @@ use identifier::data::{
     read_biaxial_csv, read_curve_csv, BiaxialState, Curve, LoadCase, ReadOptions,
 };
 use identifier::fe_cards::write_cards;
-use identifier::fit::{
-    evaluate_data, fit_ranked_data, Fit, FitData, FitError, FitOptions, FitStage, ResidualKind,
-};
+use identifier::fit::{Fit, FitData, FitOptions, FitStage, ResidualKind};
 use identifier::initial_modulus::initial_shear_modulus_mpa;
 use identifier::models::{parse_model_list, Model};
-use identifier::report::fit_json;
+use identifier::ranking::{identify, outcome_json, Outcome};
 use identifier::residual_plot::write_residual_plot;
-use identifier::route::{paper_route, RouteResult};
-use identifier::subsample::{subsample_data, Subsample, DEFAULT_MAX_FIT_POINTS};
+use identifier::subsample::DEFAULT_MAX_FIT_POINTS;
 use identifier::table::TableOptions;
-use serde_json::{json, Value};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -259,17 +255,8 @@ fn read_data(args: &IdentifyArgs) -> anyhow::Result<(Vec<Curve>, Vec<BiaxialStat
     Ok((curves, states))
 }
 
-/// What the fits gave: the ranked fits, the models that failed, the paper's route (if it
-/// could run) and the subsample fitted (if the data were too many).
-struct Outcome {
-    fits: Vec<Fit>,
-    failures: Vec<(Model, FitError)>,
-    route: Result<RouteResult, String>,
-    subsample: Option<Subsample>,
-}
-
-/// Fits the models of `args` to `all` (or to its subsample above `--max-fit-points`; RMS and
-/// R² then over every point), with its notes and progress lines on `err`.
+/// Fits the models of `args` to `all` (`identifier::ranking::identify`), with its notes and
+/// progress lines on `err`.
 fn fit(
     args: &IdentifyArgs,
     all: FitData,
@@ -286,82 +273,37 @@ fn fit(
         ..FitOptions::default()
     };
     let max_fit_points = usize::try_from(args.max_fit_points).unwrap_or(usize::MAX);
-    let subsampled = subsample_data(all.curves, all.states, max_fit_points);
-    if let Some((_, _, s)) = &subsampled {
+    let mut line = ProgressLine::new(&models, progress, PROGRESS_REDRAW);
+    let outcome = identify(
+        &models,
+        all.curves,
+        all.states,
+        &options,
+        max_fit_points,
+        &mut |index, stage| line.update(err, index, stage),
+    );
+    line.finish(err);
+    if let Some(s) = &outcome.subsample {
         writeln!(
             err,
             "{} points exceed --max-fit-points {}: fitting a subsample of {} (each curve's ends and shape kept); RMS and R² over every point",
             s.points_total, s.max_points, s.points_fitted
         )?;
     }
-    let fitted = subsampled.as_ref().map_or(all, |(c, s, _)| FitData {
-        curves: c,
-        states: s,
-    });
-    let mut line = ProgressLine::new(&models, progress, PROGRESS_REDRAW);
-    let (mut fits, failures) = fit_ranked_data(&models, fitted, &options, &mut |index, stage| {
-        line.update(err, index, stage)
-    });
-    line.finish(err);
-    if subsampled.is_some() {
-        for fit in &mut fits {
-            (fit.rms_mpa, fit.cases) = evaluate_data(&fit.model, &fit.params, all);
-        }
-    }
-    let route = paper_route(all.curves, 2, 2).map_err(|e| e.to_string());
-    if let Err(e) = &route {
+    if let Err(e) = &outcome.route {
         writeln!(err, "paper route (eqs. 20-25) not run: {e}")?;
     }
-    Ok(Outcome {
-        fits,
-        failures,
-        route,
-        subsample: subsampled.map(|(_, _, s)| s),
-    })
+    Ok(outcome)
 }
 
 /// `--json`: the fits, the failures, the paper's route and the subsample as one object.
 fn write_json(out: &mut dyn Write, outcome: &Outcome) -> anyhow::Result<()> {
-    let mut rank = 0;
-    let fits_json: Vec<Value> = outcome
-        .fits
-        .iter()
-        .map(|fit| {
-            let mut value = fit_json(fit);
-            value["rank"] = match fit.identifiability.identifiable() {
-                true => {
-                    rank += 1;
-                    json!(rank)
-                }
-                false => Value::Null,
-            };
-            value
-        })
-        .collect();
-    let failures_json: Vec<Value> = outcome
-        .failures
-        .iter()
-        .map(|(m, e)| json!({"model": m.name(), "error": e.to_string()}))
-        .collect();
-    let mut json_out = json!({"fits": fits_json, "failures": failures_json});
-    if let Ok(r) = &outcome.route {
-        json_out["paper_route"] = json!({"a": r.a, "b": r.b, "c": r.c});
-    }
-    if let Some(s) = &outcome.subsample {
-        json_out["subsample"] = subsample_json(s);
-    }
-    writeln!(out, "{}", serde_json::to_string_pretty(&json_out)?)?;
+    writeln!(
+        out,
+        "{}",
+        serde_json::to_string_pretty(&outcome_json(outcome))?
+    )?;
     Ok(())
-}
-
-/// The JSON note of a subsampled fit.
-fn subsample_json(s: &Subsample) -> Value {
-    json!({
-        "points_total": s.points_total,
-        "points_fitted": s.points_fitted,
-        "max_fit_points": s.max_points,
-        "note": "parameters, stderr, objective and aic from the fitted subsample (each curve's ends and shape kept); rms and r2 over every point",
-    })
 }
 
 /// Least time between two redraws of the progress line.
@@ -518,6 +460,7 @@ fn print_table(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::Value;
 
     /// A folder of Mooney-law curves (`points` rows per case), removed on drop.
     struct Data(PathBuf);
