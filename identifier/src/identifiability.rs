@@ -23,6 +23,20 @@ pub struct Identifiability {
     pub sigmas: f64,
 }
 
+/// The ranks shown for fits in their ranked order: the identifiable ones numbered from 1, None
+/// for the others (listed, not ranked). `identify --json`'s and `identify --fields`'s.
+pub fn ranks<'a>(fits: impl IntoIterator<Item = &'a Identifiability>) -> Vec<Option<usize>> {
+    let mut rank = 0;
+    fits.into_iter()
+        .map(|id| {
+            id.identifiable().then(|| {
+                rank += 1;
+                rank
+            })
+        })
+        .collect()
+}
+
 impl Identifiability {
     /// From the fit's names, values, standard deviations and scaled condition number.
     pub fn new(

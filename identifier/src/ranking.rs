@@ -5,6 +5,7 @@
 
 use crate::data::{BiaxialState, Curve};
 use crate::fit::{evaluate_data, fit_ranked_data, Fit, FitData, FitError, FitOptions, FitStage};
+use crate::identifiability::ranks;
 use crate::models::Model;
 use crate::report::fit_json;
 use crate::route::{paper_route, RouteResult};
@@ -53,19 +54,14 @@ pub fn identify(
 /// The outcome as one object: the fits (each with its rank among the identifiable ones, null
 /// for the others), the failures, the paper's route and the subsample.
 pub fn outcome_json(outcome: &Outcome) -> Value {
-    let mut rank = 0;
+    let ranks = ranks(outcome.fits.iter().map(|fit| &fit.identifiability));
     let fits_json: Vec<Value> = outcome
         .fits
         .iter()
-        .map(|fit| {
+        .zip(ranks)
+        .map(|(fit, rank)| {
             let mut value = fit_json(fit);
-            value["rank"] = match fit.identifiability.identifiable() {
-                true => {
-                    rank += 1;
-                    json!(rank)
-                }
-                false => Value::Null,
-            };
+            value["rank"] = json!(rank);
             value
         })
         .collect();

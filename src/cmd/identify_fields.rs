@@ -8,7 +8,7 @@
 
 use super::identify::IdentifyArgs;
 use anyhow::{bail, Context};
-use identifier::identifiability::Identifiability;
+use identifier::identifiability::{ranks, Identifiability};
 use identifier::models::parse_model_list;
 use identifier::saved_fields::{fit_saved, SavedFit};
 use serde_json::{json, Value};
@@ -136,21 +136,6 @@ pub(super) fn run_config(dir: &Path) -> anyhow::Result<live::RunConfig> {
         .with_context(|| format!("{}: the run's configuration", dir.display()))
 }
 
-/// The ranks shown: identifiable fits in the route's order (BIC, Occam's window), None for the
-/// others.
-fn ranks(identifiability: &[Identifiability]) -> Vec<Option<usize>> {
-    let mut rank = 0;
-    identifiability
-        .iter()
-        .map(|id| {
-            id.identifiable().then(|| {
-                rank += 1;
-                rank
-            })
-        })
-        .collect()
-}
-
 fn saved_json(
     dir: &Path,
     forces: Option<&Path>,
@@ -162,7 +147,7 @@ fn saved_json(
         for ((fit, id), rank) in fits
             .iter_mut()
             .zip(identifiability)
-            .zip(ranks(identifiability))
+            .zip(ranks(identifiability.iter()))
         {
             fit["rank"] = json!(rank);
             fit["warning"] = json!(id.warning());
@@ -208,7 +193,7 @@ fn print_table(
     for ((fit, rank), _) in fits
         .fits
         .iter()
-        .zip(ranks(identifiability))
+        .zip(ranks(identifiability.iter()))
         .zip(identifiability)
     {
         let params: Vec<String> = fit
