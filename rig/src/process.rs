@@ -14,7 +14,7 @@ use crate::refusal::Refusal;
 use crate::rig::Rig;
 use crate::session::SessionError;
 use crate::specimen::SpecimenConfig;
-use crate::strain::{StrainRunEvent, StrainTest};
+use crate::strain::{ProgramEnd, StrainRunEvent, StrainTest};
 use iceoryx2::prelude::*;
 use std::path::{Path, PathBuf};
 use wire::rig::RigState;
@@ -267,19 +267,21 @@ fn strain_message(event: &StrainRunEvent) -> String {
             "strain control started from ln λ ({:.4}, {:.4})",
             from_log[0], from_log[1]
         ),
-        StrainRunEvent::Waiting(reason) => format!(
-            "strain control waits for a usable field, the grips held at rest: {reason}"
-        ),
+        StrainRunEvent::Waiting(reason) => {
+            format!("strain control waits for a usable field, the grips held at rest: {reason}")
+        }
         StrainRunEvent::Held(reason) => {
             format!("strain control HELD, the grips held in displacement: {reason}")
         }
         StrainRunEvent::Resumed => "strain control resumed: fields usable again".into(),
-        StrainRunEvent::Unloading { stopped: false } => {
-            "strain program done: unloading in displacement control".into()
-        }
-        StrainRunEvent::Unloading { stopped: true } => {
-            "strain control stopped after the hold (on_interlock = stop): unloading in displacement control".into()
-        }
+        StrainRunEvent::Unloading(end @ ProgramEnd::Stopped) => format!(
+            "strain control {}: unloading in displacement control",
+            end.describe()
+        ),
+        StrainRunEvent::Unloading(end) => format!(
+            "strain program done, {}: unloading in displacement control",
+            end.describe()
+        ),
         StrainRunEvent::Finished => "strain-controlled test finished (unloaded)".into(),
     }
 }

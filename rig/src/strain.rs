@@ -21,6 +21,7 @@ pub mod interlock;
 pub mod outer;
 pub mod path;
 pub mod run;
+pub mod settle;
 pub mod test;
 
 pub use control::{StrainControl, StrainEvent, StrainMode};
@@ -29,4 +30,5 @@ pub use interlock::{HoldReason, InterlockLimits};
 pub use outer::{GaugeMeasurement, OuterLoop, OuterLoopConfig};
 pub use path::{StrainPath, StrainSegment};
 pub use run::{ControlColumns, StrainRun, StrainRunEvent};
+pub use settle::{ProgramEnd, ShortBecause};
 pub use test::{StrainKind, StrainTest, TestControl};

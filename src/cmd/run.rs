@@ -112,6 +112,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
     if let Some(field) = &report.field_acceptance {
         println!("run: {}", field.verdict_line());
     }
+    if let Some(strain) = &report.strain_target {
+        println!("run: {}", strain.line());
+    }
     println!("run: results in {}", report.results.display());
     if report.leftover_shm_files > 0 {
         eprintln!(

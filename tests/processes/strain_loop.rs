@@ -200,7 +200,13 @@ fn kill_correlator_mid_ramp(on_interlock: &str) {
     match on_interlock {
         "resume" => {
             assert!(rig_log.contains("strain control resumed"), "{rig_log}");
-            assert!(rig_log.contains("strain program done"), "{rig_log}");
+            // The program ends when a field shows its last target, and the run says so.
+            assert!(
+                rig_log.contains("strain program done, the last target reached"),
+                "{rig_log}"
+            );
+            assert_eq!(s["strain_target"]["reached"], true, "{s}");
+            assert_eq!(s["strain_target"]["target_stretch"], 1.3, "{s}");
             // The ramp went on to the target after the correlator came back.
             let after_hold = modes[first_strain..]
                 .iter()
@@ -210,6 +216,7 @@ fn kill_correlator_mid_ramp(on_interlock: &str) {
         }
         _ => {
             assert!(rig_log.contains("stopped after the hold"), "{rig_log}");
+            assert_eq!(s["strain_target"]["reached"], false, "{s}");
             assert!(!rig_log.contains("strain program done"), "{rig_log}");
         }
     }

@@ -91,6 +91,7 @@ impl Stopped<'_> {
             machine_csv,
             scale: crate::field_scale::ScaleReport::of(config),
             strain_map: outputs.strain_map,
+            strain_target: super::report::StrainTargetReport::of(config, recorder),
             leftover_shm_files: self.leftover_shm_files,
             exit_code: verdict.exit_code,
         };

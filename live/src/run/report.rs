@@ -43,6 +43,48 @@ impl TruthReport {
     }
 }
 
+/// A strain-controlled test's target against the largest stretch its control gauge reached
+/// (the rig's log says why a test stopped short: the stroke, the settling limit, an interlock).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct StrainTargetReport {
+    pub target_stretch: f64,
+    pub reached_stretch: f64,
+    /// Within the tolerance the rig ends a program by ([`rig::strain::settle`]).
+    pub reached: bool,
+}
+
+impl StrainTargetReport {
+    /// None without a strain-controlled test.
+    pub fn of(
+        config: &crate::config::RunConfig,
+        recorder: &crate::recorder::Recorder,
+    ) -> Option<StrainTargetReport> {
+        let test = config.strain_test().ok().flatten()?;
+        // A strain test runs alone in its campaign: its load case's largest stretch.
+        let reached_stretch = recorder.max_stretch.iter().copied().fold(1.0, f64::max);
+        let target_log = test.stretch.ln();
+        Some(StrainTargetReport {
+            target_stretch: test.stretch,
+            reached_stretch,
+            reached: (reached_stretch.ln() - target_log).abs()
+                <= rig::strain::settle::tolerance_log(target_log),
+        })
+    }
+
+    /// `strain control aimed at λ 1.300 in its gauge and reached λ 1.284: SHORT (…)`.
+    pub fn line(&self) -> String {
+        let verdict = match self.reached {
+            true => "reached".to_string(),
+            false => "SHORT of it (logs/rig.log says why)".to_string(),
+        };
+        format!(
+            "strain control aimed at λ {:.3} in its gauge; the largest it measured was λ {:.3}: \
+             {verdict}",
+            self.target_stretch, self.reached_stretch
+        )
+    }
+}
+
 /// What the run did, also written as `summary.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct RunReport {
@@ -103,6 +145,8 @@ pub struct RunReport {
     pub scale: crate::field_scale::ScaleReport,
     /// What `strain_map.png` shows.
     pub strain_map: Option<StrainMapInfo>,
+    /// A strain-controlled test's target and what its gauge reached.
+    pub strain_target: Option<StrainTargetReport>,
     /// Files of the instance left once every process had stopped (named, then removed).
     pub leftover_shm_files: usize,
     /// The exit code of `dicstream run` (see [`super::exit_code`]).

@@ -12,6 +12,10 @@
 //! the event says why. With [`OnRestore::Resume`], three consecutive good fields resume the
 //! program where it was held (the model re-anchored on them); with [`OnRestore::Stop`] the test
 //! ends there, held.
+//!
+//! The program's clock reaching its end is not the gauge reaching the last target: the loop
+//! keeps that target until a field shows it ([`crate::strain::settle`]), and the end says
+//! whether it did ([`ProgramEnd`]).
 
 use crate::control::{AxisControl, ControlMode};
 use crate::ids::{Axis, Channel};
@@ -20,6 +24,12 @@ use crate::rig::{Rig, RigCommand};
 use crate::strain::interlock::{HoldReason, InterlockLimits};
 use crate::strain::outer::{GaugeMeasurement, OuterLoop, OuterLoopConfig};
 use crate::strain::path::StrainPath;
+use crate::strain::settle::{ProgramEnd, Settling, ShortBecause};
+
+/// How far from each grip's stroke limit the loop stops (mm): it ends its program short
+/// rather than command the grips onto the limit, where the inner loop's following error
+/// would trip it (hydraulics off, no unloading).
+pub const STROKE_MARGIN_MM: f64 = 2.0;
 
 /// Good fields in a row that end a hold (with [`OnRestore::Resume`]).
 pub const RESUME_AFTER_FIELDS: u32 = 3;
@@ -61,7 +71,7 @@ impl StrainMode {
 pub enum StrainEvent {
     Held(HoldReason),
     Resumed,
-    Finished,
+    Finished(ProgramEnd),
 }
 
 #[derive(Clone, Debug)]
@@ -79,7 +89,14 @@ pub struct StrainControl {
     target: [f64; 2],
     /// Largest elongation change per step (mm), from the rig's rate limits.
     max_step_mm: [f64; 2],
+    /// (lowest, highest) elongation the loop commands per pair: the two grips' strokes less
+    /// [`STROKE_MARGIN_MM`] each.
+    elongation_range_mm: [(f64, f64); 2],
     setpoint_mm: [f64; 2],
+    /// Past the program's end, waiting for a field at the last target.
+    settling: Option<Settling>,
+    /// The newest usable field's log strains (NaN before the first).
+    newest_log: [f64; 2],
 }
 
 /// Why strain control did not start.
@@ -134,6 +151,13 @@ impl StrainControl {
                     .min(channels[a.minus().index()].rate_max_mm_s);
             machine_mm_s.min(config.max_elongation_rate_mm_s) * dt
         });
+        let elongation_range_mm = [Axis::X, Axis::Y].map(|a| {
+            let (plus, minus) = (&channels[a.plus().index()], &channels[a.minus().index()]);
+            (
+                plus.stroke_min_mm + minus.stroke_min_mm + 2.0 * STROKE_MARGIN_MM,
+                plus.stroke_max_mm + minus.stroke_max_mm - 2.0 * STROKE_MARGIN_MM,
+            )
+        });
         let mut outer = OuterLoop::new(config, gauge_mm);
         outer.record(rig.state().t_s, elongations(rig));
         Ok(StrainControl {
@@ -150,7 +174,10 @@ impl StrainControl {
             good_in_row: 0,
             target: [0.0; 2],
             max_step_mm,
+            elongation_range_mm,
             setpoint_mm: elongations(rig),
+            settling: None,
+            newest_log: [f64::NAN; 2],
         })
     }
 
@@ -194,6 +221,8 @@ impl StrainControl {
         self.good_in_row = 0;
         self.target = self.start;
         self.setpoint_mm = [Axis::X, Axis::Y].map(|a| rig_setpoint(rig, a));
+        self.settling = None;
+        self.newest_log = latest.log_strain;
         Ok(())
     }
 
@@ -220,6 +249,14 @@ impl StrainControl {
     }
 
     fn hold(&mut self, rig: &mut Rig, reason: HoldReason) -> Option<StrainEvent> {
+        self.hold_position(rig);
+        self.good_in_row = 0;
+        self.mode = StrainMode::Held(reason.clone());
+        Some(StrainEvent::Held(reason))
+    }
+
+    /// The pairs' set-points at their present elongations.
+    fn hold_position(&mut self, rig: &mut Rig) {
         self.setpoint_mm = elongations(rig);
         for (i, axis) in [Axis::X, Axis::Y].into_iter().enumerate() {
             // Holding the present position is always within the limits it is at.
@@ -228,9 +265,6 @@ impl StrainControl {
                 value: self.setpoint_mm[i],
             });
         }
-        self.good_in_row = 0;
-        self.mode = StrainMode::Held(reason.clone());
-        Some(StrainEvent::Held(reason))
     }
 
     /// One control period, before `rig.step()`: `newest` is the newest field sample known
@@ -270,6 +304,15 @@ impl StrainControl {
                 (Err(_), _) => self.good_in_row = 0,
                 (Ok(()), StrainMode::Strain) => {
                     self.outer.update(m);
+                    self.newest_log = m.log_strain;
+                    let target = self.target;
+                    if let Some(end) = self
+                        .settling
+                        .as_mut()
+                        .and_then(|s| s.field(m.log_strain, target))
+                    {
+                        return Some(self.finish(end));
+                    }
                 }
                 (Ok(()), StrainMode::Held(_)) => {
                     self.good_in_row += 1;
@@ -278,8 +321,7 @@ impl StrainControl {
                     {
                         match self.on_restore {
                             OnRestore::Stop => {
-                                self.mode = StrainMode::Done;
-                                return Some(StrainEvent::Finished);
+                                return Some(self.finish(ProgramEnd::Stopped));
                             }
                             OnRestore::Resume => {
                                 if self.outer.reset_to(m) {
@@ -296,6 +338,7 @@ impl StrainControl {
                                         self.path.time_nearest(self.start, self.program_t_s, state);
                                     self.target = self.path.target(self.start, self.program_t_s);
                                     self.setpoint_mm = elongations(rig);
+                                    self.settling = None;
                                     self.mode = StrainMode::Strain;
                                     return Some(StrainEvent::Resumed);
                                 }
@@ -312,25 +355,65 @@ impl StrainControl {
         if let Err(reason) = self.limits.check_age(now, self.last_capture_s) {
             return self.hold(rig, reason);
         }
-        self.program_t_s += rig.dt_s();
+        self.program_t_s = (self.program_t_s + rig.dt_s()).min(self.duration_s);
         self.target = self.path.target(self.start, self.program_t_s);
         let wanted = self.outer.elongation_for(self.target);
         for (i, axis) in [Axis::X, Axis::Y].into_iter().enumerate() {
             let step =
                 (wanted[i] - self.setpoint_mm[i]).clamp(-self.max_step_mm[i], self.max_step_mm[i]);
             let value = self.setpoint_mm[i] + step;
-            if let Err(refusal) = rig.command(RigCommand::SetSetpoint {
-                channel: Channel::Elongation(axis),
-                value,
-            }) {
+            let (lowest, highest) = self.elongation_range_mm[i];
+            let within = match value > highest {
+                true => Err(highest),
+                false => (value >= lowest).then_some(()).ok_or(lowest),
+            };
+            let command = within
+                .map_err(|limit| Refusal::BeyondLimit {
+                    channel: Channel::Elongation(axis),
+                    what: "elongation (mm; the grips' strokes less the strain loop's margin)",
+                    value,
+                    limit,
+                })
+                .and_then(|()| {
+                    rig.command(RigCommand::SetSetpoint {
+                        channel: Channel::Elongation(axis),
+                        value,
+                    })
+                });
+            if let Err(refusal) = command {
+                if matches!(refusal, Refusal::BeyondLimit { .. }) {
+                    // The path leads out of the rig's reach: no resume can go on with it.
+                    self.hold_position(rig);
+                    return Some(self.finish(ProgramEnd::Short {
+                        measured_log: self.newest_log,
+                        target_log: self.path.target(self.start, self.duration_s),
+                        because: ShortBecause::Refused(refusal),
+                    }));
+                }
                 return self.hold(rig, HoldReason::Refused(refusal.to_string()));
             }
             self.setpoint_mm[i] = value;
         }
         if self.program_t_s >= self.duration_s {
-            self.mode = StrainMode::Done;
-            return Some(StrainEvent::Finished);
+            let dt_s = rig.dt_s();
+            if self
+                .settling
+                .get_or_insert_with(Settling::default)
+                .tick(dt_s)
+            {
+                return Some(self.finish(ProgramEnd::Short {
+                    measured_log: self.newest_log,
+                    target_log: self.target,
+                    because: ShortBecause::SettleLimit,
+                }));
+            }
         }
         None
+    }
+
+    fn finish(&mut self, end: ProgramEnd) -> StrainEvent {
+        self.mode = StrainMode::Done;
+        self.settling = None;
+        StrainEvent::Finished(end)
     }
 }

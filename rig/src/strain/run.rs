@@ -19,6 +19,7 @@ use crate::specimen::SpecimenConfig;
 use crate::strain::control::{StrainControl, StrainEvent, StrainMode, StrainStartError};
 use crate::strain::interlock::HoldReason;
 use crate::strain::outer::{GaugeMeasurement, OuterLoopConfig};
+use crate::strain::settle::ProgramEnd;
 use crate::strain::test::StrainTest;
 use wire::RigControl;
 
@@ -44,10 +45,9 @@ pub enum StrainRunEvent {
     Waiting(HoldReason),
     Held(HoldReason),
     Resumed,
-    /// The program ended (or was stopped by an interlock with `stop`): unloading.
-    Unloading {
-        stopped: bool,
-    },
+    /// The program ended, at its last target or short of it, or was stopped by an interlock
+    /// with `stop`: unloading.
+    Unloading(ProgramEnd),
     Finished,
 }
 
@@ -205,21 +205,18 @@ impl StrainRun {
                 None
             }
             Phase::Controlling => {
-                let was_held = matches!(self.control.mode(), StrainMode::Held(_));
                 let event = self.control.advance(rig, newest);
                 match event {
                     Some(StrainEvent::Held(reason)) => Some(StrainRunEvent::Held(reason)),
                     Some(StrainEvent::Resumed) => Some(StrainRunEvent::Resumed),
-                    Some(StrainEvent::Finished) => {
-                        self.stopped = was_held;
+                    Some(StrainEvent::Finished(end)) => {
+                        self.stopped = end == ProgramEnd::Stopped;
                         match rig.command(RigCommand::StartProgram(Box::new(self.unload(rig)))) {
                             Ok(()) => self.phase = Phase::Unloading,
                             // Cannot unload (a tripped limit): stay where the rig put it.
                             Err(_) => self.phase = Phase::Finished,
                         }
-                        Some(StrainRunEvent::Unloading {
-                            stopped: self.stopped,
-                        })
+                        Some(StrainRunEvent::Unloading(end))
                     }
                     None => None,
                 }
@@ -338,7 +335,14 @@ mod tests {
         let (rig, strain, events, _) = run(test, f64::INFINITY, 0.0, 30.0);
         assert!(strain.is_done(), "{events:?}");
         assert!(matches!(events[0], StrainRunEvent::Started { .. }));
-        assert!(events.contains(&StrainRunEvent::Unloading { stopped: false }));
+        // The program ended at its last target (the measurement here is the truth, 0.1 s
+        // late), not when its clock did.
+        assert!(
+            events
+                .iter()
+                .any(|e| matches!(e, StrainRunEvent::Unloading(ProgramEnd::Reached { .. }))),
+            "{events:?}"
+        );
         // Unloaded.
         for axis in 0..2 {
             assert!(rig.state().axes[axis].elongation_mm.abs() < 0.1);
@@ -383,7 +387,7 @@ mod tests {
             } else {
                 assert_eq!(
                     events[held + 1],
-                    StrainRunEvent::Unloading { stopped: true },
+                    StrainRunEvent::Unloading(ProgramEnd::Stopped),
                     "{events:?}"
                 );
                 assert!(strain.was_stopped());

@@ -12,8 +12,8 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, LogNormal, Normal};
 use rig::strain::control::OnRestore;
 use rig::strain::{
-    GaugeMeasurement, HoldReason, InterlockLimits, OuterLoopConfig, StrainControl, StrainEvent,
-    StrainMode, StrainPath, StrainSegment,
+    GaugeMeasurement, HoldReason, InterlockLimits, OuterLoopConfig, ProgramEnd, ShortBecause,
+    StrainControl, StrainEvent, StrainMode, StrainPath, StrainSegment,
 };
 use rig::{
     Axis, AxisControl, ControlMode, Loading, Program, Rig, RigCommand, RigConfig, SpecimenConfig,
@@ -154,7 +154,7 @@ fn run_path(
         camera.observe(rig);
         trace.push((control.target(), truth(rig)));
         match event {
-            Some(StrainEvent::Finished) => return trace,
+            Some(StrainEvent::Finished(_)) => return trace,
             Some(StrainEvent::Held(reason)) => panic!("held: {reason}"),
             _ => {}
         }
@@ -356,7 +356,8 @@ fn fields_stopped_mid_ramp_hold_position_and_resume_bumplessly() {
                 assert!(held_at.is_some());
                 assert_eq!(control.mode(), &StrainMode::Strain);
             }
-            Some(StrainEvent::Finished) => {
+            Some(StrainEvent::Finished(end)) => {
+                assert!(matches!(end, ProgramEnd::Reached { .. }), "{end:?}");
                 finished = true;
                 break;
             }
@@ -435,7 +436,8 @@ fn a_hold_and_resume_mid_ramp_under_latency_jitter_keeps_the_path() {
                     let off = (target[0] - y[0]).abs().max((target[1] - y[1]).abs());
                     worst_restart = worst_restart.max(off);
                 }
-                Some(StrainEvent::Finished) => {
+                Some(StrainEvent::Finished(end)) => {
+                    assert!(matches!(end, ProgramEnd::Reached { .. }), "{end:?}");
                     finished = true;
                     break;
                 }
@@ -500,7 +502,7 @@ fn fields_back_after_a_hold_end_the_test_held_when_configured_to_stop() {
         events[0],
         StrainEvent::Held(HoldReason::Stale { .. })
     ));
-    assert_eq!(events[1], StrainEvent::Finished);
+    assert_eq!(events[1], StrainEvent::Finished(ProgramEnd::Stopped));
     assert_eq!(control.mode().code(), "displacement");
     for i in 0..2 {
         assert!((rig.state().axes[i].elongation_mm - held[i]).abs() < 0.05);
@@ -623,4 +625,110 @@ fn switching_to_strain_and_back_is_bumpless() {
     for i in 0..2 {
         assert!((rig.state().axes[i].elongation_mm - at[i]).abs() < 0.05);
     }
+}
+
+/// The default cruciform (80 mm arms): its central square takes about a fifth of the grips'
+/// log stretch, so the loop's elongation rate cap and the stroke bound what the gauge reaches.
+fn default_cruciform_bench(
+    max_elongation_rate_mm_s: f64,
+) -> (Rig, StrainControl, DelayedMeasurement) {
+    let settings = SpecimenSettings {
+        model: SpecimenModel::Structure,
+        ..SpecimenSettings::default()
+    };
+    let config = RigConfig {
+        specimen: Some(SpecimenConfig::of(Loading::Equibiaxial, &settings)),
+        ..RigConfig::default()
+    };
+    let mut rig = Rig::new(config, 5).unwrap();
+    let loop_config = OuterLoopConfig {
+        max_elongation_rate_mm_s,
+        ..OuterLoopConfig::for_specimen(rig.specimen().unwrap())
+    };
+    let mut control = StrainControl::new(
+        &rig,
+        loop_config,
+        InterlockLimits::default(),
+        OnRestore::Resume,
+    )
+    .unwrap();
+    let mut camera = DelayedMeasurement::new(10.0, 0.15, 5);
+    for _ in 0..(0.5 * rig.config().control_hz) as usize {
+        control.advance(&mut rig, camera.newest.as_ref());
+        rig.step();
+        camera.observe(&rig);
+    }
+    (rig, control, camera)
+}
+
+/// Runs `path` to its end; the end and the gauge's truth then.
+fn run_to_end(
+    rig: &mut Rig,
+    control: &mut StrainControl,
+    camera: &mut DelayedMeasurement,
+    path: StrainPath,
+) -> (ProgramEnd, [f64; 2]) {
+    let latest = camera.newest.unwrap();
+    control.start(rig, path, &latest).unwrap();
+    for _ in 0..(400.0 * rig.config().control_hz) as usize {
+        let event = control.advance(rig, camera.newest.as_ref());
+        rig.step();
+        camera.observe(rig);
+        match event {
+            Some(StrainEvent::Finished(end)) => return (end, truth(rig)),
+            Some(StrainEvent::Held(reason)) => panic!("held: {reason}"),
+            _ => {}
+        }
+    }
+    panic!("strain program did not finish in budget");
+}
+
+#[test]
+fn a_rate_capped_loop_reaches_the_last_target_after_the_programs_clock() {
+    // 0.03 log strain per s in the gauge needs some 26 mm/s of elongation per pair (about
+    // 120 mm to λ 1.15 in 4.7 s): capped at 15, the gauge trails the program, which waits
+    // for it at its end.
+    let (mut rig, mut control, mut camera) = default_cruciform_bench(15.0);
+    let path = StrainPath::ratio_path(1.0, 1.15, 0.03).unwrap();
+    let (end, y) = run_to_end(&mut rig, &mut control, &mut camera, path);
+    println!("rate-capped: {}", end.describe());
+    let ProgramEnd::Reached { after_s, .. } = end else {
+        panic!("{end:?}")
+    };
+    assert!(
+        after_s > 0.3,
+        "the cap did not hold the gauge back: {after_s} s"
+    );
+    let target = 1.15f64.ln();
+    assert!(
+        (y[0] - target).abs() < 0.01 * target && (y[1] - target).abs() < 0.01 * target,
+        "{y:?}"
+    );
+}
+
+#[test]
+fn a_target_beyond_the_stroke_ends_the_program_short_with_the_reason() {
+    // λ 1.3 in the default cruciform's gauge needs some 130 mm per grip: the stroke is 120.
+    let (mut rig, mut control, mut camera) = default_cruciform_bench(25.0);
+    let path = StrainPath::ratio_path(1.0, 1.3, 0.03).unwrap();
+    let (end, y) = run_to_end(&mut rig, &mut control, &mut camera, path);
+    println!("beyond the stroke: {}", end.describe());
+    let ProgramEnd::Short {
+        measured_log,
+        target_log,
+        because: ShortBecause::Refused(refusal),
+    } = &end
+    else {
+        panic!("{end:?}")
+    };
+    assert!(refusal.to_string().contains("stroke"), "{refusal}");
+    assert_eq!(*target_log, [1.3f64.ln(); 2]);
+    assert!(measured_log[0] < target_log[0] && (measured_log[0] - y[0]).abs() < 0.01);
+    assert_eq!(control.mode(), &StrainMode::Done);
+    // Held where it stopped, short of the two grips' strokes (120 mm each) by the loop's
+    // margin, so that no limit tripped: the rig can unload.
+    for axis in &rig.state().axes[..2] {
+        assert!(axis.elongation_mm <= 236.1, "{}", axis.elongation_mm);
+    }
+    assert_eq!(rig.state().limits_tripped, 0);
 }
