@@ -25,7 +25,7 @@ const SAMPLES: usize = 100;
 
 /// The ranked models not told apart from the lowest BIC (more than one), the first the one
 /// chosen, and their nominal stresses' spread.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ModelWindow {
     /// Names, the chosen one first, then by BIC.
     pub models: Vec<String>,
@@ -43,11 +43,10 @@ pub struct ModelWindow {
 impl ModelWindow {
     /// One line for the logs and the tables.
     pub fn describe(&self) -> String {
-        let spread = |s: Option<f64>| s.map_or("-".to_string(), |s| format!("{:.1} %", 100.0 * s));
         format!(
             "{} not told apart by the forces (BIC within {} of the lowest: {}); {} has the \
-             fewest parameters and goes first; their nominal stresses differ by up to {} \
-             uniaxial, {} equibiaxial, {} pure shear over the states reached",
+             fewest parameters and goes first; their nominal stresses differ by up to {} over \
+             the states reached",
             self.models.join(", "),
             self.bic_window,
             self.delta_bic
@@ -56,6 +55,26 @@ impl ModelWindow {
                 .collect::<Vec<_>>()
                 .join(", "),
             self.models[0],
+            self.spreads()
+        )
+    }
+
+    /// The chosen model's line: `the forces do not tell it apart from hart-smith: stresses
+    /// differ by up to 8.1 % uniaxial, … pure shear; it has the fewest parameters`.
+    pub fn versus_chosen(&self) -> String {
+        format!(
+            "the forces do not tell it apart from {}: stresses differ by up to {}; it has the \
+             fewest parameters",
+            self.models[1..].join(", "),
+            self.spreads()
+        )
+    }
+
+    /// `8.1 % uniaxial, 0.4 % equibiaxial, - pure shear` (`-`: not reached).
+    fn spreads(&self) -> String {
+        let spread = |s: Option<f64>| s.map_or("-".to_string(), |s| format!("{:.1} %", 100.0 * s));
+        format!(
+            "{} uniaxial, {} equibiaxial, {} pure shear",
             spread(self.spread_uniaxial),
             spread(self.spread_equibiaxial),
             spread(self.spread_pure_shear)

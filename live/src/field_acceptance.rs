@@ -41,7 +41,7 @@ pub struct FieldAcceptance {
     pub refused: Value,
     /// The models the forces did not tell apart from the first (`identifier::model_window`),
     /// with their stresses' spread; null when the first stood out.
-    pub not_told_apart: Value,
+    pub not_told_apart: Option<identifier::model_window::ModelWindow>,
     /// Each kept frame's grip forces, measured and computed from the field under the first
     /// ranked fit (`frame_id, grip, measured_n, computed_n, fields`), as the identifier wrote it.
     pub force_balance: Value,
@@ -138,24 +138,10 @@ impl FieldAcceptance {
         .collect::<Vec<_>>()
         .join("; ");
         let frames = self.frames.unwrap_or(0);
-        let others = self.not_told_apart["models"]
-            .as_array()
-            .map(|models| {
-                let names: Vec<&str> = models.iter().skip(1).filter_map(Value::as_str).collect();
-                let spread = |key: &str| {
-                    self.not_told_apart[key]
-                        .as_f64()
-                        .map_or("-".into(), |s| format!("{:.1} %", 100.0 * s))
-                };
-                format!(
-                    " (the forces do not tell it apart from {}: stresses up to {} apart uniaxial, \
-                     {} equibiaxial, {} pure shear; it has the fewest parameters)",
-                    names.join(", "),
-                    spread("spread_uniaxial"),
-                    spread("spread_equibiaxial"),
-                    spread("spread_pure_shear")
-                )
-            })
+        let others = self
+            .not_told_apart
+            .as_ref()
+            .map(|window| format!(" ({})", window.versus_chosen()))
             .unwrap_or_default();
         format!("field route, {model} over {frames} frames{others}: {cases} -> {verdict} ({limit})")
     }
@@ -195,7 +181,9 @@ pub fn judge_route(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
         cost_ms: route["cost_ms"].clone(),
         fits: route["fits"].clone(),
         refused: route["refused"].clone(),
-        not_told_apart: route["not_told_apart"].clone(),
+        not_told_apart: serde_json::from_value(route["not_told_apart"].clone())
+            .ok()
+            .flatten(),
         force_balance: route["force_balance"].clone(),
         error: route["error"].as_str().map(str::to_string),
         tolerance: FIELD_TOLERANCE,
@@ -231,7 +219,7 @@ mod tests {
         });
         let line = judge_route(&truth, &tied).verdict_line();
         assert!(
-            line.contains("do not tell it apart from hart-smith: stresses up to 8.1 % apart uniaxial, 0.4 % equibiaxial, - pure shear"),
+            line.contains("do not tell it apart from hart-smith: stresses differ by up to 8.1 % uniaxial, 0.4 % equibiaxial, - pure shear"),
             "{line}"
         );
         assert_eq!(exact.model.as_deref(), Some("lambert-diani-rey:2,2"));
