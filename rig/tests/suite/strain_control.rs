@@ -120,15 +120,21 @@ fn bench_with(
     seed: u64,
     on_restore: OnRestore,
 ) -> (Rig, StrainControl, DelayedMeasurement) {
-    let mut rig = structure_rig(seed);
-    let mut control = StrainControl::new(
-        &rig,
-        OuterLoopConfig::for_specimen(rig.specimen().unwrap()),
-        InterlockLimits::default(),
-        on_restore,
-    )
-    .unwrap();
-    let mut camera = DelayedMeasurement::new(fps, latency_s, seed);
+    let rig = structure_rig(seed);
+    let loop_config = OuterLoopConfig::for_specimen(rig.specimen().unwrap());
+    let camera = DelayedMeasurement::new(fps, latency_s, seed);
+    bench_on(rig, loop_config, camera, on_restore)
+}
+
+/// `rig` at rest, strain control idle on `loop_config`, `camera`'s fields flowing for 0.5 s.
+fn bench_on(
+    mut rig: Rig,
+    loop_config: OuterLoopConfig,
+    mut camera: DelayedMeasurement,
+    on_restore: OnRestore,
+) -> (Rig, StrainControl, DelayedMeasurement) {
+    let mut control =
+        StrainControl::new(&rig, loop_config, InterlockLimits::default(), on_restore).unwrap();
     for _ in 0..(0.5 * rig.config().control_hz) as usize {
         control.advance(&mut rig, camera.newest.as_ref());
         rig.step();
@@ -137,13 +143,26 @@ fn bench_with(
     (rig, control, camera)
 }
 
+/// Per step: (target, gauge truth).
+type Trace = Vec<([f64; 2], [f64; 2])>;
+
 /// Per step until the program ends: (target, gauge truth).
 fn run_path(
     rig: &mut Rig,
     control: &mut StrainControl,
     camera: &mut DelayedMeasurement,
     path: StrainPath,
-) -> Vec<([f64; 2], [f64; 2])> {
+) -> Trace {
+    run_path_to_end(rig, control, camera, path).0
+}
+
+/// [`run_path`]'s trace and how the program ended.
+fn run_path_to_end(
+    rig: &mut Rig,
+    control: &mut StrainControl,
+    camera: &mut DelayedMeasurement,
+    path: StrainPath,
+) -> (Trace, ProgramEnd) {
     let latest = camera.newest.unwrap();
     control.start(rig, path, &latest).unwrap();
     let mut trace = Vec::new();
@@ -154,7 +173,7 @@ fn run_path(
         camera.observe(rig);
         trace.push((control.target(), truth(rig)));
         match event {
-            Some(StrainEvent::Finished(_)) => return trace,
+            Some(StrainEvent::Finished(end)) => return (trace, end),
             Some(StrainEvent::Held(reason)) => panic!("held: {reason}"),
             _ => {}
         }
@@ -640,25 +659,13 @@ fn default_cruciform_bench(
         specimen: Some(SpecimenConfig::of(Loading::Equibiaxial, &settings)),
         ..RigConfig::default()
     };
-    let mut rig = Rig::new(config, 5).unwrap();
+    let rig = Rig::new(config, 5).unwrap();
     let loop_config = OuterLoopConfig {
         max_elongation_rate_mm_s,
         ..OuterLoopConfig::for_specimen(rig.specimen().unwrap())
     };
-    let mut control = StrainControl::new(
-        &rig,
-        loop_config,
-        InterlockLimits::default(),
-        OnRestore::Resume,
-    )
-    .unwrap();
-    let mut camera = DelayedMeasurement::new(10.0, 0.15, 5);
-    for _ in 0..(0.5 * rig.config().control_hz) as usize {
-        control.advance(&mut rig, camera.newest.as_ref());
-        rig.step();
-        camera.observe(&rig);
-    }
-    (rig, control, camera)
+    let camera = DelayedMeasurement::new(10.0, 0.15, 5);
+    bench_on(rig, loop_config, camera, OnRestore::Resume)
 }
 
 /// Runs `path` to its end; the end and the gauge's truth then.
@@ -668,19 +675,8 @@ fn run_to_end(
     camera: &mut DelayedMeasurement,
     path: StrainPath,
 ) -> (ProgramEnd, [f64; 2]) {
-    let latest = camera.newest.unwrap();
-    control.start(rig, path, &latest).unwrap();
-    for _ in 0..(400.0 * rig.config().control_hz) as usize {
-        let event = control.advance(rig, camera.newest.as_ref());
-        rig.step();
-        camera.observe(rig);
-        match event {
-            Some(StrainEvent::Finished(end)) => return (end, truth(rig)),
-            Some(StrainEvent::Held(reason)) => panic!("held: {reason}"),
-            _ => {}
-        }
-    }
-    panic!("strain program did not finish in budget");
+    let (_, end) = run_path_to_end(rig, control, camera, path);
+    (end, truth(rig))
 }
 
 #[test]
