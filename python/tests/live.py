@@ -3,6 +3,7 @@ and a correlator (``dicstream correlator``) on an instance of the test's own, st
 processes and stopped (SIGTERM, then SIGKILL) whatever the test's outcome, with the instance's
 files removed after them (as the Rust tests' ``testkit::TestInstance``)."""
 
+import gc
 import os
 import signal
 import subprocess
@@ -102,6 +103,7 @@ class Bench:
     def stop(self):
         for child in reversed(self.children):
             child.stop()
+        gc.collect()  # the tests' own subscriptions (nodes) go before their files do
         remove_instance_files(self.instance)
 
 
