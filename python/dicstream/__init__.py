@@ -8,6 +8,12 @@
 - ``read_results(path)``: a run's results folder (``summary.json``, ``identification.json``,
   ``frames.csv``, the ``fields/`` CSV files) as dicts and numpy arrays.
 - ``read_image(path)``: a PNG, TIFF or BMP file as a uint16 array, by the CLI's reader.
+- ``subscribe(service, instance=None, timeout=None)``: a live service's samples (``frames``,
+  ``fields``, ``rig/state``, ``identification``); a frame's ``pixels`` and a field's ``nodes``
+  are numpy views of the shared memory (no copy), the header's fields are attributes.
+- ``layouts()``: the numpy dtypes of the shared-memory layouts, built from the Rust ones;
+  ``NODE_STATUS`` and ``STRAIN_MEASURES``: their codes by name (a node's ``status``, a
+  field's ``strain_measure``).
 
 Bad input raises ``ValueError`` with the library's message.
 """
@@ -19,9 +25,31 @@ import os
 import numpy as np
 
 from . import _dicstream
-from ._dicstream import LAYOUT_VERSION, read_image
+from ._dicstream import LAYOUT_VERSION, NODE_STATUS, STRAIN_MEASURES, layouts, read_image
 
-__all__ = ["correlate", "identify", "read_results", "read_image", "LAYOUT_VERSION"]
+__all__ = [
+    "correlate", "identify", "read_results", "read_image", "subscribe", "layouts",
+    "LAYOUT_VERSION", "NODE_STATUS", "STRAIN_MEASURES",
+]
+
+
+def subscribe(service, instance=None, timeout=None):
+    """An iterator of the live samples of ``service`` ("frames", "fields", "rig/state",
+    "identification") of ``instance`` (None: the default instance, ``dicstream_$USER``, as the
+    CLI's). Each ``next()`` waits at most ``timeout`` seconds (None: until a sample comes) and
+    then raises ``TimeoutError``; a sample of another layout version raises ``ValueError``.
+
+    A sample has ``header`` (a 0-d numpy structured array) and the header's fields as
+    attributes (``frame_id``, ``mesh_cols``, ``u_mean_px``, ...); a frame has ``pixels``
+    (uint16, (height_px, width_px)), a field ``nodes`` (structured: ``x_px``, ``y_px``,
+    ``u_px``, ``v_px``, ``exx``, ``eyy``, ``exy``, ``score``, ``iterations``, ``status``,
+    ``du_dx``..``dv_dy``; (mesh_rows, mesh_cols)). Both are read-only views of the iceoryx2
+    sample's shared memory: no copy is made, and the sample goes back to the publisher when
+    the sample object and every view of it are gone. A subscriber holds at most
+    ``max_borrowed`` samples at once: keep copies (``nodes.copy()``), not views, of samples
+    you keep longer. A rig state or an identification report is a copied value.
+    """
+    return _dicstream.subscribe(service, instance=instance, timeout=timeout)
 
 
 def correlate(reference, deformed, **settings):

@@ -17,7 +17,7 @@ use std::str::FromStr;
 use wire::names::Named;
 
 /// A `ValueError` from any error's message.
-fn value_error(e: impl std::fmt::Display) -> PyErr {
+pub(crate) fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 

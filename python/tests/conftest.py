@@ -27,12 +27,10 @@ def shared_data(relative):
 def cli():
     """The dicstream binary: a function running it with arguments, returning the completed
     process (stdout and stderr as text)."""
-    binary = Path(os.environ.get("DICSTREAM_BIN", REPO / "target" / "release" / "dicstream"))
-    if not binary.exists():
-        pytest.fail(f"{binary} not found: build it (cargo build --release) or set DICSTREAM_BIN")
+    path = binary()
 
     def run(*args, check=True):
-        done = subprocess.run([str(binary), *map(str, args)], capture_output=True, text=True)
+        done = subprocess.run([str(path), *map(str, args)], capture_output=True, text=True)
         if check and done.returncode != 0:
             raise AssertionError(f"dicstream {' '.join(map(str, args))} failed: {done.stderr}")
         return done
@@ -45,3 +43,11 @@ def sample5():
     """DIC Challenge sample 5: its reference and the image shifted by (0.1, 0.1) px."""
     folder = shared_data("dic-challenge/sample5")
     return folder / "Sample5 Reference.tif", folder / "Sample5-001 X0.10 Y0.10 N2 C100 R20.tif"
+
+
+def binary():
+    """The dicstream binary (target/release/dicstream, or DICSTREAM_BIN)."""
+    path = Path(os.environ.get("DICSTREAM_BIN", REPO / "target" / "release" / "dicstream"))
+    if not path.exists():
+        pytest.fail(f"{path} not found: build it (cargo build --release) or set DICSTREAM_BIN")
+    return path

@@ -15,10 +15,8 @@ use anyhow::Context;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
 use wire::frame::pixel_checksum;
-use wire::pubsub::{SliceSubscriber, ValueSubscriber};
-use wire::{
-    services, FieldHeader, FieldNode, FrameHeader, IdentificationReport, Instance, RigState,
-};
+use wire::pubsub::TappedSubscriber;
+use wire::Instance;
 
 /// Options of `dicstream tap`.
 #[derive(Debug, clap::Args)]
@@ -46,41 +44,21 @@ use sample::LastSample;
 use stats::{Kind, Observation, TapStats};
 
 /// The subscriber of the tapped service.
-enum Tap {
-    Frames(SliceSubscriber<u16, FrameHeader>),
-    Fields(SliceSubscriber<FieldNode, FieldHeader>),
-    Rig(ValueSubscriber<RigState>),
-    Identification(ValueSubscriber<IdentificationReport>),
-}
+struct Tap(TappedSubscriber);
 
 impl Tap {
     fn open(node: &Node<ipc::Service>, kind: Kind) -> anyhow::Result<Tap> {
-        Ok(match kind {
-            Kind::Frames => Tap::Frames(SliceSubscriber::create(node, &services::FRAMES)?),
-            Kind::Fields => Tap::Fields(SliceSubscriber::create(node, &services::FIELDS)?),
-            Kind::RigState => Tap::Rig(ValueSubscriber::create(node, &services::RIG_STATE)?),
-            Kind::Identification => {
-                Tap::Identification(ValueSubscriber::create(node, &services::IDENTIFICATION)?)
-            }
-        })
+        let subscriber = TappedSubscriber::open(node, kind.name())
+            .expect("every Kind names a tappable service")?;
+        Ok(Tap(subscriber))
     }
 
     fn listener(&self) -> &Listener<ipc::Service> {
-        match self {
-            Tap::Frames(s) => s.listener(),
-            Tap::Fields(s) => s.listener(),
-            Tap::Rig(s) => s.listener(),
-            Tap::Identification(s) => s.listener(),
-        }
+        self.0.listener()
     }
 
     fn clear_events(&self) {
-        match self {
-            Tap::Frames(s) => s.clear_events(),
-            Tap::Fields(s) => s.clear_events(),
-            Tap::Rig(s) => s.clear_events(),
-            Tap::Identification(s) => s.clear_events(),
-        }
+        self.0.clear_events()
     }
 
     /// Receives queued samples into `stats` until the queue is empty or `budget` are taken.
@@ -97,8 +75,8 @@ impl Tap {
     }
 
     fn receive_one(&self) -> anyhow::Result<Option<Observation>> {
-        Ok(match self {
-            Tap::Frames(s) => s.receive()?.map(|sample| {
+        Ok(match &self.0 {
+            TappedSubscriber::Frames(s) => s.receive()?.map(|sample| {
                 let received_ns = wire::monotonic_ns();
                 let header = *sample.user_header();
                 let pixels = sample.payload();
@@ -116,7 +94,7 @@ impl Tap {
                     },
                 }
             }),
-            Tap::Fields(s) => s.receive()?.map(|sample| {
+            TappedSubscriber::Fields(s) => s.receive()?.map(|sample| {
                 let received_ns = wire::monotonic_ns();
                 let header = *sample.user_header();
                 Observation {
@@ -129,10 +107,11 @@ impl Tap {
                     last: LastSample::Field {
                         header,
                         mean_gradient: sample::mean_gradient(sample.payload()),
+                        nodes_checksum: wire::field::nodes_checksum(sample.payload()),
                     },
                 }
             }),
-            Tap::Rig(s) => s.receive()?.map(|state| Observation {
+            TappedSubscriber::RigState(s) => s.receive()?.map(|state| Observation {
                 id: Some(state.sample_id),
                 sent_ns: state.t_published_ns,
                 received_ns: wire::monotonic_ns(),
@@ -140,7 +119,7 @@ impl Tap {
                 invalid: state.layout_version != wire::LAYOUT_VERSION,
                 last: LastSample::Rig { state },
             }),
-            Tap::Identification(s) => s.receive()?.map(|report| Observation {
+            TappedSubscriber::Identification(s) => s.receive()?.map(|report| Observation {
                 id: Some(report.frame_id),
                 sent_ns: report.t_published_ns,
                 received_ns: wire::monotonic_ns(),
@@ -214,13 +193,8 @@ pub fn run(args: TapArgs) -> anyhow::Result<()> {
 
 /// The service's kind, and the checks of the options no parser makes.
 fn check(args: &TapArgs) -> anyhow::Result<Kind> {
-    let kind = Kind::of(&args.service).ok_or_else(|| {
-        anyhow::anyhow!(
-            "unknown service {:?}: expected one of {}",
-            args.service,
-            services::TAPPABLE.map(|s| s.name).join(", ")
-        )
-    })?;
+    let kind = Kind::of(&args.service)
+        .ok_or_else(|| anyhow::anyhow!(TappedSubscriber::unknown_text(&args.service)))?;
     anyhow::ensure!(
         args.count != Some(0),
         "--count 0: expected at least 1 sample"

@@ -206,9 +206,50 @@ impl FieldHeader {
         self.mesh_cols as usize * self.mesh_rows as usize
     }
 
+    /// Checks the header is one this build understands and consistent with its payload of
+    /// `payload_len` nodes.
+    pub fn validate(&self, payload_len: usize) -> Result<(), FieldError> {
+        crate::layouts::check_version("field", self.layout_version)?;
+        if payload_len != self.node_count() {
+            return Err(FieldError::PayloadLength {
+                frame_id: self.frame_id,
+                mesh_cols: self.mesh_cols,
+                mesh_rows: self.mesh_rows,
+                payload_len,
+            });
+        }
+        Ok(())
+    }
+
     pub fn gauge_of(&self, measure: StrainMeasure) -> GaugeStrain {
         self.gauge[measure as usize]
     }
+}
+
+/// Why a field's header was refused by [`FieldHeader::validate`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum FieldError {
+    #[error(transparent)]
+    LayoutVersion(#[from] crate::layouts::LayoutVersionError),
+    #[error("field of frame {frame_id}: header says {mesh_cols}x{mesh_rows} = {} nodes but the payload holds {payload_len}", *.mesh_cols as usize * *.mesh_rows as usize)]
+    PayloadLength {
+        frame_id: u64,
+        mesh_cols: u32,
+        mesh_rows: u32,
+        payload_len: usize,
+    },
+}
+
+/// The nodes' bytes as they lie in shared memory (a `FieldNode` has no padding: `layouts`).
+pub fn node_bytes(nodes: &[FieldNode]) -> &[u8] {
+    // SAFETY: FieldNode is `repr(C)` of 4-byte numbers without padding (every byte is
+    // initialised), and u8 has no alignment requirement; the length is the slice's size.
+    unsafe { std::slice::from_raw_parts(nodes.as_ptr().cast::<u8>(), std::mem::size_of_val(nodes)) }
+}
+
+/// [`crate::frame::byte_checksum`] of the nodes' bytes: two readers of one field agree on it.
+pub fn nodes_checksum(nodes: &[FieldNode]) -> u64 {
+    crate::frame::byte_checksum(node_bytes(nodes))
 }
 
 impl Default for FieldHeader {
@@ -261,5 +302,33 @@ mod tests {
         }
         assert_eq!(GradientSource::from_code(3), None);
         assert_eq!(GradientSource::NeighbourFit.name(), "neighbour_fit");
+    }
+
+    #[test]
+    fn validate_refuses_another_version_and_length_and_the_checksum_sees_a_value() {
+        let header = FieldHeader {
+            mesh_cols: 3,
+            mesh_rows: 2,
+            ..FieldHeader::default()
+        };
+        assert_eq!(header.validate(6), Ok(()));
+        assert_eq!(
+            header.validate(5).unwrap_err().to_string(),
+            "field of frame 0: header says 3x2 = 6 nodes but the payload holds 5"
+        );
+        let old = FieldHeader {
+            layout_version: 1,
+            ..header
+        };
+        assert!(old
+            .validate(6)
+            .unwrap_err()
+            .to_string()
+            .starts_with("field layout version 1 but this build reads version"));
+        let mut nodes = [FieldNode::default(); 6];
+        assert_eq!(node_bytes(&nodes).len(), 6 * 56);
+        let before = nodes_checksum(&nodes);
+        nodes[4].dv_dy = 1e-6;
+        assert_ne!(nodes_checksum(&nodes), before);
     }
 }

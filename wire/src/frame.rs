@@ -109,11 +109,7 @@ impl FrameHeader {
 
     /// Checks the header is one this build understands and consistent with its payload length.
     pub fn validate(&self, payload_len: usize) -> Result<(), FrameError> {
-        if self.layout_version != crate::LAYOUT_VERSION {
-            return Err(FrameError::LayoutVersion {
-                layout_version: self.layout_version,
-            });
-        }
+        crate::layouts::check_version("frame", self.layout_version)?;
         if payload_len != self.pixel_count() {
             return Err(FrameError::PayloadLength {
                 frame_id: self.frame_id,
@@ -135,11 +131,8 @@ impl FrameHeader {
 /// Why a frame's header was refused by [`FrameHeader::validate`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum FrameError {
-    #[error(
-        "frame layout version {layout_version} but this build reads version {}",
-        crate::LAYOUT_VERSION
-    )]
-    LayoutVersion { layout_version: u32 },
+    #[error(transparent)]
+    LayoutVersion(#[from] crate::layouts::LayoutVersionError),
     #[error("frame {frame_id} header says {width_px}x{height_px} = {} pixels but the payload holds {payload_len}", *.width_px as usize * *.height_px as usize)]
     PayloadLength {
         frame_id: u64,
@@ -268,10 +261,13 @@ mod tests {
             layout_version: 0,
             ..header
         };
-        assert!(matches!(
-            old.validate(8),
-            Err(FrameError::LayoutVersion { layout_version: 0 })
-        ));
+        assert_eq!(
+            old.validate(8).unwrap_err().to_string(),
+            format!(
+                "frame layout version 0 but this build reads version {}",
+                crate::LAYOUT_VERSION
+            )
+        );
         let odd = FrameHeader {
             bit_depth: 9,
             ..header

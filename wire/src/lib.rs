@@ -26,6 +26,7 @@ pub mod identification;
 #[cfg(feature = "ipc")]
 pub mod instance;
 mod layout_check;
+pub mod layouts;
 pub mod names;
 pub mod owner;
 #[cfg(feature = "ipc")]

@@ -16,6 +16,9 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 mod connect;
+mod tapped;
+
+pub use tapped::TappedSubscriber;
 
 type Ipc = ipc::Service;
 

@@ -61,11 +61,8 @@ pub struct SpecimenParts<'a> {
 /// Why a sample cannot be read.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum SpecimenError {
-    #[error(
-        "specimen layout version {layout_version} but this build reads version {}",
-        crate::LAYOUT_VERSION
-    )]
-    LayoutVersion { layout_version: u32 },
+    #[error(transparent)]
+    LayoutVersion(#[from] crate::layouts::LayoutVersionError),
     #[error("specimen solve {solve_id} declares {grips} grips, at most {MAX_SPECIMEN_GRIPS}")]
     Grips { solve_id: u64, grips: u32 },
     #[error("specimen solve {solve_id}: {nodes} nodes, {elements} elements and {grips} grips need {expected} values, the payload holds {found}")]
@@ -104,11 +101,7 @@ impl SpecimenHeader {
     /// finite and every element names nodes of the mesh.
     pub fn split<'a>(&self, payload: &'a [f64]) -> Result<SpecimenParts<'a>, SpecimenError> {
         let solve_id = self.solve_id;
-        if self.layout_version != crate::LAYOUT_VERSION {
-            return Err(SpecimenError::LayoutVersion {
-                layout_version: self.layout_version,
-            });
-        }
+        crate::layouts::check_version("specimen", self.layout_version)?;
         if self.grips as usize > MAX_SPECIMEN_GRIPS {
             return Err(SpecimenError::Grips {
                 solve_id,

@@ -17,6 +17,9 @@ pub(super) enum LastSample {
         header: FieldHeader,
         /// Mean displacement gradient of the `ok` nodes: du/dx, du/dy, dv/dx, dv/dy.
         mean_gradient: [f64; 4],
+        /// `wire::field::nodes_checksum` of its nodes: another reader of the field (the Python
+        /// package) proves it read the same node values.
+        nodes_checksum: u64,
     },
     Rig {
         state: RigState,
@@ -93,6 +96,7 @@ impl LastSample {
             LastSample::Field {
                 header,
                 mean_gradient: d,
+                ..
             } => {
                 let g = header.gauge_of(StrainMeasure::Log);
                 format!(
@@ -179,6 +183,7 @@ impl LastSample {
             LastSample::Field {
                 header,
                 mean_gradient: d,
+                nodes_checksum,
             } => {
                 let g = header.gauge_of(StrainMeasure::Log);
                 json!({
@@ -192,6 +197,8 @@ impl LastSample {
                     "correlator_frames_dropped": header.frames_dropped,
                     "gradient_source": gradient_source(header),
                     "mean_gradient": {"du_dx": d[0], "du_dy": d[1], "dv_dx": d[2], "dv_dy": d[3]},
+                    // A string: a u64 beyond 2^53 does not survive JSON readers as a number.
+                    "nodes_checksum": nodes_checksum.to_string(),
                 })
             }
             LastSample::Rig { state } => json!({

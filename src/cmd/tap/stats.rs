@@ -379,7 +379,8 @@ mod tests {
             status: wire::NodeStatus::LowZncc as u32,
             ..wire::FieldNode::default()
         };
-        let mean_gradient = super::super::sample::mean_gradient(&[ok(0.1), ok(0.3), refused]);
+        let nodes = [ok(0.1), ok(0.3), refused];
+        let mean_gradient = super::super::sample::mean_gradient(&nodes);
         let expected = [0.2, 0.0, 0.0, -0.5];
         assert!(
             mean_gradient
@@ -391,6 +392,7 @@ mod tests {
         let last = LastSample::Field {
             header,
             mean_gradient,
+            nodes_checksum: wire::field::nodes_checksum(&nodes),
         };
         let line = last.line();
         assert!(
@@ -402,6 +404,10 @@ mod tests {
         let json = last.json();
         assert_eq!(json["gradient_source"], "icgn1");
         assert_eq!(json["mean_gradient"]["dv_dy"], -0.5);
+        assert_eq!(
+            json["nodes_checksum"],
+            wire::field::nodes_checksum(&nodes).to_string()
+        );
     }
 
     #[test]
