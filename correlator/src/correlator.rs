@@ -10,6 +10,7 @@ mod growth;
 mod guess;
 mod icgn_stage;
 mod neighbour_check;
+mod order_stage;
 mod parts;
 mod reanchor;
 mod renewal;
@@ -22,7 +23,7 @@ use crate::interpolate::{identity_plus, Mat2};
 use crate::keypoints::KeypointMatcher;
 use crate::mesh::Mesh;
 use crate::pool::{Pool, SharedSlice};
-use crate::settings::{CorrelatorSettings, GuessMode, Roi, SettingsError};
+use crate::settings::{CorrelatorSettings, GuessMode, Method, Roi, SettingsError};
 use crate::strain::AffineSums;
 use crate::zoi::{
     spectrum_len, GradientSensitivity, Image, SubpixelIterations, TimeSplit, ZoiResult,
@@ -256,6 +257,11 @@ impl Correlator {
         let fft_px = settings.fft_zoi_px();
         let n2 = spectrum_len(fft_px);
         let icgn = settings.method.is_icgn();
+        let adaptive_nodes = if settings.method == Method::Icgn {
+            nodes
+        } else {
+            0
+        };
         let subset_values = if icgn {
             crate::icgn::subset::PLANES * settings.zoi_px * settings.zoi_px
         } else {
@@ -267,6 +273,7 @@ impl Correlator {
             ny: mesh.ny,
             nodes: vec![Node::default(); nodes],
             gradients: vec![[[0.0; 2]; 2]; nodes],
+            second_order: vec![false; nodes],
             gauges: Vec::with_capacity(settings.gauges.len()),
             ..Field::default()
         };
@@ -299,6 +306,8 @@ impl Correlator {
                 subset_planes: vec![0.0; nodes * subset_values],
                 subset_stats: vec![SubsetStats::default(); if icgn { nodes } else { 0 }],
                 subset_states: vec![SubsetState::default(); if icgn { nodes } else { 0 }],
+                second_order_stats: vec![SubsetStats::default(); adaptive_nodes],
+                second_order_states: vec![SubsetState::default(); adaptive_nodes],
                 coefficients: icgn.then(|| Coefficients::new(width_px, height_px)),
                 keypoints: None,
                 global_stale: true,
@@ -637,6 +646,7 @@ impl Correlator {
         if icgn {
             self.refine_icgn(image);
         }
+        self.refine_second_order(image);
         self.assemble(image);
         self.decide_renewal();
         Ok(&self.field)
@@ -732,7 +742,6 @@ fn fft_iterations(settings: &CorrelatorSettings) -> SubpixelIterations {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::settings::Method;
     use crate::zoi::{ICGN_GUESS_ITERATIONS, ICGN_GUESS_NOT_CONVERGED_STEP_PX};
 
     /// `correli` keeps the paper's iterations; the IC-GN methods' guess stops at its own cap

@@ -54,12 +54,20 @@ fn steady_state_allocates_nothing() {
         .into_iter()
         .map(|(r, g)| (Method::Correli, 32, r, g))
         .chain(modes.into_iter().map(|(r, g)| (Method::Icgn1, 33, r, g)))
-        .chain([(
-            Method::Icgn2,
-            24,
-            ReferenceMode::AUTO_DEFAULT,
-            GuessMode::Predict,
-        )]);
+        .chain([
+            (
+                Method::Icgn2,
+                24,
+                ReferenceMode::AUTO_DEFAULT,
+                GuessMode::Predict,
+            ),
+            (
+                Method::Icgn,
+                33,
+                ReferenceMode::AUTO_DEFAULT,
+                GuessMode::Predict,
+            ),
+        ]);
     for (method, zoi_px, reference, guess) in cases {
         let settings = CorrelatorSettings {
             method,
