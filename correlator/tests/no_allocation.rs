@@ -5,6 +5,7 @@ mod common;
 
 use common::{render, translation};
 use correlator::{Correlator, CorrelatorSettings, GuessMode, Method, ReferenceMode};
+use producer::motion::{Bulge, Motion};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -93,4 +94,42 @@ fn steady_state_allocates_nothing() {
             "{method:?} {reference:?} {guess:?}: {allocated} allocations in 3 frames"
         );
     }
+    second_order_re_runs_allocate_nothing();
+}
+
+/// Method `icgn` where it re-runs nodes at second order (a bulge: a curved field): no
+/// allocation either, the second-order constants of a subset derived on its first re-run.
+/// Called from the test above: the allocation counter is global, so the cases run in turn.
+fn second_order_re_runs_allocate_nothing() {
+    let (w, h) = (192, 192);
+    let frames: Vec<Vec<u16>> = (0..5)
+        .map(|k| {
+            let bulge = Bulge {
+                strain: 0.02 * k as f64,
+                width_px: 30.0,
+                centre_px: [96.0, 96.0],
+            };
+            render(w, h, 8.0, Motion::Bulge(bulge), 0.01, k as u64)
+        })
+        .collect();
+    let settings = CorrelatorSettings {
+        method: Method::Icgn,
+        zoi_px: 33,
+        step_px: 8,
+        reference: ReferenceMode::Fixed,
+        guess: GuessMode::Predict,
+        threads: 2,
+        ..Default::default()
+    };
+    let mut correlator = Correlator::new(settings, w, h).unwrap();
+    correlator.set_reference(&frames[0]).unwrap();
+    correlator.correlate(&frames[1]).unwrap();
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let mut runs = 0;
+    for frame in &frames[2..] {
+        runs += correlator.correlate(frame).unwrap().second_order_runs;
+    }
+    let allocated = ALLOCATIONS.load(Ordering::SeqCst) - before;
+    assert!(runs > 0, "the bulge re-ran no node at second order");
+    assert_eq!(allocated, 0, "{allocated} allocations in 3 frames");
 }
