@@ -82,8 +82,21 @@ struct Entry {
 fn result_gradient(
     results: &[ZoiResult],
     ref_nodes: &[RefNode],
+    mesh: (usize, usize),
+    k: usize,
+) -> Option<nalgebra::Matrix2<f64>> {
+    neighbourhood_gradient(results, ref_nodes, mesh, k, |r| (r.u_px, r.v_px))
+}
+
+/// Least-squares gradient, over the `ok` results of the 3x3 nodes around k (ZOI centres of an
+/// nx x ny mesh), of the pair of values `value` reads from each result: [[∂a/∂x, ∂a/∂y],
+/// [∂b/∂x, ∂b/∂y]]; None with fewer than 3 such nodes or collinear ones.
+fn neighbourhood_gradient(
+    results: &[ZoiResult],
+    ref_nodes: &[RefNode],
     (nx, ny): (usize, usize),
     k: usize,
+    value: impl Fn(&ZoiResult) -> (f64, f64),
 ) -> Option<nalgebra::Matrix2<f64>> {
     let (i, j) = (k % nx, k / nx);
     let mut sums = AffineSums::default();
@@ -94,12 +107,8 @@ fn result_gradient(
                 continue;
             }
             let (a, b) = (ref_nodes[m].top_left, ref_nodes[k].top_left);
-            sums.add(
-                a.0 as f64 - b.0 as f64,
-                a.1 as f64 - b.1 as f64,
-                results[m].u_px,
-                results[m].v_px,
-            );
+            let (va, vb) = value(&results[m]);
+            sums.add(a.0 as f64 - b.0 as f64, a.1 as f64 - b.1 as f64, va, vb);
         }
     }
     sums.gradient()

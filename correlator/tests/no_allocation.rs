@@ -79,15 +79,7 @@ fn steady_state_allocates_nothing() {
             threads: 2,
             ..Default::default()
         };
-        let mut correlator = Correlator::new(settings, w, h).unwrap();
-        correlator.set_reference(&frames[0]).unwrap();
-        correlator.correlate(&frames[1]).unwrap();
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
-        let mut valid = 0;
-        for frame in &frames[2..] {
-            valid += correlator.correlate(frame).unwrap().valid;
-        }
-        let allocated = ALLOCATIONS.load(Ordering::SeqCst) - before;
+        let (allocated, valid, _) = steady_frames(settings, &frames);
         assert!(valid > 0);
         assert_eq!(
             allocated, 0,
@@ -121,15 +113,24 @@ fn second_order_re_runs_allocate_nothing() {
         threads: 2,
         ..Default::default()
     };
-    let mut correlator = Correlator::new(settings, w, h).unwrap();
-    correlator.set_reference(&frames[0]).unwrap();
-    correlator.correlate(&frames[1]).unwrap();
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
-    let mut runs = 0;
-    for frame in &frames[2..] {
-        runs += correlator.correlate(frame).unwrap().second_order_runs;
-    }
-    let allocated = ALLOCATIONS.load(Ordering::SeqCst) - before;
+    let (allocated, _, runs) = steady_frames(settings, &frames);
     assert!(runs > 0, "the bulge re-ran no node at second order");
     assert_eq!(allocated, 0, "{allocated} allocations in 3 frames");
+}
+
+/// Correlates frames 2.. of `frames` (192² px) after the reference (frame 0) and a warm-up
+/// frame (1): the allocations meanwhile, and the sums of those fields' valid nodes and nodes
+/// re-run at second order.
+fn steady_frames(settings: CorrelatorSettings, frames: &[Vec<u16>]) -> (usize, usize, usize) {
+    let mut correlator = Correlator::new(settings, 192, 192).unwrap();
+    correlator.set_reference(&frames[0]).unwrap();
+    correlator.correlate(&frames[1]).unwrap();
+    let (mut valid, mut runs) = (0, 0);
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    for frame in &frames[2..] {
+        let field = correlator.correlate(frame).unwrap();
+        valid += field.valid;
+        runs += field.second_order_runs;
+    }
+    (ALLOCATIONS.load(Ordering::SeqCst) - before, valid, runs)
 }

@@ -151,6 +151,12 @@ impl Correlator {
         let states = SharedSlice::new(&mut self.reference.subset_states);
         let results = SharedSlice::new(&mut self.frame.results);
         let zncc = SharedSlice::new(&mut self.frame.zncc);
+        let check = FinalCheck {
+            reference,
+            n,
+            image,
+            min_zncc,
+        };
         self.pool.run(entries.len(), &|engine, i| {
             let entry = entries[i];
             let k = entry.node;
@@ -201,14 +207,7 @@ impl Correlator {
             let guess = Warp::affine(entry.guess_px, entry.gradient);
             let outcome = icgn::solve(&subset, order, coefficients, guess, max_iterations);
             timer.lap(&mut engine.split.iterations_ns);
-            let check = FinalCheck {
-                reference,
-                top_left,
-                n,
-                image,
-                min_zncc,
-            };
-            let (result, score) = check.apply(&outcome, entry.gradient);
+            let (result, score) = check.apply(top_left, &outcome, entry.gradient);
             timer.lap(&mut engine.split.check_ns);
             // SAFETY: item i touches only node entries[i].node's slots; nodes are distinct.
             unsafe {
@@ -223,16 +222,21 @@ impl Correlator {
 #[derive(Clone, Copy)]
 pub(super) struct FinalCheck<'a> {
     pub reference: Image<'a>,
-    pub top_left: (usize, usize),
     pub n: usize,
     pub image: Image<'a>,
     pub min_zncc: f64,
 }
 
 impl FinalCheck<'_> {
-    /// The node's result from `outcome` and its score: an `ok` outcome is `low_zncc` when both
-    /// its own ZNCC and the check through `guess_gradient` are below `min_zncc`.
-    pub fn apply(&self, outcome: &icgn::Outcome, guess_gradient: Mat2) -> (ZoiResult, f64) {
+    /// The result of the node whose reference subset is at `top_left` from `outcome`, and its
+    /// score: an `ok` outcome is `low_zncc` when both its own ZNCC and the check through
+    /// `guess_gradient` are below `min_zncc`.
+    pub fn apply(
+        &self,
+        top_left: (usize, usize),
+        outcome: &icgn::Outcome,
+        guess_gradient: Mat2,
+    ) -> (ZoiResult, f64) {
         let mut result = zoi_result(outcome);
         let (u, v) = (result.u_px, result.v_px);
         let mut score = 0.0;
@@ -247,7 +251,7 @@ impl FinalCheck<'_> {
             score = outcome.zncc;
             if score < self.min_zncc {
                 let check =
-                    |g| verify::zncc(self.reference, self.top_left, self.n, self.image, (u, v), g);
+                    |g| verify::zncc(self.reference, top_left, self.n, self.image, (u, v), g);
                 score = score.max(check(guess_gradient).unwrap_or(0.0));
             }
             if score < self.min_zncc {

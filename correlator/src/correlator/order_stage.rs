@@ -10,7 +10,7 @@
 
 use super::icgn_stage::FinalCheck;
 use super::parts::SubsetState;
-use super::{median, Correlator, Entry, RefNode};
+use super::{median, neighbourhood_gradient, Correlator, Entry, RefNode};
 use crate::field::NodeStatus;
 use crate::icgn::order_choice::{self, Curvature};
 use crate::icgn::shape::{Order, Warp};
@@ -18,7 +18,6 @@ use crate::icgn::subset::{self, PLANES};
 use crate::icgn::{self, Subset};
 use crate::pool::SharedSlice;
 use crate::settings::Method;
-use crate::strain::AffineSums;
 use crate::zoi::{Image, Timer, ZoiResult};
 
 impl Correlator {
@@ -79,6 +78,12 @@ impl Correlator {
         let results = SharedSlice::new(&mut self.frame.results);
         let zncc = SharedSlice::new(&mut self.frame.zncc);
         let flags = SharedSlice::new(&mut self.field.second_order);
+        let check = FinalCheck {
+            reference,
+            n,
+            image,
+            min_zncc,
+        };
         self.pool.run(entries.len(), &|engine, i| {
             let entry = entries[i];
             let k = entry.node;
@@ -118,14 +123,7 @@ impl Correlator {
             if outcome.status != NodeStatus::Ok || outcome.zncc < first.score {
                 return;
             }
-            let check = FinalCheck {
-                reference,
-                top_left,
-                n,
-                image,
-                min_zncc,
-            };
-            let (result, score) = check.apply(&outcome, entry.gradient);
+            let (result, score) = check.apply(top_left, &outcome, entry.gradient);
             timer.lap(&mut engine.split.check_ns);
             if result.status == NodeStatus::Ok {
                 // SAFETY: as above.
@@ -147,25 +145,14 @@ impl Correlator {
 fn curvature(
     results: &[ZoiResult],
     ref_nodes: &[RefNode],
-    (nx, ny): (usize, usize),
+    mesh: (usize, usize),
     k: usize,
 ) -> Option<Curvature> {
-    let (i, j) = (k % nx, k / nx);
-    let (mut along_x, mut along_y) = (AffineSums::default(), AffineSums::default());
-    for jj in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
-        for ii in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
-            let m = jj * nx + ii;
-            if results[m].status != NodeStatus::Ok {
-                continue;
-            }
-            let (a, b) = (ref_nodes[m].top_left, ref_nodes[k].top_left);
-            let (dx, dy) = (a.0 as f64 - b.0 as f64, a.1 as f64 - b.1 as f64);
-            let g = results[m].warp_gradient;
-            along_x.add(dx, dy, g[0][0], g[1][0]);
-            along_y.add(dx, dy, g[0][1], g[1][1]);
-        }
-    }
-    let (of_x, of_y) = (along_x.gradient()?, along_y.gradient()?);
+    let fit = |value: fn(&ZoiResult) -> (f64, f64)| {
+        neighbourhood_gradient(results, ref_nodes, mesh, k, value)
+    };
+    let of_x = fit(|r| (r.warp_gradient[0][0], r.warp_gradient[1][0]))?;
+    let of_y = fit(|r| (r.warp_gradient[0][1], r.warp_gradient[1][1]))?;
     Some(Curvature {
         u_xx: of_x[(0, 0)],
         v_xx: of_x[(1, 0)],
