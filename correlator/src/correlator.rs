@@ -10,6 +10,7 @@ mod growth;
 mod guess;
 mod icgn_stage;
 mod neighbour_check;
+mod order_stage;
 mod parts;
 mod reanchor;
 mod renewal;
@@ -22,7 +23,7 @@ use crate::interpolate::{identity_plus, Mat2};
 use crate::keypoints::KeypointMatcher;
 use crate::mesh::Mesh;
 use crate::pool::{Pool, SharedSlice};
-use crate::settings::{CorrelatorSettings, GuessMode, Roi, SettingsError};
+use crate::settings::{CorrelatorSettings, GuessMode, Method, Roi, SettingsError};
 use crate::strain::AffineSums;
 use crate::zoi::{
     spectrum_len, GradientSensitivity, Image, SubpixelIterations, TimeSplit, ZoiResult,
@@ -81,8 +82,21 @@ struct Entry {
 fn result_gradient(
     results: &[ZoiResult],
     ref_nodes: &[RefNode],
+    mesh: (usize, usize),
+    k: usize,
+) -> Option<nalgebra::Matrix2<f64>> {
+    neighbourhood_gradient(results, ref_nodes, mesh, k, |r| (r.u_px, r.v_px))
+}
+
+/// Least-squares gradient, over the `ok` results of the 3x3 nodes around k (ZOI centres of an
+/// nx x ny mesh), of the pair of values `value` reads from each result: [[∂a/∂x, ∂a/∂y],
+/// [∂b/∂x, ∂b/∂y]]; None with fewer than 3 such nodes or collinear ones.
+fn neighbourhood_gradient(
+    results: &[ZoiResult],
+    ref_nodes: &[RefNode],
     (nx, ny): (usize, usize),
     k: usize,
+    value: impl Fn(&ZoiResult) -> (f64, f64),
 ) -> Option<nalgebra::Matrix2<f64>> {
     let (i, j) = (k % nx, k / nx);
     let mut sums = AffineSums::default();
@@ -93,12 +107,8 @@ fn result_gradient(
                 continue;
             }
             let (a, b) = (ref_nodes[m].top_left, ref_nodes[k].top_left);
-            sums.add(
-                a.0 as f64 - b.0 as f64,
-                a.1 as f64 - b.1 as f64,
-                results[m].u_px,
-                results[m].v_px,
-            );
+            let (va, vb) = value(&results[m]);
+            sums.add(a.0 as f64 - b.0 as f64, a.1 as f64 - b.1 as f64, va, vb);
         }
     }
     sums.gradient()
@@ -256,6 +266,11 @@ impl Correlator {
         let fft_px = settings.fft_zoi_px();
         let n2 = spectrum_len(fft_px);
         let icgn = settings.method.is_icgn();
+        let adaptive_nodes = if settings.method == Method::Icgn {
+            nodes
+        } else {
+            0
+        };
         let subset_values = if icgn {
             crate::icgn::subset::PLANES * settings.zoi_px * settings.zoi_px
         } else {
@@ -267,6 +282,7 @@ impl Correlator {
             ny: mesh.ny,
             nodes: vec![Node::default(); nodes],
             gradients: vec![[[0.0; 2]; 2]; nodes],
+            second_order: vec![false; nodes],
             gauges: Vec::with_capacity(settings.gauges.len()),
             ..Field::default()
         };
@@ -299,6 +315,8 @@ impl Correlator {
                 subset_planes: vec![0.0; nodes * subset_values],
                 subset_stats: vec![SubsetStats::default(); if icgn { nodes } else { 0 }],
                 subset_states: vec![SubsetState::default(); if icgn { nodes } else { 0 }],
+                second_order_stats: vec![SubsetStats::default(); adaptive_nodes],
+                second_order_states: vec![SubsetState::default(); adaptive_nodes],
                 coefficients: icgn.then(|| Coefficients::new(width_px, height_px)),
                 keypoints: None,
                 global_stale: true,
@@ -637,6 +655,7 @@ impl Correlator {
         if icgn {
             self.refine_icgn(image);
         }
+        self.refine_second_order(image);
         self.assemble(image);
         self.decide_renewal();
         Ok(&self.field)
@@ -732,7 +751,6 @@ fn fft_iterations(settings: &CorrelatorSettings) -> SubpixelIterations {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::settings::Method;
     use crate::zoi::{ICGN_GUESS_ITERATIONS, ICGN_GUESS_NOT_CONVERGED_STEP_PX};
 
     /// `correli` keeps the paper's iterations; the IC-GN methods' guess stops at its own cap

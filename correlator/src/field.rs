@@ -87,9 +87,21 @@ pub struct Field {
     /// least-squares gradient of the neighbouring nodes for `correli`; zero where the node is
     /// not `ok`. A gauge is always the least-squares fit over its valid nodes' displacements.
     pub gradients: Vec<[[f64; 2]; 2]>,
+    /// Method `icgn`: the nodes whose result is a second-order IC-GN's (the others' are
+    /// first-order), see `correlator/order_stage.rs`; all false with the other methods.
+    pub second_order: Vec<bool>,
+    /// Method `icgn`: the nodes re-run at second order in this frame (kept or not).
+    pub second_order_runs: usize,
 }
 
 impl Field {
+    /// The `ok` nodes whose result is second order (method `icgn`).
+    pub fn second_order_nodes(&self) -> usize {
+        (self.nodes.iter().zip(&self.second_order))
+            .filter(|(node, &second)| second && node.status == NodeStatus::Ok)
+            .count()
+    }
+
     pub fn node(&self, i: usize, j: usize) -> &Node {
         &self.nodes[j * self.nx + i]
     }

@@ -719,11 +719,13 @@ struct FieldTimes {
 }
 
 /// IC-GN's own gradient with `icgn1`/`icgn2`, the neighbours' least-squares fit with `correli`
-/// (`Field::gradients`).
+/// (`Field::gradients`). `icgn` reports `Icgn1` (the wire's codes are fixed): its gradients
+/// are each node's own shape function's too, the first-order part of a second-order one on
+/// the nodes it re-ran at second order (`Field::second_order`).
 fn wire_gradient_source(method: Method) -> wire::GradientSource {
     match method {
         Method::Correli => wire::GradientSource::NeighbourFit,
-        Method::Icgn1 => wire::GradientSource::Icgn1,
+        Method::Icgn1 | Method::Icgn => wire::GradientSource::Icgn1,
         Method::Icgn2 => wire::GradientSource::Icgn2,
     }
 }

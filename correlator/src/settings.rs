@@ -154,9 +154,16 @@ pub enum Method {
     Icgn1,
     /// The same with a second-order shape function (12 parameters).
     Icgn2,
+    /// IC-GN with the shape function's order chosen per node: first order everywhere, then
+    /// second order, from the first-order solution, on the nodes whose neighbours' first-order
+    /// gradients show a curvature that biases the first-order displacement by more than the
+    /// second order's extra noise (`icgn::order_choice`); the second-order result is kept when
+    /// it converged with a ZNCC at least the first's. As accurate as `Icgn2` on steep fields,
+    /// as quiet as `Icgn1` on smooth ones.
+    Icgn,
 }
 
-wire::named!(Method, "method", { Correli => "correli", Icgn1 => "icgn1", Icgn2 => "icgn2" });
+wire::named!(Method, "method", { Correli => "correli", Icgn1 => "icgn1", Icgn2 => "icgn2", Icgn => "icgn" });
 
 impl Method {
     pub fn is_icgn(self) -> bool {

@@ -17,7 +17,7 @@
 //! | 72 | 16 | auto thresholds: deformation (px), mean score (f64 each; 0 unless auto) |
 //! | 88 | 8 | reference frame id (u64; `u64::MAX` for an image file) |
 //! | 96 | 8 | origin frame id: the frame the mesh is defined in (u64; `u64::MAX`: an image file) |
-//! | 104 | 8 | sequence id (u32), then the sub-pixel method (u32: 0 correli, 1 icgn1, 2 icgn2) |
+//! | 104 | 8 | sequence id (u32), then the sub-pixel method (u32: 0 correli, 1 icgn1, 2 icgn2, 3 icgn) |
 //! | 112 | 2 w h | reference pixels, row-major u16 |
 //! | … | 16 nx ny | per-node base displacement u, v (px, f64 each): total displacement when the reference was taken |
 //! | … | 8 | checksum (u64) of every byte before it |
@@ -116,7 +116,7 @@ struct Layout {
     max_iterations: u32,
     strain_window_nodes: u32,
     auto: [f64; 2],
-    /// 0 correli, 1 icgn1, 2 icgn2.
+    /// 0 correli, 1 icgn1, 2 icgn2, 3 icgn.
     method: u32,
 }
 
@@ -160,6 +160,7 @@ impl Layout {
                 Method::Correli => 0,
                 Method::Icgn1 => 1,
                 Method::Icgn2 => 2,
+                Method::Icgn => 3,
             },
         }
     }

@@ -24,6 +24,8 @@ pub fn frame_summary(field: &Field, gauges: &[Gauge]) -> Value {
         "statuses": status_json(field),
         "global_px": field.global_px.map(|(u, v)| [u, v]),
         "keypoints_used": field.keypoints_used,
+        "second_order_runs": field.second_order_runs,
+        "second_order_nodes": field.second_order_nodes(),
     })
 }
 

@@ -17,7 +17,7 @@ SAMPLE5 = Path(__file__).resolve().parents[2] / "testdata" / "dic-challenge" / "
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("images", nargs="*", type=Path, help="reference and deformed image files")
-parser.add_argument("--method", default="correli", help="correli, icgn1 or icgn2")
+parser.add_argument("--method", default="correli", help="correli, icgn1, icgn2 or icgn")
 parser.add_argument("--out", type=Path, default=Path("u.png"), help="the figure of u (PNG)")
 args = parser.parse_args()
 if args.images and len(args.images) != 2:

@@ -56,7 +56,7 @@ def correlate(reference, deformed, **settings):
     """The field between ``reference`` and ``deformed`` (2-D numpy arrays of one shape).
 
     Keyword settings, with the names and defaults of ``dicstream correlate`` (None: the
-    default): ``method`` ("correli", "icgn1", "icgn2"), ``zoi`` and ``step`` (px), ``roi``
+    default): ``method`` ("correli", "icgn1", "icgn2", "icgn"), ``zoi`` and ``step`` (px), ``roi``
     (None for the margin, "centred-pow2", "x,y,w,h" or a tuple), ``polygons`` (a list of
     "x,y x,y x,y ..."), ``mask`` (a path to a mask image), ``strain``, ``guess``,
     ``min_zncc``, ``gradient_correction``, ``threads``, ``max_iterations``, ``gauges`` (a list

@@ -22,7 +22,7 @@ pub(crate) fn value_error(e: impl std::fmt::Display) -> PyErr {
 }
 
 /// A named choice (`method`, `strain`, `guess`) as the CLI reads it: `method: method "x":
-/// expected correli, icgn1 or icgn2`.
+/// expected correli, icgn1, icgn2 or icgn`.
 fn named<T: Named>(flag: &str, text: Option<&str>, default: T) -> PyResult<T> {
     text.map_or(Ok(default), |t| {
         T::parse_name(t).map_err(|e| value_error(format!("{flag}: {e}")))

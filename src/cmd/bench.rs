@@ -36,7 +36,7 @@ pub struct CorrelateBenchArgs {
     /// Image height in px.
     #[arg(long, default_value_t = 1024)]
     pub height: usize,
-    /// Sub-pixel method: icgn1, icgn2 or correli.
+    /// Sub-pixel method: icgn1, icgn2, icgn or correli.
     #[arg(long, value_parser = named::<Method>(), default_value_t = Method::default())]
     pub method: Method,
     /// ZOI (subset) side in px (a power of two for correli).

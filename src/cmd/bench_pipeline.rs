@@ -14,7 +14,7 @@ pub struct PipelineBenchArgs {
     pub width: u32,
     #[arg(long, default_value_t = 1024)]
     pub height: u32,
-    /// Sub-pixel method (with --zoi 33 for icgn1 or icgn2).
+    /// Sub-pixel method (with --zoi 33 for icgn1, icgn2 or icgn).
     #[arg(long, value_parser = named::<Method>(), default_value_t = Method::default())]
     pub method: Method,
     /// ZOI side and step, px.

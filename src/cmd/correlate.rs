@@ -33,10 +33,11 @@ pub struct CorrelationArgs {
     /// iterations; the default: several times faster, robust on low-contrast noisy images);
     /// icgn1: inverse compositional Gauss-Newton, first-order (affine) shape function, ZNSSD,
     /// quintic B-spline (about 1.5 times less noise, any subset size from 9 px); icgn2: the same
-    /// with a second-order shape function. See the README.
+    /// with a second-order shape function; icgn: the order chosen per node (second order where
+    /// the field's curvature biases the first, icgn1 elsewhere). See the README.
     #[arg(long, value_parser = named::<Method>(), default_value_t = defaults().method)]
     pub method: Method,
-    /// ZOI (subset) side in px: any size from 9 px for icgn1/icgn2 (odd or even), a power of
+    /// ZOI (subset) side in px: any size from 9 px for the IC-GN methods (odd or even), a power of
     /// two (2^s) for correli.
     #[arg(long, default_value_t = defaults().zoi_px)]
     pub zoi: usize,

@@ -16,6 +16,7 @@ use crate::icgn::bspline::Coefficients;
 use crate::icgn::shape::{Order, Warp};
 use crate::icgn::subset::{self, PLANES};
 use crate::icgn::{self, Subset};
+use crate::interpolate::Mat2;
 use crate::pool::SharedSlice;
 use crate::settings::{GuessMode, Method};
 use crate::verify;
@@ -25,7 +26,8 @@ impl Correlator {
     fn order(&self) -> Order {
         match self.settings.method {
             Method::Icgn2 => Order::Second,
-            Method::Icgn1 | Method::Correli => Order::First,
+            // `icgn` starts at first order; `order_stage.rs` re-runs some nodes at second.
+            Method::Icgn1 | Method::Icgn | Method::Correli => Order::First,
         }
     }
 
@@ -80,6 +82,7 @@ impl Correlator {
             .data
             .copy_from_slice(&frame.data);
         self.reference.subset_states.fill(SubsetState::Unprepared);
+        (self.reference.second_order_states).fill(SubsetState::Unprepared);
     }
 
     /// IC-GN of node k's subset in the origin frame against the frame whose coefficients the
@@ -148,6 +151,12 @@ impl Correlator {
         let states = SharedSlice::new(&mut self.reference.subset_states);
         let results = SharedSlice::new(&mut self.frame.results);
         let zncc = SharedSlice::new(&mut self.frame.zncc);
+        let check = FinalCheck {
+            reference,
+            n,
+            image,
+            min_zncc,
+        };
         self.pool.run(entries.len(), &|engine, i| {
             let entry = entries[i];
             let k = entry.node;
@@ -198,26 +207,7 @@ impl Correlator {
             let guess = Warp::affine(entry.guess_px, entry.gradient);
             let outcome = icgn::solve(&subset, order, coefficients, guess, max_iterations);
             timer.lap(&mut engine.split.iterations_ns);
-            let mut result = zoi_result(&outcome);
-            let (u, v) = (result.u_px, result.v_px);
-            let mut score = 0.0;
-            if result.status == NodeStatus::Ok {
-                // IC-GN's own ZNCC of the whole subset (B-spline samples) through the warp of
-                // its last evaluation: an `ok` subset stopped because the update from that
-                // warp to the final one moves no subset point by more than
-                // `icgn::CONVERGED_PX`, so it is the subset's ZNCC through the final warp
-                // within what a 0.001 px move changes. Below `min_zncc`, the check through the
-                // guess's gradient (smoother than a noisy subset's own, as the check of the
-                // other results falls back to).
-                score = outcome.zncc;
-                if score < min_zncc {
-                    let check = |g| verify::zncc(reference, top_left, n, image, (u, v), g);
-                    score = score.max(check(entry.gradient).unwrap_or(0.0));
-                }
-                if score < min_zncc {
-                    result.status = NodeStatus::LowZncc;
-                }
-            }
+            let (result, score) = check.apply(top_left, &outcome, entry.gradient);
             timer.lap(&mut engine.split.check_ns);
             // SAFETY: item i touches only node entries[i].node's slots; nodes are distinct.
             unsafe {
@@ -225,6 +215,50 @@ impl Correlator {
                 zncc.write(k, score);
             }
         });
+    }
+}
+
+/// The final check of an IC-GN result (see `refine_icgn`).
+#[derive(Clone, Copy)]
+pub(super) struct FinalCheck<'a> {
+    pub reference: Image<'a>,
+    pub n: usize,
+    pub image: Image<'a>,
+    pub min_zncc: f64,
+}
+
+impl FinalCheck<'_> {
+    /// The result of the node whose reference subset is at `top_left` from `outcome`, and its
+    /// score: an `ok` outcome is `low_zncc` when both its own ZNCC and the check through
+    /// `guess_gradient` are below `min_zncc`.
+    pub fn apply(
+        &self,
+        top_left: (usize, usize),
+        outcome: &icgn::Outcome,
+        guess_gradient: Mat2,
+    ) -> (ZoiResult, f64) {
+        let mut result = zoi_result(outcome);
+        let (u, v) = (result.u_px, result.v_px);
+        let mut score = 0.0;
+        if result.status == NodeStatus::Ok {
+            // IC-GN's own ZNCC of the whole subset (B-spline samples) through the warp of
+            // its last evaluation: an `ok` subset stopped because the update from that
+            // warp to the final one moves no subset point by more than
+            // `icgn::CONVERGED_PX`, so it is the subset's ZNCC through the final warp
+            // within what a 0.001 px move changes. Below `min_zncc`, the check through the
+            // guess's gradient (smoother than a noisy subset's own, as the check of the
+            // other results falls back to).
+            score = outcome.zncc;
+            if score < self.min_zncc {
+                let check =
+                    |g| verify::zncc(self.reference, top_left, self.n, self.image, (u, v), g);
+                score = score.max(check(guess_gradient).unwrap_or(0.0));
+            }
+            if score < self.min_zncc {
+                result.status = NodeStatus::LowZncc;
+            }
+        }
+        (result, score)
     }
 }
 

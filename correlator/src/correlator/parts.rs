@@ -28,6 +28,10 @@ pub(super) struct Reference {
     pub subset_planes: Vec<f32>,
     pub subset_stats: Vec<SubsetStats>,
     pub subset_states: Vec<SubsetState>,
+    /// Method `icgn`: per node, the subset's second-order constants (the same planes), derived
+    /// on its first second-order re-run against this reference (`order_stage.rs`).
+    pub second_order_stats: Vec<SubsetStats>,
+    pub second_order_states: Vec<SubsetState>,
     /// IC-GN: the reference's B-spline coefficients (the subsets' values), kept beside the
     /// frame's for the subsets prepared later.
     pub coefficients: Option<Coefficients>,

@@ -26,6 +26,7 @@ pub mod bspline;
 #[cfg(target_arch = "x86_64")]
 mod evaluate_avx2;
 mod first_order_sums;
+pub mod order_choice;
 pub mod shape;
 pub mod subset;
 

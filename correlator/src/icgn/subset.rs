@@ -24,6 +24,9 @@ pub struct SubsetStats {
     pub sum_jf: [f64; 12],
     /// f_m, subtracted from the deformed samples before their sums (keeps f32 sums exact enough).
     pub mean: f32,
+    /// f_n = ‖f − f_m‖ (counts): turns the normalised ZNSSD residual into counts (the noise
+    /// estimate of `super::order_choice`).
+    pub norm_counts: f32,
 }
 
 impl Default for SubsetStats {
@@ -33,6 +36,7 @@ impl Default for SubsetStats {
             sum_j: [0.0; 12],
             sum_jf: [0.0; 12],
             mean: 0.0,
+            norm_counts: 0.0,
         }
     }
 }
@@ -125,7 +129,36 @@ pub fn prepare(
     };
     stats.inverse_hessian = inverse;
     stats.mean = mean as f32;
+    stats.norm_counts = norm_sq.sqrt() as f32;
     true
+}
+
+/// The constants of an already prepared subset (`planes`, `prepared` as [`prepare`] left
+/// them, whatever its order) for the shape function of `spec.order` into `stats`: the planes
+/// do not depend on the order, only H⁻¹, Σ J and Σ J f̂ do. False when that Hessian is
+/// singular.
+pub fn restate(
+    spec: SubsetSpec,
+    planes: &[f32],
+    prepared: &SubsetStats,
+    stats: &mut SubsetStats,
+) -> bool {
+    let nn = spec.side_px * spec.side_px;
+    assert_eq!(planes.len(), PLANES * nn);
+    *stats = SubsetStats {
+        mean: prepared.mean,
+        norm_counts: prepared.norm_counts,
+        ..SubsetStats::default()
+    };
+    let (values, rest) = planes.split_at(nn);
+    let (gx, gy) = rest.split_at(nn);
+    match inverse_hessian(spec, [values, gx, gy], stats) {
+        Some(inverse) => {
+            stats.inverse_hessian = inverse;
+            true
+        }
+        None => false,
+    }
 }
 
 /// H⁻¹ of the normalised subset of `spec` (its planes f̂, ∂f̂/∂x, ∂f̂/∂y), accumulating Σ J and

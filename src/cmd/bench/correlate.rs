@@ -28,6 +28,9 @@ pub(super) struct ThreadRun {
     pub nodes: usize,
     pub valid: usize,
     pub mean_iterations: f64,
+    /// Method `icgn`: the last field's nodes re-run at second order, and those it kept.
+    pub second_order_runs: usize,
+    pub second_order_nodes: usize,
     pub error_px: [f64; 2],
     /// `set_reference` on a fresh correlator (its buffers touched for the first time), and again
     /// after the timed frames (a reference update of a running correlator).
@@ -275,6 +278,8 @@ impl CorrelateBench {
             valid: field.valid,
             mean_iterations: field.nodes.iter().map(|n| n.iterations as f64).sum::<f64>()
                 / field.nodes.len() as f64,
+            second_order_runs: field.second_order_runs,
+            second_order_nodes: field.second_order_nodes(),
             error_px: if self.rendered {
                 [
                     ok.iter().map(|n| n.u_px).sum::<f64>() / count - SHIFT_PX[0],

@@ -174,6 +174,8 @@ fn run_json(r: &ThreadRun) -> serde_json::Value {
         "zois_per_s": zois_per_s(r),
         "frames_per_s": 1.0 / r.median_s,
         "mean_iterations": r.mean_iterations,
+        "second_order_runs": r.second_order_runs,
+        "second_order_nodes": r.second_order_nodes,
         "mean_error_px": r.error_px,
         "set_reference_ms": r.set_reference_ms,
         "set_reference_again_ms": r.set_reference_again_ms,
@@ -209,8 +211,19 @@ pub(super) fn print_run(r: &ThreadRun) {
     } else {
         "no truth for image files".to_owned()
     };
+    // Method `icgn`: how many nodes its second order re-ran (the others' results are icgn1's).
+    let second_order = if r.second_order_runs > 0 || r.second_order_nodes > 0 {
+        format!(
+            "; second order: {} ZOIs re-run ({:.1} %), {} kept",
+            r.second_order_runs,
+            100.0 * r.second_order_runs as f64 / r.nodes.max(1) as f64,
+            r.second_order_nodes
+        )
+    } else {
+        String::new()
+    };
     println!(
-        "  {} thread(s): {:8.0} ZOIs/s, {:6.2} frames/s, {:7.2} ms/frame (min {:.2}, max {:.2}); {} ZOIs, {} valid, {:.2} iterations/ZOI, {error}; set_reference {:.1} ms (again, running: {:.1} ms, then its first frame {:.1} ms)",
+        "  {} thread(s): {:8.0} ZOIs/s, {:6.2} frames/s, {:7.2} ms/frame (min {:.2}, max {:.2}); {} ZOIs, {} valid, {:.2} iterations/ZOI, {error}; set_reference {:.1} ms (again, running: {:.1} ms, then its first frame {:.1} ms){second_order}",
         r.threads,
         zois_per_s(r),
         1.0 / r.median_s,
