@@ -102,8 +102,7 @@ impl Tap {
                     sent_ns: header.t_published_ns,
                     received_ns,
                     checksum_ok: None,
-                    invalid: header.layout_version != wire::LAYOUT_VERSION
-                        || sample.payload().len() != header.node_count(),
+                    invalid: header.validate(sample.payload().len()).is_err(),
                     last: LastSample::Field {
                         header,
                         mean_gradient: sample::mean_gradient(sample.payload()),

@@ -231,8 +231,7 @@ impl FieldShell {
     /// the others; None for a field of another layout (no gradients to read).
     fn grid(&self, header: &FieldHeader, nodes: &[FieldNode]) -> Option<FieldGrid> {
         let (cols, rows) = (header.mesh_cols as usize, header.mesh_rows as usize);
-        if header.layout_version != wire::LAYOUT_VERSION || nodes.len() != cols * rows || cols == 0
-        {
+        if header.validate(nodes.len()).is_err() || cols == 0 {
             return None;
         }
         let first = [f64::from(nodes[0].x_px), f64::from(nodes[0].y_px)];
