@@ -5,9 +5,11 @@
 //!
 //! Kept frames: the loading branch only, one frame each time its loading level (the process
 //! gives the mean stretching of the measured nodes) has grown by an increment since the last
-//! kept one (so a test's frames stay few and distinct whatever the frame rate). At
-//! `max_frames`, every other kept frame is dropped and the increment doubled: the frames stay
-//! spread over the whole loading, however far it goes. What is not kept is counted by reason,
+//! kept one (so a test's frames stay few and distinct whatever the frame rate). Beyond
+//! `max_frames`, the frame whose neighbours are closest in level is dropped and the increment
+//! becomes the smallest gap left: the fit always holds `max_frames` frames once the loading
+//! has gone that far, spread evenly over it, however far it goes (halving them at the limit
+//! left between half and all of them, by where the last halving fell). What is not kept is counted by reason,
 //! never fitted in part: a field without gradients, one whose grip forces have no matching rig
 //! sample, one where a grip pulls nothing (a strip's test, not the cruciform's), a virtual field
 //! with a hole or a node whose gradient is inverted (dropped for that frame, counted).
@@ -139,7 +141,8 @@ pub struct FieldRoute {
     config: FieldRouteConfig,
     placed: Option<Vec<PlacedField>>,
     frames: Vec<FieldFrame>,
-    /// The level a frame must grow by over the last kept one (doubled at each thinning).
+    /// The level a frame must grow by over the last kept one (the smallest gap between kept
+    /// frames once at the limit).
     increment: f64,
     pub counters: FieldCounters,
     /// Why the last virtual field dropped was (its frame and the reason).
@@ -213,12 +216,6 @@ impl FieldRoute {
         if forces_n.iter().any(|&f| f <= REST_FRACTION * largest) {
             return Ok(FrameOutcome::GripsUnloaded);
         }
-        if self.frames.len() >= self.config.max_frames.max(2) {
-            self.thin();
-            if !self.is_new_level(level) {
-                return Ok(FrameOutcome::NotLoading);
-            }
-        }
         if self.placed.is_none() {
             self.placed = Some(place_fields(&self.config.layout, &grid)?);
         }
@@ -261,6 +258,9 @@ impl FieldRoute {
             sequence: self.sequence,
             equations,
         });
+        if self.frames.len() > self.config.max_frames.max(2) {
+            self.thin();
+        }
         Ok(FrameOutcome::Kept)
     }
 
@@ -282,16 +282,37 @@ impl FieldRoute {
         level >= last + self.increment
     }
 
-    /// Drops every other kept frame (the first stays) and doubles the level increment.
+    /// Drops one kept frame, the one whose loss leaves the smallest gap in level between its
+    /// neighbours (both of its own sequence: a test's first and last frames stay), then sets
+    /// the increment to the smallest gap left: the frames stay `max_frames`, spread evenly over
+    /// each test's loading however far it goes, and new ones come at that spacing.
     fn thin(&mut self) {
-        let before = self.frames.len();
-        let mut index = 0;
-        self.frames.retain(|_| {
-            index += 1;
-            index % 2 == 1
-        });
-        self.counters.thinned += (before - self.frames.len()) as u64;
-        self.increment *= 2.0;
+        let same = |a: &FieldFrame, b: &FieldFrame| a.sequence == b.sequence;
+        let interior = (1..self.frames.len() - 1)
+            .filter(|&i| {
+                same(&self.frames[i - 1], &self.frames[i])
+                    && same(&self.frames[i], &self.frames[i + 1])
+            })
+            .min_by(|&a, &b| {
+                let gap = |i: usize| self.frames[i + 1].level - self.frames[i - 1].level;
+                gap(a).total_cmp(&gap(b))
+            });
+        // No interior frame (tests of two frames each, a tiny limit): the one before the
+        // newest goes.
+        let dropped = interior.unwrap_or(self.frames.len() - 2);
+        self.frames.remove(dropped);
+        self.counters.thinned += 1;
+        let smallest_gap = self
+            .frames
+            .windows(2)
+            .filter(|w| same(&w[0], &w[1]))
+            .map(|w| w[1].level - w[0].level)
+            .fold(f64::INFINITY, f64::min);
+        self.increment = if smallest_gap.is_finite() {
+            smallest_gap.max(self.config.min_level_increment)
+        } else {
+            self.config.min_level_increment
+        };
     }
 
     fn observation<'a>(
@@ -739,15 +760,68 @@ mod tests {
             route.push(k, Some(g), forces, level, &everywhere).unwrap();
         }
         let levels: Vec<f64> = route.frames().iter().map(|f| f.level).collect();
-        assert!(levels.len() <= 4 && levels.len() >= 3, "{levels:?}");
+        assert_eq!(levels.len(), 4, "{levels:?}");
         assert_eq!(levels[0], 0.01);
+        // The newest frame within one spacing (a third of the loading here) of the end.
         assert!(*levels.last().unwrap() >= 0.3, "{levels:?}");
-        assert!(levels.windows(2).all(|w| w[1] > w[0]));
+        let gaps: Vec<f64> = levels.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(gaps.iter().all(|&g| g > 0.0), "{levels:?}");
+        // Evenly spread: no gap more than twice another (halving left 0.01, 0.17, 0.33).
+        let (small, large) = gaps
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(s, l), &g| (s.min(g), l.max(g)));
+        assert!(large <= 2.0 * small + 1e-9, "{levels:?}");
         assert_eq!(
             route.counters.kept - route.counters.thinned,
             levels.len() as u64
         );
         assert!(route.counters.thinned > 0);
+    }
+
+    /// Two tests at the limit: the frames stay `max_frames`, and each test keeps its first
+    /// and its furthest frame (a thinning drops frames between two of the same test).
+    #[test]
+    fn at_the_limit_each_test_keeps_its_ends() {
+        let mut route = FieldRoute::new(FieldRouteConfig {
+            max_frames: 6,
+            ..config()
+        });
+        let forces = Some([10.0; 4]);
+        for (sequence, last_level) in [(0, 0.2), (1, 0.3)] {
+            route.set_sequence(sequence);
+            let steps = (last_level / 0.01_f64).round() as u64;
+            for k in 1..=steps {
+                let level = 0.01 * k as f64;
+                let g = grid([[1.0 + level, 0.0], [0.0, 1.0 + level]]);
+                route
+                    .push(
+                        100 * u64::from(sequence) + k,
+                        Some(g),
+                        forces,
+                        level,
+                        &everywhere,
+                    )
+                    .unwrap();
+            }
+        }
+        let frames: Vec<(u32, f64)> = route
+            .frames()
+            .iter()
+            .map(|f| (f.sequence, f.level))
+            .collect();
+        assert_eq!(frames.len(), 6, "{frames:?}");
+        assert_eq!(frames[0], (0, 0.01));
+        for (sequence, furthest) in [(0, 0.2), (1, 0.3)] {
+            let levels: Vec<f64> = frames
+                .iter()
+                .filter(|f| f.0 == sequence)
+                .map(|f| f.1)
+                .collect();
+            assert!(levels.len() >= 2, "{frames:?}");
+            // The second test's first frame comes one increment (the first's spacing) in.
+            assert!(levels[0] <= 0.1, "{frames:?}");
+            assert!(*levels.last().unwrap() >= furthest - 0.05, "{frames:?}");
+        }
     }
 
     /// A node whose gradient is inverted drops the virtual fields that weigh it, and only
