@@ -11,6 +11,7 @@ mod guess;
 mod icgn_stage;
 mod neighbour_check;
 mod order_stage;
+mod origin_order;
 mod parts;
 mod reanchor;
 mod renewal;

@@ -263,6 +263,7 @@ impl FinalCheck<'_> {
 }
 
 /// What [`Correlator::origin_icgn`] hands to the pool items of a measurement against the origin.
+#[derive(Clone, Copy)]
 pub(super) struct OriginIcgn<'a> {
     origin: Image<'a>,
     origin_coefficients: &'a Coefficients,
@@ -273,6 +274,11 @@ pub(super) struct OriginIcgn<'a> {
 }
 
 impl OriginIcgn<'_> {
+    /// The same measurement with shape function `order`.
+    pub(super) fn at_order(&self, order: Order) -> Self {
+        OriginIcgn { order, ..*self }
+    }
+
     /// Node's subset with top-left `top_left` in the origin, measured in the frame from the
     /// total displacement `guess_px` and gradient `gradient`, in `scratch` (3 n² values).
     pub(super) fn measure(

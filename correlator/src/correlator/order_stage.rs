@@ -142,7 +142,7 @@ impl Correlator {
 /// fitted to ∂u/∂x and ∂v/∂x give u_xx and v_xx along x, those fitted to ∂u/∂y and ∂v/∂y give
 /// u_yy and v_yy along y (the fit over three rows has a third of the variance of one row's
 /// central difference); None with fewer than 3 such nodes or collinear ones.
-fn curvature(
+pub(super) fn curvature(
     results: &[ZoiResult],
     ref_nodes: &[RefNode],
     mesh: (usize, usize),

@@ -126,6 +126,8 @@ pub(super) struct Scratch {
     pub grown_from: Vec<u8>,
     /// Results of the returned nodes measured against the origin.
     pub reanchored: Vec<(ZoiResult, f64)>,
+    /// Method `icgn`'s second order against the origin.
+    pub origin_order: super::origin_order::OriginOrderScratch,
 }
 
 impl PreviousFrames {
@@ -176,6 +178,7 @@ impl Scratch {
             entries: Vec::with_capacity(nodes),
             grown_from: vec![0; nodes],
             reanchored: Vec::with_capacity(nodes),
+            origin_order: super::origin_order::OriginOrderScratch::new(nodes),
         }
     }
 }

@@ -185,6 +185,7 @@ impl Correlator {
         };
         // Out of `self` while the items write it (no allocation: the buffer moves back).
         let mut reanchored = std::mem::take(&mut self.scratch.reanchored);
+        let mut origin_order = std::mem::take(&mut self.scratch.origin_order);
         reanchored.clear();
         reanchored.resize(self.scratch.entries.len(), (ZoiResult::default(), 0.0));
         let (entries, top_left) = (&self.scratch.entries, &self.mesh.top_left);
@@ -245,6 +246,10 @@ impl Correlator {
             // SAFETY: item i writes only slot i.
             unsafe { out.write(i, (result, score)) };
         });
+        if let Some(icgn) = &icgn {
+            self.origin_second_order(icgn, origin, image, &mut reanchored, &mut origin_order);
+        }
         self.scratch.reanchored = reanchored;
+        self.scratch.origin_order = origin_order;
     }
 }
