@@ -39,6 +39,26 @@ fn the_default_run_films_the_cruciform_and_its_field_decides() {
     // the default campaign, 0.046 px on the homogeneous sheet): a bound well above that,
     // far below a node lost to a false match (several px).
     assert!(p99 < 0.2, "node error p99 {p99} px\n{truth}");
+    // And per test: the strip's (uniaxial) and the cruciform's (equibiaxial) nodes, each
+    // within the same bound, together no more than all the nodes compared.
+    let by_case = truth["node_error_by_load_case"].as_array().unwrap();
+    let case = |name: &str| {
+        by_case
+            .iter()
+            .find(|c| c["load_case"] == name)
+            .unwrap_or_else(|| panic!("no {name} nodes\n{truth}"))
+    };
+    let mut nodes = 0;
+    for name in ["uniaxial", "equibiaxial"] {
+        let c = case(name);
+        assert!(c["node_error_p99_px"].as_f64().unwrap() < 0.2, "{c}");
+        nodes += c["nodes_compared"].as_u64().unwrap();
+    }
+    assert!(
+        nodes > 0 && nodes <= truth["nodes_compared"].as_u64().unwrap(),
+        "{truth}"
+    );
+    assert!(stdout.contains("(by test, p99: "), "{stdout}");
     // The field route decides: its law, compared over the stretches the field reached.
     assert_eq!(summary["field_acceptance_decides"], true, "{summary}");
     let field = &summary["field_acceptance"];

@@ -4,7 +4,7 @@
 //! control, the log strains the rig aimed at then: empty cells otherwise), the latency,
 //! and, for simulated frames, the correlator's actual error against the ground truth.
 
-use crate::truth::{self, NodeErrors};
+use crate::truth;
 use producer::FieldMotion;
 use std::collections::VecDeque;
 use std::fmt::Write as _;
@@ -259,9 +259,8 @@ fn truth_errors(
     header: &FieldHeader,
     nodes: &[FieldNode],
     origin: OriginTruth<'_>,
-    node_errors: &mut NodeErrors,
+    each: &mut dyn FnMut(f64),
 ) -> (Option<[f64; 2]>, Option<[f64; 2]>) {
-    let each = |e| node_errors.record(e);
     let log = header.gauge_of(StrainMeasure::Log);
     let strain_error = |t: [f64; 3]| [log.exx - t[0], log.eyy - t[1]];
     match origin {
@@ -298,14 +297,14 @@ impl FrameRow {
     /// Builds the row of one field. `rig` is the field's rig sample, `origin_truth` the truth
     /// of the frame its node positions are measured in (its origin frame; with a
     /// finite-element specimen, both frames' fields), each node's error going to
-    /// `node_errors`, `t0_ns` the
+    /// `each_error`, `t0_ns` the
     /// run's start and `seen_ns` when the monitor received the field.
     pub fn new(
         header: &FieldHeader,
         nodes: &[FieldNode],
         rig: Option<&RigState>,
         origin_truth: Option<OriginTruth<'_>>,
-        node_errors: &mut NodeErrors,
+        each_error: &mut dyn FnMut(f64),
         t0_ns: u64,
         seen_ns: u64,
     ) -> FrameRow {
@@ -325,7 +324,7 @@ impl FrameRow {
         let (displacement_error_px, log_strain_error) = origin_truth
             .filter(|_| header.has_truth == 1)
             .map_or((None, None), |origin| {
-                truth_errors(header, nodes, origin, node_errors)
+                truth_errors(header, nodes, origin, each_error)
             });
         let ms = |ns: u64| ns as f64 * 1e-6;
         FrameRow {
@@ -479,7 +478,7 @@ mod tests {
             &nodes,
             Some(&rig),
             Some(OriginTruth::Motion(&GroundTruth::IDENTITY)),
-            &mut NodeErrors::default(),
+            &mut |_| {},
             1_000_000_000,
             2_060_000_000,
         );
@@ -509,15 +508,7 @@ mod tests {
         rig.control_mode = wire::RigControl::Held as u32;
         rig.target_log_exx = 0.405_465_1;
         rig.target_log_eyy = -0.2;
-        let strained = FrameRow::new(
-            &header,
-            &nodes,
-            Some(&rig),
-            None,
-            &mut NodeErrors::default(),
-            0,
-            0,
-        );
+        let strained = FrameRow::new(&header, &nodes, Some(&rig), None, &mut |_| {}, 0, 0);
         assert_eq!(strained.target_log, Some([0.405_465_1, -0.2]));
         line.clear();
         strained.write_csv(&mut line);
@@ -527,15 +518,7 @@ mod tests {
         row.write_csv(&mut line);
         // Without rig sample and truth: empty cells, same count.
         header.has_truth = 0;
-        let row = FrameRow::new(
-            &header,
-            &nodes,
-            None,
-            None,
-            &mut NodeErrors::default(),
-            0,
-            0,
-        );
+        let row = FrameRow::new(&header, &nodes, None, None, &mut |_| {}, 0, 0);
         line.clear();
         row.write_csv(&mut line);
         assert_eq!(line.trim_end().split(',').count(), COLUMNS.len());
@@ -575,7 +558,7 @@ mod tests {
             rig_sample_id: wire::NO_RIG_SAMPLE,
             ..FieldHeader::default()
         };
-        let row = FrameRow::new(&field, &[], None, None, &mut NodeErrors::default(), 0, 0);
+        let row = FrameRow::new(&field, &[], None, None, &mut |_| {}, 0, 0);
         let mut line = String::new();
         row.write_csv_for(&mut line, false);
         assert_eq!(

@@ -52,6 +52,8 @@ pub struct Recorder {
     /// Fields compared with the truth, and every valid node's error in them.
     pub fields_compared: u64,
     pub node_errors: NodeErrors,
+    /// The same by the rig's load case of each field (none, uniaxial, equibiaxial).
+    pub node_errors_by_case: [NodeErrors; 3],
     pub latency_field: Latency,
     /// Where the field latency goes: waiting, correlating, delivering.
     pub latency_field_parts: FieldLatencyParts,
@@ -122,6 +124,7 @@ impl Recorder {
             specimen_refused: 0,
             fields_compared: 0,
             node_errors: NodeErrors::default(),
+            node_errors_by_case: Default::default(),
             latency_field: Latency::new(),
             latency_field_parts: FieldLatencyParts::default(),
             latency_identification: Latency::new(),
@@ -264,12 +267,20 @@ impl Recorder {
             }),
             _ => None,
         };
+        let case = rig.map(|s| s.load_case as usize).filter(|&c| c < 3);
+        let (all, by_case) = (&mut self.node_errors, &mut self.node_errors_by_case);
+        let mut each_error = |e: f64| {
+            all.record(e);
+            if let Some(c) = case {
+                by_case[c].record(e);
+            }
+        };
         let row = FrameRow::new(
             header,
             nodes,
             rig,
             origin_truth,
-            &mut self.node_errors,
+            &mut each_error,
             self.t0_ns,
             seen_ns,
         );
@@ -279,7 +290,7 @@ impl Recorder {
         if matches!(fields, Some(None)) {
             self.fields_without_truth += 1;
         }
-        if let Some(case) = rig.map(|s| s.load_case as usize).filter(|&c| c < 3) {
+        if let Some(case) = case {
             let stretch = row.stretch[0].max(row.stretch[1]);
             if header.valid_nodes > 0 && stretch.is_finite() {
                 self.max_stretch[case] = self.max_stretch[case].max(stretch);

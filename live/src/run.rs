@@ -40,7 +40,7 @@ pub use child_launch::{
     ChildLaunch,
 };
 pub use prepare::{remove_dead_runs, shm_needed_bytes};
-pub use report::{RunReport, StrainMapInfo};
+pub use report::{NodeErrorReport, RunReport, StrainMapInfo};
 
 /// What to run.
 #[derive(Clone, Debug)]

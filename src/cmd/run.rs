@@ -84,9 +84,10 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
     if let Some(error) = report.displacement_error_mean_px {
         match &report.truth {
             Some(t) => println!(
-                "run: mean displacement error against the ground truth ({}) {error:.4} px, node p99 {:.4} px{}",
+                "run: mean displacement error against the ground truth ({}) {error:.4} px, node p99 {:.4} px{}{}",
                 t.compared_with,
                 t.node_error_p99_px.unwrap_or(f64::NAN),
+                by_load_case(&t.node_error_by_load_case),
                 match t.fields_without_truth {
                     0 => String::new(),
                     n => format!(" ({n} field(s) without truth: their solves not received)"),
@@ -138,4 +139,23 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
         );
     }
     Ok(std::process::ExitCode::from(report.exit_code))
+}
+
+/// " (uniaxial p99 0.0812 px, equibiaxial 0.1143 px)" when more than one load case was
+/// compared, else nothing.
+fn by_load_case(cases: &[live::run::NodeErrorReport]) -> String {
+    if cases.len() < 2 {
+        return String::new();
+    }
+    let parts: Vec<String> = cases
+        .iter()
+        .map(|c| {
+            format!(
+                "{} {:.4} px",
+                c.load_case,
+                c.node_error_p99_px.unwrap_or(f64::NAN)
+            )
+        })
+        .collect();
+    format!(" (by test, p99: {})", parts.join(", "))
 }

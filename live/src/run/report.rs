@@ -23,6 +23,18 @@ pub struct TruthReport {
     pub nodes_compared: u64,
     pub node_error_p50_px: Option<f64>,
     pub node_error_p99_px: Option<f64>,
+    /// The same per test kind ("uniaxial": the strip's frames, "equibiaxial": the
+    /// cruciform's, "none": between tests), those with nodes compared only.
+    pub node_error_by_load_case: Vec<NodeErrorReport>,
+}
+
+/// The node errors of one load case's fields.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct NodeErrorReport {
+    pub load_case: &'static str,
+    pub nodes_compared: u64,
+    pub node_error_p50_px: Option<f64>,
+    pub node_error_p99_px: Option<f64>,
 }
 
 impl TruthReport {
@@ -39,6 +51,17 @@ impl TruthReport {
             nodes_compared: recorder.node_errors.count(),
             node_error_p50_px: recorder.node_errors.quantile_px(0.5),
             node_error_p99_px: recorder.node_errors.quantile_px(0.99),
+            node_error_by_load_case: ["none", "uniaxial", "equibiaxial"]
+                .into_iter()
+                .zip(&recorder.node_errors_by_case)
+                .filter(|(_, e)| e.count() > 0)
+                .map(|(load_case, e)| NodeErrorReport {
+                    load_case,
+                    nodes_compared: e.count(),
+                    node_error_p50_px: e.quantile_px(0.5),
+                    node_error_p99_px: e.quantile_px(0.99),
+                })
+                .collect(),
         })
     }
 }
