@@ -13,6 +13,7 @@ use super::parts::SubsetState;
 use super::{Correlator, Entry, FrameCoefficients};
 use crate::field::NodeStatus;
 use crate::icgn::bspline::Coefficients;
+use crate::icgn::order_choice::NoiseScale;
 use crate::icgn::shape::{Order, Warp};
 use crate::icgn::subset::{self, PLANES};
 use crate::icgn::{self, Subset};
@@ -280,14 +281,15 @@ impl OriginIcgn<'_> {
     }
 
     /// Node's subset with top-left `top_left` in the origin, measured in the frame from the
-    /// total displacement `guess_px` and gradient `gradient`, in `scratch` (3 n² values).
+    /// total displacement `guess_px` and gradient `gradient`, in `scratch` (3 n² values); with
+    /// what its noise needs (method `icgn`'s order choice, `origin_order.rs`).
     pub(super) fn measure(
         &self,
         top_left: (usize, usize),
         guess_px: (f64, f64),
         gradient: crate::interpolate::Mat2,
         scratch: &mut [f32],
-    ) -> ZoiResult {
+    ) -> (ZoiResult, NoiseScale) {
         let n = self.n;
         let mut stats = subset::SubsetStats::default();
         let spec = subset::SubsetSpec {
@@ -302,10 +304,11 @@ impl OriginIcgn<'_> {
             scratch,
             &mut stats,
         ) {
-            return ZoiResult {
+            let result = ZoiResult {
                 status: NodeStatus::LowContrast,
                 ..ZoiResult::default()
             };
+            return (result, NoiseScale::default());
         }
         let half = (n as f64 - 1.0) / 2.0;
         let subset = Subset {
@@ -321,7 +324,11 @@ impl OriginIcgn<'_> {
             Warp::affine(guess_px, gradient),
             self.max_iterations,
         );
-        zoi_result(&outcome)
+        let noise = match self.order {
+            Order::First => NoiseScale::of(outcome.zncc, &stats, n),
+            Order::Second => NoiseScale::default(),
+        };
+        (zoi_result(&outcome), noise)
     }
 }
 

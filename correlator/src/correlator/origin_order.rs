@@ -8,16 +8,14 @@
 //! measurements whose first-order bias exceeds `BIAS_TO_NOISE` times their noise are measured
 //! again at second order, from the first-order warp, by the criterion of the frame's: the
 //! curvature from the 3 x 3 neighbours' first-order gradients (here the origin measurements'),
-//! the noise from the field's median residual and the node's subset (the current reference's,
-//! the same material a renewal's deformation away: what the decision needs). The second order
+//! the noise from their median residual and each node's origin subset. The second order
 //! replaces the first when it converged and its ZNCC is at least the first's and `min_zncc`.
 
 use super::icgn_stage::OriginIcgn;
 use super::order_stage::curvature;
-use super::parts::SubsetState;
 use super::{median, Correlator};
 use crate::field::NodeStatus;
-use crate::icgn::order_choice;
+use crate::icgn::order_choice::{self, NoiseScale};
 use crate::icgn::shape::Order;
 use crate::pool::SharedSlice;
 use crate::settings::Method;
@@ -33,6 +31,8 @@ pub(super) struct OriginOrderScratch {
     second: Vec<usize>,
     /// Residuals, for their median.
     residuals: Vec<f64>,
+    /// Each entry's noise scale, from its first-order origin subset.
+    noise: Vec<NoiseScale>,
 }
 
 impl OriginOrderScratch {
@@ -41,7 +41,15 @@ impl OriginOrderScratch {
             results: Vec::with_capacity(nodes),
             second: Vec::with_capacity(nodes),
             residuals: Vec::with_capacity(nodes),
+            noise: Vec::with_capacity(nodes),
         }
+    }
+
+    /// `entries` slots for the first-order measurements' noise scales, written on the pool.
+    pub fn noise_slots(&mut self, entries: usize) -> SharedSlice<'_, NoiseScale> {
+        self.noise.clear();
+        self.noise.resize(entries, NoiseScale::default());
+        SharedSlice::new(&mut self.noise)
     }
 }
 
@@ -63,7 +71,6 @@ impl Correlator {
         }
         let (n, min_zncc) = (self.settings.zoi_px, self.settings.min_zncc);
         let entries = &self.scratch.entries;
-        let (stats, states) = (&self.reference.subset_stats, &self.reference.subset_states);
         let verified =
             |i: usize| reanchored[i].0.status == NodeStatus::Ok && reanchored[i].1 >= min_zncc;
         let missing = ZoiResult {
@@ -75,25 +82,25 @@ impl Correlator {
         for (i, entry) in entries.iter().enumerate().filter(|&(i, _)| verified(i)) {
             buffers.results[entry.node] = reanchored[i].0;
         }
-        let usable = |i: usize| verified(i) && states[entries[i].node] == SubsetState::Ready;
+        let noise = &buffers.noise;
         let Some(residual_counts2) = median(
-            (0..entries.len()).filter(|&i| usable(i)).map(|i| {
-                order_choice::residual_counts2(reanchored[i].0.score, &stats[entries[i].node], n)
-            }),
+            (0..entries.len())
+                .filter(|&i| verified(i))
+                .map(|i| noise[i].residual_counts2),
             &mut buffers.residuals,
         ) else {
             return;
         };
         let mesh = (self.mesh.nx, self.mesh.ny);
         buffers.second.clear();
-        for i in (0..entries.len()).filter(|&i| usable(i)) {
+        for i in (0..entries.len()).filter(|&i| verified(i)) {
             let k = entries[i].node;
             let Some(curvature) = curvature(&buffers.results, &self.reference.nodes, mesh, k)
             else {
                 continue;
             };
             let bias = order_choice::first_order_bias_px(curvature, n);
-            let noise = order_choice::displacement_noise_px(&stats[k], residual_counts2);
+            let noise = noise[i].noise_px(residual_counts2);
             if order_choice::needs_second_order(bias, noise) {
                 buffers.second.push(i);
             }
@@ -107,7 +114,7 @@ impl Correlator {
             // SAFETY: item j reads and writes only slot list[j]; the list holds an entry once.
             let (first, _) = unsafe { out.read(i) };
             let mut scratch = std::mem::take(&mut engine.subset_scratch);
-            let result = second.measure(
+            let (result, _) = second.measure(
                 top_left,
                 (first.u_px, first.v_px),
                 first.warp_gradient,

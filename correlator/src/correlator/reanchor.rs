@@ -193,13 +193,17 @@ impl Correlator {
         // IC-GN methods measure with IC-GN: the origin's subset prepared on the fly.
         let icgn = self.origin_icgn(coefficients);
         let min_zncc = self.settings.min_zncc;
+        let noise = origin_order.noise_slots(entries.len());
         self.pool.run(entries.len(), &|engine, i| {
             let entry = entries[i];
             let (x0, y0) = top_left[entry.node];
             if let Some(icgn) = &icgn {
                 let mut scratch = std::mem::take(&mut engine.subset_scratch);
-                let result = icgn.measure((x0, y0), entry.guess_px, entry.gradient, &mut scratch);
+                let (result, scale) =
+                    icgn.measure((x0, y0), entry.guess_px, entry.gradient, &mut scratch);
                 engine.subset_scratch = scratch;
+                // SAFETY: item i writes only slot i.
+                unsafe { noise.write(i, scale) };
                 let score = if result.status == NodeStatus::Ok {
                     let check =
                         |g| verify::zncc(origin, (x0, y0), n, image, (result.u_px, result.v_px), g);

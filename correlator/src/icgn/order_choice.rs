@@ -85,6 +85,36 @@ pub fn displacement_noise_px(stats: &SubsetStats, residual_counts2: f64) -> (f64
     (variance(0), variance(3))
 }
 
+/// What a first-order result's noise needs of its subset, kept where the subset is not
+/// (measurements against the origin prepare theirs on the fly): its residual per pixel
+/// (counts²) and the diagonal of its normalised H⁻¹ for u and v (1 / counts²).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NoiseScale {
+    pub residual_counts2: f64,
+    pub inverse_hessian_uv: (f64, f64),
+}
+
+impl NoiseScale {
+    /// Of a first-order result of ZNCC `zncc` on the side-n subset with `stats`.
+    pub fn of(zncc: f64, stats: &SubsetStats, n: usize) -> Self {
+        let norm2 = (stats.norm_counts as f64).powi(2);
+        let count = Order::First.parameters();
+        NoiseScale {
+            residual_counts2: residual_counts2(zncc, stats, n),
+            inverse_hessian_uv: (
+                stats.inverse_hessian[0] / norm2,
+                stats.inverse_hessian[3 * count + 3] / norm2,
+            ),
+        }
+    }
+
+    /// As [`displacement_noise_px`] of the subset, for the field's residual `residual_counts2`.
+    pub fn noise_px(&self, residual_counts2: f64) -> (f64, f64) {
+        let sd = |h: f64| (residual_counts2 * h).max(0.0).sqrt();
+        (sd(self.inverse_hessian_uv.0), sd(self.inverse_hessian_uv.1))
+    }
+}
+
 /// Whether a node whose first-order bias is `bias_px` and noise `noise_px` (u, v) is re-run
 /// at second order ([`BIAS_TO_NOISE`]).
 pub fn needs_second_order(bias_px: (f64, f64), noise_px: (f64, f64)) -> bool {
@@ -143,5 +173,13 @@ mod tests {
         assert!(!needs_second_order((0.039, -0.019), noise));
         assert!(needs_second_order((-0.041, 0.0), noise));
         assert!(needs_second_order((0.0, 0.021), noise));
+        // The same noise from what a subset leaves behind.
+        let scale = NoiseScale::of(0.995, &stats, 33);
+        assert_eq!(scale.residual_counts2, s2);
+        let (su, sv) = scale.noise_px(1.0e4);
+        assert!(
+            (su - nu).abs() < 1e-15 && (sv - nv).abs() < 1e-15,
+            "{su} {sv}"
+        );
     }
 }
