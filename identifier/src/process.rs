@@ -113,9 +113,7 @@ fn rig_sample(state: &RigState) -> RigSample {
 }
 
 fn field_sample(header: &FieldHeader) -> Option<FieldSample> {
-    if header.layout_version != wire::LAYOUT_VERSION {
-        return None;
-    }
+    wire::layouts::check_version("field", header.layout_version).ok()?;
     let gauge = header.gauge_of(StrainMeasure::Log);
     // A control gauge without a reading (NaN) gives no state.
     if !(gauge.exx.is_finite() && gauge.eyy.is_finite()) {

@@ -46,11 +46,8 @@ pub(super) fn handle(
 
 /// The request's kind, once its layout and value are known good.
 fn checked_kind(request: &wire::RigCommand) -> Result<RigCommandKind, CommandRefused> {
-    if request.layout_version != wire::LAYOUT_VERSION {
-        return Err(CommandRefused::LayoutVersion {
-            found: request.layout_version,
-        });
-    }
+    wire::layouts::check_version("rig command", request.layout_version)
+        .map_err(|e| CommandRefused::LayoutVersion { found: e.found })?;
     let kind = RigCommandKind::from_code(request.kind)
         .ok_or(CommandRefused::UnknownKind { kind: request.kind })?;
     if !request.value.is_finite() {

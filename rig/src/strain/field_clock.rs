@@ -78,9 +78,7 @@ impl FieldClock {
     /// gauge has no reading (NaN: too few valid nodes in it); the loop holds on those as on a
     /// stale field.
     pub fn measurement(&self, header: &wire::FieldHeader) -> Option<GaugeMeasurement> {
-        if header.layout_version != wire::LAYOUT_VERSION {
-            return None;
-        }
+        wire::layouts::check_version("field", header.layout_version).ok()?;
         let t_capture_s = match header.rig_sample_id {
             wire::NO_RIG_SAMPLE => self.of_capture_ns(header.t_capture_ns)?,
             id => self.of_sample(id)?,
