@@ -199,6 +199,15 @@ pub(crate) mod tests {
             + 5000.0 * (0.37 * x * x / 40.0 + 0.61 * y).sin()
     }
 
+    /// A square image of side `size` over `pixels`.
+    fn square(pixels: &[u16], size: usize) -> Image<'_> {
+        Image {
+            pixels,
+            width_px: size,
+            height_px: size,
+        }
+    }
+
     fn image(size: usize, map: impl Fn(f64, f64) -> (f64, f64)) -> Vec<u16> {
         (0..size * size)
             .map(|i| {
@@ -224,18 +233,7 @@ pub(crate) mod tests {
                 (-a[1][0] * dx + a[0][0] * dy) / det,
             )
         });
-        let (r, d) = (
-            Image {
-                pixels: &reference,
-                width_px: size,
-                height_px: size,
-            },
-            Image {
-                pixels: &deformed,
-                width_px: size,
-                height_px: size,
-            },
-        );
+        let (r, d) = (square(&reference, size), square(&deformed, size));
         let top_left = (30, 34);
         let c = (30.0 + 15.5, 34.0 + 15.5);
         let u = (
@@ -259,18 +257,7 @@ pub(crate) mod tests {
         let size = 80;
         let reference = image(size, |x, y| (x, y));
         let deformed = image(size, |x, y| (1.1 * x + 0.3, 0.95 * y - 0.2 * x));
-        let (r, d) = (
-            Image {
-                pixels: &reference,
-                width_px: size,
-                height_px: size,
-            },
-            Image {
-                pixels: &deformed,
-                width_px: size,
-                height_px: size,
-            },
-        );
+        let (r, d) = (square(&reference, size), square(&deformed, size));
         let mut compared = 0;
         for case in 0..40 {
             let s = case as f64;
