@@ -37,50 +37,25 @@ pub fn zncc(
     }
     let stride = n.div_ceil(CHECK_SIDE);
     let first = stride / 2;
-    let (max_x, max_y) = (
-        deformed.width_px as f64 - 1.0,
-        deformed.height_px as f64 - 1.0,
-    );
     // Sums of (value − offset) in f32 per row (the offset keeps 16-bit squares exact enough),
     // rows added in f64.
     let offset =
         reference.pixels[(top_left.1 + first) * reference.width_px + top_left.0 + first] as f32;
-    let (mut sf, mut sg, mut sff, mut sgg, mut sfg) = (0.0f64, 0.0, 0.0, 0.0, 0.0);
-    let mut count = 0usize;
-    let step = (a[0][0] * stride as f64, a[1][0] * stride as f64);
-    let (w, p) = (deformed.width_px, deformed.pixels);
-    for y in (first..n).step_by(stride) {
-        let row = (top_left.1 + y) * reference.width_px + top_left.0;
-        let start = apply(a, (first as f64 - half, y as f64 - half));
-        let (mut px, mut py) = (centre.0 + u.0 + start.0, centre.1 + u.1 + start.1);
-        let mut sums = [0.0f32; 5];
-        for x in (first..n).step_by(stride) {
-            let inside = px >= 0.0 && py >= 0.0 && px <= max_x && py <= max_y;
-            if inside {
-                let ix = (px as usize).min(w - 2);
-                let iy = (py as usize).min(deformed.height_px - 2);
-                let (fx, fy) = ((px - ix as f64) as f32, (py - iy as f64) as f32);
-                let at = iy * w + ix;
-                let top = p[at] as f32 + fx * (p[at + 1] as f32 - p[at] as f32);
-                let bottom = p[at + w] as f32 + fx * (p[at + w + 1] as f32 - p[at + w] as f32);
-                let g = top + fy * (bottom - top) - offset;
-                let f = reference.pixels[row + x] as f32 - offset;
-                sums[0] += f;
-                sums[1] += g;
-                sums[2] += f * f;
-                sums[3] += g * g;
-                sums[4] += f * g;
-                count += 1;
-            }
-            px += step.0;
-            py += step.1;
-        }
-        sf += sums[0] as f64;
-        sg += sums[1] as f64;
-        sff += sums[2] as f64;
-        sgg += sums[3] as f64;
-        sfg += sums[4] as f64;
-    }
+    let grid = Grid {
+        top_left,
+        n,
+        first,
+        stride,
+        start: (centre.0 + u.0, centre.1 + u.1),
+        a,
+        offset,
+    };
+    let (sums, count) = if grid.well_inside(deformed) {
+        grid.sums_inside(reference, deformed)
+    } else {
+        grid.sums_clipped(reference, deformed)
+    };
+    let [sf, sg, sff, sgg, sfg] = sums;
     let count = count as f64;
     // Samples per side: first, first + stride, ... below n (any n, not only 2^s).
     let side = (n - first).div_ceil(stride);
@@ -98,6 +73,121 @@ pub fn zncc(
     })
 }
 
+/// The check's sample grid: reference pixels `first, first + stride, ...` below n on both axes
+/// of the n x n block at `top_left`, each sent to `start + a (x − half)` in the deformed image
+/// (`start` = centre + u), values less `offset`.
+struct Grid {
+    top_left: (usize, usize),
+    n: usize,
+    first: usize,
+    stride: usize,
+    start: (f64, f64),
+    a: Mat2,
+    offset: f32,
+}
+
+/// How far inside the image (px) every sample of a grid takes [`Grid::sums_inside`]: well
+/// above the rounding of the positions' running sums.
+const INSIDE_MARGIN_PX: f64 = 0.5;
+
+impl Grid {
+    /// The deformed position of the grid's first sample of row `y` and the step along the row.
+    fn row_start(&self, y: usize) -> ((f64, f64), (f64, f64)) {
+        let half = (self.n as f64 - 1.0) / 2.0;
+        let d = apply(self.a, (self.first as f64 - half, y as f64 - half));
+        let step = (
+            self.a[0][0] * self.stride as f64,
+            self.a[1][0] * self.stride as f64,
+        );
+        ((self.start.0 + d.0, self.start.1 + d.1), step)
+    }
+
+    /// Whether every sample lies at least [`INSIDE_MARGIN_PX`] inside [0, w − 2] x [0, h − 2]
+    /// (the bilinear 2 x 2 then needs no clamp) of an image whose positions fit in i32: the map
+    /// is affine, so its four corners decide.
+    fn well_inside(&self, deformed: Image) -> bool {
+        let last = self.first + (self.n - 1 - self.first) / self.stride * self.stride;
+        let (max_x, max_y) = (
+            deformed.width_px as f64 - 2.0 - INSIDE_MARGIN_PX,
+            deformed.height_px as f64 - 2.0 - INSIDE_MARGIN_PX,
+        );
+        let columns = (last - self.first) as f64;
+        let small = deformed.width_px.max(deformed.height_px) < i32::MAX as usize;
+        small
+            && [self.first, last].into_iter().all(|y| {
+                let ((x0, y0), step) = self.row_start(y);
+                let along = columns / self.stride as f64;
+                [(x0, y0), (x0 + along * step.0, y0 + along * step.1)]
+                    .into_iter()
+                    .all(|(x, y)| {
+                        x >= INSIDE_MARGIN_PX && y >= INSIDE_MARGIN_PX && x <= max_x && y <= max_y
+                    })
+            })
+    }
+
+    /// The sums Σ f, Σ g, Σ f², Σ g², Σ f g (f32 per row, f64 over rows) and the sample count
+    /// of a grid [`Self::well_inside`] the deformed image: no sample is tested or clamped
+    /// (the same values as [`Self::sums_clipped`] gives there, bit for bit).
+    fn sums_inside(&self, reference: Image, deformed: Image) -> ([f64; 5], usize) {
+        self.sums::<false>(reference, deformed)
+    }
+
+    /// [`Self::sums_inside`] over the samples inside [0, w − 1] x [0, h − 1] only, the 2 x 2
+    /// clamped into the image at its last row and column.
+    fn sums_clipped(&self, reference: Image, deformed: Image) -> ([f64; 5], usize) {
+        self.sums::<true>(reference, deformed)
+    }
+
+    /// The sums of both: `CLIPPED` tests and clamps every sample.
+    #[inline(always)]
+    fn sums<const CLIPPED: bool>(&self, reference: Image, deformed: Image) -> ([f64; 5], usize) {
+        let (w, h, p) = (deformed.width_px, deformed.height_px, deformed.pixels);
+        let (max_x, max_y) = (w as f64 - 1.0, h as f64 - 1.0);
+        let mut total = [0.0f64; 5];
+        let mut count = 0;
+        for y in (self.first..self.n).step_by(self.stride) {
+            let row = (self.top_left.1 + y) * reference.width_px + self.top_left.0;
+            let f_row = &reference.pixels[row..row + self.n];
+            let ((mut px, mut py), step) = self.row_start(y);
+            let mut sums = [0.0f32; 5];
+            for &f in f_row[self.first..].iter().step_by(self.stride) {
+                let (x, y) = (px, py);
+                px += step.0;
+                py += step.1;
+                if CLIPPED && !(x >= 0.0 && y >= 0.0 && x <= max_x && y <= max_y) {
+                    continue;
+                }
+                // Inside, positive positions well inside: truncation to i32 is the floor (and
+                // cheaper than a conversion to usize, which saturates).
+                let (ix, iy) = if CLIPPED {
+                    ((x as usize).min(w - 2), (y as usize).min(h - 2))
+                } else {
+                    (x as i32 as usize, y as i32 as usize)
+                };
+                let (fx, fy) = ((x - ix as f64) as f32, (y - iy as f64) as f32);
+                let at = iy * w + ix;
+                let block = &p[at..at + w + 2];
+                let (t0, t1) = (block[0] as f32, block[1] as f32);
+                let (b0, b1) = (block[w] as f32, block[w + 1] as f32);
+                let top = t0 + fx * (t1 - t0);
+                let bottom = b0 + fx * (b1 - b0);
+                let g = top + fy * (bottom - top) - self.offset;
+                let f = f as f32 - self.offset;
+                sums[0] += f;
+                sums[1] += g;
+                sums[2] += f * f;
+                sums[3] += g * g;
+                sums[4] += f * g;
+                count += 1;
+            }
+            for (t, s) in total.iter_mut().zip(sums) {
+                *t += s as f64;
+            }
+        }
+        (total, count)
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
@@ -107,6 +197,15 @@ pub(crate) mod tests {
         20000.0
             + 8000.0 * (0.9 * x + 0.3 * y).sin() * (0.5 * y - 0.2 * x).cos()
             + 5000.0 * (0.37 * x * x / 40.0 + 0.61 * y).sin()
+    }
+
+    /// A square image of side `size` over `pixels`.
+    fn square(pixels: &[u16], size: usize) -> Image<'_> {
+        Image {
+            pixels,
+            width_px: size,
+            height_px: size,
+        }
     }
 
     fn image(size: usize, map: impl Fn(f64, f64) -> (f64, f64)) -> Vec<u16> {
@@ -134,18 +233,7 @@ pub(crate) mod tests {
                 (-a[1][0] * dx + a[0][0] * dy) / det,
             )
         });
-        let (r, d) = (
-            Image {
-                pixels: &reference,
-                width_px: size,
-                height_px: size,
-            },
-            Image {
-                pixels: &deformed,
-                width_px: size,
-                height_px: size,
-            },
-        );
+        let (r, d) = (square(&reference, size), square(&deformed, size));
         let top_left = (30, 34);
         let c = (30.0 + 15.5, 34.0 + 15.5);
         let u = (
@@ -160,5 +248,50 @@ pub(crate) mod tests {
         assert!(wrong < 0.5, "{wrong}");
         assert_eq!(zncc(r, top_left, 32, d, (60.0, 0.0), g), None);
         assert_eq!(zncc(r, top_left, 32, d, (f64::NAN, 0.0), g), None);
+    }
+
+    /// Inside the image, the unclamped sums are the clamped ones bit for bit; at the border
+    /// the grid is not well inside and the clamped path decides.
+    #[test]
+    fn the_inside_sums_are_the_clipped_ones() {
+        let size = 80;
+        let reference = image(size, |x, y| (x, y));
+        let deformed = image(size, |x, y| (1.1 * x + 0.3, 0.95 * y - 0.2 * x));
+        let (r, d) = (square(&reference, size), square(&deformed, size));
+        let mut compared = 0;
+        for case in 0..40 {
+            let s = case as f64;
+            let n = [32usize, 33, 24, 12][case % 4];
+            let stride = n.div_ceil(CHECK_SIDE);
+            let grid = Grid {
+                top_left: (10 + case % 7, 12 + case % 5),
+                n,
+                first: stride / 2,
+                stride,
+                start: (30.0 + 1.37 * s - 20.0, 28.0 - 0.91 * s + 10.0),
+                a: identity_plus([[0.01 * (s - 20.0), -0.004 * s], [0.003 * s, 0.02]]),
+                offset: 1000.0,
+            };
+            if !grid.well_inside(d) {
+                continue;
+            }
+            assert_eq!(
+                grid.sums_inside(r, d),
+                grid.sums_clipped(r, d),
+                "case {case}"
+            );
+            compared += 1;
+        }
+        assert!(compared > 20, "{compared}");
+        let border = Grid {
+            top_left: (0, 0),
+            n: 32,
+            first: 1,
+            stride: 3,
+            start: (15.5 - 16.0, 15.5),
+            a: identity_plus([[0.0; 2]; 2]),
+            offset: 0.0,
+        };
+        assert!(!border.well_inside(d));
     }
 }

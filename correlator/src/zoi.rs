@@ -25,6 +25,14 @@ pub const MIN_STD_COUNTS: f32 = 0.5;
 pub const CONVERGED_STEP_PX: f64 = 1e-3;
 /// A ZOI whose last correction at the iteration cap is above this (px) is `NotConverged`.
 pub const NOT_CONVERGED_STEP_PX: f64 = 0.02;
+/// The sub-pixel corrections shrink geometrically (each quadratic peak fit leaves a fixed
+/// fraction of the residual, 0.1 to 0.25 of it): once two corrections show a ratio below
+/// [`MAX_CONTRACTION`] and the next one is predicted (the last times that ratio) below this
+/// (px), the iterations stop. A correction below [`CONVERGED_STEP_PX`] leaves about the same
+/// residual (the ratio times it), so the estimate is as converged, one Fourier shift sooner.
+pub const PREDICTED_STEP_PX: f64 = 2.5e-4;
+/// The largest ratio of two successive corrections that [`PREDICTED_STEP_PX`] trusts.
+pub const MAX_CONTRACTION: f64 = 0.5;
 /// Cap of the sub-pixel iterations of the IC-GN methods' FFT guess: IC-GN refines every guess,
 /// and from the estimate after one Fourier shift it needs as many iterations as from a fully
 /// converged one (2.11 per ZOI on DIC Challenge sample 14 at 33 px either way), while each
@@ -840,7 +848,8 @@ impl ZoiEngine {
     /// The sub-pixel iterations (at most `max_iterations`) against the reference's windowed
     /// ZOI `windowed`, from the shift `start_px` (the ZOI's axes; the first iteration shifts
     /// there unless it is zero): window, correlate, quadratic peak, Fourier shift, while the
-    /// interpolated maximum increases. `confirm`: the start is a prediction, and the first
+    /// interpolated maximum increases, until a correction below [`CONVERGED_STEP_PX`] or the
+    /// next one predicted below [`PREDICTED_STEP_PX`]. `confirm`: the start is a prediction, and the first
     /// windowed correlation must confirm it ([`SubpixelStop::Unconfirmed`] otherwise).
     fn subpixel(
         &mut self,
@@ -859,6 +868,7 @@ impl ZoiEngine {
             iterations: 0,
         };
         let mut shift = start_px;
+        let mut previous_step_px = f64::INFINITY;
         for iteration in 0..max_iterations {
             if iteration > 0 || shift != (0.0, 0.0) {
                 self.shift_into_spatial(shift);
@@ -892,12 +902,19 @@ impl ZoiEngine {
             estimate.value = value;
             let step = (px as f64 + fx, py as f64 + fy);
             estimate.shift_px = (shift.0 + step.0, shift.1 + step.1);
-            estimate.last_step_px = step.0.abs().max(step.1.abs());
+            let step_px = step.0.abs().max(step.1.abs());
+            estimate.last_step_px = step_px;
             shift = estimate.shift_px;
-            if estimate.last_step_px < CONVERGED_STEP_PX {
+            // No ratio before the second correction (the first one's predecessor is infinite).
+            let ratio = step_px / previous_step_px;
+            let predicted_small = previous_step_px.is_finite()
+                && ratio < MAX_CONTRACTION
+                && ratio * step_px < PREDICTED_STEP_PX;
+            if step_px < CONVERGED_STEP_PX || predicted_small {
                 estimate.converged = true;
                 break;
             }
+            previous_step_px = step_px;
             if shift.0.abs() > MAX_SUBPIXEL_DRIFT_PX || shift.1.abs() > MAX_SUBPIXEL_DRIFT_PX {
                 break;
             }
