@@ -518,6 +518,43 @@ fn the_network_down_for_five_seconds_loses_samples_counted_and_the_link_resumes(
     );
 }
 
+#[test]
+fn bad_configurations_are_refused_before_anything_starts() {
+    // Refused before any session opens: nothing here reaches a network.
+    let scratch = Scratch::new(&testkit::unique_instance("link_refusals"));
+    let refused = |name: &str, text: &str| {
+        let config = scratch.write(name, text);
+        let out = Command::new(DICSTREAM)
+            .args(["link", "--instance", "refusals", "--config"])
+            .arg(&config)
+            .output()
+            .unwrap();
+        assert!(out.stdout.is_empty(), "{out:?}");
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let good = "[link]\nlisten = [\"tcp/10.0.0.1:7447\"]\nuser = \"a\"\n\
+                password_file = \"/nonexistent/pw\"\npeers_file = \"/nonexistent/peers\"\n\
+                services = [{ name = \"fields\", direction = \"out\" }]\n";
+    let (code, stderr) = refused("any.toml", &good.replace("10.0.0.1", "0.0.0.0"));
+    assert_eq!(code, Some(78), "{stderr}");
+    assert!(
+        stderr.contains("[link] listen: tcp/0.0.0.0:7447 listens on every interface"),
+        "{stderr}"
+    );
+    let (code, stderr) = refused("none.toml", "[run]\nvtk = false\n");
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(stderr.contains("no [link] section"), "{stderr}");
+    let (code, stderr) = refused("pw.toml", good);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("[link] password_file /nonexistent/pw"),
+        "{stderr}"
+    );
+}
+
 /// The helpers, when this binary is run again inside a host (`ROLE` set); otherwise nothing.
 #[test]
 fn helper_role() {
