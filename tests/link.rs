@@ -445,6 +445,74 @@ fn a_peer_not_in_the_configuration_gets_nothing() {
     assert_eq!(json_c["in"]["fields"]["received"], 0, "{json_c}");
 }
 
+/// What crossed from a to b while a fault happened.
+struct Faulted {
+    /// b's link's counts at its exit.
+    json_b: serde_json::Value,
+    /// Fields a's links sent, in all.
+    sent_by_a: u64,
+    /// Fields b's reader received, and the ids it missed.
+    received_on_b: usize,
+    missing_on_b: u64,
+}
+
+impl Lab {
+    /// Publishes `count` fields on a at 200 Hz; once b has the first, `fault` (which returns
+    /// the fields sent by a's links it stopped); after the last, stops b's reader and both
+    /// links. Every field b received is byte-identical, and every id was received or counted
+    /// lost by b's link.
+    fn stream_through(&mut self, count: u64, fault: impl FnOnce(&mut Lab) -> u64) -> Faulted {
+        let sub_b = self.subscriber(true, "b.txt", u64::MAX);
+        let sent = self.scratch.path("sent.txt");
+        let publisher = self
+            .a
+            .helper("publish", &self.instance.clone(), &sent, count);
+        self.b.proc(sub_b).wait_line("helper: first sample");
+        let sent_before = fault(self);
+        let (status, _, stderr) = self.a.proc(publisher).wait();
+        assert!(status.success(), "{stderr}");
+        self.b
+            .proc(sub_b)
+            .wait_line(&format!("helper: received {}", count - 1));
+        self.b.proc(sub_b).signal(libc::SIGTERM);
+        assert!(self.b.proc(sub_b).wait().0.success());
+        let json_b = stop_link(&mut self.b, self.link_b);
+        let json_a = stop_link(&mut self.a, self.link_a);
+
+        let on_b = read_samples(&self.scratch.path("b.txt"));
+        let sent = read_samples(&sent);
+        for b in &on_b {
+            assert_eq!(
+                sent[b.0 as usize].1, b.1,
+                "field {} not byte-identical",
+                b.0
+            );
+        }
+        let missing_on_b: u64 = on_b.windows(2).map(|w| w[1].0 - w[0].0 - 1).sum();
+        assert_every_id_received_or_counted_lost(&json_b, count, missing_on_b);
+        Faulted {
+            json_b,
+            sent_by_a: sent_before + json_a["out"]["fields"]["sent"].as_u64().unwrap(),
+            received_on_b: on_b.len(),
+            missing_on_b,
+        }
+    }
+}
+
+impl Faulted {
+    fn print(&self, fault: &str, count: u64) {
+        println!(
+            "{fault}: a's links sent {} of {count}; b's link received {}, counted {} lost; \
+             b's reader received {}, missed {}",
+            self.sent_by_a,
+            self.json_b["in"]["fields"]["received"],
+            self.json_b["in"]["fields"]["lost"],
+            self.received_on_b,
+            self.missing_on_b
+        );
+    }
+}
+
 #[test]
 fn a_link_restarted_mid_stream_resumes_with_the_gap_counted() {
     if !namespaces_available("restart") {
@@ -452,40 +520,17 @@ fn a_link_restarted_mid_stream_resumes_with_the_gap_counted() {
     }
     const COUNT: u64 = 1600;
     let mut lab = Lab::new("link_restart", 80);
-    let sub_b = lab.subscriber(true, "b.txt", u64::MAX);
-    let sent = lab.scratch.path("sent.txt");
-    let publisher = lab.a.helper("publish", &lab.instance.clone(), &sent, COUNT);
-    lab.b.proc(sub_b).wait_line("helper: first sample");
     // a's link stops mid-stream (the publisher goes on) and starts again.
-    let first = stop_link(&mut lab.a, lab.link_a);
-    let config_a = lab.config_a.clone();
-    let restarted = lab.a.link(&lab.instance, &config_a);
-    lab.a
-        .proc(restarted)
-        .wait_line("fields out: a peer subscribes");
-    let (status, _, stderr) = lab.a.proc(publisher).wait();
-    assert!(status.success(), "{stderr}");
-    // The last samples reach b, then b's subscriber and link stop.
-    let last_id = COUNT - 1;
-    lab.b
-        .proc(sub_b)
-        .wait_line(&format!("helper: received {last_id}"));
-    lab.b.proc(sub_b).signal(libc::SIGTERM);
-    assert!(lab.b.proc(sub_b).wait().0.success());
-    let json_b = stop_link(&mut lab.b, lab.link_b);
-    let second = stop_link(&mut lab.a, restarted);
-
-    let on_b = read_samples(&lab.scratch.path("b.txt"));
-    let missing: u64 = on_b.windows(2).map(|w| w[1].0 - w[0].0 - 1).sum();
-    assert_every_id_received_or_counted_lost(&json_b, COUNT, missing);
-    let sent_by_a = first["out"]["fields"]["sent"].as_u64().unwrap()
-        + second["out"]["fields"]["sent"].as_u64().unwrap();
-    println!(
-        "restart: a's link sent {sent_by_a} of {COUNT}; b's link counted {} lost; b's reader \
-         received {}, missed {missing}",
-        json_b["in"]["fields"]["lost"],
-        on_b.len()
-    );
+    let faulted = lab.stream_through(COUNT, |lab| {
+        let first = stop_link(&mut lab.a, lab.link_a);
+        let config_a = lab.config_a.clone();
+        lab.link_a = lab.a.link(&lab.instance, &config_a);
+        lab.a
+            .proc(lab.link_a)
+            .wait_line("fields out: a peer subscribes");
+        first["out"]["fields"]["sent"].as_u64().unwrap()
+    });
+    faulted.print("restart", COUNT);
 }
 
 #[test]
@@ -493,46 +538,16 @@ fn the_network_down_for_five_seconds_loses_samples_counted_and_the_link_resumes(
     if !namespaces_available("network_down") {
         return;
     }
-    // 12 s of fields at 200 Hz; b's interface down for 5 s from the first sample b gets.
+    // 12 s of fields at 200 Hz; b's interface down for 5 s from the first field b gets.
     const COUNT: u64 = 2400;
     let mut lab = Lab::new("link_down", 81);
-    let sub_b = lab.subscriber(true, "b.txt", u64::MAX);
-    let sent = lab.scratch.path("sent.txt");
-    let publisher = lab.a.helper("publish", &lab.instance.clone(), &sent, COUNT);
-    lab.b.proc(sub_b).wait_line("helper: first sample");
-    lab.b.sh("ip link set v81a down");
-    std::thread::sleep(Duration::from_secs(5));
-    lab.b.sh("ip link set v81a up");
-    let (status, _, stderr) = lab.a.proc(publisher).wait();
-    assert!(status.success(), "{stderr}");
-    let last_id = COUNT - 1;
-    lab.b
-        .proc(sub_b)
-        .wait_line(&format!("helper: received {last_id}"));
-    lab.b.proc(sub_b).signal(libc::SIGTERM);
-    assert!(lab.b.proc(sub_b).wait().0.success());
-    let json_b = stop_link(&mut lab.b, lab.link_b);
-    let json_a = stop_link(&mut lab.a, lab.link_a);
-
-    let on_b = read_samples(&lab.scratch.path("b.txt"));
-    let sent = read_samples(&sent);
-    for b in &on_b {
-        assert_eq!(
-            sent[b.0 as usize].1, b.1,
-            "sample {} not byte-identical",
-            b.0
-        );
-    }
-    let missing: u64 = on_b.windows(2).map(|w| w[1].0 - w[0].0 - 1).sum();
-    assert_every_id_received_or_counted_lost(&json_b, COUNT, missing);
-    println!(
-        "network down 5 s: a's link sent {} of {COUNT}; b's link received {}, counted {} lost; \
-         b's reader received {}, missed {missing}",
-        json_a["out"]["fields"]["sent"],
-        json_b["in"]["fields"]["received"],
-        json_b["in"]["fields"]["lost"],
-        on_b.len()
-    );
+    let faulted = lab.stream_through(COUNT, |lab| {
+        lab.b.sh("ip link set v81a down");
+        std::thread::sleep(Duration::from_secs(5));
+        lab.b.sh("ip link set v81a up");
+        0
+    });
+    faulted.print("network down 5 s", COUNT);
 }
 
 #[test]
