@@ -9,6 +9,8 @@
 mod cmd;
 #[cfg(feature = "genicam")]
 mod genicam;
+#[cfg(feature = "link")]
+mod link_zenoh;
 
 use clap::{Parser, Subcommand};
 
@@ -34,6 +36,8 @@ enum Command {
     Identify(cmd::identify::IdentifyArgs),
     /// Live identification process: fields + rig/state in, identification reports out.
     Identifier(cmd::identifier::IdentifierArgs),
+    /// Carry chosen services between this host's instance and another host's over Zenoh.
+    Link(cmd::link::LinkArgs),
     /// Live dashboard in the browser, attached read-only to a running instance.
     Monitor(cmd::monitor::MonitorArgs),
     /// Camera process: publishes frames (scenario, replay, or following the rig state).
@@ -85,6 +89,7 @@ fn main() -> std::process::ExitCode {
         Command::Correlator(args) => ok(cmd::correlator::run(args)),
         Command::Identify(args) => ok(cmd::identify::run(args)),
         Command::Identifier(args) => ok(cmd::identifier::run(args)),
+        Command::Link(args) => ok(cmd::link::run(args)),
         Command::Monitor(args) => ok(cmd::monitor::run(args)),
         Command::Producer(args) => ok(cmd::producer::run(*args)),
         Command::Rig(args) => ok(cmd::rig::run(*args)),

@@ -10,6 +10,7 @@ pub mod identifier;
 pub mod identify;
 pub mod identify_femu;
 pub mod identify_fields;
+pub mod link;
 pub mod log_rows;
 pub mod monitor;
 pub mod named_arg;

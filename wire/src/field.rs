@@ -242,9 +242,7 @@ pub enum FieldError {
 
 /// The nodes' bytes as they lie in shared memory (a `FieldNode` has no padding: `layouts`).
 pub fn node_bytes(nodes: &[FieldNode]) -> &[u8] {
-    // SAFETY: FieldNode is `repr(C)` of 4-byte numbers without padding (every byte is
-    // initialised), and u8 has no alignment requirement; the length is the slice's size.
-    unsafe { std::slice::from_raw_parts(nodes.as_ptr().cast::<u8>(), std::mem::size_of_val(nodes)) }
+    crate::plain::slice_bytes(nodes)
 }
 
 /// [`crate::frame::byte_checksum`] of the nodes' bytes: two readers of one field agree on it.

@@ -27,8 +27,10 @@ pub mod identification;
 pub mod instance;
 mod layout_check;
 pub mod layouts;
+pub mod linked;
 pub mod names;
 pub mod owner;
+pub mod plain;
 #[cfg(feature = "ipc")]
 pub mod pubsub;
 #[cfg(feature = "ipc")]

@@ -42,6 +42,9 @@ pub struct RunConfig {
     pub rig: RigSection,
     pub specimen: SpecimenSection,
     pub identifier: IdentifierSection,
+    /// The link to another host's instance (`dicstream link`; absent: none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link: Option<link::LinkSection>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

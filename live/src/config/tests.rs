@@ -318,3 +318,28 @@ fn gauges_are_read_checked_and_passed_on() {
         "is an extensometer",
     );
 }
+
+#[test]
+fn a_link_section_is_read_checked_and_written_back() {
+    let text = "[link]\nlisten = [\"tcp/10.0.0.1:7447\"]\nuser = \"rig-pc\"\n\
+                password_file = \"pw\"\npeers_file = \"peers\"\n\
+                services = [{ name = \"rig/state\", direction = \"out\" }]\n";
+    let config = RunConfig::from_toml(text, "t.toml").unwrap();
+    config.validate().unwrap();
+    let link = config.link.as_ref().unwrap();
+    assert_eq!(link.plan().unwrap().routes.len(), 1);
+    let round = RunConfig::from_toml(&config.to_toml(), "round").unwrap();
+    assert_eq!(round, config);
+    assert!(RunConfig::default().link.is_none());
+
+    let everywhere = text.replace("10.0.0.1", "0.0.0.0");
+    let error = RunConfig::from_toml(&everywhere, "t.toml")
+        .and_then(|config| config.validate())
+        .unwrap_err();
+    assert!(
+        error
+            .to_string()
+            .starts_with("[link] listen: tcp/0.0.0.0:7447 listens on every"),
+        "{error}"
+    );
+}

@@ -18,6 +18,9 @@ impl RunConfig {
         self.correlator_settings()?;
         self.validate_rig()?;
         self.validate_identifier()?;
+        if let Some(link) = &self.link {
+            link.plan()?;
+        }
         Ok(())
     }
 

@@ -1,0 +1,173 @@
+//! The ids a link lost, counted from each sample's own id (`LinkedService::sample_id`).
+//!
+//! The sender counts the ids missing in what it takes from its instance (a field skips the
+//! frames its correlator did not correlate; a full queue dropped some) and those its rate limit
+//! held back, and declares them with the next sample it sends (`Envelope`). The receiver counts
+//! a gap in the ids it receives, less what the sender declared, as lost by the link: dropped
+//! on the way, or never sent because the sending link was down. A sender restarted mid-stream
+//! declares nothing for what it missed while down, so that gap is counted at the receiver.
+//! An id at or below the last one is a source that started again (a restarted rig counts from
+//! 0): counted as a restart, not a loss, and the count goes on from it. Both sides count
+//! with `wire::stats::IdGaps`, as `dicstream tap` does.
+
+use wire::stats::{IdGaps, IdStep};
+
+/// The sender's side: ids it did not send, declared with the next sample it does send.
+#[derive(Debug, Clone, Default)]
+pub struct SendGaps {
+    /// The ids taken from the local instance: `lost` is what was missing there.
+    pub seen: IdGaps,
+    undeclared_ids: u64,
+    /// Samples taken but held back by the rate limit.
+    pub held_back: u64,
+    pub sent: u64,
+}
+
+impl SendGaps {
+    /// A sample with `id` taken from the local instance.
+    pub fn seen(&mut self, id: u64) {
+        match self.seen.observe(id) {
+            IdStep::Forward { skipped } => self.undeclared_ids += skipped,
+            // The source started again: what went before is no gap of this sample's.
+            IdStep::Back { .. } => self.undeclared_ids = 0,
+            IdStep::First => {}
+        }
+    }
+
+    /// The sample last seen is not sent (rate limit).
+    pub fn hold_back(&mut self) {
+        self.held_back += 1;
+        self.undeclared_ids += 1;
+    }
+
+    /// The sample last seen is sent: the ids to declare with it.
+    pub fn send(&mut self) -> u64 {
+        self.sent += 1;
+        std::mem::take(&mut self.undeclared_ids)
+    }
+}
+
+/// What one received sample says about the link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Arrival {
+    /// The first sample, or the next one after what the sender declared.
+    InOrder,
+    /// `lost` ids before this sample were lost by the link.
+    AfterLoss { lost: u64 },
+    /// The id is at or below the last: the source started again.
+    Restarted,
+}
+
+/// The receiver's side: gaps less what the sender declared.
+#[derive(Debug, Clone, Default)]
+pub struct ReceiveGaps {
+    /// The ids received: `lost` counts every gap, `restarts` the ids going back.
+    pub ids: IdGaps,
+    pub received: u64,
+    /// Ids lost by the link (dropped, or not sent while the sending link was down).
+    pub lost: u64,
+    /// Ids the sender declared it did not send (missing at its source, held back).
+    pub declared: u64,
+}
+
+impl ReceiveGaps {
+    /// A sample with `id`, whose sender declared `skipped_ids` before it.
+    pub fn received(&mut self, id: u64, skipped_ids: u64) -> Arrival {
+        self.received += 1;
+        match self.ids.observe(id) {
+            IdStep::First => Arrival::InOrder,
+            IdStep::Back { .. } => Arrival::Restarted,
+            IdStep::Forward { skipped } => {
+                let declared = skipped_ids.min(skipped);
+                self.declared += declared;
+                match skipped - declared {
+                    0 => Arrival::InOrder,
+                    lost => {
+                        self.lost += lost;
+                        Arrival::AfterLoss { lost }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Sends ids through a sender that holds back what `hold` says, and a receiver that gets
+    /// what `deliver` says; returns the receiver.
+    fn carry(
+        ids: impl Iterator<Item = u64>,
+        mut hold: impl FnMut(u64) -> bool,
+        mut deliver: impl FnMut(u64) -> bool,
+    ) -> (SendGaps, ReceiveGaps) {
+        let (mut sender, mut receiver) = (SendGaps::default(), ReceiveGaps::default());
+        for id in ids {
+            sender.seen(id);
+            if hold(id) {
+                sender.hold_back();
+                continue;
+            }
+            let skipped = sender.send();
+            if deliver(id) {
+                receiver.received(id, skipped);
+            }
+        }
+        (sender, receiver)
+    }
+
+    #[test]
+    fn nothing_lost_when_everything_arrives() {
+        let (sender, receiver) = carry(0..100, |_| false, |_| true);
+        assert_eq!(
+            (sender.sent, receiver.received, receiver.lost),
+            (100, 100, 0)
+        );
+    }
+
+    #[test]
+    fn held_back_and_source_gaps_are_declared_not_lost() {
+        // Fields of every other frame, one in three of them held back by the rate limit.
+        let (sender, receiver) = carry((0..60).map(|i| 2 * i), |id| id % 3 == 1, |_| true);
+        assert_eq!(sender.seen.lost, 59);
+        assert_eq!(sender.held_back, 20);
+        assert_eq!(receiver.lost, 0);
+        // The last id, 118, is held back: it and the gap before it have no sample to go with.
+        assert_eq!(receiver.declared, 59 + 20 - 2);
+    }
+
+    #[test]
+    fn ids_dropped_on_the_way_are_lost() {
+        let (_, receiver) = carry(0..100, |_| false, |id| !(40..45).contains(&id));
+        assert_eq!((receiver.received, receiver.lost), (95, 5));
+    }
+
+    #[test]
+    fn a_restarted_sender_declares_nothing_for_what_it_missed() {
+        let mut receiver = ReceiveGaps::default();
+        let mut sender = SendGaps::default();
+        for id in 0..10 {
+            sender.seen(id);
+            receiver.received(id, sender.send());
+        }
+        // The sending link is restarted: a new SendGaps, its first sample id 25.
+        let mut sender = SendGaps::default();
+        sender.seen(25);
+        assert_eq!(
+            receiver.received(25, sender.send()),
+            Arrival::AfterLoss { lost: 15 }
+        );
+        assert_eq!(receiver.lost, 15);
+    }
+
+    #[test]
+    fn a_source_starting_again_is_a_restart_not_a_loss() {
+        let mut receiver = ReceiveGaps::default();
+        assert_eq!(receiver.received(7, 0), Arrival::InOrder);
+        assert_eq!(receiver.received(0, 0), Arrival::Restarted);
+        assert_eq!(receiver.received(1, 0), Arrival::InOrder);
+        assert_eq!((receiver.ids.restarts, receiver.lost), (1, 0));
+    }
+}

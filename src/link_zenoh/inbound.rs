@@ -1,0 +1,111 @@
+//! The services coming in: a Zenoh subscriber of each (`dicstream/<instance>/<service>`),
+//! whose callback, on Zenoh's threads, hands the bytes over a bounded queue to this loop, which
+//! counts their ids (`link::gaps`, less what the sender declared) and publishes them into the
+//! local instance. A full queue drops the sample (counted as lost, as the gap it leaves).
+
+use super::local_publisher::LocalPublisher;
+use link::envelope::Envelope;
+use link::gaps::Arrival;
+use link::{LinkedService, ReceiveGaps};
+use std::sync::mpsc::{sync_channel, RecvTimeoutError, TrySendError};
+use zenoh::Wait;
+
+/// Samples waiting between Zenoh's threads and the local publishers.
+const QUEUE_SAMPLES: usize = 256;
+
+/// What was received of one service.
+pub struct Received {
+    pub service: LinkedService,
+    pub gaps: ReceiveGaps,
+    /// Samples whose bytes or attachment were refused (another version, a foreign sender).
+    pub refused: u64,
+}
+
+/// One sample off Zenoh.
+struct Arrived {
+    route: usize,
+    bytes: Vec<u8>,
+    attachment: Option<Vec<u8>>,
+}
+
+/// Carries `services` in until a signal.
+pub fn run(
+    instance: &wire::Instance,
+    session: &zenoh::Session,
+    services: &[LinkedService],
+) -> anyhow::Result<Vec<Received>> {
+    let (node, _) = instance.create_node("link-in")?;
+    let (sender, queue) = sync_channel::<Arrived>(QUEUE_SAMPLES);
+    let mut publishers = Vec::new();
+    let mut received = Vec::new();
+    let mut subscribers = Vec::new();
+    for (route, &service) in services.iter().enumerate() {
+        publishers.push(LocalPublisher::create(&node, service)?);
+        received.push(Received {
+            service,
+            gaps: ReceiveGaps::default(),
+            refused: 0,
+        });
+        let sender = sender.clone();
+        let subscriber = session
+            .declare_subscriber(link::key::key_expr(instance.name(), service))
+            .callback(move |sample: zenoh::sample::Sample| {
+                let arrived = Arrived {
+                    route,
+                    bytes: sample.payload().to_bytes().into_owned(),
+                    attachment: sample.attachment().map(|a| a.to_bytes().into_owned()),
+                };
+                match sender.try_send(arrived) {
+                    Ok(()) | Err(TrySendError::Disconnected(_)) => {}
+                    // The gap it leaves is counted as lost when the next one arrives.
+                    Err(TrySendError::Full(_)) => {}
+                }
+            })
+            .wait()
+            .map_err(|e| {
+                anyhow::anyhow!("link: declaring the Zenoh subscriber of {service}: {e}")
+            })?;
+        subscribers.push(subscriber);
+    }
+    drop(sender);
+    while !super::stop_requested() {
+        let arrived = match queue.recv_timeout(super::STOP_CHECK) {
+            Ok(arrived) => arrived,
+            Err(RecvTimeoutError::Timeout) => continue,
+            Err(RecvTimeoutError::Disconnected) => break,
+        };
+        let counts = &mut received[arrived.route];
+        let service = counts.service;
+        let envelope = arrived.attachment.as_deref().map(Envelope::from_bytes);
+        let (Some(Ok(envelope)), Some(id)) = (
+            envelope,
+            service.sample_id(arrived.bytes.get(..service.header_bytes()).unwrap_or(&[])),
+        ) else {
+            counts.refused += 1;
+            eprintln!(
+                "link: {service}: a sample of {} bytes without a dicstream link's attachment or \
+                 header, refused",
+                arrived.bytes.len()
+            );
+            continue;
+        };
+        match publishers[arrived.route].publish(&node, service, &arrived.bytes)? {
+            Ok(()) => {}
+            Err(refused) => {
+                counts.refused += 1;
+                eprintln!("link: refused: {refused}");
+                continue;
+            }
+        }
+        match counts.gaps.received(id, envelope.skipped_ids) {
+            Arrival::InOrder => {}
+            Arrival::AfterLoss { lost } => eprintln!(
+                "link: {service}: {lost} id(s) lost by the link before {id} ({} in all)",
+                counts.gaps.lost
+            ),
+            Arrival::Restarted => eprintln!("link: {service}: ids started again at {id}"),
+        }
+    }
+    drop(subscribers);
+    Ok(received)
+}
