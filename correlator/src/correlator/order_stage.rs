@@ -48,12 +48,8 @@ impl Correlator {
         let mesh = (self.mesh.nx, self.mesh.ny);
         self.scratch.entries.clear();
         for k in (0..results.len()).filter(|&k| first_order_ok(k)) {
-            let Some(curvature) = curvature(results, &self.reference.nodes, mesh, k) else {
-                continue;
-            };
-            let bias = order_choice::first_order_bias_px(curvature, n);
             let noise = order_choice::displacement_noise_px(&stats[k], residual_counts2);
-            if order_choice::needs_second_order(bias, noise) {
+            if second_order_needed(results, &self.reference.nodes, mesh, k, n, noise) {
                 self.scratch.entries.push(Entry {
                     node: k,
                     guess_px: (results[k].u_px, results[k].v_px),
@@ -137,12 +133,30 @@ impl Correlator {
     }
 }
 
+/// Whether node k's first-order result (`results` by node, on an nx x ny mesh of side-n
+/// subsets) is biased by the curvature of its neighbours' gradients by more than
+/// `order_choice::BIAS_TO_NOISE` times its noise `noise_px` (u, v): the choice of this frame's
+/// second pass and of the measurements against the origin (`origin_order.rs`). False without a
+/// curvature.
+pub(super) fn second_order_needed(
+    results: &[ZoiResult],
+    ref_nodes: &[RefNode],
+    mesh: (usize, usize),
+    k: usize,
+    n: usize,
+    noise_px: (f64, f64),
+) -> bool {
+    curvature(results, ref_nodes, mesh, k).is_some_and(|c| {
+        order_choice::needs_second_order(order_choice::first_order_bias_px(c, n), noise_px)
+    })
+}
+
 /// The curvature at node k of an nx x ny mesh from the first-order gradients
 /// (`warp_gradient`) of the `ok` nodes among the 3 x 3 around it: the slopes of the planes
 /// fitted to ∂u/∂x and ∂v/∂x give u_xx and v_xx along x, those fitted to ∂u/∂y and ∂v/∂y give
 /// u_yy and v_yy along y (the fit over three rows has a third of the variance of one row's
 /// central difference); None with fewer than 3 such nodes or collinear ones.
-pub(super) fn curvature(
+fn curvature(
     results: &[ZoiResult],
     ref_nodes: &[RefNode],
     mesh: (usize, usize),

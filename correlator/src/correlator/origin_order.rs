@@ -12,10 +12,10 @@
 //! replaces the first when it converged and its ZNCC is at least the first's and `min_zncc`.
 
 use super::icgn_stage::OriginIcgn;
-use super::order_stage::curvature;
+use super::order_stage::second_order_needed;
 use super::{median, Correlator};
 use crate::field::NodeStatus;
-use crate::icgn::order_choice::{self, NoiseScale};
+use crate::icgn::order_choice::NoiseScale;
 use crate::icgn::shape::Order;
 use crate::pool::SharedSlice;
 use crate::settings::Method;
@@ -95,13 +95,8 @@ impl Correlator {
         buffers.second.clear();
         for i in (0..entries.len()).filter(|&i| verified(i)) {
             let k = entries[i].node;
-            let Some(curvature) = curvature(&buffers.results, &self.reference.nodes, mesh, k)
-            else {
-                continue;
-            };
-            let bias = order_choice::first_order_bias_px(curvature, n);
             let noise = noise[i].noise_px(residual_counts2);
-            if order_choice::needs_second_order(bias, noise) {
+            if second_order_needed(&buffers.results, &self.reference.nodes, mesh, k, n, noise) {
                 buffers.second.push(i);
             }
         }

@@ -74,43 +74,46 @@ pub fn residual_counts2(zncc: f64, stats: &SubsetStats, n: usize) -> f64 {
 /// residual variance is `residual_counts2` (counts²): √(s² H⁻¹) with H⁻¹ of the normalised
 /// subset (hence s² / f_n²).
 pub fn displacement_noise_px(stats: &SubsetStats, residual_counts2: f64) -> (f64, f64) {
-    let count = Order::First.parameters();
-    let norm = stats.norm_counts as f64;
-    let scale = residual_counts2 / (norm * norm);
-    let variance = |a: usize| {
-        (scale * stats.inverse_hessian[a * count + a])
-            .max(0.0)
-            .sqrt()
-    };
-    (variance(0), variance(3))
+    NoiseScale::of_subset(stats).noise_px(residual_counts2)
 }
 
 /// What a first-order result's noise needs of its subset, kept where the subset is not
 /// (measurements against the origin prepare theirs on the fly): its residual per pixel
-/// (counts²) and the diagonal of its normalised H⁻¹ for u and v (1 / counts²).
+/// (counts²), f_n² (counts²) and the diagonal of its H⁻¹ for u and v.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct NoiseScale {
     pub residual_counts2: f64,
-    pub inverse_hessian_uv: (f64, f64),
+    norm_counts2: f64,
+    inverse_hessian_uv: (f64, f64),
 }
 
 impl NoiseScale {
     /// Of a first-order result of ZNCC `zncc` on the side-n subset with `stats`.
     pub fn of(zncc: f64, stats: &SubsetStats, n: usize) -> Self {
-        let norm2 = (stats.norm_counts as f64).powi(2);
-        let count = Order::First.parameters();
         NoiseScale {
             residual_counts2: residual_counts2(zncc, stats, n),
+            ..Self::of_subset(stats)
+        }
+    }
+
+    /// The subset's part alone (no residual).
+    fn of_subset(stats: &SubsetStats) -> Self {
+        let count = Order::First.parameters();
+        let norm = stats.norm_counts as f64;
+        NoiseScale {
+            residual_counts2: 0.0,
+            norm_counts2: norm * norm,
             inverse_hessian_uv: (
-                stats.inverse_hessian[0] / norm2,
-                stats.inverse_hessian[3 * count + 3] / norm2,
+                stats.inverse_hessian[0],
+                stats.inverse_hessian[3 * count + 3],
             ),
         }
     }
 
-    /// As [`displacement_noise_px`] of the subset, for the field's residual `residual_counts2`.
+    /// [`displacement_noise_px`] of the subset, for the field's residual `residual_counts2`.
     pub fn noise_px(&self, residual_counts2: f64) -> (f64, f64) {
-        let sd = |h: f64| (residual_counts2 * h).max(0.0).sqrt();
+        let scale = residual_counts2 / self.norm_counts2;
+        let sd = |h: f64| (scale * h).max(0.0).sqrt();
         (sd(self.inverse_hessian_uv.0), sd(self.inverse_hessian_uv.1))
     }
 }
