@@ -24,7 +24,8 @@ pub struct TruthReport {
     pub node_error_p50_px: Option<f64>,
     pub node_error_p99_px: Option<f64>,
     /// The same per test kind ("uniaxial": the strip's frames, "equibiaxial": the
-    /// cruciform's, "none": between tests), those with nodes compared only.
+    /// cruciform's, "no test": between tests; `status::load_case_name`), those with nodes
+    /// compared only.
     pub node_error_by_load_case: Vec<NodeErrorReport>,
 }
 
@@ -51,12 +52,11 @@ impl TruthReport {
             nodes_compared: recorder.node_errors.count(),
             node_error_p50_px: recorder.node_errors.quantile_px(0.5),
             node_error_p99_px: recorder.node_errors.quantile_px(0.99),
-            node_error_by_load_case: ["none", "uniaxial", "equibiaxial"]
-                .into_iter()
+            node_error_by_load_case: (0u32..)
                 .zip(&recorder.node_errors_by_case)
                 .filter(|(_, e)| e.count() > 0)
-                .map(|(load_case, e)| NodeErrorReport {
-                    load_case,
+                .map(|(code, e)| NodeErrorReport {
+                    load_case: crate::status::load_case_name(code),
                     nodes_compared: e.count(),
                     node_error_p50_px: e.quantile_px(0.5),
                     node_error_p99_px: e.quantile_px(0.99),
