@@ -64,7 +64,7 @@ fn the_default_run_films_the_cruciform_and_its_field_decides() {
     let field = &summary["field_acceptance"];
     assert!(field["error"].is_null(), "{field}");
     assert!(field["model"].is_string(), "{field}");
-    let reached = field["max_stretches"].as_array().unwrap();
+    let reached = field["reach"]["max_stretches"].as_array().unwrap();
     // The arms' roots go further than the centre: uniaxial-like states beyond the
     // equibiaxial ones, both loaded.
     let (major, minor) = (reached[0].as_f64().unwrap(), reached[1].as_f64().unwrap());

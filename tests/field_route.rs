@@ -11,6 +11,7 @@ use common::bench_run::{completed_summary, config, start_run};
 use common::Run;
 use identifier::data::LoadCase;
 use identifier::models::Model;
+use identifier::reach::Reach;
 use live::field_acceptance::judge_route;
 use serde_json::Value;
 use std::path::Path;
@@ -77,9 +78,11 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
     assert!(dropped * 10 <= kept_now, "{field}");
     // The states reached by the frames kept: the arms' near-uniaxial states to λ 1.4, the
     // centre's equibiaxial ones.
-    let reach = field["max_stretches"].as_array().unwrap();
-    assert!(reach[0].as_f64().unwrap() > 1.3, "{field}");
-    assert!(reach[1].as_f64().unwrap() > 1.05, "{field}");
+    let reach = &field["reach"];
+    let max_stretches = reach["max_stretches"].as_array().unwrap();
+    assert!(max_stretches[0].as_f64().unwrap() > 1.3, "{field}");
+    assert!(max_stretches[1].as_f64().unwrap() > 1.05, "{field}");
+    println!("reach: {reach}");
     // The first ranked law's nominal stresses against the truth over the stretches reached.
     // Issue 25's target is 2 %. The true law (Smactane, `[specimen] law_f, law_g`) is
     // Mooney-Rivlin's C10 0.277, C01 0.364 MPa within 0.5 % (least squares over uniaxial and
@@ -88,8 +91,10 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
     // equations (`field_route::information_criteria`), Hart-Smith ranked first in 5 of 10
     // runs and missed the uniaxial stress by 10-16 % at λ 1.35 (its forces within the noise
     // of Mooney-Rivlin's). Mooney-Rivlin first, measured on 10 runs: uniaxial 1.3-1.5 %,
-    // equibiaxial 1.9-2.8 %, pure shear 1.7-2.0 % (camera noise moves them). Asserted with
-    // that spread's margin.
+    // equibiaxial 1.9-2.8 %, pure shear 1.7-2.0 % (camera noise moves them), each case then
+    // judged up to the largest major (equibiaxial: minor) stretch of any node. Judged since up
+    // to each case's own states (`identifier::reach`), one run: uniaxial 1.2 % to λ 1.33,
+    // equibiaxial 2.8 % to 1.09, pure shear 1.4 % to 1.20. Asserted with the spread's margin.
     for case in ["uniaxial", "equibiaxial", "pure_shear"] {
         let error = field[case]["max_relative_error"].as_f64().unwrap();
         assert!(error < 0.035, "{case}: {field}");
@@ -154,14 +159,16 @@ fn offline_agrees_with_the_live_fit(out: &Path) {
     };
     let model = Model::parse(&best).unwrap();
     let (live_p, offline_p) = (law(&fit_of(live_route)), law(&fit_of(&offline)));
-    let reached = |route: &Value, k: usize| route["max_stretches"][k].as_f64().unwrap();
+    let reached = |route: &Value, case: LoadCase| {
+        let reach: Reach = serde_json::from_value(route["reach"].clone()).unwrap();
+        reach.case(case)
+    };
     for case in [
         LoadCase::Uniaxial,
         LoadCase::Equibiaxial,
         LoadCase::PureShear,
     ] {
-        let k = usize::from(case == LoadCase::Equibiaxial);
-        let max = reached(live_route, k).min(reached(&offline, k));
+        let max = reached(live_route, case).min(reached(&offline, case));
         let worst = (1..=100)
             .map(|i| {
                 let l = 1.0 + (max - 1.0) * i as f64 / 100.0;

@@ -26,6 +26,7 @@ use crate::fit::gaussian_fit_term;
 use crate::identifiability::Identifiability;
 use crate::model_window::{self, Candidate, ModelWindow};
 use crate::models::Model;
+use crate::reach::Reach;
 use crate::section_cut::FieldGrid;
 use crate::tapered_ramp::RampQuadrature;
 use crate::vfm::{compile_each, fit_equations, CutObservation, VfmError, VfmFit, VirtualField};
@@ -131,9 +132,9 @@ pub struct FieldFits {
     pub window: Option<ModelWindow>,
     pub refused: Vec<(String, String)>,
     pub frames: usize,
-    /// The reach of the nodes the fit used: their largest major principal stretch (the arms'
-    /// uniaxial-like states) and largest minor one (how far the most equibiaxial state went).
-    pub max_stretches: [f64; 2],
+    /// How far the measured nodes of the kept frames went ([`Reach`]): their largest principal
+    /// stretches, and each load case's largest stretch among its own states.
+    pub reach: Reach,
 }
 
 /// The frames of the test so far.
@@ -355,7 +356,7 @@ impl FieldRoute {
             forces,
             models: self.config.models.clone(),
             frames: self.frames.len(),
-            max_stretches: self.max_stretches(),
+            reach: self.reach(),
             last_frame_id: self.frames.last().map(|f| f.frame_id),
             warm_starts: vec![],
         })
@@ -366,30 +367,10 @@ impl FieldRoute {
         Some(self.fit_job()?.run())
     }
 
-    /// The largest major and minor principal stretches of the kept frames' measured nodes.
-    fn max_stretches(&self) -> [f64; 2] {
-        max_stretches(self.frames.iter().map(|f| &f.grid))
+    /// How far the kept frames' measured nodes went.
+    fn reach(&self) -> Reach {
+        Reach::of_grids(self.frames.iter().map(|f| &f.grid))
     }
-}
-
-/// The largest major and largest minor in-plane principal stretch over the measured nodes of
-/// `grids` ([1, 1] for none): how far the field went towards uniaxial-like (λ1) and equibiaxial
-/// (λ2) states ([`FieldFits::max_stretches`]).
-pub fn max_stretches<'a>(grids: impl IntoIterator<Item = &'a FieldGrid>) -> [f64; 2] {
-    let mut range = [1.0_f64, 1.0_f64];
-    for grid in grids {
-        for f in grid.gradients.iter().flatten() {
-            let c = [
-                f[0][0] * f[0][0] + f[1][0] * f[1][0],
-                f[0][0] * f[0][1] + f[1][0] * f[1][1],
-                f[0][1] * f[0][1] + f[1][1] * f[1][1],
-            ];
-            let (mean, radius) = (0.5 * (c[0] + c[2]), (0.5 * (c[0] - c[2])).hypot(c[1]));
-            range[0] = range[0].max((mean + radius).sqrt());
-            range[1] = range[1].max((mean - radius).max(0.0).sqrt());
-        }
-    }
-    range
 }
 
 /// One kept frame's force balance on one grip: the grip's measured force, and the force its
@@ -450,7 +431,7 @@ pub struct FitJob {
     pub forces: usize,
     pub models: Vec<Model>,
     pub frames: usize,
-    pub max_stretches: [f64; 2],
+    pub reach: Reach,
     /// The last kept frame.
     pub last_frame_id: Option<u64>,
     /// Nonlinear models' starts from an earlier fit (a refit on line starts where the last
@@ -466,7 +447,7 @@ impl FitJob {
         let equations = &self.equations;
         let mut out = FieldFits {
             frames: self.frames,
-            max_stretches: self.max_stretches,
+            reach: self.reach,
             ..FieldFits::default()
         };
         let mooney = fit_equations(&Model::Mooney, equations, &[0.0, 0.0]);
@@ -528,7 +509,7 @@ impl FitJob {
                 bic: f.bic,
             })
             .collect();
-        let (order, window) = model_window::rank(&candidates, self.max_stretches);
+        let (order, window) = model_window::rank(&candidates, &self.reach);
         others.sort_by(|a, b| a.bic.total_cmp(&b.bic));
         out.fits = order.iter().map(|&i| ranked[i].clone()).collect();
         out.fits.extend(others);
@@ -909,8 +890,8 @@ mod tests {
         }
         assert_eq!(fits.fits[0].model, model, "the true family ranks first");
         assert_eq!(fits.frames, 3);
-        assert!((fits.max_stretches[0] - 1.4).abs() < 1e-12);
-        assert!((fits.max_stretches[1] - 1.2).abs() < 1e-12);
+        assert!((fits.reach.max_stretches[0] - 1.4).abs() < 1e-12);
+        assert!((fits.reach.max_stretches[1] - 1.2).abs() < 1e-12);
         // Under the truth every grip's fields balance its force; under a stiffer law they
         // compute more than was measured.
         let balance = route.force_balance(&model, &truth);
@@ -952,9 +933,9 @@ mod tests {
         assert!((w1 - c10).abs() < 1e-15 && (w2 - c01).abs() < 1e-15);
         // A field's reach: the largest major and minor stretches over its nodes.
         let g = grid([[1.2, 0.0], [0.0, 0.9]]);
-        assert_eq!(max_stretches([&g]), [1.2, 1.0]);
+        assert_eq!(Reach::of_grids([&g]).max_stretches, [1.2, 1.0]);
         let h = grid([[1.1, 0.0], [0.0, 1.3]]);
-        let reach = max_stretches([&g, &h]);
+        let reach = Reach::of_grids([&g, &h]).max_stretches;
         assert!((reach[0] - 1.3).abs() < 1e-15 && (reach[1] - 1.1).abs() < 1e-15);
     }
 

@@ -62,6 +62,7 @@ pub mod plot;
 #[cfg(feature = "process")]
 pub mod process;
 pub mod ranking;
+pub mod reach;
 pub mod report;
 pub mod residual_plot;
 pub mod residuals;

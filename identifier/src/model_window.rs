@@ -17,6 +17,7 @@
 
 use crate::data::LoadCase;
 use crate::models::Model;
+use crate::reach::Reach;
 
 /// A BIC within this of the lowest is not told apart from it.
 pub const TOLD_APART_BIC: f64 = 10.0;
@@ -91,8 +92,8 @@ pub struct Candidate<'a> {
 
 /// The order of `candidates` (indices): by BIC, except that among those within
 /// [`TOLD_APART_BIC`] of the lowest the one with the fewest parameters comes first; and the
-/// window when it holds more than one. `reach`: the largest major and minor stretches.
-pub fn rank(candidates: &[Candidate], reach: [f64; 2]) -> (Vec<usize>, Option<ModelWindow>) {
+/// window when it holds more than one; the spreads over each case's `reach`.
+pub fn rank(candidates: &[Candidate], reach: &Reach) -> (Vec<usize>, Option<ModelWindow>) {
     let mut order: Vec<usize> = (0..candidates.len()).collect();
     order.sort_by(|&a, &b| candidates[a].bic.total_cmp(&candidates[b].bic));
     let Some(&best) = order.first() else {
@@ -112,7 +113,7 @@ pub fn rank(candidates: &[Candidate], reach: [f64; 2]) -> (Vec<usize>, Option<Mo
         return (order, None);
     }
     let members = &order[..within];
-    let spread = |case: LoadCase, top: f64| spread(candidates, members, case, top);
+    let spread = |case: LoadCase| spread(candidates, members, case, reach.case(case));
     let window = ModelWindow {
         models: members
             .iter()
@@ -123,9 +124,9 @@ pub fn rank(candidates: &[Candidate], reach: [f64; 2]) -> (Vec<usize>, Option<Mo
             .map(|&i| candidates[i].bic - lowest)
             .collect(),
         bic_window: TOLD_APART_BIC,
-        spread_uniaxial: spread(LoadCase::Uniaxial, reach[0]),
-        spread_equibiaxial: spread(LoadCase::Equibiaxial, reach[1]),
-        spread_pure_shear: spread(LoadCase::PureShear, reach[0]),
+        spread_uniaxial: spread(LoadCase::Uniaxial),
+        spread_equibiaxial: spread(LoadCase::Equibiaxial),
+        spread_pure_shear: spread(LoadCase::PureShear),
     };
     (order, Some(window))
 }
@@ -166,6 +167,16 @@ mod tests {
         Candidate { model, params, bic }
     }
 
+    /// A reach: uniaxial and pure shear to `major`, equibiaxial to `minor`.
+    fn reach(major: f64, minor: f64) -> Reach {
+        Reach {
+            max_stretches: [major, minor],
+            uniaxial: major,
+            equibiaxial: minor,
+            pure_shear: major,
+        }
+    }
+
     #[test]
     fn the_fewest_parameters_lead_a_window_and_strong_evidence_still_wins() {
         let (mooney, hart_smith, neo) = (Model::Mooney, Model::HartSmith, Model::NeoHookean);
@@ -176,7 +187,7 @@ mod tests {
             candidate(&hart_smith, &ph, 258.9),
             candidate(&mooney, &pm, 266.4),
         ];
-        let (order, window) = rank(&fits, [1.35, 1.08]);
+        let (order, window) = rank(&fits, &reach(1.35, 1.08));
         assert_eq!(order, vec![2, 1, 0]);
         let window = window.unwrap();
         assert_eq!(window.models, vec!["mooney", "hart-smith"]);
@@ -190,11 +201,11 @@ mod tests {
             candidate(&mooney, &pm, 266.4),
             candidate(&hart_smith, &ph, 250.0),
         ];
-        let (order, window) = rank(&fits, [1.35, 1.08]);
+        let (order, window) = rank(&fits, &reach(1.35, 1.08));
         assert_eq!((order, window), (vec![1, 0], None));
         // A lone fit, and none.
-        assert_eq!(rank(&fits[..1], [1.35, 1.08]), (vec![0], None));
-        assert_eq!(rank(&[], [1.35, 1.08]), (vec![], None));
+        assert_eq!(rank(&fits[..1], &reach(1.35, 1.08)), (vec![0], None));
+        assert_eq!(rank(&[], &reach(1.35, 1.08)), (vec![], None));
     }
 
     #[test]
@@ -206,7 +217,7 @@ mod tests {
             candidate(&ogden, &[1.2, 2.0], 95.0),
             candidate(&neo, &[0.6], 120.0),
         ];
-        let (order, window) = rank(&fits, [1.3, 1.0]);
+        let (order, window) = rank(&fits, &reach(1.3, 1.0));
         assert_eq!(order, vec![1, 0, 2]);
         let window = window.unwrap();
         // Equibiaxial not reached (λ2 1.0): no spread there.

@@ -2,9 +2,10 @@
 //! field route ranked first by BIC among the fits whose parameters it identifies
 //! (`identification.json`'s `field_route`, any family of the catalogue) against
 //! `[specimen]`'s, in uniaxial, equibiaxial and pure-shear nominal stress over the states the
-//! field reached: uniaxial and pure shear up to the largest major principal stretch of the
-//! nodes used, equibiaxial up to the largest minor one. The worst relative error over
-//! (1, max] (200 stretches), as the gauge route's acceptance measures it. Reported in
+//! field reached: each case up to the largest stretch at which the kept frames' nodes held a
+//! state of that case (`identifier::reach::Reach`: a state's biaxiality ln λ2 / ln λ1 within
+//! 0.1 of the case's). The worst relative error over (1, max] (200 stretches), as the gauge
+//! route's acceptance measures it. Reported in
 //! `summary.json` (`field_acceptance`) beside the gauge route's acceptance; on a structure it
 //! decides the run's ending (the gauge's force / section is no stress there).
 
@@ -12,6 +13,7 @@ use crate::acceptance::CaseComparison;
 use identifier::data::LoadCase;
 use identifier::law::InvariantLaw;
 use identifier::models::Model;
+use identifier::reach::Reach;
 use serde::Serialize;
 use serde_json::Value;
 use std::path::Path;
@@ -29,7 +31,8 @@ pub struct FieldAcceptance {
     /// its parameter names.
     pub model: Option<String>,
     pub params: Vec<f64>,
-    pub max_stretches: Option<[f64; 2]>,
+    /// How far the field went, per case (the route's `reach`).
+    pub reach: Option<Reach>,
     pub uniaxial: Option<CaseComparison>,
     pub equibiaxial: Option<CaseComparison>,
     pub pure_shear: Option<CaseComparison>,
@@ -92,14 +95,9 @@ pub(crate) const CASES: [(&str, LoadCase, TrueCurve); 3] = [
     ),
 ];
 
-/// How far the field reached `case`, given the nodes' largest major and minor principal
-/// stretches: uniaxial and pure shear to the major one, equibiaxial to the minor one; None
-/// when not reached (at most 1.005).
-pub(crate) fn reach(case: LoadCase, [major, minor]: [f64; 2]) -> Option<f64> {
-    let max = match case {
-        LoadCase::Equibiaxial => minor,
-        _ => major,
-    };
+/// How far the field reached `case`; None when not reached (at most 1.005).
+pub(crate) fn reach(case: LoadCase, reach: &Reach) -> Option<f64> {
+    let max = reach.case(case);
     (max > 1.005).then_some(max)
 }
 
@@ -155,12 +153,10 @@ pub fn judge_route(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
         .as_array()
         .and_then(|f| f.iter().find(|fit| fit["identifiable"] != false))
         .and_then(law_of);
-    let max_stretches = route["max_stretches"]
-        .as_array()
-        .and_then(|m| Some([m.first()?.as_f64()?, m.get(1)?.as_f64()?]));
+    let reached: Option<Reach> = serde_json::from_value(route["reach"].clone()).ok();
     let [uniaxial, equibiaxial, pure_shear] = CASES.map(|(_, case, true_curve)| {
         let (model, p) = best.as_ref()?;
-        let max = reach(case, max_stretches?)?;
+        let max = reach(case, reached.as_ref()?)?;
         Some(worst(
             |l| true_curve(truth, l),
             |l| model.nominal_stress_mpa(p, case, l),
@@ -172,7 +168,7 @@ pub fn judge_route(truth: &InvariantLaw, route: &Value) -> FieldAcceptance {
     FieldAcceptance {
         model: best.as_ref().map(|(m, _)| m.name()),
         params: best.map(|(_, p)| p).unwrap_or_default(),
-        max_stretches,
+        reach: reached,
         uniaxial,
         equibiaxial,
         pure_shear,
@@ -202,7 +198,8 @@ mod tests {
         let route = |a0: f64| {
             json!({
                 "frames": 12,
-                "max_stretches": [1.5, 1.3],
+                "reach": {"max_stretches": [1.5, 1.3], "uniaxial": 1.5, "equibiaxial": 1.3,
+                          "pure_shear": 1.2},
                 "fits": [{"model": "lambert-diani-rey:2,2",
                           "params": {"a0": a0, "a1": -2.52e-2, "a2": 1.40e-3,
                                      "b0": -1.02, "b1": -3.92e-3, "b2": -5.30e-4}}],
@@ -225,6 +222,7 @@ mod tests {
         assert_eq!(exact.model.as_deref(), Some("lambert-diani-rey:2,2"));
         assert_eq!(exact.uniaxial.unwrap().max_stretch, 1.5);
         assert_eq!(exact.equibiaxial.unwrap().max_stretch, 1.3);
+        assert_eq!(exact.pure_shear.unwrap().max_stretch, 1.2);
         assert!(exact.pure_shear.unwrap().max_relative_error < 1e-12);
         // f 10 % stiffer: measured, not passed.
         let off = judge_route(&truth, &route(-1.27 + 0.1_f64.ln_1p()));

@@ -25,7 +25,7 @@ fn stretches(max: f64, samples: usize) -> impl Iterator<Item = f64> {
 /// The figure's series: per case the field reached, the true law (line) and the identified
 /// one (markers, in the line's colour); empty when the route identified no law or reached no stretch.
 pub fn series(truth: &InvariantLaw, acceptance: &FieldAcceptance) -> Vec<Series> {
-    let (Some(name), Some(reached)) = (&acceptance.model, acceptance.max_stretches) else {
+    let (Some(name), Some(reached)) = (&acceptance.model, &acceptance.reach) else {
         return Vec::new();
     };
     let Ok(model) = Model::parse(name) else {
@@ -34,7 +34,7 @@ pub fn series(truth: &InvariantLaw, acceptance: &FieldAcceptance) -> Vec<Series>
     let p = &acceptance.params;
     let mut out = Vec::new();
     for (case_name, case, true_curve) in CASES {
-        // As the acceptance compares them: equibiaxial up to the minor stretch reached.
+        // As the acceptance compares them: each case up to its own states' reach.
         let Some(max) = reach(case, reached) else {
             continue;
         };
@@ -158,12 +158,14 @@ mod tests {
     use crate::field_acceptance::judge_route;
     use serde_json::json;
 
-    fn acceptance(max_stretches: [f64; 2]) -> FieldAcceptance {
+    /// Each case reached to its stretch.
+    fn acceptance([uniaxial, equibiaxial, pure_shear]: [f64; 3]) -> FieldAcceptance {
         judge_route(
             &InvariantLaw::smactane(),
             &json!({
                 "frames": 12,
-                "max_stretches": max_stretches,
+                "reach": {"max_stretches": [uniaxial, equibiaxial], "uniaxial": uniaxial,
+                          "equibiaxial": equibiaxial, "pure_shear": pure_shear},
                 "fits": [{"model": "mooney", "params": {"C10": 0.3, "C01": 0.05}}],
             }),
         )
@@ -172,7 +174,7 @@ mod tests {
     #[test]
     fn each_case_reached_has_its_true_line_and_the_identified_markers() {
         let truth = InvariantLaw::smactane();
-        let series = series(&truth, &acceptance([1.6, 1.3]));
+        let series = series(&truth, &acceptance([1.6, 1.3, 1.2]));
         let labels: Vec<&str> = series.iter().map(|s| s.label.as_str()).collect();
         assert_eq!(
             labels,
@@ -185,10 +187,11 @@ mod tests {
                 "pure shear: field route (mooney)",
             ]
         );
-        // Each over the stretches the acceptance compares: equibiaxial to the minor one.
+        // Each over the stretches the acceptance compares: each case to its own reach.
         let last_x = |s: &Series| s.points.last().unwrap().0;
         assert!((last_x(&series[0]) - 1.6).abs() < 1e-12);
         assert!((last_x(&series[3]) - 1.3).abs() < 1e-12);
+        assert!((last_x(&series[4]) - 1.2).abs() < 1e-12);
         assert!(series[1].markers && !series[0].markers);
         // The true line is the law's: at λ 1.6 in uniaxial tension.
         let (l, s) = *series[0].points.last().unwrap();
@@ -201,14 +204,14 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let png = dir.join("field_route_law.png");
         let truth = InvariantLaw::smactane();
-        assert!(field_route_law_png(&png, &truth, &acceptance([1.6, 1.3])).unwrap());
+        assert!(field_route_law_png(&png, &truth, &acceptance([1.6, 1.3, 1.2])).unwrap());
         assert!(std::fs::metadata(&png).unwrap().len() > 1000);
         std::fs::remove_file(&png).unwrap();
         let nothing = judge_route(&truth, &json!({"error": "crosses no arm", "fits": null}));
         assert!(!field_route_law_png(&png, &truth, &nothing).unwrap());
         assert!(!png.exists());
         // At rest: no stretch reached, no figure.
-        assert!(!field_route_law_png(&png, &truth, &acceptance([1.0, 1.0])).unwrap());
+        assert!(!field_route_law_png(&png, &truth, &acceptance([1.0, 1.0, 1.0])).unwrap());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

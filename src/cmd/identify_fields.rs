@@ -175,15 +175,19 @@ fn print_table(
     writeln!(
         out,
         "{} frames fitted of {} field files ({} not a new loading state, {} with a grip at rest, \
-         {} thinned); {} virtual fields dropped; stretches reached: major {:.3}, minor {:.3}",
+         {} thinned); {} virtual fields dropped; stretches reached: major {:.3}, minor {:.3}; \
+         in uniaxial states {:.3}, equibiaxial {:.3}, pure shear {:.3}",
         fits.frames,
         saved.fields_read,
         c.not_loading,
         c.grips_unloaded,
         c.thinned,
         c.virtual_fields_dropped,
-        fits.max_stretches[0],
-        fits.max_stretches[1]
+        fits.reach.max_stretches[0],
+        fits.reach.max_stretches[1],
+        fits.reach.uniaxial,
+        fits.reach.equibiaxial,
+        fits.reach.pure_shear,
     )?;
     writeln!(
         out,
@@ -339,7 +343,14 @@ pub(super) mod tests {
         assert_eq!(value["fields_read"], 5);
         assert_eq!(value["counters"]["kept"], 5);
         assert_eq!(value["source"]["per_grip_forces"], true);
-        assert_eq!(value["max_stretches"], json!([1.25, 1.25]));
+        // Equibiaxial fields: only the equibiaxial case was reached.
+        let reach = &value["reach"];
+        assert_eq!(reach["max_stretches"], json!([1.25, 1.25]));
+        assert_eq!(reach["equibiaxial"], 1.25, "{reach}");
+        assert_eq!(
+            (&reach["uniaxial"], &reach["pure_shear"]),
+            (&json!(1.0), &json!(1.0))
+        );
         let fit = &value["fits"][0];
         assert_eq!(fit["model"], "mooney", "the run's models: {value}");
         assert_eq!(fit["rank"].is_null(), !fit["warning"].is_null(), "{value}");

@@ -382,7 +382,7 @@ impl FieldShell {
             },
         });
         let fitted = fits.map_or(
-            json!({"frames": null, "max_stretches": null, "fits": null, "refused": null, "not_told_apart": null}),
+            json!({"frames": null, "reach": null, "fits": null, "refused": null, "not_told_apart": null}),
             fits_json,
         );
         if let (Some(out), Value::Object(fitted)) = (out.as_object_mut(), fitted) {
@@ -393,7 +393,8 @@ impl FieldShell {
     }
 }
 
-/// The fits' part of the field route's JSON: frames, the stretches reached, each fit
+/// The fits' part of the field route's JSON: frames, the stretches reached (`reach`:
+/// [`crate::reach::Reach`]), each fit
 /// (parameters, σ, RMS force, equations, condition number, AIC, BIC; the first ranked first:
 /// by BIC, the fewest parameters first among the models the forces do not tell apart, listed
 /// in `not_told_apart` with their stresses' spread, null when one stands out) and the models
@@ -401,7 +402,7 @@ impl FieldShell {
 pub fn fits_json(fits: &FieldFits) -> Value {
     json!({
         "frames": fits.frames,
-        "max_stretches": fits.max_stretches,
+        "reach": fits.reach,
         "fits": fits.fits.iter().map(|fit| {
             let names = fit.model.param_names();
             json!({

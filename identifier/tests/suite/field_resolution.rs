@@ -169,7 +169,7 @@ fn at_the_live_resolution_mooney_rivlin_ranks_above_hart_smith_and_fits_within_3
             found.unwrap_or_else(|| panic!("{way}: {model} not fitted {:?}", fits.refused))
         };
         let (mooney, hart_smith) = (of(Model::Mooney), of(Model::HartSmith));
-        let reach = fits.max_stretches;
+        let reach = fits.reach.max_stretches;
         // Uniaxial and pure shear to the largest major stretch, equibiaxial to the minor one.
         let gaps = smactane_gaps(
             &mooney.model,
@@ -179,7 +179,7 @@ fn at_the_live_resolution_mooney_rivlin_ranks_above_hart_smith_and_fits_within_3
         println!(
             "{way}: reach {:.3?}; BIC Mooney-Rivlin {:.1}, Hart-Smith {:.1}; Mooney-Rivlin's \
              worst gaps (uniaxial, equibiaxial, pure shear) {gaps:.4?}",
-            fits.max_stretches, mooney.bic, hart_smith.bic
+            fits.reach.max_stretches, mooney.bic, hart_smith.bic
         );
         assert!(mooney.ranked() && hart_smith.ranked(), "{way}");
         // Noise-free, the forces tell the two apart by far more than any noise could blur.

@@ -8,9 +8,10 @@
 use crate::cruciform;
 
 use cruciform::{observations, ramp_quadratures, smactane_gaps, solved_frames, GRID_STEP_MM};
-use identifier::field_route::{max_stretches, FieldFits, FitJob};
+use identifier::field_route::{FieldFits, FitJob};
 use identifier::models::Model;
 use identifier::online::OnlineConfig;
+use identifier::reach::Reach;
 use identifier::vfm::compile;
 use identifier::virtual_work::Equations;
 use material::InvariantLaw;
@@ -71,7 +72,7 @@ impl Evidence {
             forces: 4 * frames.len(),
             models: models(),
             frames: frames.len(),
-            max_stretches: max_stretches(frames.iter().map(|f| &f.grid)),
+            reach: Reach::of_grids(frames.iter().map(|f| &f.grid)),
             last_frame_id: None,
             warm_starts: earlier.map_or(vec![], |e| {
                 e.fits
@@ -108,7 +109,7 @@ impl Evidence {
     fn report(&self, mesh: &str) {
         println!(
             "{mesh}: reach (max λ1, max λ2) {:.3?}; true law's relative RMS {:.3e}",
-            self.fits.max_stretches,
+            self.fits.reach.max_stretches,
             self.relative_rms(&LDR, &truth())
         );
         for (rank, f) in self.fits.fits.iter().enumerate() {
@@ -134,7 +135,7 @@ impl Evidence {
 /// largest minor one, pure shear (I1 = I2) up to the largest I2 of its nodes (beyond, g is
 /// extrapolated: the arms' uniaxial states reach I1 ≈ 21 but I2 ≈ 9 only). Each case's worst.
 fn stress_gaps(model: &Model, params: &[f64], evidence: &Evidence) -> [f64; 3] {
-    let reach = evidence.fits.max_stretches;
+    let reach = evidence.fits.reach.max_stretches;
     let max_i2 = evidence
         .equations
         .stretches()
@@ -171,7 +172,7 @@ fn the_field_rejects_mooney_rivlin_beyond_100_percent_and_ranks_smactane_s_famil
     coarse.report("10 mm elements");
     fine.report("5 mm elements");
     for evidence in [&coarse, &fine] {
-        let reach = evidence.fits.max_stretches;
+        let reach = evidence.fits.reach.max_stretches;
         // The arms beyond 100 % strain.
         assert!(reach[0] > 3.0, "{reach:?}");
         let best = &evidence.fits.fits[0];

@@ -214,7 +214,8 @@ mod tests {
         let route = |a0: f64| {
             serde_json::json!({
                 "frames": 12,
-                "max_stretches": [1.7, 1.13],
+                "reach": {"max_stretches": [1.7, 1.13], "uniaxial": 1.7, "equibiaxial": 1.13,
+                          "pure_shear": 1.3},
                 "fits": [{"model": "lambert-diani-rey:2,2",
                           "params": {"a0": a0, "a1": -2.52e-2, "a2": 1.40e-3,
                                      "b0": -1.02, "b1": -3.92e-3, "b2": -5.30e-4}}],
