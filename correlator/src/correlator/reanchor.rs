@@ -14,6 +14,7 @@
 
 use super::{
     to_mat2, Correlator, Entry, FrameCoefficients, Support, CARRY_RINGS, EXTRAPOLATION_RINGS,
+    LOCAL_RINGS,
 };
 use crate::field::NodeStatus;
 use crate::interpolate::Mat2;
@@ -99,7 +100,8 @@ impl Correlator {
                 continue;
             }
             let gradient: Mat2 = self
-                .affine_fit(Some(k), EXTRAPOLATION_RINGS, None, Support::Valid)
+                .affine_fit(Some(k), LOCAL_RINGS, None, Support::Valid)
+                .or_else(|| self.affine_fit(Some(k), EXTRAPOLATION_RINGS, None, Support::Valid))
                 .map_or([[0.0; 2]; 2], |fit| to_mat2(fit.gradient));
             entries.push(Entry {
                 node: k,
