@@ -196,9 +196,8 @@ fn between_rows(a: &InversePoint, c: &InversePoint, basis: &[f64; 4], s: f64) ->
 
 #[cfg(test)]
 mod tests {
-    use super::super::{ReferenceMesh, View};
+    use super::super::View;
     use super::*;
-    use membrane::specimens::cruciform::CruciformGeometry;
 
     /// On a solved cruciform (equibiaxial grip stretch 1.5: the fillets' strain concentrations,
     /// the arms' edges and the room between them in view), seen at two scales, the cell walk of
@@ -206,17 +205,12 @@ mod tests {
     /// as the row walk, and interpolates most block ends between grid rows.
     #[test]
     fn the_cell_walk_is_within_1e_3_px_of_the_exact_inverse() {
-        let specimen = CruciformGeometry::default().mesh().unwrap();
-        let law = material::InvariantLaw::smactane();
-        let solved = specimen
-            .solve_at(&law, membrane::GripStretch { x: 1.5, y: 1.5 })
-            .unwrap();
-        let reference = ReferenceMesh::new(specimen.mesh);
+        let (reference, displacement_mm) = super::super::tests::stretched_cruciform();
         let side = 1024usize;
         for mm_per_px in [0.16, 0.25] {
             let view = View::centred(mm_per_px, side as u32, side as u32);
             let motion =
-                FieldMotion::new(reference.clone(), solved.displacement_mm.clone(), view).unwrap();
+                FieldMotion::new(reference.clone(), displacement_mm.clone(), view).unwrap();
             let mut cells = CellRows::new(side);
             let (mut worst, mut worst_rows, mut material) = (0.0f64, 0.0f64, 0usize);
             let (mut interpolated, mut material_ends) = (0usize, 0usize);
