@@ -213,6 +213,7 @@ mod tests {
                 FieldMotion::new(reference.clone(), displacement_mm.clone(), view).unwrap();
             let mut cells = CellRows::new(side);
             let (mut worst, mut worst_rows, mut material) = (0.0f64, 0.0f64, 0usize);
+            let mut apart = 0.0f64;
             let (mut interpolated, mut material_ends) = (0usize, 0usize);
             for y in 0..side {
                 let mut row_walk = RowWalker::new(&motion, y as f64);
@@ -231,6 +232,9 @@ mod tests {
                         let off = |p: &Vec2| (p[0] - want[0]).abs().max((p[1] - want[1]).abs());
                         worst = worst.max(off(got));
                         worst_rows = worst_rows.max(rows.as_ref().map_or(0.0, off));
+                        if let Some(r) = rows {
+                            apart = apart.max((got[0] - r[0]).abs().max((got[1] - r[1]).abs()));
+                        }
                         material += 1;
                     }
                 }
@@ -251,7 +255,7 @@ mod tests {
             let share = interpolated as f64 / material_ends as f64;
             eprintln!(
                 "cell walk at {mm_per_px} mm/px: worst {worst:.2e} px (the row walk's \
-                 {worst_rows:.2e}) over {material} pixels \
+                 {worst_rows:.2e}; the two walks {apart:.1e} px apart) over {material} pixels \
                  on the specimen; between grid rows, {:.0} % of the block ends near the specimen \
                  interpolated",
                 100.0 * share
