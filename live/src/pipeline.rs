@@ -4,12 +4,15 @@
 //! latency from capture to field published and to identification published, the sustained
 //! rate, the frames the correlator never measured (`pipeline/gaps.rs`: where and why), what the
 //! reference renewals cost the fields around them (`pipeline/renewals.rs`), and the
-//! CPU each process used. With
+//! CPU each process used, and what the simulated camera costs filming the finite-element
+//! cruciform of a default run (`pipeline/camera_cost.rs`). With
 //! `--fps max` trials at increasing rates find the highest rate without a dropped frame.
 
+pub mod camera_cost;
 mod gaps;
 mod renewals;
 
+pub use camera_cost::CameraCost;
 pub use gaps::FrameGaps;
 pub use renewals::{FieldCostMs, RenewalCosts};
 
@@ -55,6 +58,9 @@ pub struct PipelineResult {
     /// What the reference renewals cost the fields around them.
     pub renewal_costs: RenewalCosts,
     pub results: PathBuf,
+    /// The simulated camera filming the finite-element cruciform (the trials film the
+    /// homogeneous sheet): measured once, after the trials.
+    pub camera_on_cruciform: Option<CameraCost>,
 }
 
 impl PipelineResult {
@@ -140,6 +146,7 @@ fn result_of(report: &RunReport, fps: f64) -> PipelineResult {
             &std::fs::read_to_string(report.results.join("frames.csv")).unwrap_or_default(),
         ),
         results: report.results.clone(),
+        camera_on_cruciform: None,
     }
 }
 
@@ -164,9 +171,25 @@ pub fn trial(settings: &PipelineSettings, fps: f64) -> anyhow::Result<PipelineRe
     Ok(result_of(&report, fps))
 }
 
-/// The requested rate, or the search for the highest rate without drops. `progress` sees
-/// each trial as it ends.
+/// Frames the camera films the cruciform for its cost.
+const CAMERA_COST_FRAMES: usize = 30;
+
+/// The requested rate, or the search for the highest rate without drops (`progress` sees
+/// each trial as it ends); then the camera's cost on the cruciform at the trials' frame size.
 pub fn measure(
+    settings: &PipelineSettings,
+    progress: impl FnMut(&PipelineResult),
+) -> anyhow::Result<PipelineResult> {
+    let mut result = trials(settings, progress)?;
+    result.camera_on_cruciform = Some(camera_cost::on_cruciform(
+        settings.width_px,
+        settings.height_px,
+        CAMERA_COST_FRAMES,
+    )?);
+    Ok(result)
+}
+
+fn trials(
     settings: &PipelineSettings,
     mut progress: impl FnMut(&PipelineResult),
 ) -> anyhow::Result<PipelineResult> {

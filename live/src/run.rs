@@ -17,7 +17,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 use std::time::Duration;
 
-mod child_launch;
+pub(crate) mod child_launch;
 mod deaths;
 mod drain;
 mod event_loop;

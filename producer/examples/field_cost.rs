@@ -9,7 +9,7 @@
 //! `cargo run --release -p producer --example field_cost -- --frames 20`
 
 use membrane::specimens::cruciform::CruciformGeometry;
-use producer::field_motion::{RowWalker, BLOCK_SPAN_PX};
+use producer::field_motion::CellRows;
 use producer::{
     Affine, FastRenderer, FieldMotion, Motion, ReferenceMesh, Speckle, SpeckleParams, View,
 };
@@ -98,13 +98,11 @@ fn main() {
         fast.render(&affine, side, &mut out[..]);
         let t3 = Instant::now();
         let mut sum = 0.0;
-        let mut points = [None; BLOCK_SPAN_PX];
+        let mut cells = CellRows::new(side);
         for y in 0..side {
-            let mut walker = RowWalker::new(&field, y as f64);
-            for b in 0..side / BLOCK_SPAN_PX {
-                walker.block(b * BLOCK_SPAN_PX, &mut points);
+            cells.walk_row(&field, y, |_, points| {
                 sum += points.iter().flatten().map(|p| p[0]).sum::<f64>();
-            }
+            });
         }
         let t4 = Instant::now();
         walk_ms.push((t4 - t3).as_secs_f64() * 1e3);

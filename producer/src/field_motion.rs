@@ -18,12 +18,16 @@
 //! coordinates (one or two Newton steps of the quadratic map), and falls back to the element
 //! grid when it crosses into another element.
 
+mod cells;
 mod element_map;
+mod outline;
 
 use std::sync::Arc;
 
+pub use cells::{CellRows, CELL_ROWS};
 use element_map::QuadraticMap;
 use membrane::{sample_at, ElementGrid, Location, Mesh, PointSample};
+use outline::{near_a_span, Outline};
 
 use crate::error::ProducerError;
 use crate::motion::{inverse, mul_mat, Mat2, Vec2};
@@ -105,14 +109,53 @@ pub struct ReferenceMesh {
     pub mesh: Mesh,
     grid: ElementGrid,
     maps: Vec<QuadraticMap>,
+    /// Per element: whether one of its edges is on the specimen's boundary (no other element
+    /// shares it).
+    on_boundary: Vec<bool>,
+    /// The boundary edges: corner, midside, corner.
+    boundary_edges: Vec<[usize; 3]>,
 }
 
 impl ReferenceMesh {
     pub fn new(mesh: Mesh) -> Arc<ReferenceMesh> {
         let grid = ElementGrid::new(&mesh);
         let maps = element_maps(&mesh);
-        Arc::new(ReferenceMesh { mesh, grid, maps })
+        let (on_boundary, boundary_edges) = boundary(&mesh);
+        Arc::new(ReferenceMesh {
+            mesh,
+            grid,
+            maps,
+            on_boundary,
+            boundary_edges,
+        })
     }
+}
+
+/// Per element of `mesh`, whether an edge of it belongs to no other element; and those edges
+/// (corner, midside, corner).
+fn boundary(mesh: &Mesh) -> (Vec<bool>, Vec<[usize; 3]>) {
+    // Edge k of a six-node triangle: corners k and k + 1, midside 3 + k.
+    let edge = |e: &[usize; 6], k: usize| [e[k], e[3 + k], e[(k + 1) % 3]];
+    let key = |e: &[usize; 3]| (e[0].min(e[2]), e[0].max(e[2]));
+    let mut count = std::collections::HashMap::new();
+    for e in &mesh.elements {
+        for k in 0..3 {
+            *count.entry(key(&edge(e, k))).or_insert(0usize) += 1;
+        }
+    }
+    let alone = |e: &[usize; 3]| count[&key(e)] == 1;
+    let on_boundary = mesh
+        .elements
+        .iter()
+        .map(|e| (0..3).any(|k| alone(&edge(e, k))))
+        .collect();
+    let edges = mesh
+        .elements
+        .iter()
+        .flat_map(|e| (0..3).map(move |k| edge(e, k)))
+        .filter(|e| alone(e))
+        .collect();
+    (on_boundary, edges)
 }
 
 fn element_maps(mesh: &Mesh) -> Vec<QuadraticMap> {
@@ -125,9 +168,11 @@ fn element_maps(mesh: &Mesh) -> Vec<QuadraticMap> {
 #[derive(Clone, Debug)]
 pub struct FieldMotion {
     reference: Arc<ReferenceMesh>,
-    /// The element grid and maps of the deformed mesh (nodes at Xᵢ + uᵢ).
+    /// The element grid and maps of the deformed mesh (nodes at Xᵢ + uᵢ), and its outline in
+    /// the image.
     current_grid: ElementGrid,
     current_maps: Vec<QuadraticMap>,
+    outline: Outline,
     /// Nodal displacements, two per node, mm.
     u_mm: Vec<f64>,
     view: View,
@@ -198,10 +243,13 @@ impl FieldMotion {
         }
         let current_grid = ElementGrid::new(&current);
         let current_maps = element_maps(&current);
+        let nodes_px: Vec<Vec2> = current.nodes_mm.iter().map(|&x| view.to_px(x)).collect();
+        let outline = Outline::new(&reference.boundary_edges, &nodes_px);
         Ok(FieldMotion {
             reference,
             current_grid,
             current_maps,
+            outline,
             u_mm,
             view,
         })
@@ -249,7 +297,7 @@ impl FieldMotion {
     /// updates `hint` (None off the specimen).
     #[inline]
     pub fn inverse_along_row(&self, x_px: Vec2, hint: &mut RowHint) -> Option<Vec2> {
-        let l = self.locate_current(x_px, hint)?;
+        let l = self.locate_current(x_px, [*hint, None], hint)?;
         Some(
             self.view
                 .to_px(self.reference.maps[l.element].at(l.xi, l.eta)),
@@ -259,7 +307,19 @@ impl FieldMotion {
     /// X = φ⁻¹(x) with its gradient ∂X/∂x = F⁻¹ there (what a renderer interpolates between
     /// two exact points of a row), from `hint` like [`Self::inverse_along_row`].
     pub fn inverse_point(&self, x_px: Vec2, hint: &mut RowHint) -> Option<InversePoint> {
-        let l = self.locate_current(x_px, hint)?;
+        self.inverse_point_from(x_px, [*hint, None], hint)
+    }
+
+    /// [`Self::inverse_point`] trying the elements of `hints` in turn before the element grid
+    /// (a point between two of a row's points in different elements is in one of the two, as
+    /// a rule); `found` is where it was found.
+    fn inverse_point_from(
+        &self,
+        x_px: Vec2,
+        hints: [RowHint; 2],
+        found: &mut RowHint,
+    ) -> Option<InversePoint> {
+        let l = self.locate_current(x_px, hints, found)?;
         let reference = &self.reference.maps[l.element];
         // J = ∂(position)/∂(ξ, η) in both configurations; ∂X/∂x = J_reference J_current⁻¹.
         let j_cur_inverse = inverse(&self.current_maps[l.element].jacobian(l.xi, l.eta));
@@ -285,23 +345,30 @@ impl FieldMotion {
         )
     }
 
-    /// Where `x_px` is in the deformed mesh: Newton in the element of `hint` from its natural
-    /// coordinates, else through the element grid; updates `hint`.
+    /// Where `x_px` is in the deformed mesh: Newton in the elements of `hints` from their
+    /// natural coordinates, in turn, else through the element grid; `found` is where.
     #[inline]
-    fn locate_current(&self, x_px: Vec2, hint: &mut RowHint) -> Option<Location> {
+    fn locate_current(
+        &self,
+        x_px: Vec2,
+        hints: [RowHint; 2],
+        found: &mut RowHint,
+    ) -> Option<Location> {
         let x_mm = self.view.to_mm(x_px);
         let in_element = |element: usize, start: (f64, f64)| {
             let (xi, eta) = self.current_maps[element].natural(x_mm, start)?;
             Some(Location { element, xi, eta })
         };
-        let location = hint
+        let second = hints[1].filter(|h| hints[0].is_none_or(|f| f.element != h.element));
+        let location = hints[0]
             .and_then(|h| in_element(h.element, (h.xi, h.eta)))
+            .or_else(|| second.and_then(|h| in_element(h.element, (h.xi, h.eta))))
             .or_else(|| {
                 self.current_grid
                     .candidates(x_mm)
                     .find_map(|e| in_element(e, (1.0 / 3.0, 1.0 / 3.0)))
             });
-        *hint = location;
+        *found = location;
         location
     }
 }
@@ -360,6 +427,9 @@ pub struct RowWalker<'f> {
     /// The exact point at the start of the next block.
     left: Option<InversePoint>,
     hint: RowHint,
+    /// Where the row crosses the specimen's outline (pairs: the spans on it), when known: a
+    /// point outside every span is off the specimen without locating it.
+    spans: Option<&'f [f64]>,
 }
 
 impl<'f> RowWalker<'f> {
@@ -372,7 +442,31 @@ impl<'f> RowWalker<'f> {
             y_px,
             left,
             hint,
+            spans: None,
         }
+    }
+
+    /// Whether the columns `from_col..=to_col` may show material (all of them off every span
+    /// of the outline when not; near an element's box when the spans are not known).
+    fn material_near(&self, from_col: usize, to_col: usize) -> bool {
+        match self.spans {
+            Some(spans) => near_a_span(spans, from_col as f64, to_col as f64),
+            None => self.field.material_near(from_col, to_col, self.y_px),
+        }
+    }
+
+    /// The exact point of column `col` with `hint` as the Newton start; None (at once, with no
+    /// search) off every span of the outline.
+    fn locate(&mut self, col: usize, hints: [RowHint; 2]) -> Option<InversePoint> {
+        if self
+            .spans
+            .is_some_and(|spans| !near_a_span(spans, col as f64, col as f64))
+        {
+            self.hint = None;
+            return None;
+        }
+        self.field
+            .inverse_point_from([col as f64, self.y_px], hints, &mut self.hint)
     }
 
     /// X of the columns `first_col`.. `first_col + BLOCK_SPAN_PX` (the block after the previous
@@ -392,11 +486,11 @@ impl<'f> RowWalker<'f> {
         from: &Option<InversePoint>,
         ahead_px: f64,
     ) -> Option<InversePoint> {
-        if let Some(p) = from {
-            self.hint = p.hint_ahead(ahead_px);
-        }
-        self.field
-            .inverse_point([col as f64, self.y_px], &mut self.hint)
+        let hint = match from {
+            Some(p) => p.hint_ahead(ahead_px),
+            None => self.hint,
+        };
+        self.locate(col, [hint, None])
     }
 
     /// Pixels k0..k1 of the block from the exact points at k0 and k1.
@@ -423,21 +517,35 @@ impl<'f> RowWalker<'f> {
             _ if k1 - k0 == 1 => out[k0] = a.map(|p| p.reference_px),
             // Both ends off the specimen and no element near the segment between them: all
             // of it shows the backdrop.
-            (None, None)
-                if !self
-                    .field
-                    .material_near(first_col + k0, first_col + k1, self.y_px) =>
-            {
+            (None, None) if !self.material_near(first_col + k0, first_col + k1) => {
                 out[k0..k1].fill(None);
             }
             _ => {
                 let mid = (k0 + k1) / 2;
-                let m = self.point(first_col + mid, a, (mid - k0) as f64);
+                // From both ends, the element of the one whose prediction lands inside its
+                // element first.
+                let from_a = a.and_then(|p| p.hint_ahead((mid - k0) as f64));
+                let from_c = c.and_then(|p| p.hint_ahead(-((k1 - mid) as f64)));
+                let hints = match from_a {
+                    None => [from_c, None],
+                    Some(h)
+                        if outside_by(&h) <= from_c.map_or(f64::INFINITY, |h| outside_by(&h)) =>
+                    {
+                        [from_a, from_c]
+                    }
+                    _ => [from_c, from_a],
+                };
+                let m = self.locate(first_col + mid, hints);
                 self.fill(first_col, (k0, a), (mid, &m), out);
                 self.fill(first_col, (mid, &m), (k1, c), out);
             }
         }
     }
+}
+
+/// How far natural coordinates are outside their triangle (≤ 0 inside).
+fn outside_by(l: &Location) -> f64 {
+    (-l.xi).max(-l.eta).max(l.xi + l.eta - 1.0)
 }
 
 /// An image point's reference point and the inverse map's gradient there.
@@ -594,23 +702,29 @@ mod tests {
         }
     }
 
-    /// How far the Hermite interpolation between exact points `span` px apart in one element is
-    /// from the exact inverse, on a solved cruciform (equibiaxial grip stretch 1.5, the fillets'
-    /// strain concentrations in view at 0.16 mm/px, as the default camera sees it).
-    #[test]
-    fn hermite_between_exact_points_of_one_element_is_within_1e_3_px() {
+    /// The default cruciform solved at an equibiaxial grip stretch of 1.5 (Smactane™): its
+    /// reference mesh and nodal displacements, mm.
+    pub(super) fn stretched_cruciform() -> (Arc<ReferenceMesh>, Vec<f64>) {
         let specimen = CruciformGeometry::default().mesh().unwrap();
         let law = material::InvariantLaw::smactane();
         let solved = specimen
             .solve_at(&law, membrane::GripStretch { x: 1.5, y: 1.5 })
             .unwrap();
-        let reference = ReferenceMesh::new(specimen.mesh);
+        (ReferenceMesh::new(specimen.mesh), solved.displacement_mm)
+    }
+
+    /// How far the Hermite interpolation between exact points `span` px apart in one element is
+    /// from the exact inverse, on a solved cruciform (equibiaxial grip stretch 1.5, the fillets'
+    /// strain concentrations in view at 0.16 mm/px, as the default camera sees it).
+    #[test]
+    fn hermite_between_exact_points_of_one_element_is_within_1e_3_px() {
+        let (reference, displacement_mm) = stretched_cruciform();
         let view = View {
             mm_per_px: 0.16,
             centre_px: [511.5, 511.5],
             centre_mm: [0.0, 0.0],
         };
-        let motion = FieldMotion::new(reference, solved.displacement_mm, view).unwrap();
+        let motion = FieldMotion::new(reference, displacement_mm, view).unwrap();
         for span in [8usize, 16] {
             let mut worst = 0.0f64;
             for y in (0..1024).step_by(37) {

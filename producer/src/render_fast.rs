@@ -4,7 +4,7 @@
 //! interpolation. The footprint is the undeformed pixel: the error this makes under strain is
 //! even (a slight blur difference), not a displacement bias.
 
-use crate::field_motion::{FieldMotion, RowWalker, BACKDROP, BLOCK_SPAN_PX};
+use crate::field_motion::{CellRows, FieldMotion, BACKDROP, BLOCK_SPAN_PX};
 use crate::motion::{inverse, mul_vec, Affine, Motion};
 use crate::parallel::for_row_bands;
 use crate::row_inverse::RowInverse;
@@ -273,20 +273,27 @@ impl FastRenderer {
     /// [`BACKDROP`] where the camera sees no material. See [`Self::render_field_row`].
     pub fn render_field(&self, field: &FieldMotion, width: usize, out: &mut [f32]) {
         for_row_bands(out, width, self.threads, |first_row, band| {
+            let mut cells = CellRows::new(width);
             for (r, row) in band.chunks_exact_mut(width).enumerate() {
-                self.render_field_row(field, first_row + r, row);
+                self.render_field_row(field, &mut cells, first_row + r, row);
             }
         });
     }
 
-    /// Row `y` under a finite-element field, block by block ([`RowWalker`]: exact points at
-    /// the ends of each block, interpolated between them inside one element).
-    pub fn render_field_row(&self, field: &FieldMotion, y: usize, row: &mut [f32]) {
+    /// Row `y` under a finite-element field, block by block ([`CellRows`]: exact points on
+    /// every eighth row at the ends of each block, interpolated between them inside one
+    /// element); `cells` is the walk of the rows before (rows in increasing order are cheapest).
+    pub fn render_field_row(
+        &self,
+        field: &FieldMotion,
+        cells: &mut CellRows,
+        y: usize,
+        row: &mut [f32],
+    ) {
         let os = self.oversample as f64;
-        let mut walker = RowWalker::new(field, y as f64);
-        let mut points = [None; BLOCK_PX];
-        for (b, block) in row.chunks_mut(BLOCK_PX).enumerate() {
-            walker.block(b * BLOCK_PX, &mut points);
+        let width = row.len();
+        cells.walk_row(field, y, |first_col, points| {
+            let block = &mut row[first_col..(first_col + BLOCK_PX).min(width)];
             let (mut fx, mut fy) = ([f64::NAN; BLOCK_PX], [f64::NAN; BLOCK_PX]);
             for (k, p) in points.iter().enumerate() {
                 if let Some(p) = p {
@@ -295,12 +302,12 @@ impl FastRenderer {
                 }
             }
             self.sample_positions(&fx, &fy, block);
-            for (value, p) in block.iter_mut().zip(&points) {
+            for (value, p) in block.iter_mut().zip(points) {
                 if p.is_none() {
                     *value = BACKDROP;
                 }
             }
-        }
+        });
     }
 
     /// Renders row `y` (pixel row index) of the frame into `row` (values in [0, 1]).

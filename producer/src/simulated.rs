@@ -8,7 +8,7 @@
 
 use crate::camera::{Blur, CameraModel};
 use crate::error::ProducerError;
-use crate::field_motion::FieldMotion;
+use crate::field_motion::{CellRows, FieldMotion};
 use crate::motion::Motion;
 use crate::parallel::for_row_bands;
 use crate::render_exact::ExactRenderer;
@@ -331,12 +331,16 @@ impl SimulatedCamera {
             (Renderer::Fast(fast), None) => {
                 for_row_bands(out, width, threads, |first_row, band| {
                     let mut pattern_row = vec![0f32; width];
+                    let mut cells = CellRows::new(width);
                     for (r, row) in band.chunks_exact_mut(width).enumerate() {
                         match shown {
                             Shown::Motion(m) => fast.render_row(m, first_row + r, &mut pattern_row),
-                            Shown::Field(f) => {
-                                fast.render_field_row(f, first_row + r, &mut pattern_row)
-                            }
+                            Shown::Field(f) => fast.render_field_row(
+                                f,
+                                &mut cells,
+                                first_row + r,
+                                &mut pattern_row,
+                            ),
                         }
                         camera.expose_row(frame_index, first_row + r, &pattern_row, row);
                     }

@@ -1,5 +1,6 @@
 //! `dicstream bench pipeline`: the live bench's per-frame latency, sustained rate, drops and
-//! CPU per process on this machine (see `live::pipeline`).
+//! CPU per process on this machine, and the simulated camera's CPU on the finite-element
+//! cruciform (see `live::pipeline`).
 
 use super::named_arg::named;
 use anyhow::Result;
@@ -39,7 +40,8 @@ pub struct PipelineBenchArgs {
     /// identification}{p50,p90,p99,p999,max}, latency_field_parts_ms{waiting, correlating,
     /// delivering}, cpu_cores, frame_gaps{missing, gaps, longest, after_renewal, skipped,
     /// lost}, renewal_costs{renewals, renewing, after[3], others: {fields, waiting,
-    /// correlating, latency}}) instead of text.
+    /// correlating, latency}}, camera_on_cruciform{width_px, height_px, mm_per_px,
+    /// grip_stretch, frames, cpu_ms_per_frame, fps, cores}) instead of text.
     #[arg(long)]
     pub json: bool,
 }
@@ -156,6 +158,12 @@ pub fn run(args: PipelineBenchArgs) -> Result<()> {
             args.threads,
             describe(&result)
         );
+        if let Some(c) = &result.camera_on_cruciform {
+            println!(
+                "  simulated camera on the finite-element cruciform (a default run's, {}x{} px at {} mm/px, equibiaxial grip stretch up to {}): {:.1} ms CPU per frame over {} frames, {:.2} core at {} frames/s",
+                c.width_px, c.height_px, c.mm_per_px, c.grip_stretch, c.cpu_ms_per_frame, c.frames, c.cores, c.fps
+            );
+        }
     }
     Ok(())
 }

@@ -139,19 +139,10 @@ pub fn producer_settings(
     use producer::settings::{ProducerSettings, SourceSettings};
     let c = &config.camera;
     let source = match c.source {
-        CameraSource::Simulated => SourceSettings::FollowRig {
-            camera: simulated_camera(c),
-            follow: producer::RigFollowConfig {
-                mm_per_px: c.mm_per_px,
-                strip_mm_per_px: c.strip_mm_per_px,
-                envelope: producer::RigEnvelope {
-                    // The rig overshoots a level by a little: the camera covers a margin
-                    // beyond it.
-                    max_stretch: config.max_stretch() * (1.0 + STRETCH_MARGIN),
-                    ..producer::RigEnvelope::default()
-                },
-            },
-        },
+        CameraSource::Simulated => {
+            let (camera, follow) = rig_camera(config);
+            SourceSettings::FollowRig { camera, follow }
+        }
         CameraSource::Watch => SourceSettings::Watch {
             dir: c.watch_dir.clone(),
             from_start: c.watch_from_start,
@@ -189,6 +180,24 @@ pub fn producer_settings(
         max_frames: None,
         first_frame_id,
     }
+}
+
+/// The simulated camera following the rig, as `[camera]` and the campaign make it: the camera
+/// and how it follows.
+pub(crate) fn rig_camera(
+    config: &RunConfig,
+) -> (producer::SimulatedConfig, producer::RigFollowConfig) {
+    let c = &config.camera;
+    let follow = producer::RigFollowConfig {
+        mm_per_px: c.mm_per_px,
+        strip_mm_per_px: c.strip_mm_per_px,
+        envelope: producer::RigEnvelope {
+            // The rig overshoots a level by a little: the camera covers a margin beyond it.
+            max_stretch: config.max_stretch() * (1.0 + STRETCH_MARGIN),
+            ..producer::RigEnvelope::default()
+        },
+    };
+    (simulated_camera(c), follow)
 }
 
 /// The simulated camera of `[camera]`: `dicstream producer`'s defaults (pattern, noise, the
