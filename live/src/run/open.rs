@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 #[derive(Default)]
 pub(super) struct Incidents {
     pub(super) restarts: Vec<String>,
-    pub(super) restart_counts: [u32; 4],
+    pub(super) restart_counts: [u32; Role::COUNT],
     /// Deaths and stale processes, as noticed (`<role> <how>`).
     pub(super) faults: Vec<String>,
 }
