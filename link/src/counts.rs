@@ -201,11 +201,12 @@ mod tests {
         }
         let counts = before.counts(1);
         let mut after = ReceiveGaps::resumed(&counts);
+        // Ids 10 to 19 came while it was down.
         after.received(20, Envelope::default());
         let resumed = after.counts(1);
         assert_eq!(
             (resumed.received, resumed.lost, resumed.first_id),
-            (11, 9, Some(0))
+            (11, 10, Some(0))
         );
     }
 
