@@ -12,27 +12,29 @@
 //! - `outbound.rs`: a thread that sleeps in a WaitSet on the out services' listeners;
 //! - `inbound.rs`: the in services, from Zenoh's callbacks through a bounded queue into the
 //!   local publishers (`local_publisher.rs`);
-//! - `report.rs`: the counts said at exit.
 //!
-//! The ids each side lost are counted by `link::gaps` (pure). A signal stops both loops within
+//! The ids each side lost are counted by `link::gaps` (pure) into one `link::LinkCounts`, kept
+//! current by both loops, written to the counts file every second and at exit, and resumed from
+//! it when the link starts again (`dicstream run` reads it for its verdict). A signal stops both loops within
 //! 100 ms: Zenoh's threads may take the process's signals, so neither loop relies on one
 //! interrupting its own wait.
 
 mod inbound;
 mod local_publisher;
 mod outbound;
-mod report;
 mod session;
 
 use anyhow::Context;
-use link::{LinkDirection, LinkPlan};
+use link::{LinkCounts, LinkDirection, LinkPlan};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
-
-pub use report::LinkReport;
+use std::sync::{Mutex, MutexGuard};
+use std::time::{Duration, Instant};
 
 /// How long a loop waits before looking at the stop request again.
 const STOP_CHECK: Duration = Duration::from_millis(100);
+/// How often the counts file is written while the link runs.
+const COUNTS_EVERY: Duration = Duration::from_secs(1);
 
 /// Set when one side failed: the other stops too.
 static FAILED: AtomicBool = AtomicBool::new(false);
@@ -50,10 +52,51 @@ fn noting_failure<T>(result: anyhow::Result<T>) -> anyhow::Result<T> {
     result
 }
 
-/// Runs the link of `plan` on `instance_name` until a termination signal.
-pub fn run(plan: &LinkPlan, instance_name: &str) -> anyhow::Result<LinkReport> {
+/// The counts, whoever held them last (a loop that failed leaves them usable).
+fn lock(counts: &Mutex<LinkCounts>) -> MutexGuard<'_, LinkCounts> {
+    counts
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// The counts a link started again goes on from: those of `file`, if it exists.
+fn resumed_counts(file: Option<&Path>, instance: &str) -> anyhow::Result<LinkCounts> {
+    let Some(file) = file else {
+        return Ok(LinkCounts::new(instance));
+    };
+    match std::fs::read_to_string(file) {
+        Ok(text) => {
+            let counts = LinkCounts::parse(&text)
+                .with_context(|| format!("link: the counts file {}", file.display()))?;
+            eprintln!(
+                "link: going on from the counts in {} (a link started again)",
+                file.display()
+            );
+            Ok(counts)
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(LinkCounts::new(instance)),
+        Err(e) => Err(e).with_context(|| format!("link: reading {}", file.display())),
+    }
+}
+
+fn write_counts(file: Option<&Path>, counts: &Mutex<LinkCounts>) -> anyhow::Result<()> {
+    if let Some(file) = file {
+        let json = lock(counts).to_json();
+        wire::files::write_atomic(file, json.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// Runs the link of `plan` on `instance_name` until a termination signal, keeping its counts in
+/// `counts_file` (resumed from it when it exists).
+pub fn run(
+    plan: &LinkPlan,
+    instance_name: &str,
+    counts_file: Option<&Path>,
+) -> anyhow::Result<LinkCounts> {
     let instance = wire::Instance::new(instance_name)?;
     let _owner = instance.claim("link")?;
+    let counts = Mutex::new(resumed_counts(counts_file, instance_name)?);
     let session = session::open(plan).context("link: opening the Zenoh session")?;
     eprintln!(
         "link: instance {}; listening on [{}], connecting to [{}]; {}",
@@ -74,29 +117,43 @@ pub fn run(plan: &LinkPlan, instance_name: &str) -> anyhow::Result<LinkReport> {
             .collect::<Vec<_>>()
     };
     let (out_services, in_services) = (routes_of(LinkDirection::Out), routes_of(LinkDirection::In));
-    let (sent, received) = std::thread::scope(|scope| {
+    // What `dicstream run` waits for before it starts the next child.
+    eprintln!("link: ready");
+    let result = std::thread::scope(|scope| {
         let outbound = scope.spawn(|| {
             noting_failure(match out_services.is_empty() {
-                true => Ok(Vec::new()),
-                false => outbound::run(&instance, &session, &out_services, plan.frames_max_hz),
+                true => Ok(()),
+                false => outbound::run(
+                    &instance,
+                    &session,
+                    &out_services,
+                    plan.frames_max_hz,
+                    &counts,
+                ),
             })
         });
-        let received = noting_failure(match in_services.is_empty() {
-            true => {
-                while !stop_requested() && !outbound.is_finished() {
-                    std::thread::sleep(STOP_CHECK);
-                }
-                Ok(Vec::new())
-            }
-            false => inbound::run(&instance, &session, &in_services),
+        let inbound = scope.spawn(|| {
+            noting_failure(match in_services.is_empty() {
+                true => Ok(()),
+                false => inbound::run(&instance, &session, &in_services, &counts),
+            })
         });
+        let mut written = Instant::now();
+        while !(outbound.is_finished() && inbound.is_finished()) {
+            std::thread::sleep(STOP_CHECK);
+            if written.elapsed() >= COUNTS_EVERY {
+                noting_failure(write_counts(counts_file, &counts))?;
+                written = Instant::now();
+            }
+        }
         let sent = outbound.join().expect("the outbound thread does not panic");
-        (sent, received)
+        let received = inbound.join().expect("the inbound thread does not panic");
+        sent.and(received)
     });
-    Ok(LinkReport {
-        sent: sent?,
-        received: received?,
-    })
+    // The counts as they ended, whatever ended the loops.
+    write_counts(counts_file, &counts)?;
+    result?;
+    Ok(counts.into_inner().unwrap_or_else(|p| p.into_inner()))
 }
 
 fn join(endpoints: &[link::Endpoint]) -> String {

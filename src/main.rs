@@ -192,6 +192,10 @@ mod tests {
             config.rig.source = rig.parse().unwrap();
             config.rig.csv.time_column = "Time".into();
             config.rig.csv.force_x_column = "Fx".into();
+            config.link = Some(link::LinkSection {
+                start_with_run: true,
+                ..link::LinkSection::default()
+            });
             configs.push(config);
         }
         for config in &configs {
@@ -220,6 +224,7 @@ mod tests {
                     live::children::Role::Identifier => {
                         read::<identifier::process::ProcessConfig>(file).map(|_| ())
                     }
+                    live::children::Role::Link => read::<link::LinkSettings>(file).map(|_| ()),
                 };
                 read.unwrap_or_else(|e| panic!("{role:?}: {e:#}"));
             }

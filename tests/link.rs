@@ -14,6 +14,8 @@
 
 #![cfg(feature = "link")]
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -548,6 +550,210 @@ fn the_network_down_for_five_seconds_loses_samples_counted_and_the_link_resumes(
         0
     });
     faulted.print("network down 5 s", COUNT);
+}
+
+/// The configuration of one host's part of a split strain-controlled run: the analytic sheet,
+/// a small camera, one equibiaxial test under strain control to λ 1.12 at 0.01 /s (11 s of
+/// ramp), and `[link]`, started by the run, with `endpoints` and `services`.
+fn split_run_config(
+    scratch: &Scratch,
+    user: &str,
+    processes: &str,
+    endpoints: &str,
+    services: &str,
+) -> PathBuf {
+    let link = link_config(scratch, user, endpoints, services);
+    let link = std::fs::read_to_string(link).unwrap();
+    scratch.write(
+        &format!("{user}-run.toml"),
+        &format!(
+            "[run]\nprocesses = [{processes}]\ndashboard = \"off\"\nstatus_interval_s = 0.5\n\
+             [camera]\nwidth_px = 256\nheight_px = 256\nfps = 10.0\n\
+             [correlator]\nthreads = 1\n\
+             [rig]\npublish_hz = 100.0\nlog_hz = 20.0\n\
+             [[rig.tests]]\nkind = \"equibiaxial\"\ncontrol = \"strain\"\nstretch = 1.12\n\
+             rate_per_s = 0.01\nstale_s = 0.5\n\
+             [specimen]\nmodel = \"homogeneous\"\n\
+             {link}start_with_run = true\n"
+        ),
+    )
+}
+
+/// `dicstream run` of one host's part, results in `out`.
+fn split_run(host: &mut Host, instance: &str, config: &Path, out: &Path) -> usize {
+    let command = host.command(
+        DICSTREAM,
+        &[
+            "run",
+            "--quiet",
+            "--instance",
+            instance,
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    host.spawn("run", command)
+}
+
+fn summary(out: &Path) -> serde_json::Value {
+    let path = out.join("summary.json");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
+/// Waits (bounded by the hang guard) until `path` holds `text`.
+fn wait_for_text(path: &Path, text: &str) {
+    let give_up = Instant::now() + HANG_GUARD;
+    while !std::fs::read_to_string(path).is_ok_and(|t| t.contains(text)) {
+        assert!(
+            Instant::now() < give_up,
+            "no {text:?} in {}",
+            path.display()
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// (control, X elongation, Y elongation) of every row of a whole `rig.csv`.
+fn rig_rows(rig_csv: &Path) -> Vec<(String, f64, f64)> {
+    let rows = common::bench_run::whole_rows(rig_csv).unwrap();
+    let text = std::fs::read_to_string(rig_csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let at = |name: &str| header.iter().position(|c| *c == name).unwrap();
+    let (mode, ex, ey) = (at("control"), at("X_elongation_mm"), at("Y_elongation_mm"));
+    rows.iter()
+        .map(|r| {
+            (
+                r[mode].clone(),
+                r[ex].parse().unwrap(),
+                r[ey].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// Issue 31, faults across the link: the rig on host a is strain-controlled from the fields
+/// the camera, correlator and identifier compute on host b, each host's part started by its
+/// own `dicstream run`, which starts the link. b's interface goes down for 5 s mid-ramp: the
+/// rig holds within `stale_s` (its stale-field interlock), resumes once the link is back and
+/// finishes its test; a's run says it held, resumed and what the link lost (its verdict
+/// doubtful for it), b's run what it lost of the rig's samples; every row written is whole.
+#[test]
+fn a_split_strain_controlled_run_holds_through_a_link_outage_and_resumes() {
+    if !namespaces_available("split_outage") {
+        return;
+    }
+    let instance = testkit::unique_instance("link_split");
+    let scratch = Scratch::new(&instance);
+    write_peers(&scratch);
+    let (mut a, mut b) = (Host::new("a"), Host::new("b"));
+    let (ip_a, _) = wire_up(&a, &b, 82);
+    let service = |name: &str, direction: &str| {
+        format!("{{ name = \"{name}\", direction = \"{direction}\" }}")
+    };
+    let config_a = split_run_config(
+        &scratch,
+        "host-a",
+        "\"rig\"",
+        &format!("listen = [\"tcp/{ip_a}:{PORT}\"]"),
+        &[service("rig/state", "out"), service("fields", "in")].join(", "),
+    );
+    let config_b = split_run_config(
+        &scratch,
+        "host-b",
+        "\"producer\", \"correlator\", \"identifier\"",
+        &format!("connect = [\"tcp/{ip_a}:{PORT}\"]"),
+        &[service("rig/state", "in"), service("fields", "out")].join(", "),
+    );
+    let (out_a, out_b) = (scratch.path("a"), scratch.path("b"));
+    // The rig's host first: its strain control waits at rest for the first usable field.
+    let run_a = split_run(&mut a, &instance, &config_a, &out_a);
+    a.proc(run_a).wait_line("run: rig ready");
+    let run_b = split_run(&mut b, &instance, &config_b, &out_b);
+    // Strain control runs on a from b's fields: the link down once the ramp is under way.
+    wait_for_text(&out_a.join("logs/rig.log"), "strain control started");
+    common::bench_run::wait_rows(&out_a.join("frames.csv"), 0, 30);
+    b.sh("ip link set v82a down");
+    std::thread::sleep(Duration::from_secs(5));
+    b.sh("ip link set v82a up");
+    let (status_a, stdout_a, stderr_a) = a.proc(run_a).wait();
+    let (status_b, stdout_b, stderr_b) = b.proc(run_b).wait();
+    println!("host a's run: {status_a:?}\n{stdout_a}");
+    println!("host b's run: {status_b:?}\n{stdout_b}");
+    let (summary_a, summary_b) = (summary(&out_a), summary(&out_b));
+    assert_eq!(summary_a["ending"], "completed", "{summary_a}\n{stderr_a}");
+    assert_eq!(summary_b["ending"], "completed", "{summary_b}\n{stderr_b}");
+
+    // The rig held on stale fields, then resumed, and its grips stayed still while held.
+    let rig_log = std::fs::read_to_string(out_a.join("logs/rig.log")).unwrap();
+    let held = rig_log
+        .find("strain control HELD")
+        .unwrap_or_else(|| panic!("no hold:\n{rig_log}"));
+    let held_line = rig_log[held..].lines().next().unwrap();
+    println!("{held_line}");
+    assert!(held_line.contains("stale"), "{held_line}");
+    assert!(
+        rig_log[held..].contains("strain control resumed"),
+        "no resumption after the hold:\n{rig_log}"
+    );
+    assert!(
+        rig_log.contains("strain-controlled test finished"),
+        "{rig_log}"
+    );
+    let rows = rig_rows(&out_a.join("rig.csv"));
+    let mut k = 0;
+    while k < rows.len() {
+        let start = k;
+        while k < rows.len() && rows[k].0 == "held" {
+            k += 1;
+        }
+        if k > start + 1 {
+            for axis in [1, 2] {
+                let values = rows[start..k]
+                    .iter()
+                    .map(|r| if axis == 1 { r.1 } else { r.2 });
+                let (lo, hi) =
+                    values.fold((f64::MAX, f64::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
+                assert!(hi - lo < 0.1, "grips moved {} mm while held", hi - lo);
+            }
+        }
+        k += 1;
+    }
+    for out in [&out_a, &out_b] {
+        common::bench_run::whole_rows(&out.join("frames.csv")).unwrap();
+    }
+    // a's run says so: held and resumed, and what the link lost, in its verdict too.
+    let holds = &summary_a["strain_target"]["holds"];
+    assert!(holds["holds"].as_u64().unwrap() >= 1, "{summary_a}");
+    assert!(holds["resumed"].as_u64().unwrap() >= 1, "{summary_a}");
+    assert!(stdout_a.contains("HELD"), "{stdout_a}");
+    let lost_a = summary_a["link"]["lost"].as_u64().unwrap();
+    assert!(lost_a > 0, "a's link lost no field? {summary_a}");
+    assert!(stdout_a.contains("run: link: LOST"), "{stdout_a}");
+    assert_eq!(
+        status_a.code(),
+        Some(2),
+        "doubtful for the link's loss: {stderr_a}"
+    );
+    assert!(
+        summary_a["failure"]
+            .as_str()
+            .is_some_and(|f| f.contains("the link to the other host lost")),
+        "{summary_a}"
+    );
+    let rig_in_b = &summary_b["link"]["counts"]["in"]["rig/state"];
+    assert!(rig_in_b["lost"].as_u64().unwrap() > 0, "{summary_b}");
+    println!(
+        "link down 5 s: a's run: {lost_a} lost ({}), strain control held {} time(s) for {:.1} s; \
+         b's run: rig/state {} received, {} lost",
+        summary_a["link"]["counts"]["in"]["fields"],
+        holds["holds"],
+        holds["held_s"].as_f64().unwrap(),
+        rig_in_b["received"],
+        rig_in_b["lost"]
+    );
 }
 
 #[test]

@@ -9,6 +9,7 @@
 //! password_file = "link.password"     # this host's password (one line)
 //! peers_file = "link.peers"           # the peers let in: `user:password` lines
 //! frames_max_hz = 5.0                 # frames, when carried out, at most this often
+//! start_with_run = true               # `dicstream run` starts it as one of its children
 //! services = [
 //!   { name = "rig/state", direction = "out" },
 //!   { name = "fields", direction = "in" },
@@ -42,6 +43,10 @@ pub struct LinkSection {
     /// The peers allowed in, Zenoh's dictionary file (`user:password` lines); required when
     /// listening.
     pub peers_file: Option<PathBuf>,
+    /// `dicstream run` starts this link as one of its children (supervised, logged under the
+    /// run's `logs/link.log`, stopped last) and counts what it lost in its verdict; false: the
+    /// link is started beside the run (`dicstream link`).
+    pub start_with_run: bool,
 }
 
 /// One entry of `services`.
@@ -312,7 +317,7 @@ mod tests {
     fn unknown_keys_and_services_are_refused_by_the_reader() {
         assert!(toml::from_str::<LinkSection>("listn = []").is_err());
         let error = toml::from_str::<LinkSection>(
-            r#"services = [{ name = "specimen", direction = "out" }]"#,
+            r#"services = [{ name = "rig/command", direction = "out" }]"#,
         )
         .unwrap_err();
         assert!(

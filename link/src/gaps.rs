@@ -2,22 +2,28 @@
 //!
 //! The sender counts the ids missing in what it takes from its instance (a field skips the
 //! frames its correlator did not correlate; a full queue dropped some) and those its rate limit
-//! held back, and declares them with the next sample it sends (`Envelope`). The receiver counts
-//! a gap in the ids it receives, less what the sender declared, as lost by the link: dropped
+//! held back, and declares their running total with every sample it sends (`Envelope`). The
+//! receiver counts a gap in the ids it receives, less what the sender declared since the last
+//! sample received (a declaration is not lost with a dropped sample), as lost by the link: dropped
 //! on the way, or never sent because the sending link was down. A sender restarted mid-stream
 //! declares nothing for what it missed while down, so that gap is counted at the receiver.
 //! An id at or below the last one is a source that started again (a restarted rig counts from
 //! 0): counted as a restart, not a loss, and the count goes on from it. Both sides count
 //! with `wire::stats::IdGaps`, as `dicstream tap` does.
 
+use crate::envelope::Envelope;
 use wire::stats::{IdGaps, IdStep};
 
-/// The sender's side: ids it did not send, declared with the next sample it does send.
+/// The sender's side: ids it did not send, declared as a running total with every sample it
+/// does send.
 #[derive(Debug, Clone, Default)]
 pub struct SendGaps {
+    /// This sender, drawn at its start (`Envelope::sender`).
+    pub sender: u64,
     /// The ids taken from the local instance: `lost` is what was missing there.
     pub seen: IdGaps,
-    undeclared_ids: u64,
+    /// Ids not sent on purpose since this sender started (missing at the source, held back).
+    pub(crate) declared_total: u64,
     /// Samples taken but held back by the rate limit.
     pub held_back: u64,
     pub sent: u64,
@@ -26,24 +32,24 @@ pub struct SendGaps {
 impl SendGaps {
     /// A sample with `id` taken from the local instance.
     pub fn seen(&mut self, id: u64) {
-        match self.seen.observe(id) {
-            IdStep::Forward { skipped } => self.undeclared_ids += skipped,
-            // The source started again: what went before is no gap of this sample's.
-            IdStep::Back { .. } => self.undeclared_ids = 0,
-            IdStep::First => {}
+        if let IdStep::Forward { skipped } = self.seen.observe(id) {
+            self.declared_total += skipped;
         }
     }
 
     /// The sample last seen is not sent (rate limit).
     pub fn hold_back(&mut self) {
         self.held_back += 1;
-        self.undeclared_ids += 1;
+        self.declared_total += 1;
     }
 
-    /// The sample last seen is sent: the ids to declare with it.
-    pub fn send(&mut self) -> u64 {
+    /// The sample last seen is sent: what to declare with it.
+    pub fn send(&mut self) -> Envelope {
         self.sent += 1;
-        std::mem::take(&mut self.undeclared_ids)
+        Envelope {
+            sender: self.sender,
+            skipped_total: self.declared_total,
+        }
     }
 }
 
@@ -68,17 +74,27 @@ pub struct ReceiveGaps {
     pub lost: u64,
     /// Ids the sender declared it did not send (missing at its source, held back).
     pub declared: u64,
+    /// The last envelope received: what its sender had declared by then.
+    pub(crate) last: Option<Envelope>,
 }
 
 impl ReceiveGaps {
-    /// A sample with `id`, whose sender declared `skipped_ids` before it.
-    pub fn received(&mut self, id: u64, skipped_ids: u64) -> Arrival {
+    /// A sample with `id` and its sender's `envelope`.
+    pub fn received(&mut self, id: u64, envelope: Envelope) -> Arrival {
         self.received += 1;
+        // Declared since the last sample received: the difference of the running totals, or
+        // the whole total of a sender that started again.
+        let newly_declared = match self.last.replace(envelope) {
+            Some(last) if last.sender == envelope.sender => {
+                envelope.skipped_total.saturating_sub(last.skipped_total)
+            }
+            _ => envelope.skipped_total,
+        };
         match self.ids.observe(id) {
             IdStep::First => Arrival::InOrder,
             IdStep::Back { .. } => Arrival::Restarted,
             IdStep::Forward { skipped } => {
-                let declared = skipped_ids.min(skipped);
+                let declared = newly_declared.min(skipped);
                 self.declared += declared;
                 match skipped - declared {
                     0 => Arrival::InOrder,
@@ -110,9 +126,9 @@ mod tests {
                 sender.hold_back();
                 continue;
             }
-            let skipped = sender.send();
+            let envelope = sender.send();
             if deliver(id) {
-                receiver.received(id, skipped);
+                receiver.received(id, envelope);
             }
         }
         (sender, receiver)
@@ -139,6 +155,17 @@ mod tests {
     }
 
     #[test]
+    fn a_dropped_sample_does_not_take_its_senders_declaration_with_it() {
+        // Fields of every other frame (the odd ids declared), five of them dropped on the way.
+        let (_, receiver) = carry(
+            (0..60).map(|i| 2 * i),
+            |_| false,
+            |id| !(40..50).contains(&id),
+        );
+        assert_eq!((receiver.received, receiver.lost), (55, 5));
+    }
+
+    #[test]
     fn ids_dropped_on_the_way_are_lost() {
         let (_, receiver) = carry(0..100, |_| false, |id| !(40..45).contains(&id));
         assert_eq!((receiver.received, receiver.lost), (95, 5));
@@ -153,7 +180,10 @@ mod tests {
             receiver.received(id, sender.send());
         }
         // The sending link is restarted: a new SendGaps, its first sample id 25.
-        let mut sender = SendGaps::default();
+        let mut sender = SendGaps {
+            sender: 2,
+            ..SendGaps::default()
+        };
         sender.seen(25);
         assert_eq!(
             receiver.received(25, sender.send()),
@@ -165,9 +195,10 @@ mod tests {
     #[test]
     fn a_source_starting_again_is_a_restart_not_a_loss() {
         let mut receiver = ReceiveGaps::default();
-        assert_eq!(receiver.received(7, 0), Arrival::InOrder);
-        assert_eq!(receiver.received(0, 0), Arrival::Restarted);
-        assert_eq!(receiver.received(1, 0), Arrival::InOrder);
+        let none = Envelope::default();
+        assert_eq!(receiver.received(7, none), Arrival::InOrder);
+        assert_eq!(receiver.received(0, none), Arrival::Restarted);
+        assert_eq!(receiver.received(1, none), Arrival::InOrder);
         assert_eq!((receiver.ids.restarts, receiver.lost), (1, 0));
     }
 }

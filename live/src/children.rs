@@ -22,14 +22,18 @@ pub enum Role {
     Producer,
     Correlator,
     Identifier,
+    /// `dicstream link` to another host's instance, when `[link] start_with_run = true`.
+    Link,
 }
 
 impl Role {
-    pub const ALL: [Role; 4] = [
+    pub const COUNT: usize = 5;
+    pub const ALL: [Role; Role::COUNT] = [
         Role::Rig,
         Role::Producer,
         Role::Correlator,
         Role::Identifier,
+        Role::Link,
     ];
 
     /// The `dicstream` subcommand, also the log file name and the prefix of its lines.
@@ -39,6 +43,7 @@ impl Role {
             Role::Producer => "producer",
             Role::Correlator => "correlator",
             Role::Identifier => "identifier",
+            Role::Link => "link",
         }
     }
 }
@@ -279,7 +284,10 @@ impl Supervisor {
     /// Whether the running `role` said its input reached it (only the identifier says so).
     pub fn heard_input(&mut self, role: Role) -> bool {
         self.drain_lines();
-        self.managed(role).heard_input
+        // A process this host does not run (`[run] processes`) heard nothing here.
+        self.children
+            .iter()
+            .any(|m| m.role == role && m.heard_input)
     }
 
     pub fn pid(&self, role: Role) -> Option<u32> {
@@ -288,6 +296,11 @@ impl Supervisor {
             .find(|m| m.role == role)
             .and_then(|m| m.child.as_ref())
             .map(Child::id)
+    }
+
+    /// Whether `role` was ever started in this run (a run without a link has none).
+    pub fn started(&self, role: Role) -> bool {
+        self.children.iter().any(|m| m.role == role)
     }
 
     pub fn is_running(&self, role: Role) -> bool {

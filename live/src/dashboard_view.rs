@@ -39,7 +39,7 @@ pub fn update(
     supervisor: &Supervisor,
     faults: &[String],
     restarts: &[String],
-    restart_counts: &[u32; 4],
+    restart_counts: &[u32; Role::COUNT],
     started: Instant,
 ) {
     let Some(dashboard) = dashboard else {
@@ -48,6 +48,7 @@ pub fn update(
     let wall_s = started.elapsed().as_secs_f64().max(1e-9);
     let roles: Vec<_> = Role::ALL
         .iter()
+        .filter(|&&role| supervisor.started(role))
         .map(|&role| {
             let cpu_s = supervisor.cpu_seconds(role);
             json!({

@@ -29,7 +29,9 @@ impl Counts {
             Role::Rig => Some((self.rig_states, None)),
             Role::Producer => Some((self.frames, Some(self.rig_states))),
             Role::Correlator => Some((self.fields, Some(self.frames))),
-            Role::Identifier => None,
+            // The identifier is watched by what it heard; a link publishes what the far host
+            // sends, whose silence is no hang of its own (a stopped link is still caught).
+            Role::Identifier | Role::Link => None,
         }
     }
 }
@@ -49,18 +51,18 @@ struct Watch {
 
 pub struct Liveness {
     stale_after: Duration,
-    watches: [Option<Watch>; 4],
+    watches: [Option<Watch>; Role::COUNT],
     /// Roles whose silence is not a hang (a real camera, a followed machine log): only their
     /// stopped state is watched.
-    silence_ignored: [bool; 4],
+    silence_ignored: [bool; Role::COUNT],
 }
 
 impl Liveness {
     pub fn new(stale_after: Duration) -> Liveness {
         Liveness {
             stale_after,
-            watches: [None; 4],
-            silence_ignored: [false; 4],
+            watches: [None; Role::COUNT],
+            silence_ignored: [false; Role::COUNT],
         }
     }
 

@@ -69,6 +69,9 @@ pub struct Recorder {
     /// The field route's last report (`identification`'s reports of `ReportRoute::Field`).
     pub last_field_report: Option<IdentificationReport>,
     pub rig_samples_seen: u64,
+    /// A strain-controlled test's holds by an interlock (strain control then held), and the
+    /// rig's simulated time held in all after strain control first ran.
+    pub strain_holds: StrainHolds,
     /// Frames the correlators that have ended skipped (their last `frames_dropped`), and the
     /// running one's so far: a restarted correlator counts from 0.
     pub frames_dropped_by_ended_correlators: u64,
@@ -136,6 +139,7 @@ impl Recorder {
             last_report: None,
             last_field_report: None,
             rig_samples_seen: 0,
+            strain_holds: StrainHolds::default(),
             frames_dropped_by_ended_correlators: 0,
             frames_dropped_by_correlator: 0,
             origin_frames: OriginFrames::default(),
@@ -220,6 +224,7 @@ impl Recorder {
 
     pub fn on_rig(&mut self, state: RigState) {
         self.rig_samples_seen += 1;
+        self.strain_holds.on_rig(&state);
         self.rigs.push(state);
     }
 
@@ -572,5 +577,60 @@ mod tests {
             rows[1]
         );
         assert!(rows[2].ends_with(",low_zncc,0.0000000,0.0000000,0.0000000,0.0000000"));
+    }
+}
+
+/// The holds of a strain-controlled test as the rig's samples show them: strain control, then
+/// held in displacement by an interlock (stale fields, too few nodes, a jump), then resumed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct StrainHolds {
+    /// Times strain control went to held.
+    pub holds: u32,
+    /// Times it went back from held to strain control.
+    pub resumed: u32,
+    /// Simulated time held after strain control first ran (s).
+    pub held_s: f64,
+    #[serde(skip)]
+    last: Option<(wire::RigControl, f64)>,
+    #[serde(skip)]
+    strain_ran: bool,
+}
+
+impl StrainHolds {
+    fn on_rig(&mut self, state: &RigState) {
+        use wire::RigControl::{Held, Strain};
+        let control = state.control();
+        if let Some((last, t_s)) = self.last {
+            match (last, control) {
+                (Strain, Held) => self.holds += 1,
+                // After a hold (not the wait for a first usable field).
+                (Held, Strain) if self.holds > 0 => self.resumed += 1,
+                _ => {}
+            }
+            if last == Held && self.strain_ran {
+                self.held_s += (state.t_sim_s - t_s).max(0.0);
+            }
+        }
+        self.strain_ran |= control == Strain;
+        self.last = Some((control, state.t_sim_s));
+    }
+}
+
+#[cfg(test)]
+mod strain_hold_tests {
+    use super::*;
+
+    #[test]
+    fn holds_and_resumptions_are_counted_from_the_rig_samples() {
+        let mut holds = StrainHolds::default();
+        // Waiting for a first field (held at rest, not counted), strain, held 1.5 s, strain.
+        for (k, control) in [2, 2, 1, 1, 2, 2, 2, 2, 1, 1].into_iter().enumerate() {
+            holds.on_rig(&RigState {
+                control_mode: control,
+                t_sim_s: 0.5 * k as f64,
+                ..RigState::default()
+            });
+        }
+        assert_eq!((holds.holds, holds.resumed, holds.held_s), (1, 1, 2.0));
     }
 }

@@ -81,6 +81,10 @@ impl ResultsDir {
     pub fn machine_csv_json(&self) -> PathBuf {
         self.path("machine_csv.json")
     }
+    /// What the link (`[link] start_with_run`) carried and lost, kept by the link as it goes.
+    pub fn link_counts_json(&self) -> PathBuf {
+        self.path("link_counts.json")
+    }
     pub fn identification_json(&self) -> PathBuf {
         self.path("identification.json")
     }

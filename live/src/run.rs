@@ -25,10 +25,12 @@ mod exits;
 mod finish;
 mod judge;
 mod launch;
+mod link_report;
 mod open;
 mod outputs;
 mod prepare;
 mod read_back;
+mod remote_rig;
 mod report;
 mod stale;
 pub mod start;
@@ -39,6 +41,7 @@ pub use child_launch::{
     child_launch, correlator_settings, identifier_settings, producer_settings, rig_settings,
     ChildLaunch,
 };
+pub use link_report::LinkReport;
 pub use prepare::{remove_dead_runs, shm_needed_bytes};
 pub use report::{NodeErrorReport, RunReport, StrainMapInfo};
 

@@ -52,6 +52,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
         config.run.dashboard = DashboardListen::Off;
     }
     config.validate().context("configuration refused")?;
+    refuse_a_link_not_built(&config)?;
     let exe = std::env::current_exe().context("cannot find the dicstream binary")?;
     let report = live::run(RunOptions {
         config,
@@ -116,6 +117,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
     if let Some(strain) = &report.strain_target {
         println!("run: {}", strain.line());
     }
+    if let Some(link) = &report.link {
+        println!("run: {}", link.line());
+    }
     println!("run: results in {}", report.results.display());
     if report.leftover_shm_files > 0 {
         eprintln!(
@@ -139,6 +143,22 @@ pub fn run(args: RunArgs) -> anyhow::Result<std::process::ExitCode> {
         );
     }
     Ok(std::process::ExitCode::from(report.exit_code))
+}
+
+/// A `[link]` that asks the run to start it, in a binary built without the `link` feature:
+/// refused before anything starts (exit 78, a configuration this binary cannot run).
+fn refuse_a_link_not_built(config: &RunConfig) -> anyhow::Result<()> {
+    if config.link_started_by_run() && !cfg!(feature = "link") {
+        return Err(wire::exit::ExitWith {
+            code: wire::exit::CONFIG,
+            message: format!(
+                "configuration refused: [link] start_with_run = true, but {}",
+                super::link::NO_LINK
+            ),
+        }
+        .into());
+    }
+    Ok(())
 }
 
 /// " (by test, p99: uniaxial 0.0812 px, equibiaxial 0.1143 px)" when more than one load case was

@@ -6,19 +6,20 @@
 use super::local_publisher::LocalPublisher;
 use link::envelope::Envelope;
 use link::gaps::Arrival;
-use link::{LinkedService, ReceiveGaps};
+use link::{LinkCounts, LinkedService, ReceiveGaps};
 use std::sync::mpsc::{sync_channel, RecvTimeoutError, TrySendError};
+use std::sync::Mutex;
 use zenoh::Wait;
 
 /// Samples waiting between Zenoh's threads and the local publishers.
 const QUEUE_SAMPLES: usize = 256;
 
 /// What was received of one service.
-pub struct Received {
-    pub service: LinkedService,
-    pub gaps: ReceiveGaps,
+struct Received {
+    service: LinkedService,
+    gaps: ReceiveGaps,
     /// Samples whose bytes or attachment were refused (another version, a foreign sender).
-    pub refused: u64,
+    refused: u64,
 }
 
 /// One sample off Zenoh.
@@ -28,12 +29,13 @@ struct Arrived {
     attachment: Option<Vec<u8>>,
 }
 
-/// Carries `services` in until a signal.
+/// Carries `services` in until a signal, going on from `counts` and keeping them current there.
 pub fn run(
     instance: &wire::Instance,
     session: &zenoh::Session,
     services: &[LinkedService],
-) -> anyhow::Result<Vec<Received>> {
+    counts: &Mutex<LinkCounts>,
+) -> anyhow::Result<()> {
     let (node, _) = instance.create_node("link-in")?;
     let (sender, queue) = sync_channel::<Arrived>(QUEUE_SAMPLES);
     let mut publishers = Vec::new();
@@ -41,10 +43,14 @@ pub fn run(
     let mut subscribers = Vec::new();
     for (route, &service) in services.iter().enumerate() {
         publishers.push(LocalPublisher::create(&node, service)?);
+        // Every service carried is in the counts, from the start (a service that received
+        // nothing shows zeros).
+        let before = super::lock(counts).in_of(service);
+        super::lock(counts).set_in(service, before.clone());
         received.push(Received {
             service,
-            gaps: ReceiveGaps::default(),
-            refused: 0,
+            gaps: ReceiveGaps::resumed(&before),
+            refused: before.refused,
         });
         let sender = sender.clone();
         let subscriber = session
@@ -74,38 +80,50 @@ pub fn run(
             Err(RecvTimeoutError::Timeout) => continue,
             Err(RecvTimeoutError::Disconnected) => break,
         };
-        let counts = &mut received[arrived.route];
-        let service = counts.service;
-        let envelope = arrived.attachment.as_deref().map(Envelope::from_bytes);
-        let (Some(Ok(envelope)), Some(id)) = (
-            envelope,
-            service.sample_id(arrived.bytes.get(..service.header_bytes()).unwrap_or(&[])),
-        ) else {
-            counts.refused += 1;
-            eprintln!(
-                "link: {service}: a sample of {} bytes without a dicstream link's attachment or \
-                 header, refused",
-                arrived.bytes.len()
-            );
-            continue;
-        };
-        match publishers[arrived.route].publish(&node, service, &arrived.bytes)? {
-            Ok(()) => {}
-            Err(refused) => {
-                counts.refused += 1;
-                eprintln!("link: refused: {refused}");
-                continue;
-            }
-        }
-        match counts.gaps.received(id, envelope.skipped_ids) {
-            Arrival::InOrder => {}
-            Arrival::AfterLoss { lost } => eprintln!(
-                "link: {service}: {lost} id(s) lost by the link before {id} ({} in all)",
-                counts.gaps.lost
-            ),
-            Arrival::Restarted => eprintln!("link: {service}: ids started again at {id}"),
-        }
+        let route = &mut received[arrived.route];
+        let service = route.service;
+        let outcome = take(route, &mut publishers[arrived.route], &node, arrived)?;
+        super::lock(counts).set_in(service, route.gaps.counts(route.refused));
+        let Some(line) = outcome else { continue };
+        eprintln!("{line}");
     }
     drop(subscribers);
-    Ok(received)
+    Ok(())
+}
+
+/// Checks, publishes and counts one arrived sample; what to say about it, if anything.
+fn take(
+    counts: &mut Received,
+    publisher: &mut LocalPublisher,
+    node: &iceoryx2::prelude::Node<iceoryx2::prelude::ipc::Service>,
+    arrived: Arrived,
+) -> anyhow::Result<Option<String>> {
+    let service = counts.service;
+    let envelope = arrived.attachment.as_deref().map(Envelope::from_bytes);
+    let (Some(Ok(envelope)), Some(id)) = (
+        envelope,
+        service.sample_id(arrived.bytes.get(..service.header_bytes()).unwrap_or(&[])),
+    ) else {
+        counts.refused += 1;
+        return Ok(Some(format!(
+            "link: {service}: a sample of {} bytes without a dicstream link's attachment or \
+             header, refused",
+            arrived.bytes.len()
+        )));
+    };
+    if let Err(refused) = publisher.publish(node, service, &arrived.bytes)? {
+        counts.refused += 1;
+        return Ok(Some(format!("link: refused: {refused}")));
+    }
+    Ok(match counts.gaps.received(id, envelope) {
+        Arrival::InOrder => None,
+        Arrival::AfterLoss { lost } => Some(format!(
+            "link: {service}: {lost} id(s) lost by the link before {id} ({} in all)",
+            counts.gaps.lost
+        )),
+        // The two routes' reports name their own frames, out of order: not a source started
+        // again.
+        Arrival::Restarted if service == LinkedService::Identification => None,
+        Arrival::Restarted => Some(format!("link: {service}: ids started again at {id}")),
+    })
 }

@@ -7,7 +7,7 @@
 use link::LinkedService;
 use wire::plain::{copy_into, element_count, read_value, Plain};
 use wire::pubsub::{SlicePublisher, ValuePublisher};
-use wire::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, RigState};
+use wire::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, RigState, SpecimenHeader};
 
 /// Why received bytes were not published.
 #[derive(Debug, thiserror::Error)]
@@ -27,6 +27,7 @@ pub enum LocalPublisher {
     Fields(Option<SlicePublisher<FieldNode, FieldHeader>>),
     RigState(ValuePublisher<RigState>),
     Identification(ValuePublisher<IdentificationReport>),
+    Specimen(Option<SlicePublisher<f64, SpecimenHeader>>),
 }
 
 impl LocalPublisher {
@@ -37,6 +38,7 @@ impl LocalPublisher {
         Ok(match service {
             LinkedService::Frames => LocalPublisher::Frames(None),
             LinkedService::Fields => LocalPublisher::Fields(None),
+            LinkedService::Specimen => LocalPublisher::Specimen(None),
             LinkedService::RigState => {
                 LocalPublisher::RigState(ValuePublisher::create(node, service.spec())?)
             }
@@ -72,6 +74,18 @@ impl LocalPublisher {
             LocalPublisher::Fields(publisher) => {
                 let checked = checked::<FieldHeader, FieldNode>(service, bytes, |h, len| {
                     h.validate(len).map_err(|e| e.to_string())
+                });
+                publish_slice(publisher, node, service, checked)
+            }
+            LocalPublisher::Specimen(publisher) => {
+                // The solve checked whole (version, length, finite values, elements) as the
+                // camera checks it: a copy of its values (a few per second).
+                let checked = checked::<SpecimenHeader, f64>(service, bytes, |h, _| {
+                    let values: Vec<f64> = bytes[size_of::<SpecimenHeader>()..]
+                        .chunks_exact(size_of::<f64>())
+                        .map(|b| f64::from_ne_bytes(b.try_into().expect("8 bytes")))
+                        .collect();
+                    h.split(&values).map(|_| ()).map_err(|e| e.to_string())
                 });
                 publish_slice(publisher, node, service, checked)
             }

@@ -4,17 +4,48 @@
 //! when the network cannot keep up (congestion control `Drop`), and the local queues overflow
 //! safely: the link never holds the rig or the camera.
 
-use link::envelope::Envelope;
-use link::{LinkedService, RateLimit, SendGaps};
-use wire::plain::{slice_bytes, value_bytes};
-use wire::pubsub::TappedSubscriber;
-use zenoh::qos::CongestionControl;
+use link::{LinkCounts, LinkedService, RateLimit, SendGaps};
+use std::sync::Mutex;
+use wire::plain::{slice_bytes, value_bytes, Plain};
+use wire::pubsub::{SliceSubscriber, TappedSubscriber};
+use zenoh::qos::{CongestionControl, Priority};
 use zenoh::Wait;
 
-/// What was sent of one service.
-pub struct Sent {
-    pub service: LinkedService,
-    pub gaps: SendGaps,
+/// The local subscriber of a service going out: a tappable one, or the specimen's solves.
+enum OutSubscriber {
+    Tapped(TappedSubscriber),
+    Specimen(SliceSubscriber<f64, wire::SpecimenHeader>),
+}
+
+impl OutSubscriber {
+    fn open(
+        node: &iceoryx2::prelude::Node<iceoryx2::prelude::ipc::Service>,
+        service: LinkedService,
+    ) -> anyhow::Result<OutSubscriber> {
+        Ok(match service {
+            LinkedService::Specimen => {
+                OutSubscriber::Specimen(SliceSubscriber::create(node, service.spec())?)
+            }
+            _ => OutSubscriber::Tapped(
+                TappedSubscriber::open(node, service.name())
+                    .expect("a linked service but the specimen is tappable")?,
+            ),
+        })
+    }
+
+    fn listener(&self) -> &iceoryx2::port::listener::Listener<iceoryx2::prelude::ipc::Service> {
+        match self {
+            OutSubscriber::Tapped(s) => s.listener(),
+            OutSubscriber::Specimen(s) => s.listener(),
+        }
+    }
+
+    fn clear_events(&self) {
+        match self {
+            OutSubscriber::Tapped(s) => s.clear_events(),
+            OutSubscriber::Specimen(s) => s.clear_events(),
+        }
+    }
 }
 
 /// One service going out (its subscriber apart: the WaitSet holds its listener).
@@ -50,7 +81,7 @@ impl Route<'_> {
     }
 
     /// Sends what `subscriber` has queued.
-    fn drain(&mut self, subscriber: &TappedSubscriber) -> anyhow::Result<()> {
+    fn drain(&mut self, subscriber: &OutSubscriber) -> anyhow::Result<()> {
         subscriber.clear_events();
         while self.take_one(subscriber)? {
             let header = &self.bytes[..self.service.header_bytes()];
@@ -64,9 +95,7 @@ impl Route<'_> {
                     continue;
                 }
             }
-            let envelope = Envelope {
-                skipped_ids: self.gaps.send(),
-            };
+            let envelope = self.gaps.send();
             self.publisher
                 .put(self.bytes.as_slice())
                 .attachment(envelope.to_bytes())
@@ -77,18 +106,16 @@ impl Route<'_> {
     }
 
     /// Copies the next queued sample's bytes into `bytes`; false when none is queued.
-    fn take_one(&mut self, subscriber: &TappedSubscriber) -> anyhow::Result<bool> {
+    fn take_one(&mut self, subscriber: &OutSubscriber) -> anyhow::Result<bool> {
         self.bytes.clear();
         let bytes = &mut self.bytes;
+        let subscriber = match subscriber {
+            OutSubscriber::Tapped(s) => s,
+            OutSubscriber::Specimen(s) => return take_slice(s, bytes),
+        };
         Ok(match subscriber {
-            TappedSubscriber::Frames(s) => s.receive()?.map(|sample| {
-                bytes.extend_from_slice(value_bytes(sample.user_header()));
-                bytes.extend_from_slice(slice_bytes(sample.payload()));
-            }),
-            TappedSubscriber::Fields(s) => s.receive()?.map(|sample| {
-                bytes.extend_from_slice(value_bytes(sample.user_header()));
-                bytes.extend_from_slice(slice_bytes(sample.payload()));
-            }),
+            TappedSubscriber::Frames(s) => return take_slice(s, bytes),
+            TappedSubscriber::Fields(s) => return take_slice(s, bytes),
             TappedSubscriber::RigState(s) => s
                 .receive()?
                 .map(|state| bytes.extend_from_slice(value_bytes(&state))),
@@ -100,23 +127,54 @@ impl Route<'_> {
     }
 }
 
-/// Carries `services` out until a stop.
+/// Copies the next queued sample of a slice service, header then payload, into `bytes`; false
+/// when none is queued.
+fn take_slice<T, H>(subscriber: &SliceSubscriber<T, H>, bytes: &mut Vec<u8>) -> anyhow::Result<bool>
+where
+    T: Plain + std::fmt::Debug + iceoryx2::prelude::ZeroCopySend,
+    H: Plain + std::fmt::Debug + iceoryx2::prelude::ZeroCopySend + Default,
+{
+    Ok(subscriber
+        .receive()?
+        .map(|sample| {
+            bytes.extend_from_slice(value_bytes(sample.user_header()));
+            bytes.extend_from_slice(slice_bytes(sample.payload()));
+        })
+        .is_some())
+}
+
+/// Zenoh's priority of a service going out: each priority has its own queue, so that a
+/// specimen's solve (a few hundred kB) does not fill the queue the rig's samples need (they
+/// were dropped behind it: 2892 of 13002 in a default campaign on one queue), and goes before
+/// the rig samples that name it; frames, large, go last.
+fn priority(service: LinkedService) -> Priority {
+    match service {
+        LinkedService::Specimen => Priority::InteractiveHigh,
+        LinkedService::RigState | LinkedService::Fields => Priority::InteractiveLow,
+        LinkedService::Identification => Priority::DataHigh,
+        LinkedService::Frames => Priority::DataLow,
+    }
+}
+
+/// Carries `services` out until a stop, going on from `counts` and keeping them current there.
 pub fn run(
     instance: &wire::Instance,
     session: &zenoh::Session,
     services: &[LinkedService],
     frames_max_hz: Option<f64>,
-) -> anyhow::Result<Vec<Sent>> {
+    counts: &Mutex<LinkCounts>,
+) -> anyhow::Result<()> {
     let (node, _) = instance.create_node("link-out")?;
+    // This sender, new at each start (`link::envelope`).
+    let sender = wire::monotonic_ns() ^ (u64::from(std::process::id()) << 40);
     let mut subscribers = Vec::new();
     let mut routes = Vec::new();
     for &service in services {
-        subscribers.push(
-            TappedSubscriber::open(&node, service.name()).expect("a linked service is tappable")?,
-        );
+        subscribers.push(OutSubscriber::open(&node, service)?);
         let publisher = session
             .declare_publisher(link::key::key_expr(instance.name(), service))
             .congestion_control(CongestionControl::Drop)
+            .priority(priority(service))
             .express(true)
             .wait()
             .map_err(|e| {
@@ -130,7 +188,11 @@ pub fn run(
             service,
             publisher,
             rate,
-            gaps: SendGaps::default(),
+            gaps: {
+                let before = super::lock(counts).out_of(service);
+                super::lock(counts).set_out(service, before.clone());
+                SendGaps::resumed(&before, sender)
+            },
             bytes: Vec::new(),
             matched: false,
         });
@@ -150,6 +212,7 @@ pub fn run(
         for (route, subscriber) in routes.iter_mut().zip(&subscribers) {
             route.watch_peers()?;
             route.drain(subscriber)?;
+            super::lock(counts).set_out(route.service, route.gaps.counts());
         }
         waitset
             .wait_and_process_once_with_timeout(
@@ -159,11 +222,5 @@ pub fn run(
             .map_err(|e| anyhow::anyhow!("link: waiting on the WaitSet: {e:?}"))?;
     }
     drop(guards);
-    Ok(routes
-        .into_iter()
-        .map(|r| Sent {
-            service: r.service,
-            gaps: r.gaps,
-        })
-        .collect())
+    Ok(())
 }

@@ -243,3 +243,41 @@ fn bad_strain_control_flags_are_refused_naming_why() {
         &["--speed max is refused"],
     );
 }
+
+/// A `[link]` that asks `dicstream run` to start the link, in a binary built without the
+/// `link` feature: refused at start, exit 78, naming the key and the feature (a build with the
+/// feature starts it: tests/link.rs).
+#[cfg(not(feature = "link"))]
+#[test]
+fn a_link_the_run_should_start_needs_the_link_feature() {
+    let dir = std::env::temp_dir().join(format!("cli_refusals_link_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let config = dir.join("bench.toml");
+    std::fs::write(
+        &config,
+        "[link]\nconnect = [\"tcp/10.0.0.1:7447\"]\nuser = \"camera-pc\"\n\
+         password_file = \"pw\"\nservices = [{ name = \"fields\", direction = \"out\" }]\n\
+         start_with_run = true\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let stderr = refused_with(
+        78,
+        &[
+            "run",
+            "--instance",
+            &instance(),
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[
+            "[link] start_with_run = true",
+            "`link` feature",
+            "--features link",
+        ],
+    );
+    assert!(!out.exists(), "nothing started: {stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

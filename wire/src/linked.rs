@@ -4,7 +4,7 @@
 
 use crate::plain::read_value;
 use crate::services::{self, ServiceSpec};
-use crate::{FieldHeader, FrameHeader, IdentificationReport, RigState};
+use crate::{FieldHeader, FrameHeader, IdentificationReport, RigState, SpecimenHeader};
 
 /// A service a link can carry to another host's instance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -13,6 +13,8 @@ pub enum LinkedService {
     Fields,
     Identification,
     Frames,
+    /// The rig's finite-element solves, which a camera filming a structure renders from.
+    Specimen,
 }
 
 crate::named!(LinkedService, "linked service", {
@@ -20,6 +22,7 @@ crate::named!(LinkedService, "linked service", {
     Fields => "fields",
     Identification => "identification",
     Frames => "frames",
+    Specimen => "specimen",
 });
 
 impl LinkedService {
@@ -30,6 +33,7 @@ impl LinkedService {
             LinkedService::Fields => &services::FIELDS,
             LinkedService::Identification => &services::IDENTIFICATION,
             LinkedService::Frames => &services::FRAMES,
+            LinkedService::Specimen => &services::SPECIMEN,
         }
     }
 
@@ -41,13 +45,16 @@ impl LinkedService {
             LinkedService::Fields => size_of::<FieldHeader>(),
             LinkedService::Identification => size_of::<IdentificationReport>(),
             LinkedService::Frames => size_of::<FrameHeader>(),
+            LinkedService::Specimen => size_of::<SpecimenHeader>(),
         }
     }
 
     /// The id a sample carries, from its header's (or value's) bytes: the rig's sample id, the
     /// frame id of a frame, of a field and of the field a refit was triggered by. Consecutive
     /// at the rig and the camera; a field or a report may skip ids at its source (a frame not
-    /// correlated). None for bytes that are not one header.
+    /// correlated), a specimen's solve id jumps at each test (the test in its high 32 bits)
+    /// and skips the solves no sample was published for: what the sender declares skipped.
+    /// None for bytes that are not one header.
     pub fn sample_id(self, header: &[u8]) -> Option<u64> {
         match self {
             LinkedService::RigState => read_value::<RigState>(header).map(|s| s.sample_id),
@@ -56,6 +63,7 @@ impl LinkedService {
                 read_value::<IdentificationReport>(header).map(|r| r.frame_id)
             }
             LinkedService::Frames => read_value::<FrameHeader>(header).map(|h| h.frame_id),
+            LinkedService::Specimen => read_value::<SpecimenHeader>(header).map(|h| h.solve_id),
         }
     }
 }
@@ -81,10 +89,11 @@ mod tests {
             assert_eq!(service.name(), service.spec().name);
             assert_eq!(service.name().parse::<LinkedService>(), Ok(service));
         }
-        let error = "specimen".parse::<LinkedService>().unwrap_err();
+        let error = "rig/command".parse::<LinkedService>().unwrap_err();
         assert_eq!(
             error.to_string(),
-            "linked service \"specimen\": expected rig/state, fields, identification or frames"
+            "linked service \"rig/command\": expected rig/state, fields, identification, frames \
+             or specimen"
         );
     }
 

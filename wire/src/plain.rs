@@ -7,7 +7,7 @@
 //! padding (`layouts`' test checks that their described fields tile them), for which every
 //! byte pattern is a valid value.
 
-use crate::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, RigState};
+use crate::{FieldHeader, FieldNode, FrameHeader, IdentificationReport, RigState, SpecimenHeader};
 
 /// A wire layout (or pixel) whose bytes are all initialised and any of whose byte patterns is
 /// a valid value.
@@ -30,6 +30,11 @@ unsafe impl Plain for FieldNode {}
 unsafe impl Plain for RigState {}
 // SAFETY: as above.
 unsafe impl Plain for IdentificationReport {}
+// SAFETY: `#[repr(C)]` numbers whose offsets `layout_check.rs` asserts at compile time, 104
+// bytes: 4 + 4 + 8 + 8 + 4 + 4 + 8 + 32 + 32, no padding.
+unsafe impl Plain for SpecimenHeader {}
+// SAFETY: f64 is a plain number (a specimen's payload).
+unsafe impl Plain for f64 {}
 
 /// The bytes of `values` as they lie in memory.
 pub fn slice_bytes<T: Plain>(values: &[T]) -> &[u8] {

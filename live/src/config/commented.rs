@@ -18,6 +18,7 @@ const COMMENTS: &[(&str, &str)] = &[
     ("run.stop_timeout_s", ""),
     ("run.stale_after_s", "Seconds after which a stopped (SIGSTOP) or silent process is killed as hung."),
     ("run.dashboard", "The live dashboard (ADDR:PORT, or \"off\"); a non-loopback address serves other\nmachines too."),
+    ("run.processes", "The processes of the bench this host's run starts: rig, producer, correlator,\nidentifier (all four); on two hosts linked by [link], each host's part (docs/link.md)."),
     ("run.map_range", "Colour range of strain_map.png: auto (the 2nd-98th percentile, at least 30 times\nthe field's own noise wide), symmetric (about zero) or LO:HI (e.g. -0.01:0.05)."),
     ("[camera]", "The simulated camera renders the specimen as the rig deforms it."),
     ("camera.width_px", ""),

@@ -21,7 +21,7 @@ mod validate;
 #[cfg(test)]
 mod tests;
 
-pub use sources::{CameraSource, DashboardListen, RigSource};
+pub use sources::{BenchProcess, CameraSource, DashboardListen, RigSource};
 
 use correlator::settings::{GuessMode, Method, ReferenceKind, StrainMeasure};
 use identifier::models::ModelList;
@@ -72,6 +72,9 @@ pub struct RunSection {
     /// symmetric (about zero) or LO:HI (strain, e.g. -0.01:0.05).
     #[serde(with = "wire::names::text")]
     pub map_range: wire::colour_range::RangeChoice,
+    /// The processes of the bench this host's run starts (all four by default; on two hosts,
+    /// each its part, the others' services coming over `[link]`).
+    pub processes: Vec<BenchProcess>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -301,6 +304,22 @@ impl CameraSection {
 }
 
 impl RunConfig {
+    /// Whether this host's run starts `process` (`[run] processes`).
+    pub fn runs(&self, process: BenchProcess) -> bool {
+        self.run.processes.contains(&process)
+    }
+
+    /// Whether the run is one host's part of a bench split between two (`[run] processes`
+    /// not all four).
+    pub fn is_split(&self) -> bool {
+        BenchProcess::ALL.iter().any(|&p| !self.runs(p))
+    }
+
+    /// Whether `dicstream run` starts the link (`[link] start_with_run = true`).
+    pub fn link_started_by_run(&self) -> bool {
+        self.link.as_ref().is_some_and(|l| l.start_with_run)
+    }
+
     /// The identifier's routes, `auto` resolved by the specimen's model.
     pub fn identifier_routes(&self) -> wire::identification::IdentifierRoutes {
         self.identifier
@@ -322,6 +341,7 @@ impl Default for RunSection {
             stale_after_s: 5.0,
             dashboard: DashboardListen::default(),
             map_range: wire::colour_range::RangeChoice::Auto,
+            processes: BenchProcess::ALL.to_vec(),
         }
     }
 }

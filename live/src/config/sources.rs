@@ -41,6 +41,22 @@ pub enum RigSource {
 
 wire::named!(RigSource, "[rig] source", { Simulated => "simulated", CsvFollow => "csv-follow" });
 
+/// A process of the bench that `dicstream run` starts on this host (`[run] processes`): all
+/// four by default; on two hosts linked by `[link]`, each host's run starts its part (the rig
+/// on the machine's PC, the camera, correlator and identifier on the camera's).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BenchProcess {
+    Rig,
+    Producer,
+    Correlator,
+    Identifier,
+}
+
+wire::named!(BenchProcess, "[run] processes", {
+    Rig => "rig", Producer => "producer" | "camera", Correlator => "correlator",
+    Identifier => "identifier",
+});
+
 /// `[run] dashboard`: an address (`ADDR:PORT`, `localhost:PORT`; port 0 takes any free port)
 /// or `off`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

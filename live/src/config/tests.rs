@@ -343,3 +343,31 @@ fn a_link_section_is_read_checked_and_written_back() {
         "{error}"
     );
 }
+
+#[test]
+fn a_hosts_part_of_a_split_bench_is_read_and_checked() {
+    let config = RunConfig::from_toml(
+        "[run]\nprocesses = [\"camera\", \"correlator\", \"identifier\"]\n",
+        "b.toml",
+    )
+    .unwrap();
+    config.validate().unwrap();
+    assert!(config.is_split());
+    assert!(!config.runs(BenchProcess::Rig));
+    assert!(config.runs(BenchProcess::Producer));
+    assert!(!RunConfig::default().is_split());
+    assert!(!config.link_started_by_run());
+    for (text, start) in [
+        ("[run]\nprocesses = []\n", "[run] processes is empty"),
+        (
+            "[run]\nprocesses = [\"rig\", \"rig\"]\n",
+            "[run] processes: rig is named twice",
+        ),
+    ] {
+        let error = RunConfig::from_toml(text, "t.toml")
+            .and_then(|config| config.validate())
+            .unwrap_err();
+        assert!(error.to_string().starts_with(start), "{error}");
+    }
+    assert!(RunConfig::from_toml("[run]\nprocesses = [\"link\"]\n", "t.toml").is_err());
+}

@@ -46,6 +46,20 @@ impl RunConfig {
         if r.fields_every == 0 {
             bail!("[run] fields_every = 0: expected 1 or more (1 = every field)");
         }
+        if r.processes.is_empty() {
+            bail!(
+                "[run] processes is empty: name what this host runs ({})",
+                wire::names::expected_list(super::BenchProcess::ALL.iter().map(|p| p.name()))
+            );
+        }
+        if let Some(twice) = r
+            .processes
+            .iter()
+            .enumerate()
+            .find(|&(k, p)| r.processes[..k].contains(p))
+        {
+            bail!("[run] processes: {} is named twice", twice.1);
+        }
         for (name, v) in [
             ("status_interval_s", r.status_interval_s),
             ("stop_timeout_s", r.stop_timeout_s),

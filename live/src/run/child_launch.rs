@@ -82,6 +82,25 @@ pub fn child_launch(
             results,
             &identifier_settings(config, instance, results),
         ),
+        Role::Link => ChildLaunch::new(role, results, &link_settings(config, instance, results)?),
+    })
+}
+
+/// The link to the other host: `[link]` as written, its counts kept in the results (resumed
+/// by a link started again, read back for the verdict).
+pub fn link_settings(
+    config: &RunConfig,
+    instance: &str,
+    results: &ResultsDir,
+) -> anyhow::Result<link::LinkSettings> {
+    let section = config
+        .link
+        .clone()
+        .ok_or_else(|| anyhow::anyhow!("no [link] section: the run starts no link"))?;
+    Ok(link::LinkSettings {
+        instance: instance.to_string(),
+        link: section,
+        counts_json: Some(results.link_counts_json()),
     })
 }
 
@@ -319,16 +338,39 @@ mod tests {
         }
     }
 
+    /// The default configuration with a link the run starts.
+    fn with_link() -> RunConfig {
+        RunConfig {
+            link: Some(link::LinkSection {
+                start_with_run: true,
+                ..link::LinkSection::default()
+            }),
+            ..RunConfig::default()
+        }
+    }
+
     #[test]
     fn every_child_runs_on_the_instance() {
         for role in Role::ALL {
-            let (file, json) = settings(role, &RunConfig::default());
+            let (file, json) = settings(role, &with_link());
             assert_eq!(json["instance"], "bench_7", "{role:?}");
             assert_eq!(
                 file,
                 PathBuf::from(format!("/results/run/settings/{}.json", role.name()))
             );
         }
+    }
+
+    #[test]
+    fn the_link_keeps_its_counts_in_the_results_and_none_is_started_without_link() {
+        let (_, json) = settings(Role::Link, &with_link());
+        assert_eq!(
+            json["counts_json"], "/results/run/link_counts.json",
+            "{json}"
+        );
+        assert_eq!(json["link"]["start_with_run"], true, "{json}");
+        let error = child_launch(Role::Link, &RunConfig::default(), "i", &results(), 0);
+        assert!(error.is_err());
     }
 
     #[test]
@@ -504,7 +546,7 @@ mod tests {
 
     #[test]
     fn only_the_camera_depends_on_the_first_frame_id() {
-        let config = RunConfig::default();
+        let config = with_link();
         for role in Role::ALL {
             let launch = |first| {
                 format!(

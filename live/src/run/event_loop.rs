@@ -106,6 +106,7 @@ impl Run<'_> {
         if let Some(ending) = self.handle_exits()? {
             return Ok(Some(ending));
         }
+        self.follow_remote_rig()?;
         if self.drained()? {
             return Ok(Some(Ending::Completed));
         }

@@ -49,6 +49,7 @@ impl Stopped<'_> {
         let machine_csv = read_back::machine_csv_counts(config, results);
         let wall_s = self.started.elapsed().as_secs_f64();
         let frames = FrameCounts::of(recorder, &self.incidents.faults);
+        let link = super::LinkReport::of(config, results);
         let verdict = verdict(Facts {
             ending: self.ending,
             failure: self.failure,
@@ -56,6 +57,7 @@ impl Stopped<'_> {
             acceptance_skipped: judged.skipped.is_some(),
             field_acceptance: judged.field_decides.then_some(judged.field.as_ref()),
             frames_lost_to_faults: frames.lost_to_faults,
+            link: link.as_ref(),
             signal: self.signal,
             faults: &self.incidents.faults,
             killed_at_stop: &self.killed_at_stop,
@@ -92,6 +94,7 @@ impl Stopped<'_> {
             scale: crate::field_scale::ScaleReport::of(config),
             strain_map: outputs.strain_map,
             strain_target: super::report::StrainTargetReport::of(config, recorder),
+            link,
             leftover_shm_files: self.leftover_shm_files,
             exit_code: verdict.exit_code,
         };

@@ -3,7 +3,7 @@
 //! strain-controlled path off them. Without a ground truth, why it was skipped.
 
 use crate::acceptance::{accept, accept_path, Acceptance};
-use crate::config::{RigSource, RunConfig};
+use crate::config::{BenchProcess, RigSource, RunConfig};
 use crate::recorder::Recorder;
 use identifier::law::InvariantLaw;
 use wire::IdentificationReport;
@@ -26,14 +26,24 @@ pub(super) fn judge(
     recorder: &Recorder,
     identification_json: &std::path::Path,
 ) -> Judged {
-    let has_truth = config.camera.source.has_truth() && config.rig.source == RigSource::Simulated;
-    let skipped = (!has_truth && recorder.last_report.is_some()).then(|| {
-        format!(
-            "no ground truth with [camera] source = {:?} and [rig] source = {:?}: the \
-             identified law is not compared with [specimen]",
-            config.camera.source, config.rig.source
-        )
-    });
+    let identified_here = config.runs(BenchProcess::Identifier);
+    let has_truth = config.camera.source.has_truth()
+        && config.rig.source == RigSource::Simulated
+        && identified_here;
+    let skipped = match identified_here {
+        // The other host's run judges the law (its identifier's files are there).
+        false => Some(
+            "the identifier runs on the other host ([run] processes): its run judges the law"
+                .to_string(),
+        ),
+        true => (!has_truth && recorder.last_report.is_some()).then(|| {
+            format!(
+                "no ground truth with [camera] source = {:?} and [rig] source = {:?}: the \
+                 identified law is not compared with [specimen]",
+                config.camera.source, config.rig.source
+            )
+        }),
+    };
     if let Some(why) = &skipped {
         eprintln!("run: acceptance skipped: {why}");
     }

@@ -3,15 +3,30 @@
 use super::open::Run;
 use super::READY_TIMEOUT;
 use crate::children::{Role, StoppedBeforeReady};
-use crate::config::{CameraSource, RunConfig};
+use crate::config::{BenchProcess, CameraSource, RunConfig};
 
-/// Consumers first, so that nothing the rig and the camera publish is missed.
-const START_ORDER: [Role; 4] = [
+/// The link first (what comes from the other host is there when the others start), then the
+/// consumers, so that nothing the rig and the camera publish is missed.
+const START_ORDER: [Role; Role::COUNT] = [
+    Role::Link,
     Role::Identifier,
     Role::Correlator,
     Role::Producer,
     Role::Rig,
 ];
+
+/// Whether the run starts `role`: the processes of `[run] processes` (all four by default), and
+/// the link when `[link]` asks.
+pub(super) fn starts(role: Role, config: &RunConfig) -> bool {
+    let process = match role {
+        Role::Rig => BenchProcess::Rig,
+        Role::Producer => BenchProcess::Producer,
+        Role::Correlator => BenchProcess::Correlator,
+        Role::Identifier => BenchProcess::Identifier,
+        Role::Link => return config.link_started_by_run(),
+    };
+    config.runs(process)
+}
 
 /// Whether the run waits for `role` to say it is ready before going on: a watched folder's
 /// camera is ready only at its first image (which sets the frame size), which may come long
@@ -27,6 +42,9 @@ impl Run<'_> {
         for role in START_ORDER {
             if wire::signals::requested().is_some() {
                 return Ok(false);
+            }
+            if !starts(role, self.config()) {
+                continue;
             }
             let args = self.child_args(role, 0)?;
             self.supervisor.spawn(role, args)?;

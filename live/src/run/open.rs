@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 #[derive(Default)]
 pub(super) struct Incidents {
     pub(super) restarts: Vec<String>,
-    pub(super) restart_counts: [u32; 4],
+    pub(super) restart_counts: [u32; Role::COUNT],
     /// Deaths and stale processes, as noticed (`<role> <how>`).
     pub(super) faults: Vec<String>,
 }
@@ -51,6 +51,8 @@ pub(super) struct Run<'a> {
     pub(super) camera_away: bool,
     pub(super) phase: Phase,
     pub(super) liveness: Liveness,
+    /// Without a rig here: the rig samples seen so far and when the count last grew.
+    pub(super) remote_rig: super::remote_rig::RemoteRig,
 }
 
 impl<'a> Run<'a> {
@@ -106,6 +108,7 @@ impl<'a> Run<'a> {
             camera_away: false,
             phase: Phase::Running,
             liveness: super::stale::liveness(config),
+            remote_rig: super::remote_rig::RemoteRig::default(),
         })
     }
 

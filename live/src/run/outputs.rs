@@ -1,5 +1,6 @@
 //! The files a run writes at its end from what it recorded: the latency histograms (also
-//! rewritten during the run), `latency.png`, the identification figures, `strain_map.png`,
+//! rewritten during the run), `latency.png`, the identification figures, `strain_map.png` (on
+//! the camera's host: drawn over the field's origin image),
 //! `forces.png` and `stretch_states.png` (coloured by the identifier's `states.csv`); once the field route is judged,
 //! `field_route_law.png` and `force_balance.png`.
 //! A file that cannot be written is a note, never the end of the others.
@@ -92,6 +93,14 @@ pub(super) fn write(config: &RunConfig, results: &ResultsDir, recorder: &Recorde
         )
         .map(|_| ()),
     );
+    // Drawn over the field's origin image: a host without the camera (`[run] processes`) has
+    // the fields, not the frames; the camera's host draws it.
+    if !config.runs(crate::config::BenchProcess::Producer) {
+        return Outputs {
+            strain_map: None,
+            notes,
+        };
+    }
     let strain_map = strain_map(results, recorder, config.run.map_range);
     let strain_map = strain_map.unwrap_or_else(|e| {
         keep("strain_map.png", Err(e));

@@ -74,6 +74,9 @@ pub struct StrainTargetReport {
     pub reached_stretch: f64,
     /// Within the tolerance the rig ends a program by ([`rig::strain::settle`]).
     pub reached: bool,
+    /// The holds by an interlock (stale fields: a correlator or a link to it gone quiet) and
+    /// the resumptions after them.
+    pub holds: crate::recorder::StrainHolds,
 }
 
 impl StrainTargetReport {
@@ -91,6 +94,7 @@ impl StrainTargetReport {
             reached_stretch,
             reached: (reached_stretch.ln() - target_log).abs()
                 <= rig::strain::settle::tolerance_log(target_log),
+            holds: recorder.strain_holds,
         })
     }
 
@@ -100,9 +104,17 @@ impl StrainTargetReport {
             true => "reached".to_string(),
             false => "SHORT of it (logs/rig.log says why)".to_string(),
         };
+        let holds = match self.holds.holds {
+            0 => String::new(),
+            n => format!(
+                "; HELD {n} time(s) by an interlock ({:.1} s of the rig's time in all), resumed \
+                 {} time(s) (logs/rig.log says why)",
+                self.holds.held_s, self.holds.resumed
+            ),
+        };
         format!(
             "strain control aimed at λ {:.3} in its gauge; the largest it measured was λ {:.3}: \
-             {verdict}",
+             {verdict}{holds}",
             self.target_stretch, self.reached_stretch
         )
     }
@@ -170,6 +182,10 @@ pub struct RunReport {
     pub strain_map: Option<StrainMapInfo>,
     /// A strain-controlled test's target and what its gauge reached.
     pub strain_target: Option<StrainTargetReport>,
+    /// The link to the other host the run started (`[link] start_with_run`): its counts and
+    /// what it lost.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link: Option<super::LinkReport>,
     /// Files of the instance left once every process had stopped (named, then removed).
     pub leftover_shm_files: usize,
     /// The exit code of `dicstream run` (see [`super::exit_code`]).

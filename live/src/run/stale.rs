@@ -33,9 +33,13 @@ impl Run<'_> {
     }
 
     /// Watches every child afresh from now (at the start, and after a restart, which paused
-    /// the others too).
+    /// the others too); a process this host does not run (`[run] processes`) is not watched.
     pub(super) fn watch_all_from_now(&mut self) {
-        for role in Role::ALL {
+        let started: Vec<Role> = Role::ALL
+            .into_iter()
+            .filter(|&r| self.supervisor.started(r))
+            .collect();
+        for role in started {
             let counts = self.counts();
             self.liveness.reset(role, &counts, Instant::now());
         }

@@ -15,11 +15,13 @@ use std::time::Instant;
 pub(super) const FINAL_DRAIN_ROUNDS: usize = 16;
 
 /// Stops in the order data flows: the source first, each consumer after.
-const STOP_ORDER: [Role; 4] = [
+/// The link last: what the others published last still crosses to the other host.
+const STOP_ORDER: [Role; Role::COUNT] = [
     Role::Rig,
     Role::Producer,
     Role::Correlator,
     Role::Identifier,
+    Role::Link,
 ];
 
 /// A run once every process has stopped: what its results are made of.
@@ -62,8 +64,9 @@ impl<'a> Run<'a> {
         } = self;
         supervisor.sample_cpu();
         let mut cpu_s: BTreeMap<String, f64> = Role::ALL
-            .map(|role| (role.name().to_string(), supervisor.cpu_seconds(role)))
             .into_iter()
+            .filter(|&role| supervisor.started(role))
+            .map(|role| (role.name().to_string(), supervisor.cpu_seconds(role)))
             .collect();
         let mut killed_at_stop = vec![];
         for (role, how) in supervisor.stop_all(&STOP_ORDER, timeout) {

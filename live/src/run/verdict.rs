@@ -17,6 +17,8 @@ pub(super) struct Facts<'a> {
     /// decides in place of the gauge's; None on the homogeneous sheet.
     pub(super) field_acceptance: Option<Option<&'a FieldAcceptance>>,
     pub(super) frames_lost_to_faults: u64,
+    /// The link the run started, if any: what it lost makes the results doubtful.
+    pub(super) link: Option<&'a super::LinkReport>,
     /// The termination signal that interrupted the run.
     pub(super) signal: Option<i32>,
     pub(super) faults: &'a [String],
@@ -36,7 +38,8 @@ pub(super) struct Verdict {
 }
 
 /// The verdict of a run. A completed run passes only if its acceptance (when there is a
-/// ground truth) compared something and passed, and no frame was lost to a fault; results
+/// ground truth) compared something and passed, no frame was lost to a fault and the link to
+/// another host, when the run started one, lost nothing; results
 /// that could not be written fail a run that was not interrupted (it did not deliver them).
 pub(super) fn verdict(facts: Facts) -> Verdict {
     let (failure, exit_code) = match facts.ending {
@@ -78,6 +81,7 @@ fn doubts(facts: &Facts) -> Option<String> {
             facts.faults.join("; ")
         ));
     }
+    doubts.extend(facts.link.and_then(super::LinkReport::doubt));
     if !facts.killed_at_stop.is_empty() {
         doubts.push(format!(
             "{} did not finish within the stop timeout ([run] stop_timeout_s) and {} killed: \
@@ -163,6 +167,7 @@ mod tests {
             acceptance_skipped: false,
             field_acceptance: None,
             frames_lost_to_faults: 0,
+            link: None,
             signal: None,
             faults: &[],
             killed_at_stop: &[],
@@ -317,6 +322,34 @@ mod tests {
                  may be missing"
             )
         );
+    }
+
+    #[test]
+    fn what_the_link_lost_makes_a_completed_run_doubtful() {
+        let mut counts = link::LinkCounts::new("lab");
+        counts.set_in(
+            link::LinkedService::Fields,
+            link::InCounts {
+                received: 10,
+                lost: 4,
+                ..Default::default()
+            },
+        );
+        let report = super::super::LinkReport {
+            lost: 4,
+            counts: Some(counts),
+            unreadable: None,
+        };
+        let judged = verdict(Facts {
+            acceptance_skipped: true,
+            link: Some(&report),
+            ..facts(Ending::Completed)
+        });
+        assert_eq!(judged.exit_code, exit_code::DOUBTFUL);
+        assert!(judged
+            .failure
+            .unwrap()
+            .starts_with("the link to the other host lost 4 fields"));
     }
 
     #[test]
