@@ -199,7 +199,11 @@ mod tests {
             configs.push(config);
         }
         for config in &configs {
-            for role in live::children::Role::ALL {
+            // A run starts the link only when `[link]` asks (the default configuration has none).
+            let roles = live::children::Role::ALL
+                .into_iter()
+                .filter(|&role| role != live::children::Role::Link || config.link_started_by_run());
+            for role in roles {
                 let launch = live::run::child_launch(role, config, "bench_7", &results, 5)
                     .unwrap_or_else(|e| panic!("{role:?}: {e:#}"));
                 let args = launch.into_args().unwrap();
