@@ -18,8 +18,9 @@ use serde::{Deserialize, Serialize};
 
 /// How far a state's biaxiality may be from a case's to count as one of its states.
 pub const BIAXIALITY_TOLERANCE: f64 = 0.1;
-/// Stretches at most this far above 1 carry no biaxiality worth the name (their m is noise).
-const MIN_STRETCH: f64 = 1.005;
+/// Stretches at most this far above 1 carry no biaxiality worth the name (their m is noise):
+/// a case reached no further is not reached.
+pub const MIN_STRETCH: f64 = 1.005;
 
 /// The reach of a set of nodes' states.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -95,10 +95,11 @@ pub(crate) const CASES: [(&str, LoadCase, TrueCurve); 3] = [
     ),
 ];
 
-/// How far the field reached `case`; None when not reached (at most 1.005).
+/// How far the field reached `case`; None when not reached (at most
+/// [`identifier::reach::MIN_STRETCH`]).
 pub(crate) fn reach(case: LoadCase, reach: &Reach) -> Option<f64> {
     let max = reach.case(case);
-    (max > 1.005).then_some(max)
+    (max > identifier::reach::MIN_STRETCH).then_some(max)
 }
 
 /// Worst |identified − true| / true over (1, max].
