@@ -10,10 +10,11 @@
 //!   through the displacement over the ZOI (9 x 9 points).
 //!
 //! What it shows: the grid and the ZOI alone do not make the route prefer Hart-Smith (which
-//! ranked first in half of the live runs, `tests/field_route.rs`); they cost Mooney-Rivlin's
-//! fit its equibiaxial accuracy (the edge's loss most).
+//! ranked first in half of the live runs, `tests/field_route.rs`); the edge's loss cost
+//! Mooney-Rivlin's fit its equibiaxial accuracy while the central ramps' ∇u* reached the
+//! fillets, and costs it under 1 % once their taper clears them.
 
-use crate::cruciform::{smactane_gaps, HALF_VIEW_MM, THICKNESS_MM};
+use crate::cruciform::{smactane_gaps, THICKNESS_MM};
 use identifier::field_layout::{ArmLayout, GRIPS};
 use identifier::field_route::{FieldFits, FieldRoute, FieldRouteConfig};
 use identifier::field_stress::Mat2;
@@ -24,6 +25,8 @@ use material::InvariantLaw;
 use membrane::specimens::cruciform::CruciformGeometry;
 use membrane::{Membrane, NewtonSettings, Probe, Wrinkling};
 
+/// The live test's view (`tests/field_route.rs`: 512 px at 0.36 mm/px).
+const HALF_VIEW_MM: f64 = 92.0;
 const STEP_MM: f64 = 5.76;
 const ZOI_MM: f64 = 11.52;
 /// Points per side of the ZOI's lattice.
@@ -157,12 +160,18 @@ fn subset_gradient(
 }
 
 /// Measured when written (BIC, and Mooney-Rivlin's worst gaps uniaxial / equibiaxial / pure
-/// shear): exact, reach λ1 1.70, Mooney-Rivlin −165 against Hart-Smith −118, gaps 3.2 / 0.19
-/// / 1.8 %; edge lost, λ1 1.45, −173 against −97, 1.6 / 1.9 / 2.3 %; ZOI, λ1 1.46, −205 against
-/// −108, 1.3 / 2.3 / 2.1 %. Filling the lost nodes by a plane through their measured
-/// neighbours instead of borrowing the nearest changed nothing (2.0 and 2.4 % equibiaxial).
+/// shear) on the ±80 mm view: exact, reach λ1 1.70, Mooney-Rivlin −165 against Hart-Smith −118,
+/// gaps 3.2 / 0.19 / 1.8 %; edge lost, λ1 1.45, −173 against −97, 1.6 / 1.9 / 2.3 %; ZOI, λ1
+/// 1.46, −205 against −108, 1.3 / 2.3 / 2.1 %. Filling the lost nodes by a plane through their
+/// measured neighbours instead of borrowing the nearest changed nothing (2.0 and 2.4 %
+/// equibiaxial). On the live test's ±92 mm view, with the central ramps tapered from the
+/// square's edge: exact 0.59 / 0.29 / 1.2 %, edge lost 0.47 / 1.5 / 1.2 %, ZOI 1.4 / 1.7 /
+/// 0.99 %; tapered beyond the fillets (`field_layout::place_fields`, the lost band along the
+/// fillets out of the integrals): exact 0.60 / 0.53 / 0.93 %, edge lost 0.51 / 0.56 / 0.52 %,
+/// ZOI 0.78 / 0.74 / 0.74 %, Mooney-Rivlin's BIC −94, −86, −92 against Hart-Smith's −24, −12,
+/// −21.
 #[test]
-fn at_the_live_resolution_mooney_rivlin_ranks_above_hart_smith_and_fits_within_3_percent() {
+fn at_the_live_resolution_mooney_rivlin_ranks_above_hart_smith_and_fits_within_1_2_percent() {
     for (way, fits) in WAYS.iter().zip(fits_by_way()) {
         let of = |model: Model| {
             let found = fits.fits.iter().find(|f| f.model == model);
@@ -184,9 +193,8 @@ fn at_the_live_resolution_mooney_rivlin_ranks_above_hart_smith_and_fits_within_3
         assert!(mooney.ranked() && hart_smith.ranked(), "{way}");
         // Noise-free, the forces tell the two apart by far more than any noise could blur.
         assert!(mooney.bic < hart_smith.bic - 20.0, "{way}");
-        // The exact field reaches the fillets' edges (λ1 ≈ 1.7), where Mooney-Rivlin's form
-        // departs from Smactane's by 3.2 % in uniaxial.
-        let limit = if *way == "exact" { 0.04 } else { 0.03 };
-        assert!(gaps.iter().all(|&g| g < limit), "{way}: {gaps:?}");
+        // Within 1.2 % every way: the lost edge band costs nothing where ∇u* vanishes on it
+        // (1.7 % equibiaxial when the central ramps tapered along the fillets).
+        assert!(gaps.iter().all(|&g| g < 0.012), "{way}: {gaps:?}");
     }
 }
