@@ -23,8 +23,11 @@ const EQUIBIAXIAL: &str =
 #[test]
 fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
     let mut run = Run::new("run_field_route");
-    // 512 px at 0.36 mm/px: ±92 mm, the central square, the fillets and the arms' roots (a
-    // 32 x 32 mesh of 5.8 mm steps).
+    // 512 px at 0.5 mm/px: ±128 mm, the default camera's view (1024 px at 0.25 mm/px) at
+    // half its pixels: the central square, the fillets and the arms to beyond the fillets'
+    // reach, room for the central ramps' taper past the fillets (`field_layout`); 8 mm steps.
+    // At 0.36 mm/px (±92 mm, nodes to ±81 mm, the taper along the fillets) the equibiaxial
+    // stress missed by 2.4-2.8 %.
     let extra =
         format!("{EQUIBIAXIAL}[specimen]\nmodel = \"structure\"\n[identifier]\nroute = \"both\"\n");
     // A field file every 2nd frame (10 by default): the offline fit's frames as many as the
@@ -32,7 +35,7 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
     let config = config(&run, "fields_every = 2", &extra);
     let text = std::fs::read_to_string(&config).unwrap().replace(
         "width_px = 256\nheight_px = 256\n",
-        "width_px = 512\nheight_px = 512\nmm_per_px = 0.36\n",
+        "width_px = 512\nheight_px = 512\nmm_per_px = 0.5\n",
     );
     std::fs::write(&config, text).unwrap();
     let out = run.dir.join("out");
@@ -76,11 +79,12 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
     let kept_now = counters["kept"].as_u64().unwrap() - counters["thinned"].as_u64().unwrap();
     let dropped = counters["virtual_fields_dropped"].as_u64().unwrap();
     assert!(dropped * 10 <= kept_now, "{field}");
-    // The states reached by the frames kept: the arms' near-uniaxial states to λ 1.4, the
+    // The states reached by the frames kept: the arms' near-uniaxial states to λ 1.29 (8 mm
+    // steps: the nodes nearest the fillets' edges are 4 mm farther in than at 5.8 mm), the
     // centre's equibiaxial ones.
     let reach = &field["reach"];
     let max_stretches = reach["max_stretches"].as_array().unwrap();
-    assert!(max_stretches[0].as_f64().unwrap() > 1.3, "{field}");
+    assert!(max_stretches[0].as_f64().unwrap() > 1.25, "{field}");
     assert!(max_stretches[1].as_f64().unwrap() > 1.05, "{field}");
     println!("reach: {reach}");
     // The first ranked law's nominal stresses against the truth over the stretches reached.
@@ -94,10 +98,15 @@ fn the_field_route_identifies_the_law_from_one_equibiaxial_cruciform_test() {
     // equibiaxial 1.9-2.8 %, pure shear 1.7-2.0 % (camera noise moves them), each case then
     // judged up to the largest major (equibiaxial: minor) stretch of any node. Judged since up
     // to each case's own states (`identifier::reach`), one run: uniaxial 1.2 % to λ 1.33,
-    // equibiaxial 2.8 % to 1.09, pure shear 1.4 % to 1.20. Asserted with the spread's margin.
+    // equibiaxial 2.8 % to 1.09, pure shear 1.4 % to 1.20 (at 0.36 mm/px). At the default's
+    // framing (0.5 mm/px), the central ramps' taper past the fillets, two runs: uniaxial
+    // 1.15 / 1.38 % to λ 1.29-1.30, equibiaxial 0.81 / 0.63 % to 1.085, pure shear 0.23 /
+    // 0.27 % to 1.27 (Mooney-Rivlin's C10 0.307, C01 0.333: the sum right, the split off by
+    // about 4σ); the same framing with the taper along the fillets: 0.61 / 1.35 / 0.72 %
+    // (C10 0.250, C01 0.397). Asserted with the spread's margin over the 2 % target.
     for case in ["uniaxial", "equibiaxial", "pure_shear"] {
         let error = field[case]["max_relative_error"].as_f64().unwrap();
-        assert!(error < 0.035, "{case}: {field}");
+        assert!(error < 0.025, "{case}: {field}");
     }
 }
 
