@@ -347,8 +347,7 @@ pub fn solve(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::zoi::Image;
-    use subset::test_support::{coefficients, Prepared};
+    use subset::test_support::{pair, Prepared};
 
     use crate::verify::tests::texture;
 
@@ -383,15 +382,7 @@ mod tests {
         };
         let solve_from = |amplitude: f64, guess: (f64, f64), gradient: [[f64; 2]; 2], stop| {
             let (reference, deformed) = render(amplitude);
-            let (cr, cd) = (
-                coefficients(&reference, size),
-                coefficients(&deformed, size),
-            );
-            let image = Image {
-                pixels: &reference,
-                width_px: size,
-                height_px: size,
-            };
+            let (image, cr, cd) = pair(&reference, &deformed, size);
             let prepared = Prepared::new(image, &cr, top_left, n, Order::First);
             let outcome = solve(
                 &prepared.subset(),
@@ -449,15 +440,7 @@ mod tests {
                 (0.8 * texture(px, py) + 1500.0) as u16
             })
             .collect();
-        let (cr, cd) = (
-            coefficients(&reference, size),
-            coefficients(&deformed, size),
-        );
-        let reference_image = Image {
-            pixels: &reference,
-            width_px: size,
-            height_px: size,
-        };
+        let (reference_image, cr, cd) = pair(&reference, &deformed, size);
         for (order, n) in [
             (Order::First, 33usize),
             (Order::Second, 33),
