@@ -53,8 +53,9 @@ pub const MAX_CONTRACTION: f64 = 0.1;
 /// is predicted below this fraction of the subset's own noise: |Δp| in the metric of H (the
 /// update's predicted decrease of the ZNSSD, bᵀ H⁻¹ b) against the covariance the residual
 /// leaves the parameters (σ² H⁻¹, σ² the ZNSSD predicted after the update over n² − P). What
-/// is left of the update then adds at most a quarter of that noise's variance to the parameters,
-/// at the measured ratios well under 1 %; a noise-free subset never stops early. On the bench's
+/// is left of the update then adds at most a quarter of that noise's variance to the parameters
+/// (at the bound's ratio; at the median measured ratio under 1 %); a noise-free subset never
+/// stops early. On the bench's
 /// frames the first update is 2.6 noise deviations (median; p90 4.2): one evaluation instead of
 /// two on nearly every subset.
 pub const PREDICTED_STEP_NOISE: f64 = 0.5;
@@ -361,7 +362,7 @@ mod tests {
     }
 
     /// A noisy pair (the texture translated, each image with its own noise): from a guess a few
-    /// hundredths of a pixel off, IC-GN stops after one evaluation (the next update is predicted
+    /// thousandths of a pixel off, IC-GN stops after one evaluation (the next update is predicted
     /// within the noise) where it lands within a small fraction of the noise of what it
     /// converges to from 0.4 px away in several; the same pair without noise is never stopped
     /// early, nor is a solve asked to converge.
