@@ -147,6 +147,8 @@ impl Correlator {
         let reference_coefficients = self.reference.coefficients.as_ref();
         let reference_coefficients = reference_coefficients.expect("IC-GN reference coefficients");
         let (entries, ref_nodes) = (&self.scratch.entries, &self.reference.nodes);
+        // Nodes still `unsearched` here passed the first-pass check at their own prediction.
+        let predicted = &self.frame.unsearched;
         let planes = SharedSlice::new(&mut self.reference.subset_planes);
         let stats = SharedSlice::new(&mut self.reference.subset_stats);
         let states = SharedSlice::new(&mut self.reference.subset_states);
@@ -206,7 +208,13 @@ impl Correlator {
                 centre_px: (top_left.0 as f64 + half, top_left.1 as f64 + half),
             };
             let guess = Warp::affine(entry.guess_px, entry.gradient);
-            let outcome = icgn::solve(&subset, order, coefficients, guess, max_iterations);
+            // A prediction taken without the FFT stage is off by its frames' noise.
+            let stop = if predicted[k] {
+                icgn::Stop::WithinNoise
+            } else {
+                icgn::Stop::Converged
+            };
+            let outcome = icgn::solve(&subset, order, coefficients, guess, max_iterations, stop);
             timer.lap(&mut engine.split.iterations_ns);
             let (result, score) = check.apply(top_left, &outcome, entry.gradient);
             timer.lap(&mut engine.split.check_ns);
@@ -242,11 +250,11 @@ impl FinalCheck<'_> {
         let (u, v) = (result.u_px, result.v_px);
         let mut score = 0.0;
         if result.status == NodeStatus::Ok {
-            // IC-GN's own ZNCC of the whole subset (B-spline samples) through the warp of
-            // its last evaluation: an `ok` subset stopped because the update from that
-            // warp to the final one moves no subset point by more than
-            // `icgn::CONVERGED_PX`, so it is the subset's ZNCC through the final warp
-            // within what a 0.001 px move changes. Below `min_zncc`, the check through the
+            // IC-GN's own ZNCC of the whole subset (B-spline samples) predicted at the final
+            // warp: that of its last evaluation plus half the last update's predicted
+            // decrease of the ZNSSD; an `ok` subset stopped where that update moves no
+            // subset point by more than `icgn::CONVERGED_PX` or lies within a few noise
+            // deviations (`icgn::PREDICTED_STEP_NOISE`). Below `min_zncc`, the check through the
             // guess's gradient (smoother than a noisy subset's own, as the check of the
             // other results falls back to).
             score = outcome.zncc;
@@ -323,6 +331,7 @@ impl OriginIcgn<'_> {
             self.frame_coefficients,
             Warp::affine(guess_px, gradient),
             self.max_iterations,
+            icgn::Stop::Converged,
         );
         let noise = match self.order {
             Order::First => NoiseScale::of(outcome.zncc, &stats, n),

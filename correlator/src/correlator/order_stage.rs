@@ -114,7 +114,14 @@ impl Correlator {
             };
             let guess = Warp::affine(entry.guess_px, entry.gradient);
             let first: ZoiResult = unsafe { results.read(k) };
-            let outcome = icgn::solve(&subset, Order::Second, coefficients, guess, max_iterations);
+            let outcome = icgn::solve(
+                &subset,
+                Order::Second,
+                coefficients,
+                guess,
+                max_iterations,
+                icgn::Stop::Converged,
+            );
             timer.lap(&mut engine.split.iterations_ns);
             if outcome.status != NodeStatus::Ok || outcome.zncc < first.score {
                 return;

@@ -535,11 +535,10 @@ fn run<const SECOND: bool>(subset: &Subset, c: &Coefficients, warp: &Warp) -> Op
 
 #[cfg(test)]
 mod tests {
-    use super::super::subset::test_support::{coefficients, Prepared};
+    use super::super::subset::test_support::{pair, Prepared};
     use super::super::{evaluate_portable, Sums};
     use super::*;
     use crate::verify::tests::texture;
-    use crate::zoi::Image;
     use std::arch::x86_64::_mm256_loadu_si256;
 
     /// The largest difference between two evaluations' sums, relative to the scale of each
@@ -575,15 +574,7 @@ mod tests {
                 (0.9 * texture((i % size) as f64 - 0.37, (i / size) as f64 + 0.21) + 700.0) as u16
             })
             .collect();
-        let (cr, cd) = (
-            coefficients(&reference, size),
-            coefficients(&deformed, size),
-        );
-        let image = Image {
-            pixels: &reference,
-            width_px: size,
-            height_px: size,
-        };
+        let (image, cr, cd) = pair(&reference, &deformed, size);
         let mut worst = 0.0f64;
         let mut compared = 0;
         for order in [Order::First, Order::Second] {

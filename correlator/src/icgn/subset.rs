@@ -338,6 +338,22 @@ pub(crate) mod test_support {
         c
     }
 
+    /// A reference and a deformed `size` x `size` image: the reference as an image, and both
+    /// images' B-spline coefficients.
+    pub fn pair<'a>(
+        reference: &'a [u16],
+        deformed: &[u16],
+        size: usize,
+    ) -> (Image<'a>, Coefficients, Coefficients) {
+        let image = Image {
+            pixels: reference,
+            width_px: size,
+            height_px: size,
+        };
+        let coefficients_of = |pixels| coefficients(pixels, size);
+        (image, coefficients_of(reference), coefficients_of(deformed))
+    }
+
     /// A reference subset's planes and statistics, owned.
     pub struct Prepared {
         planes: Vec<f32>,
