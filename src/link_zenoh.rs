@@ -9,7 +9,9 @@
 //! - `session.rs`: the Zenoh session, from the plan only: peer mode, the configured endpoints
 //!   (never Zenoh's default of listening on every interface), no scouting (no multicast, no
 //!   gossip), user-password authentication against the peers file;
-//! - `outbound.rs`: a thread that sleeps in a WaitSet on the out services' listeners;
+//! - `outbound.rs`: a thread that sleeps in a WaitSet on the out services' listeners and
+//!   queues each sample, never waiting, for a sending thread per service (the small services
+//!   wait there for the network, frames are dropped);
 //! - `inbound.rs`: the in services, from Zenoh's callbacks through a bounded queue into the
 //!   local publishers (`local_publisher.rs`);
 //!
@@ -17,7 +19,8 @@
 //! current by both loops, written to the counts file every second and at exit, and resumed from
 //! it when the link starts again (`dicstream run` reads it for its verdict). A signal stops both loops within
 //! 100 ms: Zenoh's threads may take the process's signals, so neither loop relies on one
-//! interrupting its own wait.
+//! interrupting its own wait. The sending threads then put what is queued (at once, unless the
+//! network takes nothing: Zenoh gives up on a peer after 5 s of that).
 
 mod inbound;
 mod local_publisher;
