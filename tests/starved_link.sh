@@ -17,25 +17,16 @@ CPU=${CPU:-1}
 HOGS=${HOGS:-1}
 WORK=$(mktemp -d /tmp/dicstream-starved.XXXXXX)
 INSTANCE=starved_$$
-host() {
-    unshare --net --mount --propagation private sh -c '
-        mkdir -p /tmp/iceoryx2 /tmp/dicstream-owners
-        for d in /dev/shm /tmp/iceoryx2 /tmp/dicstream-owners; do
-            mount -t tmpfs -o size=256m tmpfs "$d"; done
-        ip link set lo up; exec sleep 3600' >/dev/null 2>&1 &
-    echo $!
-}
-in_host() { pid=$1; shift; nsenter --net=/proc/"$pid"/ns/net --mount=/proc/"$pid"/ns/mnt taskset -c "$CPU" "$@"; }
-bg_host() { pid=$1; shift; exec nsenter --net=/proc/"$pid"/ns/net --mount=/proc/"$pid"/ns/mnt taskset -c "$CPU" "$@"; }
-A=$(host); B=$(host)
+. "$(dirname "$0")/hosts.sh"
+# On CPU only; in the background, the command in place of this subshell (a signal reaches it).
+on_cpu() { pid=$1; shift; in_host "$pid" taskset -c "$CPU" "$@"; }
+bg_on_cpu() { pid=$1; shift; exec nsenter --net=/proc/"$pid"/ns/net --mount=/proc/"$pid"/ns/mnt taskset -c "$CPU" "$@"; }
+A=$(host 256m)
+B=$(host 256m)
 HOGPIDS=""
 trap 'kill $A $B $HOGPIDS 2>/dev/null || true' EXIT
 sleep 1
-nsenter --net=/proc/$A/ns/net ip link add va type veth peer name vb netns "$B"
-nsenter --net=/proc/$A/ns/net ip addr add 10.84.0.1/24 dev va
-nsenter --net=/proc/$A/ns/net ip link set va up
-nsenter --net=/proc/$B/ns/net ip addr add 10.84.0.2/24 dev vb
-nsenter --net=/proc/$B/ns/net ip link set vb up
+wire_up "$A" "$B" 84
 echo "a-secret" >"$WORK/a.pw"; echo "b-secret" >"$WORK/b.pw"; echo "b:b-secret" >"$WORK/peers"
 cat >"$WORK/a.toml" <<E2
 [link]
@@ -52,16 +43,16 @@ user = "b"
 password_file = "$WORK/b.pw"
 services = [{ name = "rig/state", direction = "in" }]
 E2
-bg_host $A "$BIN" link --json --instance $INSTANCE --config "$WORK/a.toml" >"$WORK/link_a.json" 2>"$WORK/link_a.log" &
+bg_on_cpu $A "$BIN" link --json --instance $INSTANCE --config "$WORK/a.toml" >"$WORK/link_a.json" 2>"$WORK/link_a.log" &
 LA=$!
-bg_host $B "$BIN" link --json --instance $INSTANCE --config "$WORK/b.toml" >"$WORK/link_b.json" 2>"$WORK/link_b.log" &
+bg_on_cpu $B "$BIN" link --json --instance $INSTANCE --config "$WORK/b.toml" >"$WORK/link_b.json" 2>"$WORK/link_b.log" &
 LB=$!
 while ! grep -q "a peer subscribes" "$WORK/link_a.log"; do sleep 0.2; done
-bg_host $B "$BIN" tap rig/state --json --instance $INSTANCE --seconds $((SECONDS_RUN + 6)) >"$WORK/tap_b.json" 2>"$WORK/tap_b.log" &
+bg_on_cpu $B "$BIN" tap rig/state --json --instance $INSTANCE --seconds $((SECONDS_RUN + 6)) >"$WORK/tap_b.json" 2>"$WORK/tap_b.log" &
 TAP=$!
 sleep 1
 for k in $(seq 1 "$HOGS"); do taskset -c "$CPU" sh -c 'while :; do :; done' & HOGPIDS="$HOGPIDS $!"; done
-in_host $A "$BIN" rig --instance $INSTANCE --test uniaxial --specimen homogeneous --stretch 1.5 --rate 0.01 \
+on_cpu $A "$BIN" rig --instance $INSTANCE --test uniaxial --specimen homogeneous --stretch 1.5 --rate 0.01 \
     --publish-hz $HZ --duration-s $SECONDS_RUN >"$WORK/rig.out" 2>"$WORK/rig.log" || true
 kill $HOGPIDS 2>/dev/null || true; HOGPIDS=""
 wait $TAP || true
