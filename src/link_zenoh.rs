@@ -10,8 +10,8 @@
 //!   (never Zenoh's default of listening on every interface), no scouting (no multicast, no
 //!   gossip), user-password authentication against the peers file;
 //! - `outbound.rs`: a thread that sleeps in a WaitSet on the out services' listeners and
-//!   queues each sample, never waiting, for a sending thread per service (the small services
-//!   wait there for the network, frames are dropped);
+//!   queues each sample, never waiting, for a sending thread per service, which waits there
+//!   for the network (up to `session::WAIT_FOR_THE_NETWORK` a sample);
 //! - `inbound.rs`: the in services, from Zenoh's callbacks through a bounded queue into the
 //!   local publishers (`local_publisher.rs`);
 //!
@@ -20,7 +20,7 @@
 //! it when the link starts again (`dicstream run` reads it for its verdict). A signal stops both loops within
 //! 100 ms: Zenoh's threads may take the process's signals, so neither loop relies on one
 //! interrupting its own wait. The sending threads then put what is queued (at once, unless the
-//! network takes nothing: Zenoh gives up on a peer after 5 s of that).
+//! network takes nothing: then up to `session::WAIT_FOR_THE_NETWORK` a sample).
 
 mod inbound;
 mod local_publisher;

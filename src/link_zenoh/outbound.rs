@@ -1,13 +1,14 @@
 //! The services going out: a subscriber of each on the local instance, woken by its listener
 //! in a WaitSet; each sample is taken at once as its header's and payload's bytes, with the
 //! ids its sender knowingly skipped before it (`link::envelope`), into a bounded queue of its
-//! service, which a thread of the service's own puts on Zenoh. The small services wait for the
-//! network (congestion control `Block`: the rig's samples, the fields, the reports and the
-//! specimen's solves are not dropped when the sending thread or the network lags a moment);
-//! frames are dropped rather than wait (`Drop`). Only the sending thread waits: the WaitSet's
+//! service, which a thread of the service's own puts on Zenoh, waiting up to
+//! `session::WAIT_FOR_THE_NETWORK` for room in Zenoh's queue before Zenoh drops the sample: the
+//! rig's samples, the fields, the reports and the specimen's solves are not dropped when the
+//! sending thread or the network lags a moment. Only the sending thread waits: the WaitSet's
 //! loop never does, so the local queues are drained and the link never holds the rig or the
 //! camera. A sample its queue has no room for (the network took less than came, or went down)
-//! is dropped and not declared: the receiver counts it lost by the link.
+//! is dropped and not declared: the receiver counts it lost by the link; frames, large and
+//! rate-limited, have room for one.
 
 use link::envelope::Envelope;
 use link::{LinkCounts, LinkedService, RateLimit, SendGaps};
@@ -195,18 +196,6 @@ fn priority(service: LinkedService) -> Priority {
     }
 }
 
-/// Whether a service waits for the network or is dropped when Zenoh's queue is full: frames
-/// (large, rate-limited, lossy by design) are dropped; the small services wait. With `Drop`,
-/// the rig's samples were dropped in bursts of 15 to 19 whenever Zenoh's sending task was
-/// starved of CPU for a few ms (its queue holds two batches, a sample waits 1 ms): 2226 of
-/// 13002 in a default campaign split over two hosts on a loaded machine.
-fn congestion_control(service: LinkedService) -> CongestionControl {
-    match service {
-        LinkedService::Frames => CongestionControl::Drop,
-        _ => CongestionControl::Block,
-    }
-}
-
 /// Samples of a service queued for the network, beyond what Zenoh and TCP hold: some seconds
 /// of each at its usual rate (rig samples at up to 500 Hz, fields and reports at the camera's
 /// 10 to 30 Hz, solves a few per second, each a few hundred kB), so that a lag of the network
@@ -239,7 +228,7 @@ pub fn run(
         publishers.push(
             session
                 .declare_publisher(link::key::key_expr(instance.name(), service))
-                .congestion_control(congestion_control(service))
+                .congestion_control(CongestionControl::Drop)
                 .priority(priority(service))
                 .express(true)
                 .wait()
