@@ -19,8 +19,8 @@
 //! current by both loops, written to the counts file every second and at exit, and resumed from
 //! it when the link starts again (`dicstream run` reads it for its verdict). A signal stops both loops within
 //! 100 ms: Zenoh's threads may take the process's signals, so neither loop relies on one
-//! interrupting its own wait. The sending threads then put what is queued (at once, unless the
-//! network takes nothing: then up to `session::WAIT_FOR_THE_NETWORK` a sample).
+//! interrupting its own wait. The sending threads end then, what is still queued not sent (a
+//! put under way on a network that takes nothing ends within `session::WAIT_FOR_THE_NETWORK`).
 
 mod inbound;
 mod local_publisher;

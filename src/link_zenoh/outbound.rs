@@ -150,14 +150,18 @@ fn take_one(subscriber: &OutSubscriber, bytes: &mut Vec<u8>) -> anyhow::Result<b
     .is_some())
 }
 
-/// Puts each queued sample of `service` on Zenoh, waiting for the network when its congestion
-/// control says so, until the WaitSet's loop stops (then what is queued goes first).
+/// Puts each queued sample of `service` on Zenoh, waiting for room in Zenoh's queue, until a
+/// stop: what is still queued then is not put (on a network that takes nothing, each put
+/// would wait `session::WAIT_FOR_THE_NETWORK`).
 fn send_queued(
     service: LinkedService,
     publisher: &zenoh::pubsub::Publisher<'static>,
     queue: Receiver<Outgoing>,
 ) -> anyhow::Result<()> {
     for outgoing in queue {
+        if super::stop_requested() {
+            break;
+        }
         publisher
             .put(outgoing.bytes)
             .attachment(outgoing.envelope.to_bytes())
@@ -263,7 +267,7 @@ pub fn run(
             });
         }
         let taken = take_until_stopped(&subscribers, &mut routes, counts);
-        // The sending threads put what is queued, then end.
+        // The sending threads end (their queues closed).
         drop(routes);
         let sent = sending
             .into_iter()
