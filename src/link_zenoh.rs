@@ -9,7 +9,9 @@
 //! - `session.rs`: the Zenoh session, from the plan only: peer mode, the configured endpoints
 //!   (never Zenoh's default of listening on every interface), no scouting (no multicast, no
 //!   gossip), user-password authentication against the peers file;
-//! - `outbound.rs`: a thread that sleeps in a WaitSet on the out services' listeners;
+//! - `outbound.rs`: a thread that sleeps in a WaitSet on the out services' listeners and
+//!   queues each sample, never waiting, for a sending thread per service, which waits there
+//!   for the network (up to `session::WAIT_FOR_THE_NETWORK` a sample);
 //! - `inbound.rs`: the in services, from Zenoh's callbacks through a bounded queue into the
 //!   local publishers (`local_publisher.rs`);
 //!
@@ -17,7 +19,8 @@
 //! current by both loops, written to the counts file every second and at exit, and resumed from
 //! it when the link starts again (`dicstream run` reads it for its verdict). A signal stops both loops within
 //! 100 ms: Zenoh's threads may take the process's signals, so neither loop relies on one
-//! interrupting its own wait.
+//! interrupting its own wait. The sending threads end then, what is still queued not sent (a
+//! put under way on a network that takes nothing ends within `session::WAIT_FOR_THE_NETWORK`).
 
 mod inbound;
 mod local_publisher;

@@ -91,19 +91,21 @@ impl Host {
         self.procs.len() - 1
     }
 
-    /// `dicstream link` with the configuration `config`.
-    fn link(&mut self, instance: &str, config: &Path) -> usize {
-        let command = self.command(
-            DICSTREAM,
-            &[
-                "link",
-                "--json",
-                "--instance",
-                instance,
-                "--config",
-                config.to_str().unwrap(),
-            ],
-        );
+    /// `dicstream link` with the configuration `config`, keeping its counts in `counts` if
+    /// given.
+    fn link(&mut self, instance: &str, config: &Path, counts: Option<&Path>) -> usize {
+        let mut args = vec![
+            "link",
+            "--json",
+            "--instance",
+            instance,
+            "--config",
+            config.to_str().unwrap(),
+        ];
+        if let Some(counts) = counts {
+            args.extend(["--counts-json", counts.to_str().unwrap()]);
+        }
+        let command = self.command(DICSTREAM, &args);
         self.spawn("link", command)
     }
 
@@ -242,21 +244,25 @@ fn read_samples(path: &Path) -> Vec<(u64, u64, u64)> {
         .collect()
 }
 
-/// Every id from 0 to `count - 1` was received by the receiving link (`json`) or counted lost
-/// by it; its host's reader missed at least that (more when a burst after an outage overflows
-/// the reader's queue, a loss on that host, not the link's).
+/// Every id from 0 to `count - 1` was received by the receiving link (`json`), counted lost
+/// by it, or declared skipped by the sending link (the ids missing in what the sending host's
+/// instance gave it: on a loaded machine its queue of 8 fields overflows now and then, which
+/// it cannot tell from a correlator's skipped frames); its host's reader missed at least what
+/// the link lost (more when a burst after an outage overflows the reader's queue, a loss on
+/// that host, not the link's).
 fn assert_every_id_received_or_counted_lost(json: &serde_json::Value, count: u64, missing: u64) {
     let fields_in = &json["in"]["fields"];
-    let (received, lost) = (
+    let (received, lost, skipped) = (
         fields_in["received"].as_u64().unwrap(),
         fields_in["lost"].as_u64().unwrap(),
+        fields_in["skipped_by_sender"].as_u64().unwrap(),
     );
     assert_eq!(fields_in["first_id"], 0, "{json}");
     assert_eq!(fields_in["last_id"], count - 1, "{json}");
     assert_eq!(
-        received + lost,
+        received + lost + skipped,
         count,
-        "every id received or counted lost: {json}"
+        "every id received, counted lost or declared skipped: {json}"
     );
     assert!(lost > 0, "the fault lost nothing? {json}");
     assert!(
@@ -289,8 +295,9 @@ fn latency_line(label: &str, samples: &[(u64, u64, u64)]) -> (f64, f64) {
     (median, p99)
 }
 
-/// Two hosts a (10.`net`.0.1, listening, fields out) and b (connecting, fields in), each with
-/// its link started and a's link seeing b subscribe.
+/// Two hosts a (10.`net`.0.1, listening, a service out) and b (connecting, the service in,
+/// its link's counts in `counts_b`), each with its link started and a's link seeing b
+/// subscribe.
 struct Lab {
     instance: String,
     scratch: Scratch,
@@ -299,31 +306,39 @@ struct Lab {
     link_a: usize,
     link_b: usize,
     config_a: PathBuf,
+    counts_b: PathBuf,
 }
 
 impl Lab {
+    /// The lab carrying `fields`.
     fn new(test: &str, net: u8) -> Lab {
+        Lab::carrying(test, net, "fields")
+    }
+
+    fn carrying(test: &str, net: u8, service: &str) -> Lab {
         let instance = testkit::unique_instance(test);
         let scratch = Scratch::new(&instance);
         write_peers(&scratch);
         let (mut a, mut b) = (Host::new("a"), Host::new("b"));
         let (ip_a, _) = wire_up(&a, &b, net);
-        let fields = |direction| format!("{{ name = \"fields\", direction = \"{direction}\" }}");
+        let route = |direction| format!("{{ name = \"{service}\", direction = \"{direction}\" }}");
         let config_a = link_config(
             &scratch,
             "host-a",
             &format!("listen = [\"tcp/{ip_a}:{PORT}\"]"),
-            &fields("out"),
+            &route("out"),
         );
         let config_b = link_config(
             &scratch,
             "host-b",
             &format!("connect = [\"tcp/{ip_a}:{PORT}\"]"),
-            &fields("in"),
+            &route("in"),
         );
-        let link_a = a.link(&instance, &config_a);
-        let link_b = b.link(&instance, &config_b);
-        a.proc(link_a).wait_line("fields out: a peer subscribes");
+        let counts_b = scratch.path("counts_b.json");
+        let link_a = a.link(&instance, &config_a, None);
+        let link_b = b.link(&instance, &config_b, Some(&counts_b));
+        a.proc(link_a)
+            .wait_line(&format!("{service} out: a peer subscribes"));
         Lab {
             instance,
             scratch,
@@ -332,6 +347,7 @@ impl Lab {
             link_a,
             link_b,
             config_a,
+            counts_b,
         }
     }
 
@@ -415,7 +431,7 @@ fn a_peer_not_in_the_configuration_gets_nothing() {
         &format!("connect = [\"tcp/10.78.0.1:{PORT}\"]"),
         "{ name = \"fields\", direction = \"in\" }",
     );
-    let link_c = c.link(&lab.instance, &intruder);
+    let link_c = c.link(&lab.instance, &intruder, None);
     let sub_c = c.helper(
         "subscribe",
         &lab.instance,
@@ -526,7 +542,7 @@ fn a_link_restarted_mid_stream_resumes_with_the_gap_counted() {
     let faulted = lab.stream_through(COUNT, |lab| {
         let first = stop_link(&mut lab.a, lab.link_a);
         let config_a = lab.config_a.clone();
-        lab.link_a = lab.a.link(&lab.instance, &config_a);
+        lab.link_a = lab.a.link(&lab.instance, &config_a, None);
         lab.a
             .proc(lab.link_a)
             .wait_line("fields out: a peer subscribes");
@@ -550,6 +566,105 @@ fn the_network_down_for_five_seconds_loses_samples_counted_and_the_link_resumes(
         0
     });
     faulted.print("network down 5 s", COUNT);
+}
+
+/// What b's link last wrote of `service` coming in (its counts file), if anything yet.
+fn counts_in(lab: &Lab, service: &str) -> Option<serde_json::Value> {
+    let text = std::fs::read_to_string(&lab.counts_b).ok()?;
+    let counts: serde_json::Value = serde_json::from_str(&text).ok()?;
+    Some(counts["in"][service].clone())
+}
+
+/// Waits (bounded by the hang guard) until b's link's counts of `service` satisfy `done`.
+fn wait_for_counts(lab: &Lab, service: &str, done: impl Fn(&serde_json::Value) -> bool) {
+    let give_up = Instant::now() + HANG_GUARD;
+    while !counts_in(lab, service).is_some_and(|c| done(&c)) {
+        assert!(
+            Instant::now() < give_up,
+            "b's link: {service} never got there: {:?}",
+            counts_in(lab, service)
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+/// Issue 31, a lossless link for the small services: the rig's samples wait for the network
+/// rather than being dropped. Host a's rig publishes at 500 Hz; b's interface goes down for
+/// 2 s once b's link has its samples, and every sample the rig published still reaches b's
+/// reader (`dicstream tap`), none counted lost by b's link, none dropped by a's. (With Zenoh's
+/// default 1 ms wait for room before a drop, the samples that came while the network was down,
+/// beyond what TCP held, were dropped and counted lost: 926 of 2500.)
+#[test]
+fn rig_samples_wait_through_a_short_outage_and_every_one_arrives() {
+    if !namespaces_available("rig_outage") {
+        return;
+    }
+    let mut lab = Lab::carrying("link_rig_outage", 83, "rig/state");
+    let tap = lab.b.command(
+        DICSTREAM,
+        &["tap", "rig/state", "--json", "--instance", &lab.instance],
+    );
+    let tap = lab.b.spawn("tap", tap);
+    lab.b.proc(tap).wait_line("tap: watching");
+    let rig = lab.a.command(
+        DICSTREAM,
+        &[
+            "rig",
+            "--instance",
+            &lab.instance,
+            "--test",
+            "uniaxial",
+            "--specimen",
+            "homogeneous",
+            "--stretch",
+            "1.2",
+            "--rate",
+            "0.01",
+            "--publish-hz",
+            "500",
+            "--duration-s",
+            "5",
+        ],
+    );
+    let rig = lab.a.spawn("rig", rig);
+    wait_for_counts(&lab, "rig/state", |c| c["received"].as_u64() > Some(0));
+    lab.b.sh("ip link set v83a down");
+    std::thread::sleep(Duration::from_secs(2));
+    lab.b.sh("ip link set v83a up");
+    let (status, _, stderr) = lab.a.proc(rig).wait();
+    assert!(status.success(), "{stderr}");
+    let published: u64 = stderr
+        .split(" samples published")
+        .next()
+        .and_then(|head| head.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no count of the samples published: {stderr}"));
+    wait_for_counts(&lab, "rig/state", |c| {
+        c["last_id"].as_u64() == Some(published - 1)
+    });
+    lab.b.proc(tap).signal(libc::SIGTERM);
+    let (status, tap_json, stderr) = lab.b.proc(tap).wait();
+    assert!(status.success(), "{stderr}");
+    let tap: serde_json::Value = serde_json::from_str(&tap_json).unwrap();
+    let json_b = stop_link(&mut lab.b, lab.link_b);
+    let json_a = stop_link(&mut lab.a, lab.link_a);
+    let (out_a, in_b) = (&json_a["out"]["rig/state"], &json_b["in"]["rig/state"]);
+    println!(
+        "rig/state through a 2 s outage: the rig published {published}; a's link sent {}, \
+         dropped {}; b's link received {}, counted {} lost; b's reader received {}, {} drops",
+        out_a["sent"],
+        out_a["overflowed"],
+        in_b["received"],
+        in_b["lost"],
+        tap["received"],
+        tap["drops"]
+    );
+    assert_eq!(in_b["lost"], 0, "{json_b}");
+    assert_eq!(in_b["received"], published, "{json_b}");
+    assert_eq!(out_a["overflowed"], 0, "{json_a}");
+    assert_eq!(tap["first_id"], 0, "{tap}");
+    assert_eq!(tap["last_id"], published - 1, "{tap}");
+    assert_eq!(tap["received"], published, "{tap}");
 }
 
 /// The configuration of one host's part of a split strain-controlled run: the analytic sheet,
@@ -638,8 +753,9 @@ fn rig_rows(rig_csv: &Path) -> Vec<(String, f64, f64)> {
 /// the camera, correlator and identifier compute on host b, each host's part started by its
 /// own `dicstream run`, which starts the link. b's interface goes down for 5 s mid-ramp: the
 /// rig holds within `stale_s` (its stale-field interlock), resumes once the link is back and
-/// finishes its test; a's run says it held, resumed and what the link lost (its verdict
-/// doubtful for it), b's run what it lost of the rig's samples; every row written is whole.
+/// finishes its test; a's run says it held and resumed; each run says what its link lost (the
+/// small services wait for the network, so that may be nothing), its verdict doubtful if
+/// anything; every row written is whole.
 #[test]
 fn a_split_strain_controlled_run_holds_through_a_link_outage_and_resumes() {
     if !namespaces_available("split_outage") {
@@ -724,33 +840,48 @@ fn a_split_strain_controlled_run_holds_through_a_link_outage_and_resumes() {
     for out in [&out_a, &out_b] {
         common::bench_run::whole_rows(&out.join("frames.csv")).unwrap();
     }
-    // a's run says so: held and resumed, and what the link lost, in its verdict too.
+    // a's run says so: held and resumed.
     let holds = &summary_a["strain_target"]["holds"];
     assert!(holds["holds"].as_u64().unwrap() >= 1, "{summary_a}");
     assert!(holds["resumed"].as_u64().unwrap() >= 1, "{summary_a}");
     assert!(stdout_a.contains("HELD"), "{stdout_a}");
-    let lost_a = summary_a["link"]["lost"].as_u64().unwrap();
-    assert!(lost_a > 0, "a's link lost no field? {summary_a}");
-    assert!(stdout_a.contains("run: link: LOST"), "{stdout_a}");
-    assert_eq!(
-        status_a.code(),
-        Some(2),
-        "doubtful for the link's loss: {stderr_a}"
+    // Each run says what its link lost, and its verdict counts it: the small services wait
+    // for the network, so a 5 s outage may lose nothing (the fields and rig samples queued
+    // came late: stale for the rig, which held on them).
+    for (host, summary, stdout, status, stderr) in [
+        ("a", &summary_a, &stdout_a, status_a, &stderr_a),
+        ("b", &summary_b, &stdout_b, status_b, &stderr_b),
+    ] {
+        let lost = summary["link"]["lost"].as_u64().unwrap();
+        match lost {
+            0 => assert!(
+                stdout.contains("run: link: nothing lost"),
+                "{host}: {stdout}"
+            ),
+            _ => {
+                assert!(stdout.contains("run: link: LOST"), "{host}: {stdout}");
+                assert_eq!(status.code(), Some(2), "{host}: doubtful: {stderr}");
+                assert!(
+                    summary["failure"]
+                        .as_str()
+                        .is_some_and(|f| f.contains("the link to the other host lost")),
+                    "{host}: {summary}"
+                );
+            }
+        }
+    }
+    let (fields_in_a, rig_in_b) = (
+        &summary_a["link"]["counts"]["in"]["fields"],
+        &summary_b["link"]["counts"]["in"]["rig/state"],
     );
-    assert!(
-        summary_a["failure"]
-            .as_str()
-            .is_some_and(|f| f.contains("the link to the other host lost")),
-        "{summary_a}"
-    );
-    let rig_in_b = &summary_b["link"]["counts"]["in"]["rig/state"];
-    assert!(rig_in_b["lost"].as_u64().unwrap() > 0, "{summary_b}");
+    assert!(rig_in_b["received"].as_u64().unwrap() > 0, "{summary_b}");
     println!(
-        "link down 5 s: a's run: {lost_a} lost ({}), strain control held {} time(s) for {:.1} s; \
-         b's run: rig/state {} received, {} lost",
-        summary_a["link"]["counts"]["in"]["fields"],
+        "link down 5 s: strain control held {} time(s) for {:.1} s; a's link: fields {} \
+         received, {} lost; b's link: rig/state {} received, {} lost",
         holds["holds"],
         holds["held_s"].as_f64().unwrap(),
+        fields_in_a["received"],
+        fields_in_a["lost"],
         rig_in_b["received"],
         rig_in_b["lost"]
     );

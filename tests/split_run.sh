@@ -24,29 +24,12 @@ WORK=$(mktemp -d /tmp/dicstream-split.XXXXXX)
 INSTANCE=split_$$
 echo "split run in $WORK (configuration: ${BASE:-the default})"
 
-# A host: a network and mount namespace held by a sleep, loopback up, private tmpfs folders.
-host() {
-    unshare --net --mount --propagation private sh -c '
-        mkdir -p /tmp/iceoryx2 /tmp/dicstream-owners
-        for d in /dev/shm /tmp/iceoryx2 /tmp/dicstream-owners; do
-            mount -t tmpfs -o size=2g tmpfs "$d"; done
-        ip link set lo up; exec sleep 3600' >/dev/null 2>&1 &
-    echo $!
-}
-in_host() {
-    pid=$1
-    shift
-    nsenter --net=/proc/"$pid"/ns/net --mount=/proc/"$pid"/ns/mnt "$@"
-}
-A=$(host)
-B=$(host)
+. "$(dirname "$0")/hosts.sh"
+A=$(host 2g)
+B=$(host 2g)
 trap 'kill $A $B 2>/dev/null || true' EXIT
 sleep 1
-in_host "$A" ip link add va type veth peer name vb netns "$B"
-in_host "$A" ip addr add 10.83.0.1/24 dev va
-in_host "$A" ip link set va up
-in_host "$B" ip addr add 10.83.0.2/24 dev vb
-in_host "$B" ip link set vb up
+wire_up "$A" "$B" 83
 
 echo "rig-pc-secret" >"$WORK/rig-pc.password"
 echo "camera-pc-secret" >"$WORK/camera-pc.password"

@@ -18,6 +18,10 @@ pub struct OutCounts {
     pub held_back: u64,
     /// Ids missing in what the local instance gave the link (frames a correlator skipped).
     pub missing_at_source: u64,
+    /// Samples dropped by this link, its queue to the network full (the receiver counts them
+    /// lost); absent from the counts of an older link.
+    #[serde(default)]
+    pub overflowed: u64,
 }
 
 /// One service coming in.
@@ -50,6 +54,7 @@ impl SendGaps {
             sent: self.sent,
             held_back: self.held_back,
             missing_at_source: self.seen.lost,
+            overflowed: self.overflowed,
         }
     }
 
@@ -63,6 +68,7 @@ impl SendGaps {
                 ..IdGaps::default()
             },
             held_back: counts.held_back,
+            overflowed: counts.overflowed,
             sent: counts.sent,
             ..SendGaps::default()
         }
@@ -164,8 +170,8 @@ impl LinkCounts {
         let out = self.out.iter().map(|(service, c)| {
             format!(
                 "link: {service} out: {} sent, {} held back by the rate limit, {} ids missing at \
-                 the source",
-                c.sent, c.held_back, c.missing_at_source
+                 the source, {} dropped (the network took less than came)",
+                c.sent, c.held_back, c.missing_at_source, c.overflowed
             )
         });
         let into = self.into.iter().map(|(service, c)| {

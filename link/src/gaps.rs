@@ -2,7 +2,9 @@
 //!
 //! The sender counts the ids missing in what it takes from its instance (a field skips the
 //! frames its correlator did not correlate; a full queue dropped some) and those its rate limit
-//! held back, and declares their running total with every sample it sends (`Envelope`). The
+//! held back, and declares their running total with every sample it sends (`Envelope`). A
+//! sample it took but could not hand to Zenoh (its queue to the network full: the network
+//! took less than came) is not declared: the receiver counts it lost by the link. The
 //! receiver counts a gap in the ids it receives, less what the sender declared since the last
 //! sample received (a declaration is not lost with a dropped sample), as lost by the link: dropped
 //! on the way, or never sent because the sending link was down. A sender restarted mid-stream
@@ -26,6 +28,8 @@ pub struct SendGaps {
     pub(crate) declared_total: u64,
     /// Samples taken but held back by the rate limit.
     pub held_back: u64,
+    /// Samples taken but dropped, their queue to the network full (not declared: lost).
+    pub overflowed: u64,
     pub sent: u64,
 }
 
@@ -43,13 +47,24 @@ impl SendGaps {
         self.declared_total += 1;
     }
 
-    /// The sample last seen is sent: what to declare with it.
-    pub fn send(&mut self) -> Envelope {
-        self.sent += 1;
+    /// What to declare with the sample last seen, if it is sent.
+    pub fn envelope(&self) -> Envelope {
         Envelope {
             sender: self.sender,
             skipped_total: self.declared_total,
         }
+    }
+
+    /// The sample last seen is sent: what to declare with it.
+    pub fn send(&mut self) -> Envelope {
+        self.sent += 1;
+        self.envelope()
+    }
+
+    /// The sample last seen could not be sent (its queue to the network full): not declared,
+    /// so the receiver counts it lost by the link.
+    pub fn overflow(&mut self) {
+        self.overflowed += 1;
     }
 }
 
@@ -163,6 +178,25 @@ mod tests {
             |id| !(40..50).contains(&id),
         );
         assert_eq!((receiver.received, receiver.lost), (55, 5));
+    }
+
+    #[test]
+    fn a_sample_its_queue_had_no_room_for_is_lost_not_declared() {
+        let (mut sender, mut receiver) = (SendGaps::default(), ReceiveGaps::default());
+        for id in 0..10 {
+            sender.seen(id);
+            match (3..6).contains(&id) {
+                true => sender.overflow(),
+                false => {
+                    receiver.received(id, sender.send());
+                }
+            }
+        }
+        assert_eq!((sender.sent, sender.overflowed), (7, 3));
+        assert_eq!(
+            (receiver.received, receiver.lost, receiver.declared),
+            (7, 3, 0)
+        );
     }
 
     #[test]

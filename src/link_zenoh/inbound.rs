@@ -1,13 +1,16 @@
 //! The services coming in: a Zenoh subscriber of each (`dicstream/<instance>/<service>`),
 //! whose callback, on Zenoh's threads, hands the bytes over a bounded queue to this loop, which
 //! counts their ids (`link::gaps`, less what the sender declared) and publishes them into the
-//! local instance. A full queue drops the sample (counted as lost, as the gap it leaves).
+//! local instance. The small services wait in the callback when the queue is full (this loop
+//! never waits on anything but the queue, so the wait is short; meanwhile TCP holds the rest
+//! and the sender's queue what follows); a frame is dropped (counted as lost, as the gap it
+//! leaves).
 
 use super::local_publisher::LocalPublisher;
 use link::envelope::Envelope;
 use link::gaps::Arrival;
 use link::{LinkCounts, LinkedService, ReceiveGaps};
-use std::sync::mpsc::{sync_channel, RecvTimeoutError, TrySendError};
+use std::sync::mpsc::{sync_channel, RecvTimeoutError};
 use std::sync::Mutex;
 use zenoh::Wait;
 
@@ -61,10 +64,11 @@ pub fn run(
                     bytes: sample.payload().to_bytes().into_owned(),
                     attachment: sample.attachment().map(|a| a.to_bytes().into_owned()),
                 };
-                match sender.try_send(arrived) {
-                    Ok(()) | Err(TrySendError::Disconnected(_)) => {}
+                match service {
                     // The gap it leaves is counted as lost when the next one arrives.
-                    Err(TrySendError::Full(_)) => {}
+                    LinkedService::Frames => drop(sender.try_send(arrived)),
+                    // Err: this loop has stopped.
+                    _ => drop(sender.send(arrived)),
                 }
             })
             .wait()
@@ -74,21 +78,27 @@ pub fn run(
         subscribers.push(subscriber);
     }
     drop(sender);
-    while !super::stop_requested() {
-        let arrived = match queue.recv_timeout(super::STOP_CHECK) {
-            Ok(arrived) => arrived,
-            Err(RecvTimeoutError::Timeout) => continue,
-            Err(RecvTimeoutError::Disconnected) => break,
-        };
-        let route = &mut received[arrived.route];
-        let service = route.service;
-        let outcome = take(route, &mut publishers[arrived.route], &node, arrived)?;
-        super::lock(counts).set_in(service, route.gaps.counts(route.refused));
-        let Some(line) = outcome else { continue };
-        eprintln!("{line}");
-    }
+    let taken = (|| {
+        while !super::stop_requested() {
+            let arrived = match queue.recv_timeout(super::STOP_CHECK) {
+                Ok(arrived) => arrived,
+                Err(RecvTimeoutError::Timeout) => continue,
+                Err(RecvTimeoutError::Disconnected) => break,
+            };
+            let route = &mut received[arrived.route];
+            let service = route.service;
+            let outcome = take(route, &mut publishers[arrived.route], &node, arrived)?;
+            super::lock(counts).set_in(service, route.gaps.counts(route.refused));
+            let Some(line) = outcome else { continue };
+            eprintln!("{line}");
+        }
+        anyhow::Ok(())
+    })();
+    // The queue first, however the loop ended: a callback waiting on it returns, so that its
+    // subscriber can go.
+    drop(queue);
     drop(subscribers);
-    Ok(())
+    taken
 }
 
 /// Checks, publishes and counts one arrived sample; what to say about it, if anything.

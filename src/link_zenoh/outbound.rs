@@ -1,10 +1,18 @@
 //! The services going out: a subscriber of each on the local instance, woken by its listener
-//! in a WaitSet; each sample is put on Zenoh as its header's and payload's bytes, with the ids
-//! its sender knowingly skipped before it (`link::envelope`). Zenoh drops rather than blocks
-//! when the network cannot keep up (congestion control `Drop`), and the local queues overflow
-//! safely: the link never holds the rig or the camera.
+//! in a WaitSet; each sample is taken at once as its header's and payload's bytes, with the
+//! ids its sender knowingly skipped before it (`link::envelope`), into a bounded queue of its
+//! service, which a thread of the service's own puts on Zenoh, waiting up to
+//! `session::WAIT_FOR_THE_NETWORK` for room in Zenoh's queue before Zenoh drops the sample: the
+//! rig's samples, the fields, the reports and the specimen's solves are not dropped when the
+//! sending thread or the network lags a moment. Only the sending thread waits: the WaitSet's
+//! loop never does, so the local queues are drained and the link never holds the rig or the
+//! camera. A sample its queue has no room for (the network took less than came, or went down)
+//! is dropped and not declared: the receiver counts it lost by the link; frames, large and
+//! rate-limited, have room for one.
 
+use link::envelope::Envelope;
 use link::{LinkCounts, LinkedService, RateLimit, SendGaps};
+use std::sync::mpsc::{sync_channel, Receiver, SyncSender, TrySendError};
 use std::sync::Mutex;
 use wire::plain::{slice_bytes, value_bytes, Plain};
 use wire::pubsub::{SliceSubscriber, TappedSubscriber};
@@ -48,14 +56,21 @@ impl OutSubscriber {
     }
 }
 
+/// A sample on its way to Zenoh: its bytes, header then payload, and what its sender declares.
+struct Outgoing {
+    bytes: Vec<u8>,
+    envelope: Envelope,
+}
+
 /// One service going out (its subscriber apart: the WaitSet holds its listener).
-struct Route<'s> {
+struct Route<'p> {
     service: LinkedService,
-    publisher: zenoh::pubsub::Publisher<'s>,
+    /// Its Zenoh publisher, which its sending thread puts on (here: who subscribes).
+    publisher: &'p zenoh::pubsub::Publisher<'static>,
+    /// To its sending thread.
+    queue: SyncSender<Outgoing>,
     rate: Option<RateLimit>,
     gaps: SendGaps,
-    /// The sample's bytes, header then payload (reused).
-    bytes: Vec<u8>,
     /// Whether a peer subscribes to it (said when it changes).
     matched: bool,
 }
@@ -80,11 +95,12 @@ impl Route<'_> {
         Ok(())
     }
 
-    /// Sends what `subscriber` has queued.
+    /// Queues for the network what `subscriber` has queued, never waiting.
     fn drain(&mut self, subscriber: &OutSubscriber) -> anyhow::Result<()> {
         subscriber.clear_events();
-        while self.take_one(subscriber)? {
-            let header = &self.bytes[..self.service.header_bytes()];
+        let mut bytes = Vec::new();
+        while take_one(subscriber, &mut bytes)? {
+            let header = bytes.get(..self.service.header_bytes()).unwrap_or(&[]);
             let Some(id) = self.service.sample_id(header) else {
                 continue;
             };
@@ -95,36 +111,64 @@ impl Route<'_> {
                     continue;
                 }
             }
-            let envelope = self.gaps.send();
-            self.publisher
-                .put(self.bytes.as_slice())
-                .attachment(envelope.to_bytes())
-                .wait()
-                .map_err(|e| anyhow::anyhow!("link: putting {} on Zenoh: {e}", self.service))?;
+            let outgoing = Outgoing {
+                bytes: std::mem::take(&mut bytes),
+                envelope: self.gaps.envelope(),
+            };
+            match self.queue.try_send(outgoing) {
+                Ok(()) => {
+                    self.gaps.send();
+                }
+                Err(TrySendError::Full(_)) => self.gaps.overflow(),
+                Err(TrySendError::Disconnected(_)) => {
+                    anyhow::bail!("link: the sending thread of {} stopped", self.service)
+                }
+            }
         }
         Ok(())
     }
+}
 
-    /// Copies the next queued sample's bytes into `bytes`; false when none is queued.
-    fn take_one(&mut self, subscriber: &OutSubscriber) -> anyhow::Result<bool> {
-        self.bytes.clear();
-        let bytes = &mut self.bytes;
-        let subscriber = match subscriber {
-            OutSubscriber::Tapped(s) => s,
-            OutSubscriber::Specimen(s) => return take_slice(s, bytes),
-        };
-        Ok(match subscriber {
-            TappedSubscriber::Frames(s) => return take_slice(s, bytes),
-            TappedSubscriber::Fields(s) => return take_slice(s, bytes),
-            TappedSubscriber::RigState(s) => s
-                .receive()?
-                .map(|state| bytes.extend_from_slice(value_bytes(&state))),
-            TappedSubscriber::Identification(s) => s
-                .receive()?
-                .map(|report| bytes.extend_from_slice(value_bytes(&report))),
-        }
-        .is_some())
+/// Copies the next queued sample's bytes into `bytes` (emptied first); false when none is
+/// queued.
+fn take_one(subscriber: &OutSubscriber, bytes: &mut Vec<u8>) -> anyhow::Result<bool> {
+    bytes.clear();
+    let subscriber = match subscriber {
+        OutSubscriber::Tapped(s) => s,
+        OutSubscriber::Specimen(s) => return take_slice(s, bytes),
+    };
+    Ok(match subscriber {
+        TappedSubscriber::Frames(s) => return take_slice(s, bytes),
+        TappedSubscriber::Fields(s) => return take_slice(s, bytes),
+        TappedSubscriber::RigState(s) => s
+            .receive()?
+            .map(|state| bytes.extend_from_slice(value_bytes(&state))),
+        TappedSubscriber::Identification(s) => s
+            .receive()?
+            .map(|report| bytes.extend_from_slice(value_bytes(&report))),
     }
+    .is_some())
+}
+
+/// Puts each queued sample of `service` on Zenoh, waiting for room in Zenoh's queue, until a
+/// stop: what is still queued then is not put (on a network that takes nothing, each put
+/// would wait `session::WAIT_FOR_THE_NETWORK`).
+fn send_queued(
+    service: LinkedService,
+    publisher: &zenoh::pubsub::Publisher<'static>,
+    queue: Receiver<Outgoing>,
+) -> anyhow::Result<()> {
+    for outgoing in queue {
+        if super::stop_requested() {
+            break;
+        }
+        publisher
+            .put(outgoing.bytes)
+            .attachment(outgoing.envelope.to_bytes())
+            .wait()
+            .map_err(|e| anyhow::anyhow!("link: putting {service} on Zenoh: {e}"))?;
+    }
+    Ok(())
 }
 
 /// Copies the next queued sample of a slice service, header then payload, into `bytes`; false
@@ -156,6 +200,20 @@ fn priority(service: LinkedService) -> Priority {
     }
 }
 
+/// Samples of a service queued for the network, beyond what Zenoh and TCP hold: some seconds
+/// of each at its usual rate (rig samples at up to 500 Hz, fields and reports at the camera's
+/// 10 to 30 Hz, solves a few per second, each a few hundred kB), so that a lag of the network
+/// or of the sending thread loses nothing; frames, dropped by Zenoh anyway, one.
+fn queue_samples(service: LinkedService) -> usize {
+    match service {
+        LinkedService::RigState => 8192,
+        LinkedService::Fields => 256,
+        LinkedService::Identification => 256,
+        LinkedService::Specimen => 32,
+        LinkedService::Frames => 1,
+    }
+}
+
 /// Carries `services` out until a stop, going on from `counts` and keeping them current there.
 pub fn run(
     instance: &wire::Instance,
@@ -168,48 +226,78 @@ pub fn run(
     // This sender, new at each start (`link::envelope`).
     let sender = wire::monotonic_ns() ^ (u64::from(std::process::id()) << 40);
     let mut subscribers = Vec::new();
-    let mut routes = Vec::new();
+    let mut publishers = Vec::new();
     for &service in services {
         subscribers.push(OutSubscriber::open(&node, service)?);
-        let publisher = session
-            .declare_publisher(link::key::key_expr(instance.name(), service))
-            .congestion_control(CongestionControl::Drop)
-            .priority(priority(service))
-            .express(true)
-            .wait()
-            .map_err(|e| {
-                anyhow::anyhow!("link: declaring the Zenoh publisher of {service}: {e}")
-            })?;
-        let rate = match service {
-            LinkedService::Frames => frames_max_hz.map(RateLimit::new),
-            _ => None,
-        };
-        routes.push(Route {
-            service,
-            publisher,
-            rate,
-            gaps: {
-                let before = super::lock(counts).out_of(service);
-                super::lock(counts).set_out(service, before.clone());
-                SendGaps::resumed(&before, sender)
-            },
-            bytes: Vec::new(),
-            matched: false,
-        });
+        publishers.push(
+            session
+                .declare_publisher(link::key::key_expr(instance.name(), service))
+                .congestion_control(CongestionControl::Drop)
+                .priority(priority(service))
+                .express(true)
+                .wait()
+                .map_err(|e| {
+                    anyhow::anyhow!("link: declaring the Zenoh publisher of {service}: {e}")
+                })?,
+        );
     }
+    std::thread::scope(|scope| {
+        let mut routes = Vec::new();
+        let mut sending = Vec::new();
+        for (&service, publisher) in services.iter().zip(&publishers) {
+            let (queue, queued) = sync_channel(queue_samples(service));
+            sending.push(
+                scope.spawn(move || super::noting_failure(send_queued(service, publisher, queued))),
+            );
+            let rate = match service {
+                LinkedService::Frames => frames_max_hz.map(RateLimit::new),
+                _ => None,
+            };
+            routes.push(Route {
+                service,
+                publisher,
+                queue,
+                rate,
+                gaps: {
+                    let before = super::lock(counts).out_of(service);
+                    super::lock(counts).set_out(service, before.clone());
+                    SendGaps::resumed(&before, sender)
+                },
+                matched: false,
+            });
+        }
+        let taken = take_until_stopped(&subscribers, &mut routes, counts);
+        // The sending threads end (their queues closed).
+        drop(routes);
+        let sent = sending
+            .into_iter()
+            .map(|thread| thread.join().expect("a sending thread does not panic"))
+            .collect::<anyhow::Result<Vec<()>>>();
+        taken.and(sent.map(|_| ()))
+    })
+}
+
+/// The WaitSet's loop: every wake-up queues what every route's subscriber has, until a stop.
+fn take_until_stopped(
+    subscribers: &[OutSubscriber],
+    routes: &mut [Route],
+    counts: &Mutex<LinkCounts>,
+) -> anyhow::Result<()> {
     let waitset = wire::signals::waitset()?;
     let mut guards = Vec::new();
-    for (subscriber, service) in subscribers.iter().zip(services) {
+    for (subscriber, route) in subscribers.iter().zip(routes.iter()) {
         guards.push(
             waitset
                 .attach_notification(subscriber.listener())
-                .map_err(|e| anyhow::anyhow!("attaching {service} to the WaitSet: {e:?}"))?,
+                .map_err(|e| {
+                    anyhow::anyhow!("attaching {} to the WaitSet: {e:?}", route.service)
+                })?,
         );
     }
     while !super::stop_requested() {
         // History samples and those queued before the WaitSet need no event: every wake-up
         // drains every route, which costs a receive that finds nothing.
-        for (route, subscriber) in routes.iter_mut().zip(&subscribers) {
+        for (route, subscriber) in routes.iter_mut().zip(subscribers) {
             route.watch_peers()?;
             route.drain(subscriber)?;
             super::lock(counts).set_out(route.service, route.gaps.counts());

@@ -58,6 +58,7 @@ impl Stopped<'_> {
             field_acceptance: judged.field_decides.then_some(judged.field.as_ref()),
             frames_lost_to_faults: frames.lost_to_faults,
             link: link.as_ref(),
+            campaign_halted: self.incidents.campaign_halted.as_deref(),
             signal: self.signal,
             faults: &self.incidents.faults,
             killed_at_stop: &self.killed_at_stop,

@@ -19,6 +19,8 @@ pub(super) struct Incidents {
     pub(super) restart_counts: [u32; Role::COUNT],
     /// Deaths and stale processes, as noticed (`<role> <how>`).
     pub(super) faults: Vec<String>,
+    /// Without a rig here: the campaign halted on the other host, as this run saw it.
+    pub(super) campaign_halted: Option<String>,
 }
 
 #[derive(Clone, Copy)]

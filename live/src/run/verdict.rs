@@ -19,6 +19,8 @@ pub(super) struct Facts<'a> {
     pub(super) frames_lost_to_faults: u64,
     /// The link the run started, if any: what it lost makes the results doubtful.
     pub(super) link: Option<&'a super::LinkReport>,
+    /// Without a rig here: the campaign halted on the other host before its end.
+    pub(super) campaign_halted: Option<&'a str>,
     /// The termination signal that interrupted the run.
     pub(super) signal: Option<i32>,
     pub(super) faults: &'a [String],
@@ -82,6 +84,7 @@ fn doubts(facts: &Facts) -> Option<String> {
         ));
     }
     doubts.extend(facts.link.and_then(super::LinkReport::doubt));
+    doubts.extend(facts.campaign_halted.map(str::to_string));
     if !facts.killed_at_stop.is_empty() {
         doubts.push(format!(
             "{} did not finish within the stop timeout ([run] stop_timeout_s) and {} killed: \
@@ -168,6 +171,7 @@ mod tests {
             field_acceptance: None,
             frames_lost_to_faults: 0,
             link: None,
+            campaign_halted: None,
             signal: None,
             faults: &[],
             killed_at_stop: &[],
@@ -350,6 +354,20 @@ mod tests {
             .failure
             .unwrap()
             .starts_with("the link to the other host lost 4 fields"));
+    }
+
+    #[test]
+    fn a_campaign_halted_on_the_other_host_makes_the_run_doubtful() {
+        let judged = verdict(Facts {
+            acceptance_skipped: true,
+            campaign_halted: Some("the campaign halted on the other host: test 1 of 3"),
+            ..facts(Ending::Completed)
+        });
+        assert_eq!(judged.exit_code, exit_code::DOUBTFUL);
+        assert_eq!(
+            judged.failure.as_deref(),
+            Some("the campaign halted on the other host: test 1 of 3")
+        );
     }
 
     #[test]
