@@ -9,6 +9,11 @@ use std::time::{Duration, Instant};
 const DRAIN_TIMEOUT: Duration = Duration::from_secs(10);
 /// The identifier's time for its last fits once the correlator has stopped.
 const LAST_FITS: Duration = Duration::from_millis(500);
+/// The least the identifier gets between its stop and its kill at the drain: it waits for the
+/// field route's running fit and fits the last frames before it writes the run's law (one fit
+/// of every model over the kept frames took 3.5 s on average and 7.4 s at most on a loaded
+/// 2-core machine, `tests/field_route.rs`; up to 19.7 s with two hosts' runs on one machine).
+const FINAL_FITS: Duration = Duration::from_secs(60);
 
 impl Run<'_> {
     /// The rig ended its campaign: the camera stops, the drain starts.
@@ -40,16 +45,26 @@ impl Run<'_> {
         if !caught_up {
             eprintln!("run: the correlator did not finish the last frames in time");
         }
-        self.supervisor.stop(Role::Correlator, self.stop_timeout());
+        self.stop_in_drain(Role::Correlator, self.stop_timeout());
         // The identifier refits on the last points, then writes its final fits.
         let quiet_since = Instant::now();
         while quiet_since.elapsed() < LAST_FITS {
             std::thread::sleep(Duration::from_millis(50));
             self.subscriptions.drain(&mut self.recorder)?;
         }
-        self.supervisor.stop(Role::Identifier, self.stop_timeout());
+        self.stop_in_drain(Role::Identifier, self.stop_timeout().max(FINAL_FITS));
         self.subscriptions
             .drain_all(&mut self.recorder, super::stop::FINAL_DRAIN_ROUNDS)?;
         Ok(true)
+    }
+
+    /// Stops `role` within `timeout`, noting it if it had to be killed.
+    fn stop_in_drain(&mut self, role: Role, timeout: Duration) {
+        if let Some(how) = self.supervisor.stop(role, timeout) {
+            eprintln!("run: stopped {} ({how})", role.name());
+            if how.ends_with(crate::children::SIGTERM_TIMED_OUT) {
+                self.killed_in_drain.push(role.name().to_string());
+            }
+        }
     }
 }

@@ -55,6 +55,9 @@ pub(super) struct Run<'a> {
     pub(super) liveness: Liveness,
     /// Without a rig here: the rig samples seen so far and when the count last grew.
     pub(super) remote_rig: super::remote_rig::RemoteRig,
+    /// The children the drain stopped only by killing them (their last results may be
+    /// missing): the verdict says so as for those killed at the stop.
+    pub(super) killed_in_drain: Vec<String>,
 }
 
 impl<'a> Run<'a> {
@@ -111,6 +114,7 @@ impl<'a> Run<'a> {
             phase: Phase::Running,
             liveness: super::stale::liveness(config),
             remote_rig: super::remote_rig::RemoteRig::default(),
+            killed_in_drain: vec![],
         })
     }
 

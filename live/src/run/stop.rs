@@ -60,6 +60,7 @@ impl<'a> Run<'a> {
             incidents,
             started,
             monitor_cpu_at_start_s,
+            killed_in_drain,
             ..
         } = self;
         supervisor.sample_cpu();
@@ -68,7 +69,7 @@ impl<'a> Run<'a> {
             .filter(|&role| supervisor.started(role))
             .map(|role| (role.name().to_string(), supervisor.cpu_seconds(role)))
             .collect();
-        let mut killed_at_stop = vec![];
+        let mut killed_at_stop = killed_in_drain;
         for (role, how) in supervisor.stop_all(&STOP_ORDER, timeout) {
             eprintln!("run: stopped {} ({how})", role.name());
             if how.ends_with(crate::children::SIGTERM_TIMED_OUT) {
