@@ -4,13 +4,14 @@
 //! read_noise_dn), rounded, clipped to [0, 2^bit_depth - 1] (saturation). The two normals are
 //! drawn as one, of the summed variance gain² N_e + read_noise_dn² (one draw per pixel). Optional Gaussian
 //! blur (optics) of the pattern before exposure. Noise is reproducible: one generator per
-//! (seed, frame, row) ([`PixelNoise`]), so results do not depend on the thread count.
+//! (seed, frame, row), so results do not depend on the thread count.
 
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
 use crate::error::ProducerError;
 use crate::parallel::for_row_bands;
-use crate::pixel_noise::{splitmix64_finish, PixelNoise};
 
 /// Bit depths a camera may have.
 pub const BIT_DEPTHS: [u8; 4] = [8, 10, 12, 16];
@@ -162,7 +163,7 @@ impl CameraModel {
     pub fn expose_row(&self, frame_index: u64, y: usize, pattern_row: &[f32], out: &mut [u16]) {
         assert_eq!(pattern_row.len(), out.len(), "pattern and row sizes differ");
         let grey = self.grey_map();
-        let mut rng = PixelNoise::from_key(mix(self.seed, frame_index, y as u64));
+        let mut rng = ChaCha8Rng::seed_from_u64(mix(self.seed, frame_index, y as u64));
         // A chunk's normal draws first (the generator's loop, with the ziggurat's rare slow
         // paths), then its grey levels in a loop free of branches, which the compiler runs in
         // vector lanes.
@@ -239,9 +240,11 @@ fn quantise(dn: f64, max_dn: f64) -> u16 {
 
 /// SplitMix64 of the three, for independent per-row streams.
 fn mix(seed: u64, frame: u64, row: u64) -> u64 {
-    splitmix64_finish(
-        seed ^ frame.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ row.wrapping_mul(0xD1B5_4A32_D192_ED03),
-    )
+    let mut z =
+        seed ^ frame.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ row.wrapping_mul(0xD1B5_4A32_D192_ED03);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// A separable Gaussian blur with its kernel and scratch made once.

@@ -15,7 +15,6 @@ mod image_out;
 pub mod motion;
 mod natural_sort;
 pub mod parallel;
-mod pixel_noise;
 mod render_exact;
 mod render_fast;
 mod replay;
