@@ -371,7 +371,9 @@ impl FastRenderer {
     }
 
     /// [`Self::sample_texels`] of a block of points all inside the texture, lane by lane
-    /// (weights computed 4 or 8 wide, then the 4 x 4 patches gathered).
+    /// (weights computed 4 or 8 wide; each point's vertical pass on its patch's four columns
+    /// at once, 4-wide, as `sample_texels`; then the horizontal passes of the whole block, 4 or
+    /// 8 wide).
     #[inline(always)]
     fn sample_block(&self, fx: &[f64; BLOCK_PX], fy: &[f64; BLOCK_PX], out: &mut [f32]) {
         let (mut ix, mut iy) = ([0i32; BLOCK_PX], [0i32; BLOCK_PX]);
@@ -385,19 +387,29 @@ impl FastRenderer {
         let wx = catmull_rom_lanes(&tx);
         let wy = catmull_rom_lanes(&ty);
         let stride = self.texels_x;
-        for (k, value) in out.iter_mut().enumerate() {
+        // columns[i][k]: column i of point k's patch, weighted down the rows.
+        let mut columns = [[0.0f32; BLOCK_PX]; 4];
+        for k in 0..BLOCK_PX {
             let first = (iy[k] as usize - 1) * stride + ix[k] as usize - 1;
             let patch = &self.texture[first..first + 3 * stride + 4];
-            let mut sum = 0.0f32;
-            for (j, w) in wy.iter().enumerate() {
-                let row = &patch[j * stride..j * stride + 4];
-                sum += w[k]
-                    * (wx[0][k] * row[0]
-                        + wx[1][k] * row[1]
-                        + wx[2][k] * row[2]
-                        + wx[3][k] * row[3]);
+            let row = |j: usize| -> &[f32; 4] {
+                patch[j * stride..j * stride + 4]
+                    .try_into()
+                    .expect("four texels")
+            };
+            let mut column = scaled(wy[0][k], row(0));
+            for (j, wyj) in wy.iter().enumerate().skip(1) {
+                column = add_scaled(column, wyj[k], row(j));
             }
-            *value = sum;
+            for (i, c) in column.iter().enumerate() {
+                columns[i][k] = *c;
+            }
+        }
+        for (k, value) in out.iter_mut().enumerate() {
+            *value = wx[0][k] * columns[0][k]
+                + wx[1][k] * columns[1][k]
+                + wx[2][k] * columns[2][k]
+                + wx[3][k] * columns[3][k];
         }
     }
 }

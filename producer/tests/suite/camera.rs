@@ -191,6 +191,70 @@ fn combined_noise_has_normal_tails() {
     assert_eq!(a, b, "no electrons, no shot noise: the same read noise");
 }
 
+/// The noise is independent between pixels and frames: at a constant pattern value, the
+/// correlation of each pixel's noise with its neighbour along the row (lags 1 to 3), in the
+/// next row, and with the same pixel in the next frame is within 5 of its standard error
+/// (1/√n, 0.0039 here) of zero, and its mean and standard deviation are the model's. A stream
+/// shared by two rows or two frames (a key that forgot them) correlates them fully.
+#[test]
+fn noise_is_independent_between_pixels_and_frames() {
+    let (w, h) = (256, 256);
+    let p = 0.5f32;
+    let pattern = vec![p; w * h];
+    let camera = CameraModel {
+        read_noise_dn: 20.0,
+        ..CameraModel::with_bit_depth(16)
+    };
+    let electrons = camera.illumination_e * f64::from(p);
+    let mean = camera.offset_dn + camera.gain_dn_per_e * electrons;
+    let std = (camera.gain_dn_per_e.powi(2) * electrons + 20.0f64.powi(2) + 1.0 / 12.0).sqrt();
+    let residuals = |frame: u64| -> Vec<f64> {
+        let mut out = vec![0u16; w * h];
+        camera.expose(frame, &pattern, w, &mut out, 2);
+        out.iter().map(|&v| f64::from(v) - mean).collect()
+    };
+    let (a, b) = (residuals(11), residuals(12));
+    let n = a.len() as f64;
+    let a_mean = a.iter().sum::<f64>() / n;
+    let a_std = (a.iter().map(|r| r * r).sum::<f64>() / n).sqrt();
+    assert!(
+        a_mean.abs() < 0.5 + 5.0 * std / n.sqrt(),
+        "mean off the model by {a_mean} DN"
+    );
+    assert!((a_std / std - 1.0).abs() < 0.02, "std {a_std} vs {std} DN");
+    // Correlation of the pairs (index, index + offset) that `pair` keeps.
+    let correlation = |x: &[f64], y: &[f64], pairs: &[(usize, usize)]| {
+        let (mut xy, mut xx, mut yy) = (0.0, 0.0, 0.0);
+        for &(i, j) in pairs {
+            xy += x[i] * y[j];
+            xx += x[i] * x[i];
+            yy += y[j] * y[j];
+        }
+        (xy / (xx * yy).sqrt(), pairs.len() as f64)
+    };
+    let along_row = |lag: usize| -> Vec<(usize, usize)> {
+        (0..h)
+            .flat_map(|y| (0..w - lag).map(move |x| (y * w + x, y * w + x + lag)))
+            .collect()
+    };
+    let next_row: Vec<(usize, usize)> = (0..(h - 1) * w).map(|i| (i, i + w)).collect();
+    let same_pixel: Vec<(usize, usize)> = (0..w * h).map(|i| (i, i)).collect();
+    let cases = [
+        ("along the row, lag 1", correlation(&a, &a, &along_row(1))),
+        ("along the row, lag 2", correlation(&a, &a, &along_row(2))),
+        ("along the row, lag 3", correlation(&a, &a, &along_row(3))),
+        ("next row", correlation(&a, &a, &next_row)),
+        ("next frame", correlation(&a, &b, &same_pixel)),
+    ];
+    for (name, (rho, pairs)) in cases {
+        eprintln!("noise correlation {name}: {rho:.5} over {pairs} pairs");
+        assert!(
+            rho.abs() < 5.0 / pairs.sqrt(),
+            "noise correlated {name}: {rho}"
+        );
+    }
+}
+
 /// Without blur the camera renders and exposes row by row (the pattern never stored): the
 /// same grey levels as the pattern rendered whole and then exposed, for an affine and a
 /// heterogeneous motion, on 1 and 3 threads.
