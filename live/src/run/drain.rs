@@ -61,10 +61,7 @@ impl Run<'_> {
     /// Stops `role` within `timeout`, noting it if it had to be killed.
     fn stop_in_drain(&mut self, role: Role, timeout: Duration) {
         if let Some(how) = self.supervisor.stop(role, timeout) {
-            eprintln!("run: stopped {} ({how})", role.name());
-            if how.ends_with(crate::children::SIGTERM_TIMED_OUT) {
-                self.killed_in_drain.push(role.name().to_string());
-            }
+            super::stop::say_stopped(role, &how, &mut self.killed_in_drain);
         }
     }
 }

@@ -71,10 +71,7 @@ impl<'a> Run<'a> {
             .collect();
         let mut killed_at_stop = killed_in_drain;
         for (role, how) in supervisor.stop_all(&STOP_ORDER, timeout) {
-            eprintln!("run: stopped {} ({how})", role.name());
-            if how.ends_with(crate::children::SIGTERM_TIMED_OUT) {
-                killed_at_stop.push(role.name().to_string());
-            }
+            say_stopped(role, &how, &mut killed_at_stop);
         }
         // Samples published while stopping (last fields, last report).
         let _ = subscriptions.drain_all(&mut recorder, FINAL_DRAIN_ROUNDS);
@@ -104,5 +101,14 @@ impl<'a> Run<'a> {
             failure,
             killed_at_stop,
         }
+    }
+}
+
+/// Says how `role` stopped (`how`, [`crate::children::Supervisor::stop`]'s description) and
+/// adds it to `killed` if it had to be killed after its SIGTERM's timeout.
+pub(super) fn say_stopped(role: Role, how: &str, killed: &mut Vec<String>) {
+    eprintln!("run: stopped {} ({how})", role.name());
+    if how.ends_with(crate::children::SIGTERM_TIMED_OUT) {
+        killed.push(role.name().to_string());
     }
 }
