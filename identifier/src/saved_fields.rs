@@ -443,11 +443,12 @@ impl RigForces {
             return within_interval(0, 1).then_some(self.rows[0].1);
         }
         if t_s > self.rows[n - 1].0 {
-            return (n >= 2 && within_interval(n - 1, n - 2)).then_some(self.rows[n - 1].1);
+            return within_interval(n - 1, n.saturating_sub(2)).then_some(self.rows[n - 1].1);
         }
+        // rows[0] ≤ t_s ≤ the last row's time: `after` is a row, and 0 only at rows[0]'s time.
         let after = self.rows.partition_point(|&(t, _)| t < t_s);
         let (t1, f1) = self.rows[after];
-        if t1 == t_s || after == 0 {
+        if t1 == t_s {
             return Some(f1);
         }
         let (t0, f0) = self.rows[after - 1];
